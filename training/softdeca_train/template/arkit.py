@@ -1,0 +1,50 @@
+"""ARKit's 52 blendshapes in canonical order, and their map onto ICT-FaceKit's 53 shapes."""
+
+from __future__ import annotations
+
+import numpy as np
+
+# Alphabetical order of ARFaceAnchor.BlendShapeLocation names, which is also AR Foundation's
+# ARKitBlendShapeLocation order: every interface of the product uses it.
+ARKIT_BLENDSHAPES: tuple[str, ...] = (
+    "browDownLeft", "browDownRight", "browInnerUp", "browOuterUpLeft", "browOuterUpRight",
+    "cheekPuff", "cheekSquintLeft", "cheekSquintRight", "eyeBlinkLeft", "eyeBlinkRight",
+    "eyeLookDownLeft", "eyeLookDownRight", "eyeLookInLeft", "eyeLookInRight", "eyeLookOutLeft",
+    "eyeLookOutRight", "eyeLookUpLeft", "eyeLookUpRight", "eyeSquintLeft", "eyeSquintRight",
+    "eyeWideLeft", "eyeWideRight", "jawForward", "jawLeft", "jawOpen", "jawRight", "mouthClose",
+    "mouthDimpleLeft", "mouthDimpleRight", "mouthFrownLeft", "mouthFrownRight", "mouthFunnel",
+    "mouthLeft", "mouthLowerDownLeft", "mouthLowerDownRight", "mouthPressLeft",
+    "mouthPressRight", "mouthPucker", "mouthRight", "mouthRollLower", "mouthRollUpper",
+    "mouthShrugLower", "mouthShrugUpper", "mouthSmileLeft", "mouthSmileRight",
+    "mouthStretchLeft", "mouthStretchRight", "mouthUpperUpLeft", "mouthUpperUpRight",
+    "noseSneerLeft", "noseSneerRight", "tongueOut",
+)  # fmt: skip
+assert len(ARKIT_BLENDSHAPES) == 52
+
+
+def arkit_to_ict_matrix(ict_names: list[str], left_suffix: str) -> np.ndarray:
+    """(53, 52) matrix M with ict_weights = M @ arkit_weights.
+
+    `left_suffix` is the ICT suffix ("_L" or "_R") whose shapes move the subject's own left,
+    determined from the geometry by the template (never assumed). browInnerUp and cheekPuff drive
+    both ICT halves; tongueOut has no ICT shape and maps to nothing.
+    """
+    right_suffix = "_R" if left_suffix == "_L" else "_L"
+    index = {n: i for i, n in enumerate(ict_names)}
+    m = np.zeros((len(ict_names), len(ARKIT_BLENDSHAPES)))
+    for j, name in enumerate(ARKIT_BLENDSHAPES):
+        if name == "tongueOut":
+            continue
+        if name in ("browInnerUp", "cheekPuff"):
+            targets = [name + left_suffix, name + right_suffix]
+        elif name.endswith("Left"):
+            targets = [name[:-4] + left_suffix]
+        elif name.endswith("Right"):
+            targets = [name[:-5] + right_suffix]
+        else:
+            targets = [name]
+        for t in targets:
+            if t not in index:
+                raise KeyError(f"ICT-FaceKit has no shape {t} for ARKit {name}")
+            m[index[t], j] = 1.0
+    return m
