@@ -128,7 +128,8 @@ std::string format_livelinkface_csv(const std::vector<stream::Frame>& frames, in
     out += format_timecode(f.capture_time, rate) + ",61";
     const llf::Values values = llf::frame_to_values(f);
     for (std::size_t i : order) {
-      std::snprintf(buf, sizeof buf, ",%.10f", double(values[i]));
+      // + 0.0 turns -0 (from the angle conversions) into 0.
+      std::snprintf(buf, sizeof buf, ",%.10f", double(values[i]) + 0.0);
       out += buf;
     }
     out += '\n';

@@ -200,7 +200,10 @@ void Receiver::deliver(const Frame& f, double now) {
   if (latencies_.size() > kLatencyWindow) latencies_.pop_front();
   delivery_times_.push_back(now);
   if (delivery_times_.size() > kRateWindow) delivery_times_.pop_front();
-  record([&](recording::RecordingWriter& w) { w.write(f); });
+  record([&](recording::RecordingWriter& w) {
+    w.write(f);
+    ++frames_recorded_;
+  });
   delivered_cv_.notify_all();
 }
 
@@ -292,6 +295,7 @@ void Receiver::start_recording(const std::string& path, const recording::Header&
   if (header.neutral.empty() && !neutral_.empty()) writer->write_neutral(neutral_);
   recorder_ = std::move(writer);
   recording_error_.clear();
+  frames_recorded_ = 0;
 }
 
 std::string Receiver::stop_recording() {
@@ -302,7 +306,7 @@ std::string Receiver::stop_recording() {
 
 std::size_t Receiver::frames_recorded() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return recorder_ ? recorder_->frames_written() : 0;
+  return frames_recorded_;
 }
 
 }  // namespace softdeca::stream

@@ -57,6 +57,7 @@ class Receiver {
   void start_recording(const std::string& path, const recording::Header& header);
   // Stops recording; returns the error that stopped it early, "" if none.
   std::string stop_recording();
+  // Frames written by the current or last recording.
   std::size_t frames_recorded() const;
   // Stops the thread and delivers what the jitter buffer still holds. Idempotent.
   void stop();
@@ -106,6 +107,7 @@ class Receiver {
   std::deque<double> latencies_;       // recent, seconds
   std::unique_ptr<recording::RecordingWriter> recorder_;
   std::string recording_error_;
+  std::size_t frames_recorded_ = 0;
 };
 
 }  // namespace softdeca::stream
