@@ -7,11 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from streaming_expected import GOLDEN, read_expected
-
 from softdeca_train.streaming import ifacialmocap, livelinkface, protocol, recording
 from softdeca_train.streaming.frame import Frame, Pose
 from softdeca_train.streaming.golden import generate
+from streaming_expected import GOLDEN, read_expected
 
 PACKETS = sorted(p.stem for p in GOLDEN.glob("*.bin"))
 
