@@ -120,7 +120,7 @@ std::string encode_packet(const Frame& f, char separator) {
   char buf[160];
   for (std::size_t i = 0; i < kBlendshapeCount; ++i) {
     require(std::isfinite(f.weights[i]), "weight not finite", SOFTDECA_ERROR_NON_FINITE);
-    const long v = std::lround(std::clamp(f.weights[i], 0.0f, 1.0f) * 100.0f);
+    const long v = std::lround(double(std::clamp(f.weights[i], 0.0f, 1.0f)) * 100.0);
     out += wire_name(i) + separator + std::to_string(v) + '|';
   }
   const auto angles = [](const Pose& p) { return unity_euler_degrees_from_quaternion(p.rotation); };

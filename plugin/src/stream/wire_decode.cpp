@@ -12,7 +12,7 @@
 namespace softdeca::stream::wire {
 namespace {
 
-constexpr std::size_t kFrameFixedBytes = 20;  // capture, send, tracking, flags, reserved
+constexpr std::size_t kFrameFixedBytes = 20;  // capture, send, tracking, flags, block count
 
 Verdict drop(DropReason reason, const char* detail) { return {reason, detail}; }
 
@@ -30,9 +30,11 @@ bool valid_pose(Pose& p) {
   return normalize_rotation(p.rotation);
 }
 
-Verdict decode_blocks(ByteReader& r, Frame& f) {
+Verdict decode_blocks(ByteReader& r, uint16_t block_count, Frame& f) {
   unsigned seen = 0;
+  std::size_t blocks = 0;
   while (r.remaining() > 0) {
+    ++blocks;
     uint16_t type = 0, length = 0;
     if (!r.u16le(type) || !r.u16le(length)) return drop(DropReason::bad_length, "truncated block header");
     if (length > r.remaining()) return drop(DropReason::bad_length, "block runs past the datagram");
@@ -81,6 +83,7 @@ Verdict decode_blocks(ByteReader& r, Frame& f) {
         break;  // a block of a newer minor version: skipped
     }
   }
+  if (blocks != block_count) return drop(DropReason::bad_length, "block count disagrees with the blocks");
   if (!(seen & (1u << static_cast<unsigned>(BlockType::weights))))
     return drop(DropReason::bad_length, "frame without a weights block");
   return {};
@@ -89,18 +92,18 @@ Verdict decode_blocks(ByteReader& r, Frame& f) {
 Verdict decode_frame(ByteReader& r, Frame& f) {
   if (r.remaining() < kFrameFixedBytes) return drop(DropReason::undersized, "frame shorter than 36 bytes");
   uint8_t tracking = 0, flags = 0;
-  uint16_t reserved = 0;
+  uint16_t block_count = 0;
   r.f64le(f.capture_time);
   r.f64le(f.send_time);
   r.u8(tracking);
   r.u8(flags);
-  r.u16le(reserved);
+  r.u16le(block_count);
   if (!std::isfinite(f.capture_time) || !std::isfinite(f.send_time))
     return drop(DropReason::bad_value, "frame time not finite");
   if (tracking > static_cast<uint8_t>(Tracking::limited))
     return drop(DropReason::bad_value, "unknown tracking state");
   f.tracking = static_cast<Tracking>(tracking);
-  return decode_blocks(r, f);
+  return decode_blocks(r, block_count, f);
 }
 
 }  // namespace

@@ -96,13 +96,16 @@ void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
   w.f64le(f.send_time);
   w.u8(static_cast<uint8_t>(f.tracking));
   w.u8(0);  // flags, reserved
-  w.u16le(0);
+  const std::size_t count_at = w.size();
+  w.u16le(0);  // block count, patched below: a datagram cut at a block boundary is detected
+  uint16_t blocks = 1;
 
   std::size_t at = begin_block(w, BlockType::weights);
   for (float v : f.weights)
     w.u16le(static_cast<uint16_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 65535.0)));
   end_block(w, at);
   if (f.has_head) {
+    ++blocks;
     require_finite_values(f.head.position.data(), 3, "head position");
     require_finite_values(f.head.rotation.data(), 4, "head rotation");
     at = begin_block(w, BlockType::head_pose);
@@ -114,12 +117,14 @@ void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
       require_finite_values(p->position.data(), 3, "eye position");
       require_finite_values(p->rotation.data(), 4, "eye rotation");
     }
+    ++blocks;
     at = begin_block(w, BlockType::eye_poses);
     pose(w, f.left_eye);
     pose(w, f.right_eye);
     end_block(w, at);
   }
   if (f.landmark_count > 0) {
+    ++blocks;
     at = begin_block(w, BlockType::landmarks);
     w.u32le(f.profile_id);
     w.u16le(f.landmark_count);
@@ -132,6 +137,7 @@ void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
     }
     end_block(w, at);
   }
+  w.patch_u16le(count_at, blocks);
   check_size(out);
 }
 
