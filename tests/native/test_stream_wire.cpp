@@ -81,7 +81,7 @@ TEST(WireFormat, EveryMessageFitsUnder1200Bytes) {
 TEST(WireFormat, EncoderRefusesWhatTheFormatCannotCarry) {
   std::vector<uint8_t> bytes;
   Frame f = make_frame(0, 3, 1);
-  f.landmarks[4] = 0.4f;  // beyond +-0.32767 m
+  f.landmarks[4] = 0.4f;  // beyond the +0.32767 m the format carries
   EXPECT_THROW(wire::encode_frame(f, bytes), Error);
   f = make_frame(0);
   f.weights[7] = std::nanf("");

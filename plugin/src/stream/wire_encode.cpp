@@ -131,8 +131,8 @@ void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
     w.u16le(0);
     for (std::size_t i = 0; i < 3u * f.landmark_count; ++i) {
       const long q = std::lround(f.landmarks[i] / kLandmarkStep);
-      require(q >= -32767 && q <= 32767, "landmark coordinate " + std::to_string(f.landmarks[i]) +
-                                             " m is beyond the +-0.32767 m the format carries");
+      require(q >= -32768 && q <= 32767, "landmark coordinate " + std::to_string(f.landmarks[i]) +
+                                             " m is outside the [-0.32768, 0.32767] m the format carries");
       w.i16le(static_cast<int16_t>(q));
     }
     end_block(w, at);

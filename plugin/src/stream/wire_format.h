@@ -85,7 +85,8 @@ Verdict read_profile_body(ByteReader& r, Profile& profile);
 Verdict decode(const uint8_t* data, std::size_t size, Message& out);
 
 // Encoders replace `out` with one datagram. They throw softdeca::Error for input that the
-// format cannot carry (non-finite values, too many landmarks, landmarks beyond +-0.327 m).
+// format cannot carry (non-finite values, too many landmarks, landmarks outside
+// [-0.32768, 0.32767] m).
 // The frame's session_id and sequence go into the header.
 void encode_frame(const Frame& frame, std::vector<uint8_t>& out);
 void encode_profile(uint32_t session_id, uint32_t sequence, const Profile& profile,

@@ -160,6 +160,7 @@ def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
     struct.pack_into("<H", newer, weights_at + 2, 104 + 4)
     newer[weights_at + 4 + 104 : weights_at + 4 + 104] = b"\x01\x02\x03\x04"
     newer += struct.pack("<HH", 99, 6) + b"future"
+    newer[protocol.HEADER_BYTES + 18] += 1  # the block count includes the unknown block
     e = Expected()
     e.put("format", "softdeca")
     e.put("kind", "frame")

@@ -141,8 +141,8 @@ def quantize_weights(weights: np.ndarray) -> np.ndarray:
 
 def quantize_landmarks(xyz: np.ndarray) -> np.ndarray:
     q = _round_half_away(np.asarray(xyz, dtype=np.float32).astype(np.float64) / LANDMARK_STEP)
-    if np.abs(q).max(initial=0) > 32767:
-        raise ValueError("landmark coordinates beyond +-0.32767 m")
+    if q.size and (q.min() < -32768 or q.max() > 32767):
+        raise ValueError("landmark coordinates outside [-0.32768, 0.32767] m")
     return q.astype(np.int16)
 
 
@@ -155,19 +155,21 @@ def encode_frame(frame: Frame) -> bytes:
     if not all(math.isfinite(v) for v in values):
         raise ValueError("frame values must be finite")
     out = bytearray(_header(MessageType.FRAME, frame.session_id, frame.sequence))
-    out += _FRAME_FIXED.pack(frame.capture_time, frame.send_time, int(frame.tracking), 0, 0)
-    out += _block(BlockType.WEIGHTS, quantize_weights(frame.weights).astype("<u2").tobytes())
+    blocks = [_block(BlockType.WEIGHTS, quantize_weights(frame.weights).astype("<u2").tobytes())]
     if frame.head is not None:
-        out += _block(BlockType.HEAD_POSE, _pose_bytes(frame.head))
+        blocks.append(_block(BlockType.HEAD_POSE, _pose_bytes(frame.head)))
     if frame.left_eye is not None and frame.right_eye is not None:
-        out += _block(
-            BlockType.EYE_POSES, _pose_bytes(frame.left_eye) + _pose_bytes(frame.right_eye)
-        )
+        eyes = _pose_bytes(frame.left_eye) + _pose_bytes(frame.right_eye)
+        blocks.append(_block(BlockType.EYE_POSES, eyes))
     if len(landmarks):
         body = struct.pack("<IHH", frame.profile_id, len(landmarks), 0)
-        out += _block(
-            BlockType.LANDMARKS, body + quantize_landmarks(landmarks).astype("<i2").tobytes()
-        )
+        q = quantize_landmarks(landmarks).astype("<i2").tobytes()
+        blocks.append(_block(BlockType.LANDMARKS, body + q))
+    # The block count lets a receiver see a datagram cut at a block boundary.
+    out += _FRAME_FIXED.pack(
+        frame.capture_time, frame.send_time, int(frame.tracking), 0, len(blocks)
+    )
+    out += b"".join(blocks)
     if len(out) >= DATAGRAM_LIMIT:
         raise ValueError(f"datagram of {len(out)} bytes exceeds the limit")
     return bytes(out)
@@ -257,7 +259,7 @@ def _pose(values: np.ndarray) -> Pose:
 def _decode_frame(r: _Reader, env: Envelope) -> Frame:
     if r.remaining() < _FRAME_FIXED.size:
         raise DecodeError(DropReason.UNDERSIZED, "frame shorter than 36 bytes")
-    capture, send, tracking, _flags, _ = r.unpack("<ddBBH")
+    capture, send, tracking, _flags, block_count = r.unpack("<ddBBH")
     if not (math.isfinite(capture) and math.isfinite(send)):
         raise DecodeError(DropReason.BAD_VALUE, "frame time not finite")
     if tracking > Tracking.LIMITED:
@@ -272,7 +274,9 @@ def _decode_frame(r: _Reader, env: Envelope) -> Frame:
     )
     seen: set[int] = set()
     r.reason, r.detail = DropReason.BAD_LENGTH, "truncated block"
+    blocks = 0
     while r.remaining() > 0:
+        blocks += 1
         kind, length = r.unpack("<HH")
         body = _Reader(r.take(length), DropReason.BAD_LENGTH, "block too short")
         if kind in seen and kind in BlockType.__members__.values():
@@ -292,6 +296,8 @@ def _decode_frame(r: _Reader, env: Envelope) -> Frame:
                 raise DecodeError(DropReason.BAD_VALUE, "more landmarks than 150")
             q = np.frombuffer(body.take(6 * count), dtype="<i2").reshape(count, 3)
             f.landmarks = (q * LANDMARK_STEP).astype(np.float32)
+    if blocks != block_count:
+        raise DecodeError(DropReason.BAD_LENGTH, "block count disagrees with the blocks")
     if BlockType.WEIGHTS not in seen:
         raise DecodeError(DropReason.BAD_LENGTH, "frame without a weights block")
     return f
