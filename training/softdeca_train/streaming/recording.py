@@ -184,7 +184,8 @@ def _read_pose(values: np.ndarray) -> Pose | None:
     n = float(np.linalg.norm(values[3:7].astype(np.float64)))
     if not (math.isfinite(n) and 0.9 <= n <= 1.1):
         return None
-    return Pose(values[:3].astype(np.float32), (values[3:7] / n).astype(np.float32))
+    rotation = (values[3:7].astype(np.float64) / n).astype(np.float32)  # as the native reader
+    return Pose(values[:3].astype(np.float32), rotation)
 
 
 def _decode_header_fields(data: bytes, h: Header) -> list[int]:
