@@ -11,7 +11,8 @@ PY        := $(VENV)/bin/python
 BUILD     := build/release
 ASAN      := build/asan
 ORT_ROOT  := $(CURDIR)/.deps/onnxruntime
-export PYTHONPATH := $(CURDIR)/$(BUILD)/python
+# training/ too: this checkout's package even when the venv's editable install points elsewhere.
+export PYTHONPATH := $(CURDIR)/$(BUILD)/python:$(CURDIR)/training
 export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
 export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
@@ -20,7 +21,7 @@ export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
 
 help:
 	@echo "make demo    render the template, its layers, sampled identities, landmarks -> $(OUT)/demo"
-	@echo "make test    run every test (ctest release + ASan/UBSan, pytest)"
+	@echo "make test    run every test (ctest release + ASan/UBSan, pytest, short fuzzing)"
 	@echo "make bench   run the benchmarks -> build/bench/<area>.json"
 	@echo "make setup   install what is missing (apt, .venv, ONNX Runtime root); idempotent"
 	@echo "variables:   ICT=<ICT-FaceKit checkout or archive folder> (default $(ICT)), OUT=$(OUT)"
@@ -53,6 +54,7 @@ demo: build
 
 bench: build
 	@mkdir -p build/bench
+	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
 
 lint: setup
