@@ -15,11 +15,13 @@
 #include "recording/recording_reader.h"
 #include "recording/recording_writer.h"
 #include "stream/frame_sender.h"
+#include "stream/percentile.h"
 #include "stream/receiver.h"
 #include "stream/steady_clock.h"
 
 namespace softdeca::cli {
 namespace {
+using stream::percentile;
 using stream::steady_seconds;
 
 constexpr std::size_t kLandmarks = 68;  // the ARKit 68-point profile: a typical frame
@@ -28,11 +30,6 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double percentile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(std::lround(q * double(v.size() - 1)))];
 }
 
 // A plausible full frame: every weight, both poses, 68 landmarks in a face-sized box.

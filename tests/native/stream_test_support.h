@@ -2,6 +2,9 @@
 // expected-values format (tests/golden/streaming/README.md), and frames to play with.
 #pragma once
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -19,6 +22,11 @@ namespace softdeca::test {
 inline std::string golden_dir() { return std::string(SOFTDECA_REPO_ROOT) + "/tests/golden/streaming/"; }
 inline std::string shared_dir() { return std::string(SOFTDECA_REPO_ROOT) + "/../shared/"; }
 inline std::string takes_dir() { return shared_dir() + "recordings/livelinkface-alexdjulin/"; }
+
+// A file name in the test's temporary folder, unique to this process.
+inline std::string temp_path(const std::string& name) {
+  return ::testing::TempDir() + "softdeca-" + std::to_string(::getpid()) + "-" + name;
+}
 
 inline std::vector<uint8_t> read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -4,8 +4,6 @@
 // requests; recording what is received. Waits are bounded; nothing asserts a duration.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 #include <functional>
@@ -221,7 +219,7 @@ TEST(Receiver, AsksForAnUnknownProfileAndForTheNeutralMesh) {
 }
 
 TEST(Receiver, RecordsWhatItDelivers) {
-  const std::string path = ::testing::TempDir() + "softdeca-receiver-" + std::to_string(::getpid()) + ".sdrec";
+  const std::string path = test::temp_path("receiver.sdrec");
   Receiver r(loopback(Format::softdeca, 0.05));
   recording::Header h;
   h.device = "loopback";

@@ -3,8 +3,6 @@
 // looping, speed and interpolation.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -23,12 +21,9 @@ using namespace softdeca;
 using namespace softdeca::recording;
 using stream::Frame;
 using test::make_frame;
+using test::temp_path;
 
 namespace {
-
-std::string temp_path(const std::string& name) {
-  return ::testing::TempDir() + "softdeca-" + std::to_string(::getpid()) + "-" + name;
-}
 
 stream::wire::Profile profile() {
   stream::wire::Profile p;

@@ -2,8 +2,6 @@
 // stream received, recorded and played back through it.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,9 +16,7 @@
 
 namespace {
 
-std::string temp_path(const std::string& name) {
-  return ::testing::TempDir() + "softdeca-abi-" + std::to_string(::getpid()) + "-" + name;
-}
+using softdeca::test::temp_path;
 
 softdeca_frame blank_frame() {
   softdeca_frame f;

@@ -5,14 +5,13 @@
 
 #include "api/error.h"
 #include "stream/arkit_names.h"
-#include "stream/rotation.h"
+#include "stream/pose_io.h"
 
 namespace softdeca::recording {
 namespace {
 using stream::ByteReader;
 using stream::ByteWriter;
 using stream::Frame;
-using stream::Pose;
 
 constexpr uint8_t kHasHead = 1, kHasEyes = 2, kHasSequence = 4;
 
@@ -35,18 +34,6 @@ std::string canonical_names() {
   for (std::size_t i = 0; i < stream::kBlendshapeCount; ++i)
     names += (i ? "," : "") + std::string(stream::blendshape_name(i));
   return names;
-}
-
-void write_pose(ByteWriter& w, const Pose& p) {
-  for (float v : p.position) w.f32le(v);
-  for (float v : p.rotation) w.f32le(v);
-}
-bool read_pose(ByteReader& r, Pose& p) {
-  for (float& v : p.position)
-    if (!r.f32le(v) || !std::isfinite(v)) return false;
-  for (float& v : p.rotation)
-    if (!r.f32le(v)) return false;
-  return stream::normalize_rotation(p.rotation);
 }
 
 }  // namespace
@@ -142,10 +129,10 @@ void encode_frame_record(const Frame& f, std::vector<uint8_t>& out) {
   w.u16le(static_cast<uint16_t>(f.weights.size()));
   w.u16le(f.landmark_count);
   for (float v : f.weights) w.f32le(v);
-  if (f.has_head) write_pose(w, f.head);
+  if (f.has_head) stream::write_pose(w, f.head);
   if (f.has_eyes) {
-    write_pose(w, f.left_eye);
-    write_pose(w, f.right_eye);
+    stream::write_pose(w, f.left_eye);
+    stream::write_pose(w, f.right_eye);
   }
   for (std::size_t i = 0; i < 3u * f.landmark_count; ++i) w.f32le(f.landmarks[i]);
 }
@@ -172,8 +159,10 @@ bool decode_frame_record(ByteReader& r, const std::vector<int>& weight_order, Fr
   }
   f.has_head = flags & kHasHead;
   f.has_eyes = flags & kHasEyes;
-  if (f.has_head && !read_pose(r, f.head)) return false;
-  if (f.has_eyes && (!read_pose(r, f.left_eye) || !read_pose(r, f.right_eye))) return false;
+  using stream::PoseRead;
+  if (f.has_head && stream::read_pose(r, f.head) != PoseRead::ok) return false;
+  if (f.has_eyes && (stream::read_pose(r, f.left_eye) != PoseRead::ok || stream::read_pose(r, f.right_eye) != PoseRead::ok))
+    return false;
   for (std::size_t i = 0; i < 3u * landmark_count; ++i)
     if (!r.f32le(f.landmarks[i]) || !std::isfinite(f.landmarks[i])) return false;
   f.landmark_count = landmark_count;

@@ -5,6 +5,7 @@
 
 #include "api/error.h"
 #include "stream/crc32.h"
+#include "stream/percentile.h"
 #include "stream/steady_clock.h"
 
 namespace softdeca::stream {
@@ -17,13 +18,6 @@ constexpr double kRateHorizon = 2.0;
 constexpr std::size_t kLatencyWindow = 2048;
 constexpr std::size_t kMaxProfiles = 16;
 constexpr double kRequestInterval = 1.0;  // at most one profile request per second
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const auto k = static_cast<std::size_t>(std::lround(q * static_cast<double>(v.size() - 1)));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
 
 const ReceiverConfig& checked(const ReceiverConfig& c) {
   require(std::isfinite(c.delay) && c.delay >= 0 && c.delay <= 5, "jitter delay must be in [0, 5] seconds");

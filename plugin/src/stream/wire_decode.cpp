@@ -6,7 +6,7 @@
 
 #include "stream/byte_io.h"
 #include "stream/crc32.h"
-#include "stream/rotation.h"
+#include "stream/pose_io.h"
 #include "stream/wire_format.h"
 
 namespace softdeca::stream::wire {
@@ -16,18 +16,13 @@ constexpr std::size_t kFrameFixedBytes = 20;  // capture, send, tracking, flags,
 
 Verdict drop(DropReason reason, const char* detail) { return {reason, detail}; }
 
-bool read_pose(ByteReader& r, Pose& p) {
-  for (float& v : p.position)
-    if (!r.f32le(v)) return false;
-  for (float& v : p.rotation)
-    if (!r.f32le(v)) return false;
-  return true;
-}
-
-bool valid_pose(Pose& p) {
-  for (float v : p.position)
-    if (!std::isfinite(v) || std::fabs(v) > 1e3f) return false;
-  return normalize_rotation(p.rotation);
+Verdict pose_verdict(PoseRead read) {
+  switch (read) {
+    case PoseRead::ok: return {};
+    case PoseRead::short_input: return drop(DropReason::bad_length, "pose block too short");
+    case PoseRead::invalid: break;
+  }
+  return drop(DropReason::bad_value, "pose not finite or not a rotation");
 }
 
 Verdict decode_blocks(ByteReader& r, uint16_t block_count, Frame& f) {
@@ -54,15 +49,12 @@ Verdict decode_blocks(ByteReader& r, uint16_t block_count, Frame& f) {
         }
         break;
       case BlockType::head_pose:
-        if (!read_pose(b, f.head)) return drop(DropReason::bad_length, "head pose block too short");
-        if (!valid_pose(f.head)) return drop(DropReason::bad_value, "head pose not finite or not a rotation");
+        if (const Verdict v = pose_verdict(read_pose(b, f.head)); v.reason != DropReason::none) return v;
         f.has_head = true;
         break;
       case BlockType::eye_poses:
-        if (!read_pose(b, f.left_eye) || !read_pose(b, f.right_eye))
-          return drop(DropReason::bad_length, "eye pose block too short");
-        if (!valid_pose(f.left_eye) || !valid_pose(f.right_eye))
-          return drop(DropReason::bad_value, "eye pose not finite or not a rotation");
+        for (Pose* eye : {&f.left_eye, &f.right_eye})
+          if (const Verdict v = pose_verdict(read_pose(b, *eye)); v.reason != DropReason::none) return v;
         f.has_eyes = true;
         break;
       case BlockType::landmarks: {

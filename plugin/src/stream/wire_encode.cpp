@@ -7,6 +7,7 @@
 #include "api/error.h"
 #include "stream/byte_io.h"
 #include "stream/crc32.h"
+#include "stream/pose_io.h"
 #include "stream/wire_format.h"
 
 namespace softdeca::stream::wire {
@@ -36,11 +37,6 @@ std::size_t begin_block(ByteWriter& w, BlockType type) {
 }
 void end_block(ByteWriter& w, std::size_t length_at) {
   w.patch_u16le(length_at, static_cast<uint16_t>(w.size() - length_at - 2));
-}
-
-void pose(ByteWriter& w, const Pose& p) {
-  for (float v : p.position) w.f32le(v);
-  for (float v : p.rotation) w.f32le(v);
 }
 
 void check_size(const std::vector<uint8_t>& out) {
@@ -109,7 +105,7 @@ void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
     require_finite_values(f.head.position.data(), 3, "head position");
     require_finite_values(f.head.rotation.data(), 4, "head rotation");
     at = begin_block(w, BlockType::head_pose);
-    pose(w, f.head);
+    write_pose(w, f.head);
     end_block(w, at);
   }
   if (f.has_eyes) {
@@ -119,8 +115,8 @@ void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
     }
     ++blocks;
     at = begin_block(w, BlockType::eye_poses);
-    pose(w, f.left_eye);
-    pose(w, f.right_eye);
+    write_pose(w, f.left_eye);
+    write_pose(w, f.right_eye);
     end_block(w, at);
   }
   if (f.landmark_count > 0) {

@@ -179,7 +179,7 @@ def write_recording(path: str | Path, header: Header, frames: list[Frame]) -> No
 
 
 def _read_pose(values: np.ndarray) -> Pose | None:
-    if not np.isfinite(values[:3]).all():
+    if not np.isfinite(values[:3]).all() or np.abs(values[:3]).max() > 1e3:
         return None
     n = float(np.linalg.norm(values[3:7].astype(np.float64)))
     if not (math.isfinite(n) and 0.9 <= n <= 1.1):
