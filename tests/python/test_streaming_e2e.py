@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -94,7 +95,7 @@ def test_virtual_device_to_recording_under_loss_reordering_and_duplication(
     tmp_path: Path,
 ) -> None:
     rx = Receiving(tmp_path, "impaired", "--format", "softdeca", "--delay", "1.0")
-    imp = Impairments(loss=0.05, duplicate=0.05, reorder=0.05, jitter_ms=0.0, seed=7)
+    imp = Impairments(loss=0.05, duplicate=0.05, reorder=0.05, jitter_ms=12.0, seed=7)
     log = run(
         VirtualDeviceConfig(
             take=TAKES / "alex_rom_3.csv",
@@ -214,6 +215,48 @@ def test_cli_replays_a_recording_printed_and_streamed(tmp_path: Path) -> None:
         # Already quantised once: a second trip over the wire changes nothing.
         np.testing.assert_array_equal(a.weights, b.weights)
         np.testing.assert_array_equal(a.landmarks, b.landmarks)
+
+
+def test_python_virtual_device_command(tmp_path: Path) -> None:
+    rx = Receiving(tmp_path, "cli", "--delay", "0.2")
+    log_path = tmp_path / "log.json"
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "softdeca_train",
+            "virtual-device",
+            str(TAKES / "S07-001.csv"),
+            "--port",
+            str(rx.port),
+            "--count",
+            "40",
+            "--speed",
+            "8",
+            "--loss",
+            "0.1",
+            "--seed",
+            "2",
+            "--log-json",
+            str(log_path),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=60,
+    )
+    stats, rec = rx.finish()
+    log = json.loads(log_path.read_text())
+    assert len(rec.frames) == log["frames"] - len(log["dropped"]) and stats[
+        "lost"
+    ] == len(log["dropped"])
+    for step in ("virtual-device", "stream-golden"):
+        out = subprocess.run(
+            [sys.executable, "-m", "softdeca_train", step, "--help"],
+            check=True,
+            capture_output=True,
+            text=True,
+        ).stdout
+        assert out.startswith("usage:")
 
 
 def test_cli_help_and_info(tmp_path: Path) -> None:

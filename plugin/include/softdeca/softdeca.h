@@ -86,8 +86,9 @@ SOFTDECA_API softdeca_status softdeca_tet_volumes(
  * metres in ARKit's face-anchor frame.
  * Structs with a `size` field: set it to sizeof(the struct) before the call; the library reads
  * and writes only the fields of the size it knows and rejects a smaller size.
- * The receiver's functions may be called from any thread; a recorder or player handle must be
- * used by one thread at a time. */
+ * The receiver's functions may be called from any thread, concurrently, except
+ * softdeca_receiver_destroy, which must follow every other call on that receiver; a recorder or
+ * player handle must be used by one thread at a time. */
 
 #define SOFTDECA_BLENDSHAPE_COUNT 52
 #define SOFTDECA_MAX_LANDMARKS 150     /* landmarks per frame (a profile names at most this many) */
