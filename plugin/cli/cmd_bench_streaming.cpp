@@ -81,8 +81,13 @@ stream::ReceiverConfig loopback() {
   return c;
 }
 
+struct Throughput {
+  double per_second;       // frames delivered per second
+  double delivered_ratio;  // of the frames sent (the rest overflowed the socket's buffer)
+};
+
 // Frames sent as fast as the socket takes them; the rate at which the receiver delivers them.
-double throughput_run(std::size_t frames) {
+Throughput throughput_run(std::size_t frames) {
   Receiving r(loopback());
   stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.receiver.port()), stream::Format::softdeca, 7);
   const double start = steady_seconds();
@@ -98,7 +103,8 @@ double throughput_run(std::size_t frames) {
     }
   }
   r.finish();
-  return r.popped > 1 ? double(r.popped) / (r.last_pop - start) : 0.0;
+  if (r.popped < 2) throw std::runtime_error("the throughput run delivered no frames");
+  return {double(r.popped) / (r.last_pop - start), double(r.popped) / double(frames)};
 }
 
 // Frames paced at `rate`; send -> available latencies of every frame.
@@ -184,11 +190,13 @@ int run_bench_streaming(const Args& args) {
   std::vector<uint8_t> probe;
   stream::wire::encode_frame(sample_frame(0), probe);
 
-  std::vector<double> tput, p50, p99, decode_ns, write_fps, read_fps;
+  std::vector<double> tput, delivered, p50, p99, decode_ns, write_fps, read_fps;
   double bytes_per_frame = 0;
   for (long run = 0; run < runs; ++run) {
     std::fprintf(stderr, "\rbench-streaming: run %ld/%ld: throughput", run + 1, runs);
-    tput.push_back(throughput_run(static_cast<std::size_t>(tp)));
+    const Throughput t = throughput_run(static_cast<std::size_t>(tp));
+    tput.push_back(t.per_second);
+    delivered.push_back(t.delivered_ratio);
     std::fprintf(stderr, ", latency");
     const auto l = latency_run(static_cast<std::size_t>(lat), lat_rate);
     if (l.size() < static_cast<std::size_t>(lat) / 2) throw std::runtime_error("most latency frames were lost");
@@ -213,6 +221,10 @@ int run_bench_streaming(const Args& args) {
                  cmd + ": median of " + std::to_string(runs) + " runs; " + std::to_string(tp) + " " + frame +
                      " sent as fast as possible to a receiver on 127.0.0.1 (no jitter delay); frames delivered per "
                      "second from the first send to the last delivery"));
+  out.raw("streaming.blast_delivered_ratio",
+          figure(median(delivered), "ratio", "null", "higher",
+                 cmd + ": in the throughput runs, the share of frames delivered (the rest overflowed the "
+                       "socket's receive buffer while the receiver was behind)"));
   const std::string lat_how = cmd + ": median over " + std::to_string(runs) + " runs of the percentile over " +
                               std::to_string(lat) + " " + frame + " sent at " + json_number(lat_rate) +
                               " Hz to 127.0.0.1; from the sender's clock reading before encoding to the consumer "
