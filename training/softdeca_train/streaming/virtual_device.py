@@ -49,9 +49,8 @@ class SendLog:
 
     session_id: int
     datagrams: list[tuple[int | None, str]] = field(default_factory=list)
-    frames: list[Frame] = field(
-        default_factory=list
-    )  # the take's frames as planned, with landmarks
+    # The take's frames as planned (with landmarks), whether sent or not.
+    frames: list[Frame] = field(default_factory=list)
     dropped: list[int] = field(default_factory=list)  # planned frame indices not sent
     duplicated: int = 0
     held: int = 0
