@@ -44,22 +44,36 @@ def head_center(
     return 0.5 * (skin[lm68[0]] + skin[lm68[16]]) + np.asarray(offset)
 
 
-def surface_samples(verts: np.ndarray, tris: np.ndarray, spacing: float) -> np.ndarray:
-    """Points inside every triangle (not its corners) on a barycentric grid fine enough that no
-    point of the triangle is farther than about `spacing` from a sample or a corner: the wraps
-    are fitted against these, so large triangles (mouth socket, neck) cannot slip through."""
+@dataclass(frozen=True)
+class SampleLayout:
+    """Where S is sampled to fit the wraps: vertices plus points inside triangles, as
+    (triangle, barycentric) pairs. Fixed per template so it applies to every identity."""
+
+    triangle: np.ndarray  # (n,) index into S's triangles
+    bary: np.ndarray  # (n, 3)
+
+    def points(self, verts: np.ndarray, tris: np.ndarray) -> np.ndarray:
+        return np.einsum("nk,nkd->nd", self.bary, verts[tris[self.triangle]])
+
+
+def surface_sample_layout(verts: np.ndarray, tris: np.ndarray, spacing: float) -> SampleLayout:
+    """Barycentric grids inside every triangle (corners excluded: vertices are samples
+    already), fine enough that no point of a triangle is farther than about `spacing` from a
+    sample: large triangles (mouth socket, neck) cannot slip through the wraps between samples."""
     p = verts[tris]
     longest = np.max(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
     n_sub = np.clip(np.ceil(longest / spacing).astype(int), 1, 32)
-    out = [p.mean(axis=1)]
+    tri_ids = [np.arange(len(tris))]
+    barys = [np.full((len(tris), 3), 1.0 / 3.0)]
     for n in np.unique(n_sub[n_sub > 1]):
-        sel = p[n_sub == n]
+        sel = np.flatnonzero(n_sub == n)
         i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
         keep = i + j <= n
         b = np.stack([i[keep], j[keep], n - i[keep] - j[keep]], 1) / n
-        b = b[(b < 1).all(axis=1)]  # corners are samples already
-        out.append(np.einsum("bk,tkd->tbd", b, sel).reshape(-1, 3))
-    return np.vstack(out)
+        b = b[(b < 1).all(axis=1)]
+        tri_ids.append(np.repeat(sel, len(b)))
+        barys.append(np.tile(b, (len(sel), 1)))
+    return SampleLayout(np.concatenate(tri_ids), np.vstack(barys))
 
 
 def _wrap_normals(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
@@ -71,10 +85,15 @@ def _wrap_normals(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
 
 
 def _radii(
-    skin: np.ndarray, skin_tris: np.ndarray, lm68: np.ndarray, center: np.ndarray, cfg: LhmConfig
+    skin: np.ndarray,
+    skin_tris: np.ndarray,
+    lm68: np.ndarray,
+    center: np.ndarray,
+    cfg: LhmConfig,
+    layout: SampleLayout,
 ) -> _Radii:
     dirs, tris, nbrs = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
-    inner_pts = surface_samples(skin, skin_tris, cfg.sample_spacing)
+    inner_pts = layout.points(skin, skin_tris)
     pts = np.vstack([skin, inner_pts])
     src = np.concatenate([np.arange(len(skin)), np.full(len(inner_pts), -1)])
     smp = radial.cast_samples(pts, center, dirs, tris)
@@ -113,13 +132,16 @@ def wrap_directions(
     return zoom(dirs, np.asarray(toward), factor), tris, vertex_neighbours(tris, len(dirs))
 
 
-def _template_radii(template: Template, cfg: LhmConfig) -> _Radii:
-    """The template's own radii (for the muscle rule), computed once per template and config."""
+def _template_radii(template: Template, cfg: LhmConfig) -> tuple[_Radii, SampleLayout]:
+    """The template's own radii (for the muscle rule) and S's sample layout, once per template
+    and configuration."""
     memo = template.__dict__.setdefault("_lhm_template_radii", {})
     if cfg not in memo:
         skin = template.neutral[:N_SKIN]
+        layout = surface_sample_layout(skin, template.skin_triangles, cfg.sample_spacing)
         center = head_center(skin, template.landmarks68, cfg.center_offset)
-        memo[cfg] = _radii(skin, template.skin_triangles, template.landmarks68, center, cfg)
+        radii = _radii(skin, template.skin_triangles, template.landmarks68, center, cfg, layout)
+        memo[cfg] = (radii, layout)
     return memo[cfg]
 
 
@@ -193,8 +215,8 @@ def fit_lhm(
     skin = head[:N_SKIN]
     dirs, tris, nbrs = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
     center = head_center(skin, template.landmarks68, cfg.center_offset)
-    rad = _radii(skin, template.skin_triangles, template.landmarks68, center, cfg)
-    tpl = _template_radii(template, cfg)
+    tpl, layout = _template_radii(template, cfg)
+    rad = _radii(skin, template.skin_triangles, template.landmarks68, center, cfg, layout)
 
     # Muscle wrap: template's absolute depth plus a share of the relative change (paper 3.1.2).
     total_t = np.maximum(tpl.skin - tpl.skull_prior, 1e-6)

@@ -37,7 +37,7 @@ def cast_samples(
     dirs: np.ndarray,
     tris: np.ndarray,
     inverses: np.ndarray | None = None,
-    candidates: int = 8,
+    candidates: int = 3,
 ) -> RaySamples:
     """Assign points to the cones of the wrap triangles (cone = centre + spherical triangle):
     nearest triangle centres first, then the first cone whose coefficients are all >= 0."""
@@ -47,10 +47,10 @@ def cast_samples(
         raise ValueError("a surface point coincides with the head centre")
     u = d / rho[:, None]
     inv = cone_inverses(dirs, tris) if inverses is None else inverses
-    tree = _centre_tree(dirs, tris)
     tri = np.full(len(u), -1)
     coeff = np.zeros((len(u), 3))
     todo = np.arange(len(u))
+    tree = _centre_tree(dirs, tris)
     k = candidates
     while len(todo):
         _, cand = tree.query(u[todo], k=min(k, len(tris)))
