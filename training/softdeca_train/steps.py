@@ -31,10 +31,35 @@ def _template_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _bench_args(p: argparse.ArgumentParser) -> None:
+    _ict_arg(p)
+    p.add_argument("--out", default="build/bench", help="folder for <area>.json (build/bench)")
+    p.add_argument("--heads", type=int, default=8, help="identities per LHM resolution (8)")
+
+
+def _bench_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.bench import bench_lhm, machine, write_area
+
+    figures = bench_lhm(args.ict, heads=args.heads)
+    path = write_area(Path(args.out), "lhm", figures)
+    print(f"machine: {machine()}")
+    for name, f in figures.items():
+        print(f"  {name:34s} {f['value']:>10.1f} {f['unit']:4s} (target {f['target']})")
+    print(f"wrote {path}")
+    return 0
+
+
 STEPS = {
     "template": (
         "Load ICT-FaceKit into the cache and summarise the template.",
         _template_args,
         _template_run,
+    ),
+    "bench": (
+        "Benchmark the pipeline (LHM fitting per resolution) into build/bench/<area>.json.",
+        _bench_args,
+        _bench_run,
     ),
 }
