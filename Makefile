@@ -46,7 +46,7 @@ test-native: build build-asan
 test-python: build
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python
 
-test: test-native test-python
+test: lint test-native test-python
 
 demo: build
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo
