@@ -221,8 +221,7 @@ def markdown(report: dict[str, Any]) -> str:
         row("registered ARKit vertices to S", nr["arkit_vertex_to_S"]),
         row("landmarks to S", lm["to_S"]),
         "",
-        f"Registered mesh: {nr['mesh']}; {nr['matched_fraction']:.1%} of the vertices had an "
-        "accepted closest point.",
+        _mesh_line(nr["mesh"], nr["matched_fraction"]),
         "",
         "Jaw pairs 0-16 are different anatomy in the two schemes (ARKit: the rim of its face "
         "mask; ICT: the frontal contour) and are left out of both steps; see "
@@ -236,6 +235,16 @@ def markdown(report: dict[str, Any]) -> str:
         ],
     ]
     return "\n".join(lines) + "\n"
+
+
+def _mesh_line(mesh: dict[str, Any], matched: float) -> str:
+    line = f"Registered ARKit mesh: {mesh['inverted_triangles']} inverted triangles"
+    if "self_intersections_registered" in mesh:
+        line += (
+            f", {mesh['self_intersections_registered']} intersecting triangle pairs (ARKit's own "
+            f"neutral: {mesh['self_intersections_arkit_neutral']}, at its closed lips)"
+        )
+    return line + f"; {matched:.1%} of its vertices had an accepted closest point."
 
 
 def write_report(report: dict[str, Any], out_dir: str | os.PathLike[str]) -> tuple[Path, Path]:
