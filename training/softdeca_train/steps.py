@@ -104,6 +104,7 @@ def _demo_run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from softdeca_train.lhm import check_lhm, fit_lhm
+    from softdeca_train.landmarks.figure import render_registration
     from softdeca_train.lhm.figures import render_identities, render_layers
     from softdeca_train.template import Template
     from softdeca_train.template.model import N_SKIN
@@ -111,12 +112,14 @@ def _demo_run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
-    with tqdm(total=3, desc="demo", unit="figure") as bar:
+    with tqdm(total=4, desc="demo", unit="figure") as bar:
         t = Template.load(args.ict)
         model = fit_lhm(t)
         written.append(render_layers(t, model, out / "template_layers.png"))
         bar.update()
         written.append(render_identities(t, list(args.seeds), out / "identities.png"))
+        bar.update()
+        written.append(render_registration(out))
         bar.update()
         reports = {"template": check_lhm(model, t.neutral[:N_SKIN], t.skin_triangles).as_dict()}
         for seed in args.seeds:
@@ -132,6 +135,60 @@ def _demo_run(args: argparse.Namespace) -> int:
     for p in written:
         print(f"  {p.resolve()}")
     return 0
+
+
+def _landmarks_args(p: argparse.ArgumentParser) -> None:
+    _ict_arg(p)
+    p.add_argument(
+        "--arkit",
+        default=None,
+        help="folder with ARKit_reference_blendshapes.zip and ARKit_landmarks68.txt "
+        "(default: $SOFTDECA_ARKIT_REFERENCE or ../shared/arkit-reference)",
+    )
+    p.add_argument(
+        "--out",
+        default="out/landmarks",
+        help="folder for registration.png and landmarks_report.{json,md}",
+    )
+    p.add_argument(
+        "--write-definition",
+        action="store_true",
+        help="regenerate the committed landmark definition (definition.json) from "
+        "its rules before registering",
+    )
+
+
+def _landmarks_run(args: argparse.Namespace) -> int:
+    from softdeca_train.landmarks.cli import run
+
+    return run(args.ict, args.arkit, args.out, args.write_definition)
+
+
+def _landmarks_args(p: argparse.ArgumentParser) -> None:
+    _ict_arg(p)
+    p.add_argument(
+        "--arkit",
+        default=None,
+        help="folder with ARKit_reference_blendshapes.zip and ARKit_landmarks68.txt "
+        "(default: $SOFTDECA_ARKIT_REFERENCE or ../shared/arkit-reference)",
+    )
+    p.add_argument(
+        "--out",
+        default="out/landmarks",
+        help="folder for registration.png and landmarks_report.{json,md}",
+    )
+    p.add_argument(
+        "--write-definition",
+        action="store_true",
+        help="regenerate the committed landmark definition (definition.json) from "
+        "its rules before registering",
+    )
+
+
+def _landmarks_run(args: argparse.Namespace) -> int:
+    from softdeca_train.landmarks.cli import run
+
+    return run(args.ict, args.arkit, args.out, args.write_definition)
 
 
 STEPS = {
@@ -154,5 +211,11 @@ STEPS = {
         "Benchmark the pipeline (LHM fitting per resolution) into build/bench/<area>.json.",
         _bench_args,
         _bench_run,
+    ),
+    "landmarks": (
+        "Register ARKit's reference face to the template, embed the ~150 landmarks "
+        "on S, and write a render and a residual report.",
+        _landmarks_args,
+        _landmarks_run,
     ),
 }
