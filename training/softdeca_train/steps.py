@@ -103,8 +103,8 @@ def _demo_run(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from softdeca_train.lhm import check_lhm, fit_lhm
     from softdeca_train.landmarks.figure import render_registration
+    from softdeca_train.lhm import check_lhm, fit_lhm
     from softdeca_train.lhm.figures import render_identities, render_layers
     from softdeca_train.template import Template
     from softdeca_train.template.model import N_SKIN
