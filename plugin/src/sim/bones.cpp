@@ -7,7 +7,8 @@
 namespace softdeca::sim {
 
 Eigen::Vector3d bone_pivot(const SimulationMesh& mesh, const Bone& bone) {
-  if (bone.pivot.allFinite() || bone.vertices.empty()) return bone.pivot.allFinite() ? bone.pivot : Eigen::Vector3d::Zero();
+  if (bone.pivot.allFinite()) return bone.pivot;
+  if (bone.vertices.empty()) return Eigen::Vector3d::Zero();
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (int32_t v : bone.vertices) c += mesh.rest.row(v).transpose();
   return c / static_cast<double>(bone.vertices.size());
@@ -17,6 +18,7 @@ Positions scaled_rest(const SimulationMesh& mesh, const ParameterSet& params) {
   Positions x = mesh.rest;
   auto scale = [&](const Bone& bone, Param sx, Param sy, Param sz) {
     const Eigen::RowVector3d s(params.global(sx), params.global(sy), params.global(sz));
+    if (s == Eigen::RowVector3d::Ones()) return;  // keep the rest exact
     const Eigen::RowVector3d pivot = bone_pivot(mesh, bone).transpose();
     for (int32_t v : bone.vertices) x.row(v) = pivot + (mesh.rest.row(v) - pivot).cwiseProduct(s);
   };

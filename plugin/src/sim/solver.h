@@ -26,7 +26,7 @@ struct SolverSettings {
   // Collision resolution (paper 3.3.2): contact weight (kPa, far above the material weights so
   // the two points coincide), rounds of detect-and-resolve, and the depth below which a point
   // no longer counts as penetrating (metres).
-  double collision_weight = 1e5;
+  double collision_weight = 1e6;
   int collision_rounds = 4;
   double penetration_tolerance = 1e-5;
 };
