@@ -34,6 +34,8 @@ nb::dict stats_dict(const SolveStats& s) {
   d["iterations"] = s.iterations;
   d["converged"] = s.converged;
   d["relative_step"] = s.relative_step;
+  d["estimated_error"] = s.estimated_error;
+  d["contraction"] = s.contraction;
   d["energy"] = s.energy;
   d["energy_history"] = s.energy_history;
   d["anderson_rejections"] = s.anderson_rejections;

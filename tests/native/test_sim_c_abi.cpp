@@ -60,7 +60,7 @@ struct CMesh {
 
 SimulationMesh head() {
   SyntheticHeadOptions o;
-  o.subdivisions = 1;
+  o.subdivisions = 2;
   o.skin_subdivisions = 2;
   return synthetic_layered_head(o);
 }

@@ -205,7 +205,9 @@ typedef struct softdeca_sim_stats {
   size_t struct_size;
   int32_t iterations;
   int32_t converged;
-  double relative_step;     /* last RMS step / rest bounding-box diagonal */
+  double relative_step;     /* last plain step's RMS move / rest bounding-box diagonal */
+  double estimated_error;   /* relative_step / (1 - contraction): distance to the solution */
+  double contraction;       /* measured contraction of a plain step on the slowest mode */
   double energy;            /* projective dynamics energy (J) */
   double target_rms;        /* RMS distance of S to its (blended) targets (m) */
   double local_seconds, global_seconds, factor_seconds, total_seconds;

@@ -163,6 +163,8 @@ void to_stats(const SolveStats& s, softdeca_sim_stats* out) {
   out->iterations = s.iterations;
   out->converged = s.converged ? 1 : 0;
   out->relative_step = s.relative_step;
+  out->estimated_error = s.estimated_error;
+  out->contraction = s.contraction;
   out->energy = s.energy;
   out->target_rms = s.target_rms;
   out->local_seconds = s.local_seconds;

@@ -14,9 +14,11 @@ namespace softdeca::sim {
 
 struct SolverSettings {
   int max_iterations = 300;
-  // Converged when the RMS vertex move of one PD step falls below tolerance * the rest
-  // bounding-box diagonal.
-  double tolerance = 1e-6;
+  // Converged when the estimated RMS distance of the free vertices to the fixed point,
+  // residual / (1 - contraction), falls below tolerance * the rest bounding-box diagonal
+  // (the residual is the RMS move of one plain PD step; the contraction is measured by plain
+  // steps before convergence is accepted).
+  double tolerance = 1e-5;
   // Anderson acceleration window (Peng et al. 2018); 0: plain projective dynamics. A step that
   // would raise the energy is replaced by the plain step, so the energy never increases.
   int anderson_window = 5;
@@ -37,7 +39,9 @@ void validate(const SolverSettings& s);
 struct SolveStats {
   int iterations = 0;
   bool converged = false;
-  double relative_step = 0;  // last RMS step / bounding-box diagonal
+  double relative_step = 0;    // last plain PD step's RMS move / bounding-box diagonal
+  double contraction = 0;      // measured contraction of a plain step (slowest mode)
+  double estimated_error = 0;  // relative_step / (1 - contraction)
   double energy = 0;         // PD energy (J) at the last evaluated iterate
   std::vector<double> energy_history;  // per accepted iterate, when recorded
   int anderson_rejections = 0;
