@@ -38,7 +38,7 @@ TEST(SimDynamics, BlendOfAConstantSequenceIsConstant) {
 TEST(SimDynamics, ConstantTargetConvergesToTheStaticSolution) {
   const SimulationMesh mesh = small_head();
   SolverSettings s;
-  s.tolerance = 1e-9;
+  s.tolerance = 1e-8;
   Simulator sim(mesh, s);
   sim.parameters().set("dyn_gamma", 0.4);
   sim.parameters().set("dyn_beta", 0.6);
@@ -48,7 +48,7 @@ TEST(SimDynamics, ConstantTargetConvergesToTheStaticSolution) {
   sim.reset_dynamics();
   sim.step_dynamic(rest);
   double last = 0;
-  for (int f = 0; f < 120; ++f) {
+  for (int f = 0; f < 50; ++f) {  // oscillation decays by sqrt(beta) = 0.77 per frame
     const FrameResult r = sim.step_dynamic(pose);
     EXPECT_TRUE(r.stats.converged) << "frame " << f;
     last = max_distance(r.skin, static_solution);
@@ -64,7 +64,7 @@ TEST(SimDynamics, StepOvershootsThenSettlesWhenUnderdamped) {
   const FrameInput rest = input_with(rest_skin(mesh));
   const FrameInput pose = input_with(bump(rest_skin(mesh), 0.01));
   SolverSettings s;
-  s.tolerance = 1e-9;
+  s.tolerance = 1e-8;
   // Track the front-most skin point along +Z.
   const Positions skin = rest_skin(mesh);
   Eigen::Index front = 0;
@@ -75,7 +75,7 @@ TEST(SimDynamics, StepOvershootsThenSettlesWhenUnderdamped) {
     sim.parameters().set("dyn_beta", beta);
     const double settled = sim.solve_static(pose).skin(front, 2) - skin(front, 2);
     std::vector<FrameInput> frames(1, rest);
-    frames.resize(80, pose);
+    frames.resize(40, pose);
     std::vector<double> z;
     for (const FrameResult& r : sim.solve_sequence(frames)) z.push_back((r.skin(front, 2) - skin(front, 2)) / settled);
     return z;  // 1 = the static response
@@ -98,7 +98,7 @@ TEST(SimDynamics, IndependentSequencesInParallelMatchSequential) {
   const SimulationMesh mesh = small_head();
   SolverSettings s;
   s.threads = 2;
-  s.tolerance = 1e-9;
+  s.tolerance = 1e-8;
   Simulator sim(mesh, s);
   sim.parameters().set("dyn_gamma", 0.6);
   sim.parameters().set("dyn_beta", 0.3);
