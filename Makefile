@@ -11,7 +11,7 @@ PY        := $(VENV)/bin/python
 BUILD     := build/release
 ASAN      := build/asan
 ORT_ROOT  := $(CURDIR)/.deps/onnxruntime
-# training/ too: this checkout's package even when the venv's editable install points elsewhere.
+# training/ first: the shared .venv may hold an editable install of another checkout.
 export PYTHONPATH := $(CURDIR)/$(BUILD)/python:$(CURDIR)/training
 export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
@@ -47,7 +47,7 @@ test-native: build build-asan
 test-python: build
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python
 
-test: test-native test-python test-fuzz
+test: lint test-native test-fuzz test-python
 
 demo: build
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo

@@ -119,8 +119,10 @@ def test_virtual_device_to_recording_under_loss_reordering_and_duplication(
 
     # Every recorded frame is the take's frame, within the quantisation, in capture order.
     face = ReferenceFace.load()
-    profile = face.profile("arkit68")
-    assert profile is not None
+    profile = face.profile(
+        "softdeca149"
+    )  # the virtual device's default: SparseSoftDECA's
+    assert profile is not None and len(profile.indices) == 149
     assert [p.indices for p in rec.profiles] == [profile.indices]
     assert rec.neutral is not None
     np.testing.assert_array_equal(rec.neutral, face.neutral.astype(np.float32))
@@ -190,7 +192,7 @@ def test_cli_replays_a_recording_printed_and_streamed(tmp_path: Path) -> None:
     for p, f in zip(printed, first.frames, strict=True):
         assert p["capture_time"] == f.capture_time
         np.testing.assert_allclose(p["weights"], f.weights, atol=1e-8)
-        assert len(p["landmarks"]) == 3 * 68
+        assert len(p["landmarks"]) == 3 * 149  # the softdeca149 profile
 
     again = Receiving(tmp_path, "second", "--delay", "0.2")
     subprocess.run(

@@ -199,7 +199,11 @@ def test_reference_face_neutral_and_blend() -> None:
     np.testing.assert_array_equal(face.blend(np.zeros(52)), face.neutral)
     profile = face.profile("arkit68")
     assert profile is not None and len(set(profile.indices)) == 68
+    ours = face.profile("softdeca149")
+    assert ours is not None and len(set(ours.indices)) == 149
     assert face.profile("none") is None
+    with pytest.raises(ValueError, match="unknown landmark profile"):
+        face.profile("dlib5")
     # Blended landmarks fit the wire format's range.
     assert np.abs(face.blend(np.ones(52))).max() < 0.32
 

@@ -31,7 +31,7 @@ class VirtualDeviceConfig:
     host: str = "127.0.0.1"
     port: int | None = None  # None: the format's default port
     format: str = "softdeca"
-    landmarks: str = "arkit68"  # landmark profile (ours only): arkit68 or none
+    landmarks: str = "softdeca149"  # landmark profile (ours only): softdeca149, arkit68 or none
     speed: float = 1.0
     start: int = 0  # first frame of the take
     count: int | None = None  # frames to send; None: to the end
