@@ -11,7 +11,8 @@ PY        := $(VENV)/bin/python
 BUILD     := build/release
 ASAN      := build/asan
 ORT_ROOT  := $(CURDIR)/.deps/onnxruntime
-export PYTHONPATH := $(CURDIR)/$(BUILD)/python
+# training/ first: the shared .venv may hold an editable install of another checkout.
+export PYTHONPATH := $(CURDIR)/$(BUILD)/python:$(CURDIR)/training
 export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
 export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
@@ -46,7 +47,7 @@ test-native: build build-asan
 test-python: build
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python
 
-test: test-native test-python
+test: lint test-native test-python
 
 demo: build
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo

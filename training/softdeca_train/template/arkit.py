@@ -35,7 +35,9 @@ def arkit_to_ict_matrix(ict_names: list[str], left_suffix: str) -> np.ndarray:
     for j, name in enumerate(ARKIT_BLENDSHAPES):
         if name == "tongueOut":
             continue
-        if name in ("browInnerUp", "cheekPuff"):
+        if name in index:  # e.g. jawLeft, mouthRight: whole-face shapes, not _L/_R halves
+            targets = [name]
+        elif name in ("browInnerUp", "cheekPuff"):
             targets = [name + left_suffix, name + right_suffix]
         elif name.endswith("Left"):
             targets = [name[:-4] + left_suffix]

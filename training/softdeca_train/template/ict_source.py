@@ -86,8 +86,9 @@ def _build_cache(source: Path, target: Path) -> None:
     neutral = polygons = indices = None
     shapes: dict[str, np.ndarray] = {}
     total = 160 if source.is_dir() else None
-    for name, data in tqdm(_iter_files(source), desc="reading ICT-FaceKit", unit="file",
-                           total=total, leave=False):
+    for name, data in tqdm(
+        _iter_files(source), desc="reading ICT-FaceKit", unit="file", total=total, leave=False
+    ):
         if name == NEUTRAL:
             neutral = _parse_vertices(data)
             polygons = _parse_polygons(data)
@@ -99,7 +100,9 @@ def _build_cache(source: Path, target: Path) -> None:
         raise FileNotFoundError(f"{source} lacks {NEUTRAL} or {INDICES}")
     expressions = list(indices["expressions"])
     missing = [e for e in expressions if e not in shapes]
-    missing += [f"identity{k:03d}" for k in range(N_IDENTITY_MODES) if f"identity{k:03d}" not in shapes]
+    missing += [
+        f"identity{k:03d}" for k in range(N_IDENTITY_MODES) if f"identity{k:03d}" not in shapes
+    ]
     if missing:
         raise FileNotFoundError(f"{source} lacks shapes: {', '.join(missing[:5])} ...")
     # ICT modes and expressions are full meshes: store differences to the neutral, in metres.

@@ -1,0 +1,106 @@
+"""The layered head model (paper 3.1) of one identity, and its configuration."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+# Skull-wrap vertex labels.
+CRANIUM, JAW = 0, 1
+
+
+@dataclass(frozen=True)
+class LhmConfig:
+    """Resolution and placement rules. Lengths in metres."""
+
+    level: int = 4  # icosphere subdivisions of the wraps: V = 10 * 4**level + 2 per wrap
+    soft_layers: int = 1  # tet layers between skin and muscle wrap
+    muscle_layers: int = 1  # tet layers between muscle and skull wrap
+    skin_margin: float = 1.0e-3  # S lies at least this far inside the skin wrap
+    inner_margin: float = 1.0e-3  # S lies at least this far outside the muscle wrap
+    sample_spacing: float = 3.0e-3  # S is sampled this densely to fit the wraps against it
+    min_layer_gap: float = 2.0e-3  # minimum radial thickness of each tissue layer
+    muscle_fraction: float = 0.5  # template muscle wrap depth, as a share of skin-to-skull
+    muscle_relative_share: float = 0.1  # paper: 10 % of the relative change is followed
+    min_skull_radius: float = 0.02  # the skull wrap keeps this far from the head centre
+    depth_sigma_deg: float = 14.0  # smoothing of the tissue-depth prior over directions
+    center_offset: tuple[float, float, float] = (0.0, 0.02, -0.03)  # from the ear midpoint
+    zoom_toward: tuple[float, float, float] = (0.0, -1.0, 0.2)  # denser wrap toward the neck
+    zoom_factor: float = 1.8
+    inner_smoothing: int = 10  # umbrella iterations on the muscle and skull radii
+
+
+@dataclass
+class LayeredHeadModel:
+    """Wraps (shared icosphere triangulation), tet meshes and S's embedding.
+
+    `vertices` stacks the wrap layers from outside in: layer 0 is the skin wrap, layer
+    `soft_layers` the muscle wrap, the last the skull wrap; each layer has `n_wrap` vertices.
+    """
+
+    config: LhmConfig
+    center: np.ndarray  # (3,)
+    directions: np.ndarray  # (n_wrap, 3)
+    wrap_triangles: np.ndarray  # (F, 3), outward
+    vertices: np.ndarray  # (n_layers * n_wrap, 3)
+    soft_tets: np.ndarray  # (T_s, 4) skin wrap .. muscle wrap
+    muscle_tets: np.ndarray  # (T_m, 4) muscle wrap .. skull wrap
+    skull_labels: np.ndarray  # (n_wrap,) CRANIUM or JAW
+    skin_tet: np.ndarray  # (n_S,) index into soft_tets
+    skin_bary: np.ndarray  # (n_S, 4)
+    tissue_depth: np.ndarray  # (n_wrap,) the prior's skin-to-skull depth (normal), metres
+    attachments: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def n_wrap(self) -> int:
+        return len(self.directions)
+
+    @property
+    def n_layers(self) -> int:
+        return len(self.vertices) // self.n_wrap
+
+    def layer(self, k: int) -> np.ndarray:
+        return self.vertices[k * self.n_wrap : (k + 1) * self.n_wrap]
+
+    @property
+    def skin_wrap(self) -> np.ndarray:
+        return self.layer(0)
+
+    @property
+    def muscle_wrap(self) -> np.ndarray:
+        return self.layer(self.config.soft_layers)
+
+    @property
+    def skull_wrap(self) -> np.ndarray:
+        return self.layer(self.n_layers - 1)
+
+    def embedded_skin(self) -> np.ndarray:
+        """S reconstructed from the tet vertices through its barycentric embedding."""
+        corners = self.vertices[self.soft_tets[self.skin_tet]]  # (n_S, 4, 3)
+        return np.einsum("nk,nkd->nd", self.skin_bary, corners)
+
+    def save(self, path: str | Path) -> None:
+        arrays = {k: v for k, v in self.__dict__.items() if isinstance(v, np.ndarray)}
+        arrays |= {f"attach_{k}": v for k, v in self.attachments.items()}
+        cfg = asdict(self.config)
+        np.savez_compressed(
+            path,
+            config_keys=np.array(list(cfg)),
+            config_values=np.array([repr(v) for v in cfg.values()]),
+            **arrays,
+        )
+
+    @classmethod
+    def load(cls, path: str | Path) -> LayeredHeadModel:
+        import ast
+
+        with np.load(path) as z:
+            cfg = {
+                str(k): ast.literal_eval(str(v))
+                for k, v in zip(z["config_keys"], z["config_values"], strict=True)
+            }
+            data = {k: z[k] for k in z.files if k not in ("config_keys", "config_values")}
+        attach = {k[7:]: data.pop(k) for k in list(data) if k.startswith("attach_")}
+        return cls(config=LhmConfig(**cfg), attachments=attach, **data)
