@@ -1,0 +1,46 @@
+// Deformation transfer DT(S_t, G) (paper eq. 17), the formulation of docs/bundle.md and
+// training/softdeca_train/models/dt.py: per-face gradients measured on the avatar's neutral
+// (cotangent Poisson) plus a small mass-weighted pull toward S_t. The matrix depends only on the
+// neutral, so it is assembled and factorised once per avatar; a frame is one right-hand side
+// pass (hypertensor.h: dg_rhs) and one three-column solve: X = S_t + K^-1 r.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "runtime/hypertensor.h"
+#include "runtime/sparse_ldlt.h"
+
+namespace softdeca::runtime {
+
+// Per-face and per-vertex measures of the avatar's neutral skin.
+struct SkinGeometry {
+  std::vector<double> face_area;    // a_f
+  std::vector<double> metric;       // a_f W_f as (w00, w01, w11) per face
+  std::vector<double> vertex_mass;  // m_v = sum a_f / 3
+
+  // Throws Error(INVALID_ARGUMENT) for a skin triangle with (almost) no area.
+  static SkinGeometry measure(const float* skin, std::size_t n_vertices, const std::vector<std::int32_t>& triangles);
+};
+
+class DeformationTransfer {
+ public:
+  DeformationTransfer(const SkinGeometry& geometry, std::size_t n_vertices, const std::vector<std::int32_t>& triangles,
+                      double regularisation);
+
+  const FaceBlocks& faces() const { return faces_; }
+  std::size_t vertices() const { return ldlt_.size(); }
+  std::size_t bytes() const { return ldlt_.bytes() + faces_.corners.bytes() + faces_.coeff.bytes(); }
+  std::size_t factor_nonzeros() const { return ldlt_.factor_nonzeros(); }
+
+  // out = skin + K^-1 (r0 + r1). `work`: 3n doubles. out must not alias r0, r1.
+  void solve(const float* r0, const float* r1, const float* skin, double* work, float* out) const;
+
+ private:
+  FaceBlocks faces_;
+  SparseLdlt ldlt_;
+};
+
+}  // namespace softdeca::runtime
