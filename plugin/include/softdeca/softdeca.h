@@ -147,7 +147,8 @@ SOFTDECA_API softdeca_status softdeca_model_get_landmark_vertices(const softdeca
 
 typedef enum softdeca_precision {
   SOFTDECA_PRECISION_HALF = 0, /* hyper-tensors in binary16 (default: half the memory traffic) */
-  SOFTDECA_PRECISION_FLOAT = 1 /* binary32 */
+  SOFTDECA_PRECISION_FLOAT = 1, /* binary32 */
+  SOFTDECA_PRECISION_INT8 = 2   /* int8 with a scale per 8 elements and latent: a quarter of float */
 } softdeca_precision;
 
 typedef struct softdeca_avatar_desc {

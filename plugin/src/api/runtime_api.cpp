@@ -182,7 +182,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
       require_finite(desc->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->blendshapes");
     }
     require(desc->threads <= kMaxThreads, "desc->threads must be at most " + std::to_string(kMaxThreads));
-    require(desc->precision <= SOFTDECA_PRECISION_FLOAT, "desc->precision is not a softdeca_precision");
+    require(desc->precision <= SOFTDECA_PRECISION_INT8, "desc->precision is not a softdeca_precision");
     runtime::AvatarDesc d;
     d.neutral = desc->neutral;
     d.vertex_count = vh;
@@ -191,7 +191,9 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
     d.blendshapes = desc->blendshape_count ? desc->blendshapes : nullptr;
     d.blendshape_count = desc->blendshape_count;
     d.threads = desc->threads == 0 ? 1 : desc->threads;
-    d.precision = desc->precision == SOFTDECA_PRECISION_FLOAT ? runtime::Precision::Float : runtime::Precision::Half;
+    d.precision = desc->precision == SOFTDECA_PRECISION_FLOAT  ? runtime::Precision::Float
+                  : desc->precision == SOFTDECA_PRECISION_INT8 ? runtime::Precision::Int8
+                                                               : runtime::Precision::Half;
     auto handle = std::make_unique<softdeca_avatar>();
     handle->avatar = std::make_unique<Avatar>(model->model, d);
     *out_avatar = handle.release();

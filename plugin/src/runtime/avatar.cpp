@@ -69,7 +69,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       offsets_(3 * m_.landmarks.size()),
       head_(vh_ * 3),
       static_(vs_ * 3),
-      solve_work_(vs_ * 3),
+      solve_work_(vs_ * 4),
       dynamics_(vs_),
       normals_(triangles_, vh_) {
   for (auto& r : rhs_) r.resize(vs_ * 3);

@@ -1,8 +1,8 @@
 // The hyper-tensor L(p, h) (paper eq. 18, 25), stored for the per-frame product z . L: elements
 // (faces for SoftDECA, vertices for SparseSoftDECA) in blocks of 8, each block laid out
-// [latent][width][8 lanes] so one SIMD lane is one element and z_k is a broadcast. Half
-// precision halves the memory the memory-bound product reads; the error it adds is measured
-// (docs/runtime.md).
+// [latent][width][8 lanes] so one SIMD lane is one element and z_k is a broadcast. The product
+// is bound by the bytes it reads, so the storage is compact: binary16, or int8 with one scale
+// per block and latent (a quarter of float); the error each adds is measured (docs/runtime.md).
 #pragma once
 
 #include <cstddef>
@@ -12,7 +12,7 @@
 
 namespace softdeca::runtime {
 
-enum class Precision { Half, Float };
+enum class Precision { Half, Float, Int8 };
 constexpr std::size_t kLanes = 8;
 
 class HyperTensor {
@@ -30,7 +30,9 @@ class HyperTensor {
   std::size_t block_stride() const { return static_cast<std::size_t>(latent_) * width_ * kLanes; }
   const std::uint16_t* half_data() const { return half_.data(); }
   const float* float_data() const { return float_.data(); }
-  std::size_t bytes() const { return half_.bytes() + float_.bytes(); }
+  const std::int8_t* int8_data() const { return int8_.data(); }
+  const float* scales() const { return scales_.data(); }  // Int8: [block][latent]
+  std::size_t bytes() const { return half_.bytes() + float_.bytes() + int8_.bytes() + scales_.bytes(); }
   // Element e, latent k, component c (for tests and the error measurement).
   float at(std::size_t e, int k, int c) const;
 
@@ -40,6 +42,8 @@ class HyperTensor {
   Precision precision_ = Precision::Half;
   AlignedArray<std::uint16_t> half_;
   AlignedArray<float> float_;
+  AlignedArray<std::int8_t> int8_;
+  AlignedArray<float> scales_;
 };
 
 // What the deformation-transfer right-hand side needs per skin triangle, in the same blocks:

@@ -13,6 +13,7 @@ import numpy as np
 from softdeca_train.paths import REPO_ROOT
 
 SOFTDECA_OK = 0
+PRECISIONS = {"half": 0, "float": 1, "int8": 2}  # softdeca_precision
 STATUS_NAMES = {
     0: "ok",
     1: "invalid argument",
@@ -220,7 +221,7 @@ class NativeAvatar:
         triangles: np.ndarray,
         blendshapes: np.ndarray | None = None,
         threads: int = 1,
-        half: bool = True,
+        precision: str = "half",
     ) -> None:
         self.model = model
         self.vh = model.info.head_vertex_count
@@ -236,7 +237,7 @@ class NativeAvatar:
             _ptr(b),
             0 if b is None else len(b),
             threads,
-            0 if half else 1,
+            PRECISIONS[precision],
         )
         self.handle = C.c_void_p()
         check(lib().softdeca_avatar_create(model.handle, C.byref(desc), C.byref(self.handle)))
