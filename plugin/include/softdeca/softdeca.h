@@ -145,6 +145,18 @@ SOFTDECA_API softdeca_status softdeca_model_find_parameter(const softdeca_model*
 SOFTDECA_API softdeca_status softdeca_model_get_landmark_vertices(const softdeca_model* model,
                                                                   int32_t* out_vertices, size_t capacity);
 
+/* The bundle's triangulation of the skin S (skin_triangle_count * 3 int32 indices): the face
+ * order of per-face parameter maps. */
+SOFTDECA_API softdeca_status softdeca_model_get_skin_triangles(const softdeca_model* model, int32_t* out_triangles,
+                                                               size_t capacity);
+
+/* The landmarks on a mesh in template topology (skin_vertex_count or head_vertex_count
+ * vertices): landmark_count points from the bundle's barycentric definition on S. For hosts
+ * that drive SparseSoftDECA from their own rig, and to show where the landmarks sit. */
+SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_model* model, const float* vertices,
+                                                               size_t vertex_count, float* out_points,
+                                                               size_t point_capacity);
+
 typedef enum softdeca_precision {
   SOFTDECA_PRECISION_HALF = 0, /* hyper-tensors in binary16 (default: half the memory traffic) */
   SOFTDECA_PRECISION_FLOAT = 1, /* binary32 */

@@ -1,5 +1,6 @@
 // Runtime part of the C ABI: handles over runtime::Model and runtime::Avatar, and the argument
 // checks every call makes before touching them.
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -156,6 +157,45 @@ SOFTDECA_API softdeca_status softdeca_model_get_landmark_vertices(const softdeca
                                        " landmarks",
             SOFTDECA_ERROR_BUFFER_TOO_SMALL);
     for (std::size_t i = 0; i < lm.size(); ++i) out_vertices[i] = lm[i].arkit_vertex;
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_model_get_skin_triangles(const softdeca_model* model, int32_t* out_triangles,
+                                                               size_t capacity) {
+  return guarded(__func__, [&] {
+    const auto& t = model_of(model).skin_triangles();
+    require_not_null(out_triangles, "out_triangles");
+    require(capacity >= t.size() / 3, "capacity " + std::to_string(capacity) + " is below the " + std::to_string(t.size() / 3) +
+                                          " skin triangles",
+            SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+    std::copy(t.begin(), t.end(), out_triangles);
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_model* model, const float* vertices,
+                                                               size_t vertex_count, float* out_points, size_t point_capacity) {
+  return guarded(__func__, [&] {
+    const Model& mo = model_of(model);
+    const auto& m = mo.manifest();
+    require_not_null(vertices, "vertices");
+    require_not_null(out_points, "out_points");
+    require(vertex_count == static_cast<std::size_t>(m.skin_vertices) || vertex_count == static_cast<std::size_t>(m.head_vertices),
+            "vertex_count " + std::to_string(vertex_count) + " is neither the skin's " + std::to_string(m.skin_vertices) +
+                " nor the head's " + std::to_string(m.head_vertices));
+    require(point_capacity >= m.landmarks.size(), "point_capacity is below the " + std::to_string(m.landmarks.size()) + " landmarks",
+            SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+    require_finite(vertices, vertex_count * 3, "vertices");
+    const auto& tri = mo.skin_triangles();
+    for (std::size_t i = 0; i < m.landmarks.size(); ++i) {
+      const auto& l = m.landmarks[i];
+      for (int c = 0; c < 3; ++c) {
+        double p = 0;
+        for (int k = 0; k < 3; ++k)
+          p += l.bary[k] * vertices[3 * static_cast<std::size_t>(tri[3 * static_cast<std::size_t>(l.triangle) + static_cast<std::size_t>(k)]) +
+                                    static_cast<std::size_t>(c)];
+        out_points[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p);
+      }
+    }
   });
 }
 

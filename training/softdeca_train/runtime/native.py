@@ -210,6 +210,25 @@ class NativeModel:
         )
         return out
 
+    def skin_triangles(self) -> np.ndarray:
+        out = np.zeros((self.info.skin_triangle_count, 3), dtype=np.int32)
+        check(
+            lib().softdeca_model_get_skin_triangles(
+                self.handle, _ptr(out, C.c_int32), C.c_size_t(len(out))
+            )
+        )
+        return out
+
+    def evaluate_landmarks(self, vertices: np.ndarray) -> np.ndarray:
+        v = _f32(vertices)
+        out = np.zeros((self.info.landmark_count, 3), dtype=np.float32)
+        check(
+            lib().softdeca_model_evaluate_landmarks(
+                self.handle, _ptr(v), len(v), _ptr(out), C.c_size_t(len(out))
+            )
+        )
+        return out
+
 
 class NativeAvatar:
     """softdeca_avatar: one head and its per-frame state."""

@@ -1,0 +1,61 @@
+#include "json.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace softdeca::cli {
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+std::string json_array(const float* values, std::size_t count) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < count; ++i) out += (i ? "," : "") + json_number(values[i]);
+  return out + "]";
+}
+
+JsonObject& JsonObject::raw(const std::string& key, std::string json) {
+  members_.emplace_back(key, std::move(json));
+  return *this;
+}
+
+std::string JsonObject::str(bool pretty) const {
+  std::string out = "{";
+  for (std::size_t i = 0; i < members_.size(); ++i) {
+    out += i ? "," : "";
+    if (pretty) out += "\n  ";
+    out += json_string(members_[i].first) + (pretty ? ": " : ":") + members_[i].second;
+  }
+  return out + (pretty ? "\n}" : "}");
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out || !out.write(text.data(), static_cast<std::streamsize>(text.size())))
+    throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace softdeca::cli
