@@ -72,7 +72,10 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       solve_work_(vs_ * 4),
       dynamics_(vs_),
       normals_(triangles_, vh_) {
-  for (auto& r : rhs_) r.resize(vs_ * 3);
+  for (std::size_t p = 0; p < worker_.parts(); ++p) {
+    rhs_.emplace_back(vs_ * 3);
+    rhs_parts_.push_back(rhs_.back().data());
+  }
   // Landmarks on the avatar's neutral skin.
   const auto& tri = model_->skin_triangles();
   for (const LandmarkSpec& l : m_.landmarks) {
@@ -243,7 +246,6 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   auto t1 = Clock::now();
   st.encoder_ms = ms(t, t1);
   const std::size_t blocks = prep.face_l.blocks();
-  const std::size_t parts = worker_.parts();
   auto pass = [&](std::size_t part, std::size_t n_parts) {
     float* rhs = rhs_[part].data();
     std::memset(rhs, 0, vs_ * 3 * sizeof(float));
@@ -253,7 +255,7 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   worker_.run(pass);
   auto t2 = Clock::now();
   st.hyper_ms = ms(t1, t2);
-  prep.dt->solve(rhs_[0].data(), parts > 1 ? rhs_[1].data() : nullptr, head_.data(), solve_work_.data(), static_.data());
+  prep.dt->solve(rhs_parts_.data(), rhs_parts_.size(), head_.data(), solve_work_.data(), static_.data());
   st.solve_ms = ms(t2, Clock::now());
 }
 
@@ -375,8 +377,14 @@ void Avatar::calibrate_landmarks(const float* points, std::size_t count) {
   for (std::size_t i = 0; i < k; ++i)
     for (int c = 0; c < 3; ++c)
       user[3 * i + c] = points[3 * (full ? static_cast<std::size_t>(landmark_arkit_[i]) : i) + static_cast<std::size_t>(c)];
+  double centroid[3] = {0, 0, 0}, spread = 0;
+  for (std::size_t i = 0; i < k; ++i)
+    for (int c = 0; c < 3; ++c) centroid[c] += user[3 * i + static_cast<std::size_t>(c)] / static_cast<double>(k);
+  for (std::size_t i = 0; i < k; ++i)
+    for (int c = 0; c < 3; ++c) spread += std::pow(user[3 * i + static_cast<std::size_t>(c)] - centroid[c], 2) / static_cast<double>(k);
+  require(spread > 1e-6, "the calibration landmarks are degenerate (they span less than a millimetre)");
   const Similarity s = fit_similarity(user.data(), neutral_landmarks_.data(), k, true);
-  require(std::isfinite(s.scale) && s.scale > 0, "the calibration landmarks are degenerate (all in one point)");
+  require(std::isfinite(s.scale) && s.scale > 0, "the calibration landmarks give no usable similarity");
   user_neutral_ = std::move(user);
   calibration_ = s;
   calibrated_ = true;
@@ -465,7 +473,7 @@ AvatarStats Avatar::stats() const {
     s = stats_;
   }
   std::size_t bytes = neutral_.size() * 4 + triangles_.size() * 4 + blendshapes_.bytes() + normals_.bytes() +
-                      dynamics_.bytes() + head_.bytes() + static_.bytes() + rhs_[0].bytes() + rhs_[1].bytes() +
+                      dynamics_.bytes() + head_.bytes() + static_.bytes() + rhs_.size() * rhs_[0].bytes() +
                       solve_work_.bytes() + geometry_.face_area.size() * 8 * 5;
   if (const auto p = current()) bytes += p->bytes() + (p->dt ? p->dt->bytes() : 0);
   s.memory_bytes = bytes;

@@ -137,7 +137,9 @@ class Avatar {
   // Frame-thread state.
   std::atomic<bool> busy_{false};
   std::atomic<bool> dynamics_enabled_{false}, reset_requested_{false};
-  AlignedArray<float> weights_, z_, offsets_, head_, static_, rhs_[2];
+  AlignedArray<float> weights_, z_, offsets_, head_, static_;
+  std::vector<AlignedArray<float>> rhs_;  // one right-hand side per thread
+  std::vector<const float*> rhs_parts_;
   AlignedArray<double> solve_work_;
   OnnxNetwork::Binding f_w_, f_l_;
   DynamicsState dynamics_;

@@ -91,8 +91,8 @@ DeformationTransfer::DeformationTransfer(const SkinGeometry& g, std::size_t n, c
                                          double regularisation)
     : faces_(face_blocks(g, t)), ldlt_(assemble(g, n, t, regularisation)) {}
 
-void DeformationTransfer::solve(const float* r0, const float* r1, const float* skin, double* work, float* out) const {
-  ldlt_.solve(r0, r1, work, out);
+void DeformationTransfer::solve(const float* const* r, std::size_t count, const float* skin, double* work, float* out) const {
+  ldlt_.solve(r, count, work, out);
   const std::size_t n = 3 * ldlt_.size();
   for (std::size_t i = 0; i < n; ++i) out[i] += skin[i];
 }

@@ -35,9 +35,9 @@ class DeformationTransfer {
   std::size_t bytes() const { return ldlt_.bytes() + faces_.corners.bytes() + faces_.coeff.bytes(); }
   std::size_t factor_nonzeros() const { return ldlt_.factor_nonzeros(); }
 
-  // out = skin + K^-1 (r0 + r1). `work`: work_size() doubles. out must not alias r0, r1.
+  // out = skin + K^-1 (r[0] + ... + r[count-1]). `work`: work_size() doubles.
   std::size_t work_size() const { return ldlt_.work_size(); }
-  void solve(const float* r0, const float* r1, const float* skin, double* work, float* out) const;
+  void solve(const float* const* r, std::size_t count, const float* skin, double* work, float* out) const;
 
  private:
   FaceBlocks faces_;

@@ -144,10 +144,14 @@ void SparseLdlt::substitute(const Index* row_cols, const Index* col_rows, double
   }
 }
 
-void SparseLdlt::solve(const float* b0, const float* b1, double* y, float* x) const {
+void SparseLdlt::solve(const float* const* b, std::size_t count, double* y, float* x) const {
   for (std::size_t q = 0; q < n_; ++q) {
     const std::size_t s = static_cast<std::size_t>(gather_[q]) * 3;
-    for (int c = 0; c < 3; ++c) y[4 * q + c] = static_cast<double>(b0[s + c]) + (b1 ? b1[s + c] : 0.0f);
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0;
+      for (std::size_t k = 0; k < count; ++k) sum += b[k][s + c];
+      y[4 * q + c] = sum;
+    }
     y[4 * q + 3] = 0.0;
   }
   if (n_ <= 65536) substitute(row_cols16_.data(), col_rows16_.data(), y);

@@ -26,8 +26,9 @@ class SparseLdlt {
   std::size_t factor_nonzeros() const { return values_lower_.size(); }
   std::size_t bytes() const;
 
-  // x = K^-1 (b0 + b1), xyz interleaved (n x 3). b1 may be null. `work`: work_size() doubles.
-  void solve(const float* b0, const float* b1, double* work, float* x) const;
+  // x = K^-1 (b[0] + ... + b[count-1]), xyz interleaved (n x 3); the right-hand side comes in
+  // parts (one per thread). `work`: work_size() doubles.
+  void solve(const float* const* b, std::size_t count, double* work, float* x) const;
   std::size_t work_size() const { return 4 * n_; }
 
  private:

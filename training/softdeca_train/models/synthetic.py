@@ -8,7 +8,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softdeca_train.lhm.sphere import icosphere
 from softdeca_train.models.topology import CRANIUM, JAW, LandmarkSet, TemplateDefinition
 
 JAW_OPEN = 24  # canonical ARKit index of jawOpen
@@ -25,6 +24,34 @@ class SyntheticHead:
 
     def user_face(self, weights: np.ndarray) -> np.ndarray:
         return self.user_neutral + np.tensordot(weights, self.user_deltas, 1)
+
+
+def icosphere(level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Unit icosphere (V, 3) and outward triangles (F, 3). Kept here (not lhm.sphere) so the
+    runtime tests' data needs no native module: they also run from the sanitizer build."""
+    t = (1.0 + 5.0**0.5) / 2.0
+    v = np.array(
+        [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
+         (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)], dtype=np.float64,
+    )  # fmt: skip
+    f = np.array(
+        [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+         (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+         (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)], dtype=np.int64,
+    )  # fmt: skip
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    for _ in range(level):
+        edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+        uniq, inv = np.unique(edges, axis=0, return_inverse=True)
+        mid = v[uniq].sum(axis=1)
+        m = inv.reshape(3, -1).T + len(v)
+        v = np.vstack([v, mid / np.linalg.norm(mid, axis=1, keepdims=True)])
+        a, b, c = f[:, 0], f[:, 1], f[:, 2]
+        f = np.concatenate([
+            np.stack([a, m[:, 0], m[:, 2]], 1), np.stack([b, m[:, 1], m[:, 0]], 1),
+            np.stack([c, m[:, 2], m[:, 1]], 1), np.stack([m[:, 0], m[:, 1], m[:, 2]], 1),
+        ])  # fmt: skip
+    return v, f.astype(np.int32)
 
 
 def _bumps(points: np.ndarray, rng: np.random.Generator, n: int, amp: float) -> np.ndarray:
