@@ -248,11 +248,11 @@ def _runtime_bundle_run(args: argparse.Namespace) -> int:
         BundleInfo,
         build_random,
         export_bundle,
-        load_parameter_specs,
         pack_bundle,
     )
+    from softdeca_train.models.parameters import specs_or_test_list
 
-    specs = load_parameter_specs(args.parameters)
+    specs = specs_or_test_list(args.parameters)
     if args.synthetic:
         from softdeca_train.models.synthetic import synthetic_head
 
@@ -339,3 +339,28 @@ STEPS |= {
         _runtime_test_data_run,
     ),
 }
+
+
+def _runtime_bench_args(p: argparse.ArgumentParser) -> None:
+    _ict_arg(p)
+    p.add_argument("--out", default="build/bench", help="folder for runtime.json (build/bench)")
+    p.add_argument("--frames", type=int, default=600, help="frames per figure (600)")
+    p.add_argument("--take", default=None, help="Live Link Face CSV (default: S07-001)")
+    p.add_argument("--parameters", default=None, help="parameter specs (parameters.json format)")
+
+
+def _runtime_bench_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.runtime.bench import DEFAULT_TAKE, bench_runtime
+
+    take = Path(args.take) if args.take else DEFAULT_TAKE
+    print(f"wrote {bench_runtime(Path(args.out), args.ict, take, args.frames, args.parameters)}")
+    return 0
+
+
+STEPS["runtime-bench"] = (
+    "Benchmark the native runtime per frame -> build/bench/runtime.json.",
+    _runtime_bench_args,
+    _runtime_bench_run,
+)

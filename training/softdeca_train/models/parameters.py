@@ -109,6 +109,21 @@ def load_parameter_specs(
     return specs
 
 
+def specs_or_test_list(source: str | None) -> tuple[ParameterSpec, ...]:
+    """For tools that must run before the physics' list exists: `source`, else
+    plugin/data/parameters.json, else (with a note on stderr) the 5-parameter test list."""
+    if source is None and not PARAMETERS_JSON.is_file():
+        import sys
+
+        from softdeca_train.models.synthetic import TEST_PARAMETERS
+
+        print(
+            f"note: {PARAMETERS_JSON} is missing: using the 5-parameter test list", file=sys.stderr
+        )
+        return load_parameter_specs(TEST_PARAMETERS)
+    return load_parameter_specs(source)
+
+
 def normalise(values: np.ndarray, specs: Sequence[ParameterSpec]) -> np.ndarray:
     """Raw values (..., P) -> [-1, 1] per the spec's scale (what the networks do first)."""
     lo = np.array([s.min for s in specs])
