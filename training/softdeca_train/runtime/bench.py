@@ -32,13 +32,7 @@ def bench_runtime(
     from softdeca_train.template import Template
 
     work = out / "runtime-inputs"
-    if parameters is None and not PARAMETERS_JSON.is_file():
-        print(
-            f"note: {PARAMETERS_JSON} is missing; using the 5-parameter test list", file=sys.stderr
-        )
-        specs = load_parameter_specs(TEST_PARAMETERS)
-    else:
-        specs = load_parameter_specs(parameters)
+    specs = specs_or_test_list(parameters)
     definition = from_template(Template.load(ict))
     nets = build_random(definition, specs, FULL_SIZES, seed=0)
     info = BundleInfo(True, "UNTRAINED full-size random networks for the runtime benchmark")
