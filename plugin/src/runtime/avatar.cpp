@@ -162,7 +162,8 @@ void Avatar::prepare() {
   double factorisation_ms = 0;
   if (!dt_ && model_->has(false)) {
     const auto f0 = Clock::now();
-    dt_ = std::make_shared<const DeformationTransfer>(geometry_, vs_, model_->skin_triangles(), m_.dt_regularisation);
+    dt_ = std::make_shared<const DeformationTransfer>(geometry_, vs_, model_->skin_triangles(), m_.dt_regularisation,
+                                                      worker_.parts());
     factorisation_ms = ms(f0, Clock::now());
   }
   auto prep = std::make_shared<Preparation>();
@@ -255,7 +256,14 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   worker_.run(pass);
   auto t2 = Clock::now();
   st.hyper_ms = ms(t1, t2);
-  prep.dt->solve(rhs_parts_.data(), rhs_parts_.size(), head_.data(), solve_work_.data(), static_.data());
+  for (int phase = 0; phase < DeformationTransfer::kPhases; ++phase) {
+    auto solve = [&](std::size_t part, std::size_t n_parts) {
+      (void)n_parts;
+      prep.dt->solve_phase(phase, part, rhs_parts_.data(), rhs_parts_.size(), head_.data(), solve_work_.data(),
+                           static_.data());
+    };
+    worker_.run(solve);
+  }
   st.solve_ms = ms(t2, Clock::now());
 }
 

@@ -88,8 +88,8 @@ SkinGeometry SkinGeometry::measure(const float* skin, std::size_t n, const std::
 }
 
 DeformationTransfer::DeformationTransfer(const SkinGeometry& g, std::size_t n, const std::vector<std::int32_t>& t,
-                                         double regularisation)
-    : faces_(face_blocks(g, t)), ldlt_(assemble(g, n, t, regularisation)) {}
+                                         double regularisation, std::size_t parts)
+    : faces_(face_blocks(g, t)), ldlt_(assemble(g, n, t, regularisation), parts) {}
 
 void DeformationTransfer::solve(const float* const* r, std::size_t count, const float* skin, double* work, float* out) const {
   ldlt_.solve(r, count, work, out);

@@ -27,8 +27,9 @@ struct SkinGeometry {
 
 class DeformationTransfer {
  public:
+  // `parts`: threads that will run solve_phase.
   DeformationTransfer(const SkinGeometry& geometry, std::size_t n_vertices, const std::vector<std::int32_t>& triangles,
-                      double regularisation);
+                      double regularisation, std::size_t parts = 1);
 
   const FaceBlocks& faces() const { return faces_; }
   std::size_t vertices() const { return ldlt_.size(); }
@@ -38,6 +39,13 @@ class DeformationTransfer {
   // out = skin + K^-1 (r[0] + ... + r[count-1]). `work`: work_size() doubles.
   std::size_t work_size() const { return ldlt_.work_size(); }
   void solve(const float* const* r, std::size_t count, const float* skin, double* work, float* out) const;
+  // The same in SparseLdlt's phases (every part of phase p before phase p + 1).
+  static constexpr int kPhases = SparseLdlt::kPhases;
+  void solve_phase(int phase, std::size_t part, const float* const* r, std::size_t count, const float* skin, double* work,
+                   float* out) const {
+    ldlt_.solve_phase(phase, part, r, count, work, skin, out);
+  }
+  double serial_fraction() const { return ldlt_.serial_fraction(); }
 
  private:
   FaceBlocks faces_;

@@ -2,6 +2,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -14,7 +15,7 @@
 
 namespace softdeca::runtime {
 
-SparseLdlt::SparseLdlt(const Eigen::SparseMatrix<double>& K) : n_(static_cast<std::size_t>(K.rows())) {
+SparseLdlt::SparseLdlt(const Eigen::SparseMatrix<double>& K, std::size_t parts) : n_(static_cast<std::size_t>(K.rows())) {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(K);
   require(ldlt.info() == Eigen::Success, "the deformation-transfer matrix cannot be factorised");
   const Eigen::VectorXd d = ldlt.vectorD();
@@ -28,11 +29,9 @@ SparseLdlt::SparseLdlt(const Eigen::SparseMatrix<double>& K) : n_(static_cast<st
   // Eigen: P b puts b[i] at P.indices()[i].
   const auto& p = ldlt.permutationP().indices();
   gather_.resize(n_);
-  scatter_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) {
     const std::int32_t pi = p.size() ? p[static_cast<Eigen::Index>(i)] : static_cast<std::int32_t>(i);
     gather_[static_cast<std::size_t>(pi)] = static_cast<std::int32_t>(i);
-    scatter_[i] = pi;
   }
   Eigen::SparseMatrix<double> L = ldlt.matrixL();
   L.prune([](Eigen::Index r, Eigen::Index c, double) { return r > c; });
@@ -51,10 +50,72 @@ SparseLdlt::SparseLdlt(const Eigen::SparseMatrix<double>& K) : n_(static_cast<st
     col_rows32_.assign(L.innerIndexPtr(), L.innerIndexPtr() + nnz);
     row_cols32_.assign(R.innerIndexPtr(), R.innerIndexPtr() + nnz);
   }
+  schedule(parts < 1 ? 1 : parts);
+}
+
+void SparseLdlt::schedule(std::size_t parts) {
+  // Elimination tree: the parent of column j is its first off-diagonal row. Row i of the
+  // forward pass reads only rows of its subtree; column j of the backward pass only ancestors.
+  const std::size_t n = n_;
+  std::vector<std::int32_t> parent(n, -1);
+  std::vector<double> weight(n), subtree(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const std::int32_t b = col_ptr_[j], e = col_ptr_[j + 1];
+    if (e > b) parent[j] = static_cast<std::int32_t>(n <= 65536 ? col_rows16_[static_cast<std::size_t>(b)] : col_rows32_[static_cast<std::size_t>(b)]);
+    weight[j] = 1.0 + (e - b) + (row_ptr_[j + 1] - row_ptr_[j]);
+  }
+  subtree = weight;
+  for (std::size_t j = 0; j < n; ++j)
+    if (parent[j] >= 0) subtree[static_cast<std::size_t>(parent[j])] += subtree[j];
+  std::vector<std::vector<std::int32_t>> children(n);
+  std::vector<std::int32_t> front;
+  double total = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (parent[j] >= 0) children[static_cast<std::size_t>(parent[j])].push_back(static_cast<std::int32_t>(j));
+    else front.push_back(static_cast<std::int32_t>(j)), total += subtree[j];
+  }
+  // Open the heaviest subtree into its children (its root joins the top part) until the front
+  // splits into `parts` bins of nearly equal weight, or the top part grows too large.
+  std::vector<char> top(n, 0);
+  double top_weight = 0;
+  std::vector<std::size_t> bin_of_front;
+  for (;;) {
+    std::sort(front.begin(), front.end(), [&](std::int32_t a, std::int32_t b) { return subtree[static_cast<std::size_t>(a)] > subtree[static_cast<std::size_t>(b)]; });
+    std::vector<double> load(parts, 0.0);
+    bin_of_front.assign(front.size(), 0);
+    for (std::size_t f = 0; f < front.size(); ++f) {
+      const std::size_t lightest = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+      load[lightest] += subtree[static_cast<std::size_t>(front[f])];
+      bin_of_front[f] = lightest;
+    }
+    const double rest = total - top_weight, heaviest = *std::max_element(load.begin(), load.end());
+    if (parts == 1 || front.empty() || heaviest <= 1.05 * rest / static_cast<double>(parts) || top_weight > 0.35 * total) break;
+    const std::int32_t open = front.front();
+    if (children[static_cast<std::size_t>(open)].empty()) break;
+    front.erase(front.begin());
+    top[static_cast<std::size_t>(open)] = 1;
+    top_weight += weight[static_cast<std::size_t>(open)];
+    for (const std::int32_t c : children[static_cast<std::size_t>(open)]) front.push_back(c);
+  }
+  // Every row below the top part belongs to the bin of its front ancestor.
+  std::vector<std::int32_t> bin(n, -1);
+  for (std::size_t f = 0; f < front.size(); ++f) bin[static_cast<std::size_t>(front[f])] = static_cast<std::int32_t>(bin_of_front[f]);
+  for (std::size_t j = n; j-- > 0;)  // parents come after children: walk down from the roots
+    if (!top[j] && bin[j] < 0 && parent[j] >= 0) bin[j] = bin[static_cast<std::size_t>(parent[j])];
+  bins_.assign(parts, {});
+  top_.clear();
+  for (std::size_t j = 0; j < n; ++j) {
+    if (top[j]) top_.push_back(static_cast<std::int32_t>(j));
+    else bins_[static_cast<std::size_t>(bin[j] < 0 ? 0 : bin[j])].push_back(static_cast<std::int32_t>(j));
+  }
+  top_down_.assign(top_.rbegin(), top_.rend());
+  bins_down_.clear();
+  for (const auto& b : bins_) bins_down_.emplace_back(b.rbegin(), b.rend());
+  serial_fraction_ = total > 0 ? top_weight / total : 0.0;
 }
 
 std::size_t SparseLdlt::bytes() const {
-  return (gather_.size() + scatter_.size() + row_ptr_.size() + col_ptr_.size()) * 4 + inv_d_.size() * 8 +
+  return (gather_.size() + row_ptr_.size() + col_ptr_.size()) * 4 + inv_d_.size() * 8 +
          (row_cols16_.size() + col_rows16_.size()) * 2 + (row_cols32_.size() + col_rows32_.size()) * 4 +
          (values_lower_.size() + values_upper_.size()) * 4;
 }
@@ -90,28 +151,24 @@ __attribute__((target("avx2,fma"))) inline __m256d dot_avx2(const Index* idx, co
   __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0, a3 = a0;
   std::int32_t p = b;
   for (; p + 4 <= e; p += 4) {
-    a0 = _mm256_fmadd_pd(_mm256_set1_pd(val[p]), _mm256_load_pd(y + 4 * static_cast<std::size_t>(idx[p])), a0);
-    a1 = _mm256_fmadd_pd(_mm256_set1_pd(val[p + 1]), _mm256_load_pd(y + 4 * static_cast<std::size_t>(idx[p + 1])), a1);
-    a2 = _mm256_fmadd_pd(_mm256_set1_pd(val[p + 2]), _mm256_load_pd(y + 4 * static_cast<std::size_t>(idx[p + 2])), a2);
-    a3 = _mm256_fmadd_pd(_mm256_set1_pd(val[p + 3]), _mm256_load_pd(y + 4 * static_cast<std::size_t>(idx[p + 3])), a3);
+    a0 = _mm256_fmadd_pd(_mm256_set1_pd(val[p]), _mm256_loadu_pd(y + 4 * static_cast<std::size_t>(idx[p])), a0);
+    a1 = _mm256_fmadd_pd(_mm256_set1_pd(val[p + 1]), _mm256_loadu_pd(y + 4 * static_cast<std::size_t>(idx[p + 1])), a1);
+    a2 = _mm256_fmadd_pd(_mm256_set1_pd(val[p + 2]), _mm256_loadu_pd(y + 4 * static_cast<std::size_t>(idx[p + 2])), a2);
+    a3 = _mm256_fmadd_pd(_mm256_set1_pd(val[p + 3]), _mm256_loadu_pd(y + 4 * static_cast<std::size_t>(idx[p + 3])), a3);
   }
   for (; p < e; ++p)
-    a0 = _mm256_fmadd_pd(_mm256_set1_pd(val[p]), _mm256_load_pd(y + 4 * static_cast<std::size_t>(idx[p])), a0);
+    a0 = _mm256_fmadd_pd(_mm256_set1_pd(val[p]), _mm256_loadu_pd(y + 4 * static_cast<std::size_t>(idx[p])), a0);
   return _mm256_add_pd(_mm256_add_pd(a0, a1), _mm256_add_pd(a2, a3));
 }
 
+// y[i] -= sum_p values[p] y[idx[p]] over the rows in `rows` (in the given order).
 template <class Index>
-__attribute__((target("avx2,fma"))) void substitute_avx2(std::size_t n, const std::int32_t* row_ptr, const Index* row_cols,
-                                                        const float* lower, const double* inv_d, const std::int32_t* col_ptr,
-                                                        const Index* col_rows, const float* upper, double* y) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const __m256d a = dot_avx2(row_cols, lower, row_ptr[i], row_ptr[i + 1], y);
-    _mm256_store_pd(y + 4 * i, _mm256_sub_pd(_mm256_load_pd(y + 4 * i), a));
-  }
-  for (std::size_t i = 0; i < n; ++i) _mm256_store_pd(y + 4 * i, _mm256_mul_pd(_mm256_load_pd(y + 4 * i), _mm256_set1_pd(inv_d[i])));
-  for (std::size_t j = n; j-- > 0;) {
-    const __m256d a = dot_avx2(col_rows, upper, col_ptr[j], col_ptr[j + 1], y);
-    _mm256_store_pd(y + 4 * j, _mm256_sub_pd(_mm256_load_pd(y + 4 * j), a));
+__attribute__((target("avx2,fma"))) void substitute_avx2(const std::int32_t* rows, std::size_t count, const std::int32_t* ptr,
+                                                        const Index* idx, const float* values, double* y) {
+  for (std::size_t r = 0; r < count; ++r) {
+    const std::size_t i = static_cast<std::size_t>(rows[r]);
+    const __m256d a = dot_avx2(idx, values, ptr[i], ptr[i + 1], y);
+    _mm256_storeu_pd(y + 4 * i, _mm256_sub_pd(_mm256_loadu_pd(y + 4 * i), a));
   }
 }
 
@@ -120,33 +177,39 @@ bool cpu_has_avx2_fma() {
   return has;
 }
 #endif
-}  // namespace
 
 template <class Index>
-void SparseLdlt::substitute(const Index* row_cols, const Index* col_rows, double* y) const {
+void substitute(const std::vector<std::int32_t>& rows, const std::vector<std::int32_t>& ptr, const Index* idx,
+                const std::vector<float>& values, double* y) {
 #ifdef SOFTDECA_X86
   if (cpu_has_avx2_fma()) {
-    substitute_avx2(n_, row_ptr_.data(), row_cols, values_lower_.data(), inv_d_.data(), col_ptr_.data(), col_rows,
-                    values_upper_.data(), y);
+    substitute_avx2(rows.data(), rows.size(), ptr.data(), idx, values.data(), y);
     return;
   }
 #endif
   double a[3];
-  for (std::size_t i = 0; i < n_; ++i) {  // forward: L y = P b, row by row
-    dot_portable(row_cols, values_lower_.data(), row_ptr_[i], row_ptr_[i + 1], y, a);
+  for (const std::int32_t r : rows) {
+    const std::size_t i = static_cast<std::size_t>(r);
+    dot_portable(idx, values.data(), ptr[i], ptr[i + 1], y, a);
     for (int c = 0; c < 3; ++c) y[4 * i + c] -= a[c];
-  }
-  for (std::size_t i = 0; i < n_; ++i)
-    for (int c = 0; c < 3; ++c) y[4 * i + c] *= inv_d_[i];
-  for (std::size_t j = n_; j-- > 0;) {  // backward: L^T x = D^-1 y, column by column
-    dot_portable(col_rows, values_upper_.data(), col_ptr_[j], col_ptr_[j + 1], y, a);
-    for (int c = 0; c < 3; ++c) y[4 * j + c] -= a[c];
   }
 }
 
-void SparseLdlt::solve(const float* const* b, std::size_t count, double* y, float* x) const {
-  for (std::size_t q = 0; q < n_; ++q) {
-    const std::size_t s = static_cast<std::size_t>(gather_[q]) * 3;
+}  // namespace
+
+void SparseLdlt::forward(const std::vector<std::int32_t>& rows, double* y) const {
+  if (n_ <= 65536) substitute(rows, row_ptr_, row_cols16_.data(), values_lower_, y);
+  else substitute(rows, row_ptr_, row_cols32_.data(), values_lower_, y);
+}
+
+void SparseLdlt::backward(const std::vector<std::int32_t>& rows, double* y) const {
+  if (n_ <= 65536) substitute(rows, col_ptr_, col_rows16_.data(), values_upper_, y);
+  else substitute(rows, col_ptr_, col_rows32_.data(), values_upper_, y);
+}
+
+void SparseLdlt::gather(const std::vector<std::int32_t>& rows, const float* const* b, std::size_t count, double* y) const {
+  for (const std::int32_t r : rows) {
+    const std::size_t q = static_cast<std::size_t>(r), s = static_cast<std::size_t>(gather_[q]) * 3;
     for (int c = 0; c < 3; ++c) {
       double sum = 0;
       for (std::size_t k = 0; k < count; ++k) sum += b[k][s + c];
@@ -154,14 +217,50 @@ void SparseLdlt::solve(const float* const* b, std::size_t count, double* y, floa
     }
     y[4 * q + 3] = 0.0;
   }
-  if (n_ <= 65536) substitute(row_cols16_.data(), col_rows16_.data(), y);
-  else substitute(row_cols32_.data(), col_rows32_.data(), y);
-  for (std::size_t i = 0; i < n_; ++i) {
-    const std::size_t q = static_cast<std::size_t>(scatter_[i]) * 4;
-    x[3 * i] = static_cast<float>(y[q]);
-    x[3 * i + 1] = static_cast<float>(y[q + 1]);
-    x[3 * i + 2] = static_cast<float>(y[q + 2]);
+}
+
+void SparseLdlt::scale(const std::vector<std::int32_t>& rows, double* y) const {
+  for (const std::int32_t r : rows) {
+    const std::size_t q = static_cast<std::size_t>(r);
+    for (int c = 0; c < 3; ++c) y[4 * q + c] *= inv_d_[q];
   }
+}
+
+void SparseLdlt::write(const std::vector<std::int32_t>& rows, const double* y, const float* base, float* x) const {
+  for (const std::int32_t r : rows) {  // row q of y is output vertex gather_[q]
+    const std::size_t q = static_cast<std::size_t>(r), i = 3 * static_cast<std::size_t>(gather_[q]);
+    for (int c = 0; c < 3; ++c) x[i + c] = static_cast<float>(y[4 * q + c] + (base ? base[i + c] : 0.0f));
+  }
+}
+
+void SparseLdlt::solve_phase(int phase, std::size_t part, const float* const* b, std::size_t count, double* y,
+                             const float* base, float* x) const {
+  switch (phase) {
+    case 0:  // this part's subtrees: right-hand side, forward pass
+      gather(bins_[part], b, count, y);
+      forward(bins_[part], y);
+      break;
+    case 1:  // the top part, alone: its forward pass (reads every subtree), D^-1, backward pass
+      if (part != 0) break;
+      gather(top_, b, count, y);
+      forward(top_, y);
+      scale(top_, y);
+      backward(top_down_, y);
+      write(top_, y, base, x);
+      break;
+    case 2:  // this part's subtrees: D^-1, backward pass (reads only ancestors), output
+      scale(bins_[part], y);
+      backward(bins_down_[part], y);
+      write(bins_[part], y, base, x);
+      break;
+    default:
+      break;
+  }
+}
+
+void SparseLdlt::solve(const float* const* b, std::size_t count, double* y, float* x) const {
+  for (int phase = 0; phase < kPhases; ++phase)
+    for (std::size_t part = 0; part < bins_.size(); ++part) solve_phase(phase, part, b, count, y, nullptr, x);
 }
 
 }  // namespace softdeca::runtime

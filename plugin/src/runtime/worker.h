@@ -1,7 +1,9 @@
 // The avatar's own helper threads for the frame's data-parallel passes. run(f) calls f(part,
-// parts) for every part: part 0 on the calling thread, the others on the helpers. Helpers spin
-// briefly after a job (the passes of one frame follow each other within microseconds) and then
-// sleep, so an idle avatar costs no CPU. The passes given to run() must not throw.
+// parts) once for every part 0..parts-1. Parts are claimed, not assigned: the caller claims
+// parts too, so when a helper is late (a busy machine, a descheduled thread) the caller simply
+// runs the remaining parts itself and a frame is never slower than with one thread by more than
+// the claim. Helpers spin briefly after a job (the passes of a frame follow each other within
+// microseconds) and then sleep, so an idle avatar costs no CPU. Passes must not throw.
 #pragma once
 
 #include <atomic>
@@ -38,13 +40,15 @@ class Worker {
     (*static_cast<F*>(ctx))(part, parts);
   }
   void dispatch(void (*fn)(void*, std::size_t, std::size_t), void* ctx);
-  void loop(std::size_t part);
+  void work(std::uint64_t job);  // claim and run parts of `job` until none is left
+  void loop();
 
   std::vector<std::thread> helpers_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::atomic<std::uint64_t> posted_{0};
-  std::atomic<std::size_t> pending_{0};
+  std::atomic<std::uint64_t> posted_{0};  // the current job's number
+  std::atomic<std::uint64_t> claim_{0};   // job number << 32 | next unclaimed part
+  std::atomic<std::size_t> done_{0};      // parts of the current job finished
   std::atomic<bool> stop_{false};
   void (*fn_)(void*, std::size_t, std::size_t) = nullptr;
   void* ctx_ = nullptr;
