@@ -27,8 +27,10 @@ constexpr std::size_t kMaxThreads = 8;
 template <class T>
 void require_struct(const T* s, const char* name) {
   require_not_null(s, name);
-  require(s->size >= sizeof(T), std::string(name) + "->size is " + std::to_string(s->size) + ", expected sizeof = " +
-                                    std::to_string(sizeof(T)) + " (set it before the call)");
+  expect(s->size >= sizeof(T), [&] {
+    return std::string(name) + "->size is " + std::to_string(s->size) + ", expected sizeof = " + std::to_string(sizeof(T)) +
+           " (set it before the call)";
+  });
 }
 
 const Model& model_of(const softdeca_model* m) {

@@ -220,23 +220,27 @@ std::shared_ptr<const Preparation> Avatar::current() const {
 
 void Avatar::check_output(const Output& out) const {
   require_not_null(out.vertices, "output.vertices");
-  require(out.vertex_capacity >= vh_, "output.vertex_capacity " + std::to_string(out.vertex_capacity) +
-                                          " is below the head's " + std::to_string(vh_) + " vertices",
-          SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+  expect(out.vertex_capacity >= vh_, [&] {
+    return "output.vertex_capacity " + std::to_string(out.vertex_capacity) + " is below the head's " + std::to_string(vh_) +
+           " vertices";
+  }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
   if (out.normals)
-    require(out.normal_capacity >= vh_, "output.normal_capacity " + std::to_string(out.normal_capacity) +
-                                            " is below the head's " + std::to_string(vh_) + " vertices",
-            SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+    expect(out.normal_capacity >= vh_, [&] {
+      return "output.normal_capacity " + std::to_string(out.normal_capacity) + " is below the head's " + std::to_string(vh_) +
+             " vertices";
+    }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
 }
 
 void Avatar::read_weights(const float* weights, std::size_t count) {
   require_not_null(weights, "weights");
-  require(count == kBlendshapeCount, "expected 52 blendshape weights (canonical ARKit order), got " + std::to_string(count));
+  expect(count == kBlendshapeCount,
+         [&] { return "expected 52 blendshape weights (canonical ARKit order), got " + std::to_string(count); });
   require_finite(weights, count, "weights");
   for (std::size_t i = 0; i < count; ++i) {
-    require(weights[i] >= -kWeightSlack && weights[i] <= 1 + kWeightSlack,
-            "weights[" + std::to_string(i) + "] (" + kArkitBlendshapes[i] + ") = " + std::to_string(weights[i]) +
-                " is outside [0, 1]");
+    expect(weights[i] >= -kWeightSlack && weights[i] <= 1 + kWeightSlack, [&] {
+      return "weights[" + std::to_string(i) + "] (" + kArkitBlendshapes[i] + ") = " + std::to_string(weights[i]) +
+             " is outside [0, 1]";
+    });
     weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
   }
 }
@@ -319,7 +323,7 @@ void Avatar::finish(const Preparation& prep, int model, const float* skin, const
 
 namespace {
 void require_model(const Model& m, bool sparse) {
-  require(m.has(sparse), std::string("the bundle has no ") + (sparse ? "SparseSoftDECA" : "SoftDECA") + " model");
+  expect(m.has(sparse), [&] { return std::string("the bundle has no ") + (sparse ? "SparseSoftDECA" : "SoftDECA") + " model"; });
 }
 std::shared_ptr<const Preparation> require_prepared(std::shared_ptr<const Preparation> p) {
   if (!p) throw Error(SOFTDECA_ERROR_NOT_READY, "the avatar is not prepared yet: call softdeca_avatar_prepare first");
@@ -332,7 +336,8 @@ void Avatar::evaluate_weights(const float* weights, std::size_t count, const Out
   const auto t0 = Clock::now();
   require_model(*model_, false);
   check_output(out);
-  require(!blendshapes_.empty(), "the avatar was created without blendshapes: use softdeca_avatar_evaluate_surface");
+  expect(!blendshapes_.empty(),
+         [] { return std::string("the avatar was created without blendshapes: use softdeca_avatar_evaluate_surface"); });
   read_weights(weights, count);
   const auto prep = require_prepared(current());
   AvatarStats st;
@@ -353,8 +358,10 @@ void Avatar::evaluate_surface(const float* weights, std::size_t count, const flo
   check_output(out);
   read_weights(weights, count);
   require_not_null(surface, "surface");
-  require(vertices == vs_ || vertices == vh_, "surface has " + std::to_string(vertices) + " vertices; expected the skin's " +
-                                                  std::to_string(vs_) + " or the head's " + std::to_string(vh_));
+  expect(vertices == vs_ || vertices == vh_, [&] {
+    return "surface has " + std::to_string(vertices) + " vertices; expected the skin's " + std::to_string(vs_) +
+           " or the head's " + std::to_string(vh_);
+  });
   require_finite(surface, vertices * 3, "surface");
   const auto prep = require_prepared(current());
   std::memcpy(head_.data(), surface, vertices * 3 * sizeof(float));
@@ -369,9 +376,10 @@ void Avatar::evaluate_surface(const float* weights, std::size_t count, const flo
 const float* Avatar::select_landmarks(const float* points, std::size_t count, const char* what) const {
   require_not_null(points, what);
   const std::size_t k = m_.landmarks.size(), a = static_cast<std::size_t>(m_.arkit_vertex_count);
-  require(count == k || count == a, std::string(what) + " has " + std::to_string(count) + " points; expected the " +
-                                        std::to_string(k) + " landmarks or the " + std::to_string(a) +
-                                        " vertices of ARKit's face mesh");
+  expect(count == k || count == a, [&] {
+    return std::string(what) + " has " + std::to_string(count) + " points; expected the " + std::to_string(k) +
+           " landmarks or the " + std::to_string(a) + " vertices of ARKit's face mesh";
+  });
   require_finite(points, count * 3, what);
   return points;
 }
@@ -449,7 +457,7 @@ void Avatar::evaluate_linear(const float* weights, std::size_t count, const Outp
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
   check_output(out);
-  require(!blendshapes_.empty(), "the avatar was created without blendshapes");
+  expect(!blendshapes_.empty(), [] { return std::string("the avatar was created without blendshapes"); });
   read_weights(weights, count);
   AvatarStats st;
   auto blend = [&](std::size_t part, std::size_t) { blendshapes_.blend(weights_.data(), neutral_.data(), out.vertices, part); };

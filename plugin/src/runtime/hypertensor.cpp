@@ -175,17 +175,20 @@ __attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, 
       d8 = _mm256_fmadd_ps(zk, load8<P>(L, at + 64), d8);
     }
     const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
-    const __m256i three = _mm256_set1_epi32(3);
-    const __m256i vi = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(idx)), three);
-    const __m256i vj = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(idx + kLanes)), three);
-    const __m256i vk = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(idx + 2 * kLanes)), three);
-    __m256 e1[3], e2[3];
-    for (int c = 0; c < 3; ++c) {
-      const __m256i off = _mm256_set1_epi32(c);
-      const __m256 si = _mm256_i32gather_ps(skin, _mm256_add_epi32(vi, off), 4);
-      e1[c] = _mm256_sub_ps(_mm256_i32gather_ps(skin, _mm256_add_epi32(vj, off), 4), si);
-      e2[c] = _mm256_sub_ps(_mm256_i32gather_ps(skin, _mm256_add_epi32(vk, off), 4), si);
+    // Edge vectors of the 8 faces, transposed to one lane per face (scalar loads: AVX2 gathers
+    // are slow on several CPUs and these vertices are in cache).
+    alignas(32) float edge[6][kLanes];
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      const float* si = skin + 3 * static_cast<std::size_t>(idx[l]);
+      const float* sj = skin + 3 * static_cast<std::size_t>(idx[kLanes + l]);
+      const float* sk = skin + 3 * static_cast<std::size_t>(idx[2 * kLanes + l]);
+      for (int c = 0; c < 3; ++c) {
+        edge[c][l] = sj[c] - si[c];
+        edge[3 + c][l] = sk[c] - si[c];
+      }
     }
+    const __m256 e1[3] = {_mm256_load_ps(edge[0]), _mm256_load_ps(edge[1]), _mm256_load_ps(edge[2])};
+    const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
     const float* cf = faces.coeff.data() + b * 3 * kLanes;
     const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
     const __m256 rows[3][3] = {{d0, d1, d2}, {d3, d4, d5}, {d6, d7, d8}};
