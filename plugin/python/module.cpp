@@ -13,6 +13,8 @@
 namespace nb = nanobind;
 using namespace softdeca::geometry;
 
+void bind_sim(nb::module_& m);  // sim_bindings.cpp: the physics simulator
+
 NB_MODULE(softdeca_native, m) {
   m.doc() = "SoftDECA native geometry (C++), used by the training pipeline";
   m.def("version", [] { return std::string(SOFTDECA_VERSION_STRING); });
@@ -39,4 +41,5 @@ NB_MODULE(softdeca_native, m) {
   m.def("mesh_intersections", &mesh_intersections, nb::arg("vertices_a"), nb::arg("triangles_a"),
         nb::arg("vertices_b"), nb::arg("triangles_b"), nb::arg("max_pairs") = 1000,
         "Pairs (triangle of A, triangle of B) that intersect.");
+  bind_sim(m);
 }

@@ -125,16 +125,20 @@ SOFTDECA_API softdeca_status softdeca_model_get_parameter(const softdeca_model* 
                                                           softdeca_parameter_info* out_info) {
   return guarded(__func__, [&] {
     const Model& m = model_of(model);
-    require_struct(out_info, "out_info");
+    require_not_null(out_info, "out_info");
+    expect(out_info->struct_size >= sizeof(softdeca_parameter_info), [&] {
+      return "out_info->struct_size is " + std::to_string(out_info->struct_size) + ", expected sizeof = " +
+             std::to_string(sizeof(softdeca_parameter_info));
+    });
     const auto& p = m.manifest().parameters[static_cast<std::size_t>(parameter_index(m, index))];
     out_info->name = p.name.c_str();
     out_info->unit = p.unit.c_str();
+    out_info->domain = p.localisable ? p.domain.c_str() : "global";
     out_info->description = p.description.c_str();
-    out_info->default_value = static_cast<float>(p.default_value);
-    out_info->min_value = static_cast<float>(p.min);
-    out_info->max_value = static_cast<float>(p.max);
-    out_info->log_scale = p.log_scale ? 1u : 0u;
-    out_info->localisable = p.localisable ? 1u : 0u;
+    out_info->default_value = p.default_value;
+    out_info->lo = p.min;
+    out_info->hi = p.max;
+    out_info->log_scale = p.log_scale ? 1 : 0;
   });
 }
 

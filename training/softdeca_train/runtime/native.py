@@ -61,16 +61,18 @@ class ModelInfo(C.Structure):
 
 
 class ParameterInfo(C.Structure):
+    """softdeca_parameter_info (shared with the simulator's compiled-in list)."""
+
     _fields_ = [
-        ("size", C.c_uint32),
+        ("struct_size", C.c_size_t),
         ("name", C.c_char_p),
         ("unit", C.c_char_p),
+        ("domain", C.c_char_p),
         ("description", C.c_char_p),
-        ("default_value", C.c_float),
-        ("min_value", C.c_float),
-        ("max_value", C.c_float),
-        ("log_scale", C.c_uint32),
-        ("localisable", C.c_uint32),
+        ("default_value", C.c_double),
+        ("lo", C.c_double),
+        ("hi", C.c_double),
+        ("log_scale", C.c_int32),
     ]
 
 
@@ -192,7 +194,7 @@ class NativeModel:
 
     def parameter(self, index: int) -> ParameterInfo:
         p = ParameterInfo()
-        p.size = C.sizeof(ParameterInfo)
+        p.struct_size = C.sizeof(ParameterInfo)
         check(lib().softdeca_model_get_parameter(self.handle, C.c_uint32(index), C.byref(p)))
         return p
 

@@ -1,0 +1,69 @@
+// The local-global iteration of projective dynamics on one frame: local projections in
+// parallel, the prefactored global solve, Anderson acceleration with an energy safeguard,
+// convergence by a relative tolerance with an iteration cap.
+#pragma once
+
+#include <vector>
+
+#include "sim/model.h"
+#include "sim/projections.h"
+#include "sim/system.h"
+#include "sim/thread_pool.h"
+
+namespace softdeca::sim {
+
+struct SolverSettings {
+  int max_iterations = 300;
+  // Converged when the estimated RMS distance of the free vertices to the fixed point,
+  // residual / (1 - contraction), falls below tolerance * the rest bounding-box diagonal
+  // (the residual is the RMS move of one plain PD step; the contraction is measured by plain
+  // steps before convergence is accepted).
+  double tolerance = 1e-5;
+  // Anderson acceleration window (Peng et al. 2018); 0: plain projective dynamics. A step that
+  // would raise the energy is replaced by the plain step, so the energy never increases.
+  int anderson_window = 5;
+  StrainLimit strain_limit = StrainLimit::kNearestInSet;
+  int threads = 0;  // 0: all hardware threads
+  bool record_energy = true;
+  // Collision resolution (paper 3.3.2): contact weight (kPa, far above the material weights so
+  // the two points coincide), rounds of detect-and-resolve, and the depth below which a point
+  // no longer counts as penetrating (metres).
+  double collision_weight = 1e6;
+  int collision_rounds = 4;
+  double penetration_tolerance = 1e-5;
+};
+
+// Throws Error when a setting is out of range.
+void validate(const SolverSettings& s);
+
+struct SolveStats {
+  int iterations = 0;
+  bool converged = false;
+  double relative_step = 0;    // last plain PD step's RMS move / bounding-box diagonal
+  double contraction = 0;      // measured contraction of a plain step (slowest mode)
+  double estimated_error = 0;  // relative_step / (1 - contraction)
+  double energy = 0;         // PD energy (J) at the last evaluated iterate
+  std::vector<double> energy_history;  // per accepted iterate, when recorded
+  int anderson_rejections = 0;
+  double target_rms = 0;     // RMS distance of the skin points to their (blended) targets (m)
+  double local_seconds = 0, global_seconds = 0, factor_seconds = 0, total_seconds = 0;
+  // Collisions: penetrating points before and after resolution, contacts used, rounds.
+  int penetrating_before = 0, penetrating_after = 0, contacts = 0, collision_rounds = 0;
+  double max_contact_gap = 0;  // largest distance between the two points of a contact (m)
+};
+
+// One frame's problem over a model and a factorised system: P holds the constant rows'
+// targets (skin, landmarks, contacts) on entry; x holds the start (pinned vertices placed).
+struct FrameProblem {
+  const Model* model;
+  const System* system;
+  const ConstraintGroup* extra = nullptr;  // contacts, rows after the model's
+  const Positions* force = nullptr;        // per vertex (N)
+  double length_scale = 1;                 // bounding-box diagonal (m)
+};
+
+// Runs the PD iterations; x is updated in place, P ends with the last projections.
+void run_projective_dynamics(const FrameProblem& problem, Positions& P, Positions& x, const SolverSettings& settings,
+                             ThreadPool* pool, SolveStats& stats);
+
+}  // namespace softdeca::sim

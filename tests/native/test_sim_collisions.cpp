@@ -1,0 +1,117 @@
+// Collision resolution (paper 3.3.2): after it no point penetrates and contacts have no gap.
+#include <gtest/gtest.h>
+
+#include "sim/collisions.h"
+#include "sim_test_support.h"
+
+using namespace sim_test;
+
+namespace {
+// Two lips: slabs of prism tets one above the other, each with its skin sheet (top face of the
+// lower lip, bottom face of the upper lip) embedded, facing each other across a 2 mm gap. The
+// far faces are pinned like the jaw and the cranium.
+struct Lips {
+  SimulationMesh mesh;
+  std::vector<int32_t> lower, upper;  // skin points of each lip's facing sheet
+};
+
+Lips make_lips(int n = 8) {
+  Lips l;
+  const double size = 0.03, thick = 0.008, gap = 0.002;
+  const int per = (n + 1) * (n + 1);
+  // Vertex layers: lower bottom, lower top, upper bottom, upper top.
+  const double heights[4] = {-gap / 2 - thick, -gap / 2, gap / 2, gap / 2 + thick};
+  l.mesh.rest.resize(4 * per, 3);
+  for (int layer = 0; layer < 4; ++layer)
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j)
+        l.mesh.rest.row(layer * per + i * (n + 1) + j) << size * i / n - size / 2, heights[layer], size * j / n - size / 2;
+  TriIndices grid(2 * n * n, 3);
+  for (int i = 0, t = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+      grid.row(t++) << a, b, c;  // normal +Y
+      grid.row(t++) << b, d, c;
+    }
+  const TetIndices lower = split_prisms(l.mesh.rest, TriIndices(grid.array() + per), -per);
+  const TetIndices upper = split_prisms(l.mesh.rest, TriIndices(grid.array() + 3 * per), -per);
+  l.mesh.soft_tets.resize(lower.rows() + upper.rows(), 4);
+  l.mesh.soft_tets << lower, upper;
+  for (int v = 0; v < per; ++v) {
+    l.mesh.jaw.vertices.push_back(v);                // lower lip's bottom
+    l.mesh.cranium.vertices.push_back(3 * per + v);  // upper lip's top
+  }
+  // Skin: the two facing sheets, points exactly on the tet vertices.
+  l.mesh.skin.vertex.resize(2 * per, 4);
+  l.mesh.skin.weight.setZero(2 * per, 4);
+  for (int v = 0; v < per; ++v) {
+    l.mesh.skin.vertex.row(v).setConstant(per + v);
+    l.mesh.skin.vertex.row(per + v).setConstant(2 * per + v);
+    l.mesh.skin.weight(v, 0) = l.mesh.skin.weight(per + v, 0) = 1;
+    l.lower.push_back(v);
+    l.upper.push_back(per + v);
+  }
+  l.mesh.skin_triangles.resize(2 * grid.rows(), 3);
+  TriIndices flipped = grid;
+  flipped.col(1).swap(flipped.col(2));  // upper sheet faces down (-Y)
+  l.mesh.skin_triangles << grid, TriIndices(flipped.array() + per);
+  l.mesh.collisions.push_back(CollisionSet{"upper against lower", l.upper, grid, true, 0.006});
+  l.mesh.collisions.push_back(CollisionSet{"lower against upper", l.lower, TriIndices(flipped.array() + per), true, 0.006});
+  return l;
+}
+
+// Targets that close the lips by 5 mm in the middle: they overlap by up to 3 mm.
+Positions squeeze(const Lips& l) {
+  Positions t = embed(l.mesh.skin, l.mesh.rest);
+  for (Eigen::Index i = 0; i < t.rows(); ++i) {
+    const double r = std::hypot(t(i, 0), t(i, 2)) / 0.015;
+    const double push = 0.0025 * std::max(0.0, 1 - r * r);
+    t(i, 1) += i < static_cast<Eigen::Index>(l.lower.size()) ? push : -push;
+  }
+  return t;
+}
+}  // namespace
+
+TEST(SimCollisions, ClosestPointOnTriangle) {
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  EXPECT_TRUE(closest_point_barycentric({0.2, 0.3, 1}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.2, 0.3)));
+  EXPECT_TRUE(closest_point_barycentric({-1, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(1, 0, 0)));
+  EXPECT_TRUE(closest_point_barycentric({2, 0.5, 0}, a, b, c).isApprox(Eigen::Vector3d(0, 1, 0)));
+  EXPECT_TRUE(closest_point_barycentric({0.5, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));
+  EXPECT_TRUE(closest_point_barycentric({1, 1, 0}, a, b, c).isApprox(Eigen::Vector3d(0, 0.5, 0.5)));
+}
+
+TEST(SimCollisions, LipsThatWouldInterpenetrateMeetWithoutGap) {
+  const Lips lips = make_lips();
+  SolverSettings without;
+  without.collision_rounds = 0;
+  Simulator plain(lips.mesh, without);
+  const FrameInput in = input_with(squeeze(lips));
+  const FrameResult through = plain.solve_static(in);
+  ASSERT_TRUE(through.stats.converged);
+  const int before = static_cast<int>(find_penetrations(lips.mesh, through.vertices, 1e-5).size());
+  EXPECT_GT(before, 10);
+
+  Simulator sim(lips.mesh);
+  const FrameResult r = sim.solve_static(in);
+  EXPECT_TRUE(r.stats.converged);
+  EXPECT_EQ(r.stats.penetrating_before, before);
+  EXPECT_EQ(r.stats.penetrating_after, 0);
+  EXPECT_EQ(find_penetrations(lips.mesh, r.vertices, 1e-5).size(), 0u);
+  EXPECT_GE(r.stats.contacts, before);
+  EXPECT_GE(r.stats.collision_rounds, 1);
+  // Contacts coincide: no gap between the touching upper and lower lip points.
+  EXPECT_LT(r.stats.max_contact_gap, 2e-5);
+  // The middle of the lips touches: the upper lip's centre sits on the lower lip's centre.
+  const int n = 8, per = (n + 1) * (n + 1), centre = (n / 2) * (n + 1) + n / 2;
+  EXPECT_LT(std::abs(r.skin(centre, 1) - r.skin(per + centre, 1)), 2e-5);
+}
+
+TEST(SimCollisions, NothingHappensWithoutContact) {
+  const Lips lips = make_lips();
+  Simulator sim(lips.mesh);
+  const FrameResult r = sim.solve_static(input_with(embed(lips.mesh.skin, lips.mesh.rest)));
+  EXPECT_EQ(r.stats.penetrating_before, 0);
+  EXPECT_EQ(r.stats.contacts, 0);
+  EXPECT_LT(max_distance(r.vertices, lips.mesh.rest), 1e-12);
+}

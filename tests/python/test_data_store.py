@@ -1,0 +1,78 @@
+"""Dataset storage and expression coverage: atomic shards, resumable manifest, streaming."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from softdeca_train.data.coverage import CoverageSampler
+from softdeca_train.data.shards import (
+    Manifest,
+    iter_shards,
+    shard_name,
+    verify,
+    write_shard,
+)
+
+
+def _arrays(n: int, start: int, split: int = 0) -> dict[str, np.ndarray]:
+    return {
+        "instance_id": np.arange(start, start + n),
+        "split": np.full(n, split, np.int8),
+        "x": np.random.default_rng(start).standard_normal((n, 4)).astype(np.float32),
+    }
+
+
+def test_shards_round_trip_and_stream(tmp_path) -> None:
+    m = Manifest.open(tmp_path, {"seed": 1})
+    m.add(write_shard(tmp_path, "static", 0, _arrays(5, 0)))
+    m.add(write_shard(tmp_path, "static", 1, _arrays(5, 5, split=1)))
+    assert m.done("static") == {0, 1} and m.done("dynamic") == set()
+    ids = np.concatenate([a["instance_id"] for a in iter_shards(tmp_path, "static")])
+    assert ids.tolist() == list(range(10))
+    test = np.concatenate(
+        [a["instance_id"] for a in iter_shards(tmp_path, "static", "test")]
+    )
+    assert test.tolist() == list(range(5, 10))
+    assert verify(tmp_path) == []
+
+
+def test_resume_needs_the_same_configuration(tmp_path) -> None:
+    Manifest.open(tmp_path, {"seed": 1, "n": 3})
+    assert Manifest.open(tmp_path, {"seed": 1, "n": 3}).done("static") == set()
+    with pytest.raises(ValueError, match="another configuration"):
+        Manifest.open(tmp_path, {"seed": 2, "n": 3})
+
+
+def test_corrupt_or_truncated_shards_are_not_counted(tmp_path) -> None:
+    m = Manifest.open(tmp_path, {"seed": 1})
+    m.add(write_shard(tmp_path, "static", 0, _arrays(5, 0)))
+    m.add(write_shard(tmp_path, "static", 1, _arrays(5, 5)))
+    path = tmp_path / shard_name("static", 1)
+    path.write_bytes(path.read_bytes()[:-10])  # cut off: a crash or a full disk
+    assert Manifest.open(tmp_path, {"seed": 1}).done("static") == {0}
+    assert any("checksum" in p for p in verify(tmp_path))
+    # A leftover temporary from a killed writer is ignored.
+    (tmp_path / (shard_name("static", 2) + ".tmp123")).write_bytes(b"partial")
+    assert Manifest.open(tmp_path, {"seed": 1}).done("static") == {0}
+    assert (
+        json.loads((tmp_path / "manifest.json").read_text())["format"]
+        == "softdeca-dataset"
+    )
+
+
+def test_coverage_sampler_keeps_co_activation_and_covers_the_range() -> None:
+    rng = np.random.default_rng(0)
+    # Synthetic "takes": weights 0 and 1 move together, the rest are small.
+    base = rng.random(2000)
+    frames = np.clip(rng.random((2000, 52)) * 0.1, 0, 1)
+    frames[:, 0] = base
+    frames[:, 1] = np.clip(base + 0.05 * rng.standard_normal(2000), 0, 1)
+    sampler = CoverageSampler.fit(frames)
+    w = sampler.sample(np.random.default_rng(1), 4000)
+    assert w.shape == (4000, 52) and w.min() >= 0 and w.max() <= 1
+    assert np.corrcoef(w[:, 0], w[:, 1])[0, 1] > 0.5  # co-activation kept
+    # Coverage: every weight reaches the upper part of its range somewhere.
+    assert (w.max(axis=0) > 0.8).all()
+    assert not np.array_equal(w, sampler.sample(np.random.default_rng(2), 4000))

@@ -1,0 +1,89 @@
+"""The material parameter vector p, read from its single definition plugin/data/parameters.json
+(the same file the C++ simulator embeds at build time, and the bundle manifest copies)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from softdeca_train.paths import REPO_ROOT
+
+DEFINITION = REPO_ROOT / "plugin" / "data" / "parameters.json"
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    name: str
+    default: float
+    lo: float
+    hi: float
+    scale: str  # "linear" or "log": how to sample uniformly between lo and hi
+    unit: str
+    domain: str  # "global" or the element kind per-element values are given for
+
+    def sample(self, rng: np.random.Generator, size: int | None = None) -> np.ndarray | float:
+        if self.scale == "log":
+            return np.exp(rng.uniform(np.log(self.lo), np.log(self.hi), size))
+        return rng.uniform(self.lo, self.hi, size)
+
+    def normalise(self, value: np.ndarray | float) -> np.ndarray | float:
+        """Map [lo, hi] to [0, 1] on the parameter's own scale (network inputs use this)."""
+        if self.scale == "log":
+            return (np.log(value) - np.log(self.lo)) / (np.log(self.hi) - np.log(self.lo))
+        return (np.asarray(value) - self.lo) / (self.hi - self.lo)
+
+
+@dataclass(frozen=True)
+class ParameterSet:
+    specs: tuple[ParameterSpec, ...]
+
+    @property
+    def names(self) -> list[str]:
+        return [s.name for s in self.specs]
+
+    def defaults(self) -> np.ndarray:
+        return np.array([s.default for s in self.specs])
+
+    def sample(self, rng: np.random.Generator) -> np.ndarray:
+        """One parameter vector, each entry uniform or log-uniform in its range (Appendix A)."""
+        return np.array([s.sample(rng) for s in self.specs])
+
+    def validate(self, p: np.ndarray) -> None:
+        p = np.asarray(p, dtype=np.float64)
+        if p.shape[-1] != len(self.specs):
+            raise ValueError(f"expected {len(self.specs)} parameters, got {p.shape[-1]}")
+        if not np.isfinite(p).all():
+            raise ValueError("parameter vector has NaN or infinity")
+        for k, s in enumerate(self.specs):
+            v = p[..., k]
+            if np.any(v < s.lo - 1e-9) or np.any(v > s.hi + 1e-9):
+                raise ValueError(f"{s.name} out of range [{s.lo}, {s.hi}]: {np.ravel(v)[:3]}")
+
+    def normalise(self, p: np.ndarray) -> np.ndarray:
+        return np.stack([s.normalise(p[..., k]) for k, s in enumerate(self.specs)], axis=-1)
+
+
+@cache
+def load_parameters(path: Path = DEFINITION) -> ParameterSet:
+    if not path.is_file():
+        raise FileNotFoundError(f"parameter definition not found: {path}")
+    doc = json.loads(path.read_text())
+    if doc.get("format") != "softdeca-parameters":
+        raise ValueError(f"{path} is not a softdeca-parameters file")
+    specs = tuple(
+        ParameterSpec(
+            p["name"],
+            float(p["default"]),
+            float(p["lo"]),
+            float(p["hi"]),
+            p["scale"],
+            p.get("unit", ""),
+            p.get("domain", "global"),
+        )
+        for p in doc["parameters"]
+    )
+    return ParameterSet(specs)

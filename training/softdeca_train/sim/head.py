@@ -1,0 +1,125 @@
+"""A head's simulation: layered head model + teeth as bone vertices + lip/teeth collision
+sets → the native SimulationMesh and Simulator; ARKit frames → skin targets and jaw motion."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import softdeca_native as native
+
+from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
+from softdeca_train.lhm.fit import jaw_motion
+from softdeca_train.lhm.model import CRANIUM, JAW
+from softdeca_train.sim.lips import LipSets, lip_sets
+from softdeca_train.template import Template
+from softdeca_train.template.model import N_SKIN
+
+
+def _homogeneous(r: np.ndarray, t: np.ndarray) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = r, t
+    return m
+
+
+@dataclass
+class HeadSimulation:
+    """Everything needed to run φ† on one identity."""
+
+    template: Template
+    identity: np.ndarray | None
+    head: np.ndarray  # neutral, whole head (V, 3)
+    lhm: LayeredHeadModel
+    mesh: native.SimulationMesh
+    teeth_upper: np.ndarray  # simulated vertex ids of the upper teeth (ICT order)
+    teeth_lower: np.ndarray
+    lips: LipSets
+
+    def simulator(self, **settings: object) -> native.Simulator:
+        return native.Simulator(self.mesh, **settings)
+
+    def blend(self, weights: np.ndarray) -> np.ndarray:
+        """Linear blendshapes S_t of this identity for (F, 52) ARKit weights: (F, V, 3)."""
+        w = np.atleast_2d(np.asarray(weights, dtype=np.float64))
+        ict = w @ self.template.arkit_to_ict.T  # (F, 53)
+        deltas = self.template.expression_deltas.reshape(len(self.template.expression_names), -1)
+        return self.head[None] + (ict.astype(np.float32) @ deltas).reshape(len(w), -1, 3)
+
+    def jaw_transforms(self, blended: np.ndarray) -> np.ndarray:
+        """(F, 4, 4) rigid jaw motion of each blended frame, from the lower teeth (Kabsch)."""
+        return np.stack([_homogeneous(*jaw_motion(self.template, self.head, b)) for b in blended])
+
+    def whole_head(self, skin: np.ndarray, blended: np.ndarray, jaw: np.ndarray) -> np.ndarray:
+        """The whole head for a simulated skin: S from the simulation, components riding the
+        jaw moved rigidly with it, the others (cranium-fixed teeth, eyes, lashes) as blended."""
+        out = blended.copy()
+        out[:N_SKIN] = skin
+        on_jaw = N_SKIN + np.flatnonzero(self.lhm.attachments["bone_of_vertex"] == JAW)
+        out[on_jaw] = self.head[on_jaw] @ jaw[:3, :3].T + jaw[:3, 3]
+        return out
+
+
+def build_head_simulation(
+    template: Template,
+    identity: np.ndarray | None = None,
+    config: LhmConfig | None = None,
+    landmarks: tuple[np.ndarray, np.ndarray] | None = None,
+) -> HeadSimulation:
+    """The simulation of identity h. `landmarks`: (triangle rows of S, barycentric (L, 3)) for
+    the sparse variant (SurfaceLandmarks.triangle / .bary)."""
+    head = template.identity_neutral(identity)
+    lhm = fit_lhm(template, identity, config)
+    n_lhm = len(lhm.vertices)
+    up = template.components["teeth_upper"]
+    lo = template.components["teeth_lower"]
+    teeth_upper = n_lhm + np.arange(up.stop - up.start)
+    teeth_lower = teeth_upper[-1] + 1 + np.arange(lo.stop - lo.start)
+    rest = np.vstack([lhm.vertices, head[up.slice], head[lo.slice]])
+    skull = lhm.wrap_triangles + (lhm.n_layers - 1) * lhm.n_wrap
+    skull_ids = (lhm.n_layers - 1) * lhm.n_wrap + np.arange(lhm.n_wrap)
+    cranium = np.concatenate([skull_ids[lhm.skull_labels == CRANIUM], teeth_upper])
+    jaw = np.concatenate([skull_ids[lhm.skull_labels == JAW], teeth_lower])
+    skin_vertices, skin_weights = native.skin_embedding_from_tets(
+        lhm.soft_tets, lhm.skin_tet.tolist(), lhm.skin_bary
+    )
+    lips = lip_sets(template, head)
+    zone = np.union1d(lips.upper, lips.lower).astype(np.int32)
+    upper_teeth_tris = template.component_triangles("teeth_upper") - up.start + teeth_upper[0]
+    lower_teeth_tris = template.component_triangles("teeth_lower") - lo.start + teeth_lower[0]
+    collisions = [
+        native.CollisionSet("upper_lip_over_lower_lip", lips.upper.tolist(), lips.lower_triangles),
+        native.CollisionSet("lower_lip_over_upper_lip", lips.lower.tolist(), lips.upper_triangles),
+        native.CollisionSet(
+            "lips_over_upper_teeth",
+            zone.tolist(),
+            upper_teeth_tris.astype(np.int32),
+            surface_on_skin=False,
+        ),
+        native.CollisionSet(
+            "lips_over_lower_teeth",
+            zone.tolist(),
+            lower_teeth_tris.astype(np.int32),
+            surface_on_skin=False,
+        ),
+    ]
+    lm_points = lm_weights = None
+    if landmarks is not None:
+        tri, bary = landmarks
+        lm_points = template.skin_triangles[tri].astype(np.int32)
+        lm_weights = np.asarray(bary, dtype=np.float64)
+    mesh = native.SimulationMesh(
+        rest=rest,
+        soft_tets=lhm.soft_tets,
+        muscle_tets=lhm.muscle_tets,
+        connecting_tets=np.zeros((0, 4), np.int32),
+        skull_triangles=skull.astype(np.int32),
+        cranium_vertices=cranium.astype(np.int32).tolist(),
+        jaw_vertices=jaw.astype(np.int32).tolist(),
+        skin_vertices=skin_vertices,
+        skin_weights=skin_weights,
+        skin_triangles=template.skin_triangles,
+        landmark_points=lm_points,
+        landmark_weights=lm_weights,
+        collisions=collisions,
+    )
+    return HeadSimulation(template, identity, head, lhm, mesh, teeth_upper, teeth_lower, lips)

@@ -1,0 +1,42 @@
+"""Lip and teeth collision sets on the template (paper 3.3.2): which skin points must stay on
+which side of which surface. Found from the geometry, for any head in template topology."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdeca_train.template import Template
+from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.plausibility import lip_contact_zone
+
+
+@dataclass(frozen=True)
+class LipSets:
+    upper: np.ndarray  # skin vertex indices of the upper lip (contact zone)
+    lower: np.ndarray
+    upper_triangles: np.ndarray  # skin triangles with all corners in `upper`
+    lower_triangles: np.ndarray
+
+
+def lip_sets(template: Template, head: np.ndarray, radius: float = 0.012) -> LipSets:
+    """Split the lip contact zone into upper and lower lip by the mouth line: the segment
+    between the inner mouth corners (ICT landmarks 60 and 64), per x."""
+    zone = np.flatnonzero(lip_contact_zone(head, template.landmarks68, radius))
+    lm = head[template.landmarks68]
+    left, right = lm[64], lm[60]
+    t = np.clip((head[zone, 0] - right[0]) / (left[0] - right[0]), 0.0, 1.0)
+    mouth_y = right[1] + t * (left[1] - right[1])
+    # The inner lip contour's midpoint between the upper (62) and lower (66) middles.
+    mouth_y += 0.5 * (lm[62, 1] + lm[66, 1]) - 0.5 * (left[1] + right[1])
+    upper = zone[head[zone, 1] >= mouth_y]
+    lower = zone[head[zone, 1] < mouth_y]
+    tris = template.skin_triangles
+
+    def inside(ids: np.ndarray) -> np.ndarray:
+        mask = np.zeros(N_SKIN, bool)
+        mask[ids] = True
+        return tris[mask[tris].all(axis=1)]
+
+    return LipSets(upper, lower, inside(upper), inside(lower))
