@@ -4,6 +4,7 @@
 // storage adds (half and int8 against float, same frames). Writes the benchmark JSON of
 // DESIGN §3 ({figure: {value, unit, target, better, how}}).
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -46,17 +47,40 @@ struct Frames {
   std::size_t point_count = 0;
 };
 
-// Median wall time of `call` over all frames after `warmup` frames.
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+// Medians over the frames after `warmup`: wall-clock time, and the calling thread's CPU time
+// (what a frame costs when the machine is not shared: preemption by other processes is not in
+// it; with helper threads only the caller's share is).
+struct Times {
+  double wall = 0, cpu = 0;
+};
 template <class F>
-double median_ms(std::size_t frames, std::size_t warmup, F&& call) {
-  std::vector<double> t;
+Times median_ms(std::size_t frames, std::size_t warmup, F&& call) {
+  std::vector<double> wall, cpu;
   for (std::size_t i = 0; i < warmup + frames; ++i) {
     const auto t0 = Clock::now();
+    const double c0 = thread_cpu_ms();
     call(i % frames);
+    const double c1 = thread_cpu_ms();
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    if (i >= warmup) t.push_back(ms);
+    if (i >= warmup) {
+      wall.push_back(ms);
+      cpu.push_back(c1 - c0);
+    }
   }
-  return median(t);
+  return {median(wall), median(cpu)};
+}
+
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double l = NAN;
+  in >> l;
+  return l;
 }
 }  // namespace
 
@@ -112,7 +136,6 @@ int run_bench_runtime(const Args& args) {
   JsonObject figures;
   std::vector<float> vertices(vh * 3), normals(vh * 3);
   softdeca_output output{sizeof(softdeca_output), vertices.data(), vh, normals.data(), vh};
-  double linear1 = 0, static1 = 0;
   for (const unsigned threads : {1u, 2u}) {
     const std::string suffix = threads == 1 ? "" : "_2threads";
     const std::string tag = threads == 1 ? " (1 thread)" : " (2 threads)";
@@ -127,37 +150,51 @@ int run_bench_runtime(const Args& args) {
     if (!user.empty())
       check(softdeca_avatar_calibrate_landmarks(a.handle, user.neutral.vertices.data(), user.neutral.vertex_count()), "calibration");
     const auto w = [&](std::size_t f) { return take.weights[f].data(); };
-    const double lin = median_ms(frames, warmup, [&](std::size_t f) {
+    const double load_before = load_average();
+    const Times lin = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_linear(a.handle, w(f), 52, &output), "linear");
     });
     check(softdeca_avatar_set_dynamics(a.handle, 0), "dynamics");
-    const double st = median_ms(frames, warmup, [&](std::size_t f) {
+    const Times st = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
     });
     check(softdeca_avatar_set_dynamics(a.handle, 1), "dynamics");
-    const double dy = median_ms(frames, warmup, [&](std::size_t f) {
+    const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
     });
-    const double sp = median_ms(frames, warmup, [&](std::size_t f) {
+    const Times sp = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
     });
     check(softdeca_avatar_set_dynamics(a.handle, 0), "dynamics");
-    const double sp_static = median_ms(frames, warmup, [&](std::size_t f) {
+    const Times sp_static = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
     });
-    figures.raw("runtime.softdeca_static_ms" + suffix, figure(st, "ms", "evaluate_weights, dynamics off, with normals" + tag + "; " + how, 2.0));
-    figures.raw("runtime.softdeca_dynamic_ms" + suffix, figure(dy, "ms", "evaluate_weights, dynamics on, with normals" + tag + "; " + how, 2.0));
-    figures.raw("runtime.sparse_ms" + suffix, figure(sp, "ms", "evaluate_landmarks, dynamics on, with normals" + tag + "; " + how, 0.5));
-    figures.raw("runtime.sparse_static_ms" + suffix, figure(sp_static, "ms", "evaluate_landmarks, dynamics off" + tag + "; " + how, 0.5));
+    const double load = std::max(load_before, load_average());
+    char load_text[96];
+    std::snprintf(load_text, sizeof load_text, "; machine load average %.1f during the run", load);
+    const std::string when = tag + "; " + how + load_text;
+    figures.raw("runtime.softdeca_static_ms" + suffix, figure(st.wall, "ms", "evaluate_weights, dynamics off, with normals, wall-clock" + when, 2.0));
+    figures.raw("runtime.softdeca_dynamic_ms" + suffix, figure(dy.wall, "ms", "evaluate_weights, dynamics on, with normals, wall-clock" + when, 2.0));
+    figures.raw("runtime.sparse_ms" + suffix, figure(sp.wall, "ms", "evaluate_landmarks, dynamics on, with normals, wall-clock" + when, 0.5));
+    figures.raw("runtime.sparse_static_ms" + suffix, figure(sp_static.wall, "ms", "evaluate_landmarks, dynamics off, wall-clock" + when, 0.5));
     figures.raw("runtime.linear_blendshapes_ms" + suffix,
-                figure(lin, "ms", "evaluate_linear: 52 sparse blendshapes over the whole head, with normals" + tag + "; " + how));
+                figure(lin.wall, "ms", "evaluate_linear: 52 sparse blendshapes over the whole head, with normals, wall-clock" + when));
     figures.raw("runtime.softdeca_over_linear" + suffix,
-                figure(st / lin, "x", "softdeca_static_ms / linear_blendshapes_ms, same avatar, same run" + tag, 3.0));
-    std::fprintf(stderr, "%u thread(s): linear %.3f  softdeca %.3f / dynamic %.3f  sparse %.3f / static %.3f ms  (x%.2f)\n",
-                 threads, lin, st, dy, sp, sp_static, st / lin);
+                figure(st.wall / lin.wall, "x", "softdeca_static_ms / linear_blendshapes_ms, same avatar, same run" + tag, 3.0));
+    if (threads == 1) {  // CPU time of the frame thread: the cost without other processes
+      figures.raw("runtime.softdeca_static_cpu_ms", figure(st.cpu, "ms", "as softdeca_static_ms, thread CPU time" + when, 2.0));
+      figures.raw("runtime.softdeca_dynamic_cpu_ms", figure(dy.cpu, "ms", "as softdeca_dynamic_ms, thread CPU time" + when, 2.0));
+      figures.raw("runtime.sparse_cpu_ms", figure(sp.cpu, "ms", "as sparse_ms, thread CPU time" + when, 0.5));
+      figures.raw("runtime.linear_blendshapes_cpu_ms", figure(lin.cpu, "ms", "as linear_blendshapes_ms, thread CPU time" + when));
+      figures.raw("runtime.softdeca_over_linear_cpu",
+                  figure(st.cpu / lin.cpu, "x", "softdeca_static_cpu_ms / linear_blendshapes_cpu_ms" + tag, 3.0));
+    }
+    std::fprintf(stderr,
+                 "%u thread(s), load %.1f: wall linear %.3f  softdeca %.3f / dynamic %.3f  sparse %.3f / static %.3f ms (x%.2f); "
+                 "cpu linear %.3f softdeca %.3f / %.3f sparse %.3f ms\n",
+                 threads, load, lin.wall, st.wall, dy.wall, sp.wall, sp_static.wall, st.wall / lin.wall, lin.cpu, st.cpu, dy.cpu,
+                 sp.cpu);
     if (threads == 1) {
-      linear1 = lin;
-      static1 = st;
       figures.raw("runtime.prepare_ms", figure(median(prep), "ms", "prepare after a parameter change: f_ph, f_ph_v, both f_dyn, "
                                                                    "compact hyper-tensors; median of " +
                                                                        std::to_string(prep.size()) + "; " + how));
@@ -169,14 +206,12 @@ int run_bench_runtime(const Args& args) {
                          "softdeca_stats.memory_bytes after prepare (both models' hyper-tensors in half precision, DT "
                          "factor, blendshapes, buffers); " + how));
       figures.raw("runtime.softdeca_static_us_per_face",
-                  figure(st * 1000.0 / model.info.skin_triangle_count, "us/face",
+                  figure(st.wall * 1000.0 / model.info.skin_triangle_count, "us/face",
                          "softdeca_static_ms per skin triangle; paper: " + std::to_string(kPaperStaticMs * 1000 / kPaperFaces) +
                              " us/face static, " + std::to_string(kPaperDynamicMs * 1000 / kPaperFaces) +
                              " dynamic (7.45 / 9.87 ms for 71,358 faces, i5-12600K, PyTorch)"));
     }
   }
-  (void)linear1;
-  (void)static1;
 
   // Error of the compact storage: the same frames with float, half and int8 hyper-tensors.
   {
