@@ -94,3 +94,22 @@ fuzz-long: fuzz-build
 	  nice -n 10 $(FUZZ)/fuzz_{} -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 -rss_limit_mb=2048 \
 	  -artifact_prefix=build/fuzz-long/{}/ build/fuzz-long/{}/corpus tests/fuzz/corpus/{} \
 	  > build/fuzz-long/{}.log 2>&1; echo "fuzz_{}: exit $$?, $$(grep -o "Done [0-9]* runs in [0-9]* second(s)" build/fuzz-long/{}.log)"'
+
+# ---- Runtime (issue 6) -----------------------------------------------------------------------
+# `make bench` also measures the native runtime (build/bench/runtime.json). `make replay-demo`
+# replays a real take through both models with an UNTRAINED random bundle (the replay path that
+# `make demo` will use once trained bundles exist) and prints where the results are.
+REPLAY_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
+REPLAY_BUNDLE ?= build/bundles/random-untrained
+.PHONY: bench-runtime replay-demo
+bench: bench-runtime
+bench-runtime: build
+	@mkdir -p build/bench
+	@$(PY) -m softdeca_train runtime-bench --ict "$(SOFTDECA_ICT)" --out build/bench
+
+replay-demo: build
+	@$(PY) -m softdeca_train runtime-bundle --ict "$(SOFTDECA_ICT)" --out $(REPLAY_BUNDLE)
+	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(REPLAY_TAKE) \
+	  --bundle $(REPLAY_BUNDLE) --seed 1 --out $(OUT)/replay --dynamics --preview \
+	  --localised "w_skin_strain=100@0.05,-0.015,0.085,0.03"
+	@echo "replay (UNTRAINED bundle): $(OUT)/replay/preview.png, $(OUT)/replay/*.pc2 over $(OUT)/replay/neutral.obj, $(OUT)/replay/replay.json"

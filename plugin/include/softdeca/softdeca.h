@@ -40,7 +40,9 @@ typedef enum softdeca_status {
   SOFTDECA_ERROR_BUFFER_TOO_SMALL = 3, /* an output buffer is shorter than required      */
   SOFTDECA_ERROR_IO = 4,               /* a file could not be read or written            */
   SOFTDECA_ERROR_FORMAT = 5,           /* malformed or incompatible data                 */
-  SOFTDECA_ERROR_INTERNAL = 6          /* unexpected failure inside the library          */
+  SOFTDECA_ERROR_INTERNAL = 6,         /* unexpected failure inside the library          */
+  SOFTDECA_ERROR_BUSY = 7,             /* the handle is in use by another thread         */
+  SOFTDECA_ERROR_NOT_READY = 8         /* a required earlier step has not run (prepare)  */
 } softdeca_status;
 
 /* Library version as "MAJOR.MINOR.PATCH". The pointer is static and never freed. */
@@ -52,6 +54,222 @@ SOFTDECA_API const char* softdeca_last_error(void);
 
 /* Human-readable name of a status code (static string). */
 SOFTDECA_API const char* softdeca_status_name(softdeca_status status);
+
+/* ==== Runtime: SoftDECA and SparseSoftDECA per frame (issue 6) ============================
+ * A model bundle (docs/bundle.md) is loaded once into a softdeca_model; each head is a
+ * softdeca_avatar made from a model and the host's own mesh. Per avatar:
+ *   create -> set parameters (optional) -> prepare -> evaluate every frame.
+ * prepare computes the hyper-tensors L(p, h), the dynamics coefficients and (first time) the
+ * deformation-transfer factorisation. It may run on a worker thread while frames keep using the
+ * previous preparation: a frame uses exactly one preparation (never a mix), and picks up a new
+ * one at its start once prepare has returned.
+ *
+ * Threads: a model may be used from any number of threads. An avatar's evaluate_* and
+ * calibrate calls must come from one thread at a time (a concurrent call fails with
+ * SOFTDECA_ERROR_BUSY instead of racing); prepare, the parameter and identity setters,
+ * set/reset dynamics and get_stats may be called from any thread, also during a frame. Different
+ * avatars are independent and run in parallel. Destroy a handle only when no call on it runs.
+ * A model may be destroyed before its avatars: they keep what they need.
+ *
+ * Structs with a `size` field: set it to sizeof(the struct); the library rejects a smaller size
+ * and reads or writes only the fields it knows.
+ *
+ * Arrays of points are xyz floats in metres in the face-anchor frame; counts are in elements
+ * (vertices, triangles, weights) unless stated. Vertex order is the template's (the bundle's
+ * head_vertex_count vertices; the first skin_vertex_count are the skin surface S).
+ * On failure, output buffers are left untouched: the last good output stays valid. */
+
+typedef struct softdeca_model softdeca_model;
+typedef struct softdeca_avatar softdeca_avatar;
+
+/* The bundle format version this library reads (manifest "format_version"). */
+#define SOFTDECA_BUNDLE_FORMAT_VERSION 1
+
+typedef struct softdeca_model_options {
+  uint32_t size;            /* sizeof(softdeca_model_options) */
+  uint32_t prepare_threads; /* ONNX Runtime threads for the per-avatar networks; 0: 1 */
+} softdeca_model_options;
+
+/* Loads a bundle from a folder or from a .tar of its files. `options` may be NULL.
+ * SOFTDECA_ERROR_IO: unreadable path; SOFTDECA_ERROR_FORMAT: wrong format or version, sizes that
+ * disagree, damaged ONNX files (the message names the file and the problem). */
+SOFTDECA_API softdeca_status softdeca_model_load(const char* path, const softdeca_model_options* options,
+                                                 softdeca_model** out_model);
+
+/* The same from memory: an uncompressed tar (ustar) of the bundle's files, e.g. a Unity
+ * TextAsset's bytes. The bytes are copied; the caller may free them on return. */
+SOFTDECA_API softdeca_status softdeca_model_load_memory(const void* data, size_t size,
+                                                        const softdeca_model_options* options,
+                                                        softdeca_model** out_model);
+
+/* Releases the caller's reference. NULL is a no-op. */
+SOFTDECA_API softdeca_status softdeca_model_destroy(softdeca_model* model);
+
+typedef struct softdeca_model_info {
+  uint32_t size; /* sizeof(softdeca_model_info) */
+  uint32_t format_version;
+  uint32_t head_vertex_count;   /* vertices of the whole head (template topology)  */
+  uint32_t skin_vertex_count;   /* the first skin_vertex_count of them are S       */
+  uint32_t skin_triangle_count; /* triangles of S (the bundle's triangulation)     */
+  uint32_t latent_size;
+  uint32_t identity_size;
+  uint32_t blendshape_count;   /* 52, canonical ARKit order                       */
+  uint32_t parameter_count;
+  uint32_t landmark_count;     /* landmarks SparseSoftDECA reads                  */
+  uint32_t arkit_vertex_count; /* vertices of ARKit's face mesh (1220)            */
+  uint32_t has_softdeca;       /* 1: evaluate_weights/evaluate_surface available  */
+  uint32_t has_sparse;         /* 1: evaluate_landmarks available                 */
+  uint32_t untrained;          /* 1: random weights (tests, demos): not a model   */
+  float dynamics_frame_rate_hz; /* the frame rate the dynamics were trained at; 0: unknown */
+} softdeca_model_info;
+
+SOFTDECA_API softdeca_status softdeca_model_get_info(const softdeca_model* model, softdeca_model_info* out_info);
+
+/* Parameter `index` of the bundle (its manifest's list, which the runtime reads instead of the
+ * compiled-in one), in the simulator's softdeca_parameter_info (declared with the physics
+ * simulator below; set struct_size). Strings are owned by the model and stay valid while it or
+ * an avatar made from it lives. Per-face / per-vertex maps are accepted unless domain is
+ * "global". */
+struct softdeca_parameter_info;
+SOFTDECA_API softdeca_status softdeca_model_get_parameter(const softdeca_model* model, uint32_t index,
+                                                          struct softdeca_parameter_info* out_info);
+/* Index of a parameter by name; SOFTDECA_ERROR_INVALID_ARGUMENT if there is none. */
+SOFTDECA_API softdeca_status softdeca_model_find_parameter(const softdeca_model* model, const char* name,
+                                                           uint32_t* out_index);
+/* The ARKit face-mesh vertex index of every landmark (landmark_count int32), so a host can send
+ * just those vertices to evaluate_landmarks. */
+SOFTDECA_API softdeca_status softdeca_model_get_landmark_vertices(const softdeca_model* model,
+                                                                  int32_t* out_vertices, size_t capacity);
+
+/* The bundle's triangulation of the skin S (skin_triangle_count * 3 int32 indices): the face
+ * order of per-face parameter maps. */
+SOFTDECA_API softdeca_status softdeca_model_get_skin_triangles(const softdeca_model* model, int32_t* out_triangles,
+                                                               size_t capacity);
+
+/* The landmarks on a mesh in template topology (skin_vertex_count or head_vertex_count
+ * vertices): landmark_count points from the bundle's barycentric definition on S. For hosts
+ * that drive SparseSoftDECA from their own rig, and to show where the landmarks sit. */
+SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_model* model, const float* vertices,
+                                                               size_t vertex_count, float* out_points,
+                                                               size_t point_capacity);
+
+typedef enum softdeca_precision {
+  SOFTDECA_PRECISION_HALF = 0, /* hyper-tensors in binary16 (default: half the memory traffic) */
+  SOFTDECA_PRECISION_FLOAT = 1, /* binary32 */
+  SOFTDECA_PRECISION_INT8 = 2   /* int8 with a scale per 8 elements and latent: a quarter of float */
+} softdeca_precision;
+
+typedef struct softdeca_avatar_desc {
+  uint32_t size;            /* sizeof(softdeca_avatar_desc) */
+  const float* neutral;     /* vertex_count * 3 floats: the avatar's neutral head       */
+  size_t vertex_count;      /* must equal head_vertex_count                              */
+  const int32_t* triangles; /* triangle_count * 3 indices over the whole head: normals   */
+  size_t triangle_count;
+  const float* blendshapes; /* NULL, or blendshape_count * vertex_count * 3 floats: the
+                               avatar's own 52 ARKit shapes (or the template's) as deltas
+                               from the neutral, canonical order                         */
+  size_t blendshape_count;  /* 0 or 52 */
+  uint32_t threads;         /* threads per frame: 0 or 1 the caller only; 2 or more: the
+                               caller plus helper threads owned by the avatar (max 8)    */
+  uint32_t precision;       /* softdeca_precision */
+} softdeca_avatar_desc;
+
+/* Checks the mesh (sizes, finite values, indices, no degenerate skin triangle) and runs the
+ * bundle's identity encoder on the neutral skin (softdeca_avatar_get_identity). */
+SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model, const softdeca_avatar_desc* desc,
+                                                    softdeca_avatar** out_avatar);
+SOFTDECA_API softdeca_status softdeca_avatar_destroy(softdeca_avatar* avatar);
+
+/* Material parameters (see softdeca_model_get_parameter), effective at the next prepare.
+ * A global value replaces any map. Maps give one value per skin triangle (skin_triangle_count,
+ * in the bundle's triangulation) or per skin vertex (skin_vertex_count); the other element
+ * kind is derived (face -> vertex: area-weighted mean of the incident faces; vertex -> face:
+ * mean of the corners). Values outside [min, max] are rejected. */
+SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avatar, uint32_t index, float value);
+SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_faces(softdeca_avatar* avatar, uint32_t index,
+                                                                 const float* values, size_t face_count);
+SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_vertices(softdeca_avatar* avatar, uint32_t index,
+                                                                    const float* values, size_t vertex_count);
+SOFTDECA_API softdeca_status softdeca_avatar_reset_parameters(softdeca_avatar* avatar);
+/* The global value (a map's parameters report their last global value) and whether a map is set;
+ * either output may be NULL. */
+SOFTDECA_API softdeca_status softdeca_avatar_get_parameter(const softdeca_avatar* avatar, uint32_t index,
+                                                           float* out_value, uint32_t* out_localised);
+
+/* The identity code h (identity_size floats): from the encoder, or as set; set takes effect at
+ * the next prepare. */
+SOFTDECA_API softdeca_status softdeca_avatar_get_identity(const softdeca_avatar* avatar, float* out_identity,
+                                                          size_t capacity);
+SOFTDECA_API softdeca_status softdeca_avatar_set_identity(softdeca_avatar* avatar, const float* identity,
+                                                          size_t count);
+
+/* Builds a new preparation from the current parameters and identity and publishes it. */
+SOFTDECA_API softdeca_status softdeca_avatar_prepare(softdeca_avatar* avatar);
+
+/* Where a frame's result goes: vertices of the whole head, and optionally unit normals. */
+typedef struct softdeca_output {
+  uint32_t size;          /* sizeof(softdeca_output) */
+  float* vertices;        /* vertex_capacity * 3 floats */
+  size_t vertex_capacity; /* at least head_vertex_count */
+  float* normals;         /* NULL, or normal_capacity * 3 floats */
+  size_t normal_capacity;
+} softdeca_output;
+
+/* SoftDECA from 52 weights in [0, 1] (canonical ARKit order): the avatar's blendshapes give
+ * S_t, the model corrects the skin; non-skin vertices (teeth, eyes, ...) follow the blendshapes.
+ * Needs blendshapes at creation and a preparation (SOFTDECA_ERROR_NOT_READY). */
+SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* avatar, const float* weights,
+                                                              size_t weight_count, const softdeca_output* output);
+
+/* SoftDECA on a caller-blended S_t: `surface` holds the skin (skin_vertex_count) or the whole
+ * head (head_vertex_count); `weights` still drive f_w. Non-skin vertices come from a whole-head
+ * surface, else they follow the skin rigidly (cranium fixed, jaw with the jaw anchors). */
+SOFTDECA_API softdeca_status softdeca_avatar_evaluate_surface(softdeca_avatar* avatar, const float* weights,
+                                                              size_t weight_count, const float* surface,
+                                                              size_t vertex_count, const softdeca_output* output);
+
+/* Landmark calibration: the user's neutral face, as the landmark_count landmarks or the whole
+ * ARKit face mesh (arkit_vertex_count vertices). Later frames are retargeted: offsets from this
+ * neutral, mapped by the similarity between the user's and the avatar's neutral landmarks.
+ * Without calibration, evaluate_landmarks takes its points as the avatar's own landmarks. */
+SOFTDECA_API softdeca_status softdeca_avatar_calibrate_landmarks(softdeca_avatar* avatar, const float* points,
+                                                                 size_t point_count);
+
+/* SparseSoftDECA from tracked landmarks (landmark_count points, or the arkit_vertex_count
+ * vertices of ARKit's face mesh); non-skin vertices follow the skin rigidly. */
+SOFTDECA_API softdeca_status softdeca_avatar_evaluate_landmarks(softdeca_avatar* avatar, const float* points,
+                                                                size_t point_count, const softdeca_output* output);
+
+/* Plain linear blendshapes and normals (the baseline, and a fallback); needs no preparation. */
+SOFTDECA_API softdeca_status softdeca_avatar_evaluate_linear(softdeca_avatar* avatar, const float* weights,
+                                                             size_t weight_count, const softdeca_output* output);
+
+/* Second-order dynamics on (1) or off (0, the default); reset forgets the past frames (the next
+ * frame starts at rest). Changing model between frames also starts at rest. */
+SOFTDECA_API softdeca_status softdeca_avatar_set_dynamics(softdeca_avatar* avatar, int enabled);
+SOFTDECA_API softdeca_status softdeca_avatar_reset_dynamics(softdeca_avatar* avatar);
+
+typedef struct softdeca_stats {
+  uint32_t size;              /* sizeof(softdeca_stats) */
+  uint32_t threads;           /* threads a frame uses */
+  uint64_t frames;            /* successful evaluations */
+  uint64_t preparations;      /* completed prepares */
+  uint64_t generation;        /* the preparation the last frame used */
+  double frame_ms;            /* the last frame, whole call */
+  double encoder_ms;          /* f_w or f_l (ONNX Runtime) */
+  double blend_ms;            /* linear blendshapes (or copying the caller's surface) */
+  double hyper_ms;            /* z . L: deformation gradients and right-hand sides, or offsets */
+  double solve_ms;            /* deformation-transfer solve */
+  double dynamics_ms;         /* dynamics and output checks */
+  double output_ms;           /* writing the head, non-skin vertices */
+  double normals_ms;
+  double prepare_ms;          /* the last prepare, whole call */
+  double prepare_networks_ms; /* its networks (f_ph, f_ph_v, f_dyn) */
+  double factorisation_ms;    /* deformation-transfer assembly and factorisation */
+  uint64_t memory_bytes;      /* memory the avatar holds (preparation, factor, buffers) */
+} softdeca_stats;
+
+SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* avatar, softdeca_stats* out_stats);
 
 /* ---- Geometry -------------------------------------------------------------------------- */
 

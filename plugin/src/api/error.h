@@ -54,7 +54,14 @@ inline void require(bool condition, const std::string& message,
 }
 
 inline void require_not_null(const void* p, const char* name) {
-  require(p != nullptr, std::string(name) + " is null");
+  if (p == nullptr) throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, std::string(name) + " is null");
+}
+
+// For per-frame paths: the message (a callable returning it) is built only on failure, so a
+// passing check allocates nothing.
+template <class Message>
+inline void expect(bool condition, Message&& message, softdeca_status status = SOFTDECA_ERROR_INVALID_ARGUMENT) {
+  if (!condition) throw Error(status, message());
 }
 
 // Rejects NaN and infinity; `name` appears in the message with the first bad index.

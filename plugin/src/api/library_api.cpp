@@ -16,6 +16,8 @@ SOFTDECA_API const char* softdeca_status_name(softdeca_status status) {
     case SOFTDECA_ERROR_IO: return "i/o error";
     case SOFTDECA_ERROR_FORMAT: return "format error";
     case SOFTDECA_ERROR_INTERNAL: return "internal error";
+    case SOFTDECA_ERROR_BUSY: return "busy";
+    case SOFTDECA_ERROR_NOT_READY: return "not ready";
   }
   return "unknown status";
 }

@@ -1,0 +1,271 @@
+// softdeca bench-runtime: per-frame cost of the runtime on one avatar, measured on the frames of
+// a real take: plain linear blendshapes, SoftDECA static and dynamic, SparseSoftDECA, with one
+// and with two threads; prepare time, memory per avatar, and the error the compact hyper-tensor
+// storage adds (half and int8 against float, same frames). Writes the benchmark JSON of
+// DESIGN §3 ({figure: {value, unit, target, better, how}}).
+#include <chrono>
+#include <ctime>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "command.h"
+#include "json.h"
+#include "options.h"
+#include "runtime_session.h"
+#include "take_csv.h"
+
+namespace softdeca::cli {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+constexpr double kPaperStaticMs = 7.45, kPaperDynamicMs = 9.87, kPaperFaces = 71358;
+
+std::string figure(double value, const std::string& unit, const std::string& how, double target = NAN,
+                   const char* better = "lower") {
+  JsonObject o;
+  o.number("value", value).text("unit", unit).raw("target", std::isfinite(target) ? json_number(target) : "null");
+  o.text("better", better).text("how", how);
+  return o.str();
+}
+
+std::string cpu_name() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown CPU";
+}
+
+struct Frames {
+  const Take& take;
+  std::vector<std::vector<float>> points;  // per frame: what SparseSoftDECA reads
+  std::size_t point_count = 0;
+};
+
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+// Medians over the frames after `warmup`: wall-clock time, and the calling thread's CPU time
+// (what a frame costs when the machine is not shared: preemption by other processes is not in
+// it; with helper threads only the caller's share is).
+struct Times {
+  double wall = 0, cpu = 0;
+};
+template <class F>
+Times median_ms(std::size_t frames, std::size_t warmup, F&& call) {
+  std::vector<double> wall, cpu;
+  for (std::size_t i = 0; i < warmup + frames; ++i) {
+    const auto t0 = Clock::now();
+    const double c0 = thread_cpu_ms();
+    call(i % frames);
+    const double c1 = thread_cpu_ms();
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    if (i >= warmup) {
+      wall.push_back(ms);
+      cpu.push_back(c1 - c0);
+    }
+  }
+  return {median(wall), median(cpu)};
+}
+
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double l = NAN;
+  in >> l;
+  return l;
+}
+}  // namespace
+
+int run_bench_runtime(const Args& args) {
+  Options o("bench-runtime", "Measure the runtime per frame on the frames of a take (medians), single- and two-threaded,\n"
+                             "and write the benchmark JSON (DESIGN §3).");
+  o.option("--bundle", "DIR", "model bundle folder or .tar")
+      .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
+      .option("--take", "CSV", "Live Link Face CSV take whose frames drive the measurement")
+      .option("--frames", "N", "frames measured per figure", "600")
+      .option("--warmup", "N", "frames run before measuring", "30")
+      .option("--prepares", "N", "prepares measured", "5")
+      .option("--out", "FILE", "benchmark JSON", "build/bench/runtime.json")
+      .option("--how", "TEXT", "the command line to record in the figures", "softdeca bench-runtime");
+  if (!o.parse(args)) return 0;
+  for (const char* req : {"--bundle", "--avatar", "--take"})
+    if (!o.given(req)) throw UsageError(std::string(req) + " is required");
+  const std::size_t n_frames = static_cast<std::size_t>(o.integer("--frames"));
+  const std::size_t warmup = static_cast<std::size_t>(o.integer("--warmup"));
+  const Take take = read_livelinkface_csv(o.text("--take"), n_frames);
+  const std::size_t frames = take.weights.size();
+  const FaceRig rig = read_rig(o.text("--avatar"));
+  const FaceRig user = read_rig(o.text("--avatar") + "/user_face", true);
+  Model model(o.text("--bundle"));
+  const std::size_t vh = model.info.head_vertex_count;
+  const std::string how = o.text("--how") + " on " + cpu_name() + " (" + std::to_string(std::thread::hardware_concurrency()) +
+                          " cores); " + std::to_string(frames) + " frames of " + take.path + ", median; " +
+                          std::to_string(model.info.skin_triangle_count) + " skin triangles, " + std::to_string(vh) +
+                          " head vertices" + (model.info.untrained ? ", untrained (random) networks of full size" : "");
+
+  // What SparseSoftDECA reads each frame: the user rig's face mesh, or the avatar's own landmarks.
+  Frames input{take, {}, 0};
+  {
+    Avatar a(model, rig.neutral, rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+    std::vector<float> head(vh * 3);
+    softdeca_output out{sizeof(softdeca_output), head.data(), vh, nullptr, 0};
+    for (std::size_t f = 0; f < frames; ++f) {
+      if (!user.empty()) {
+        std::vector<float> p(user.neutral.vertices.size());
+        user.blend(take.weights[f].data(), p.data());
+        input.points.push_back(std::move(p));
+        input.point_count = user.neutral.vertex_count();
+      } else {
+        check(softdeca_avatar_evaluate_linear(a.handle, take.weights[f].data(), 52, &out), "linear");
+        std::vector<float> p(3 * model.info.landmark_count);
+        check(softdeca_model_evaluate_landmarks(model.handle, head.data(), vh, p.data(), model.info.landmark_count), "landmarks");
+        input.points.push_back(std::move(p));
+        input.point_count = model.info.landmark_count;
+      }
+    }
+  }
+
+  JsonObject figures;
+  std::vector<float> vertices(vh * 3), normals(vh * 3);
+  softdeca_output output{sizeof(softdeca_output), vertices.data(), vh, normals.data(), vh};
+  for (const unsigned threads : {1u, 2u}) {
+    const std::string suffix = threads == 1 ? "" : "_2threads";
+    const std::string tag = threads == 1 ? " (1 thread)" : " (2 threads)";
+    Avatar a(model, rig.neutral, rig.deltas, threads, SOFTDECA_PRECISION_HALF);
+    check(softdeca_avatar_prepare(a.handle), "prepare");
+    const softdeca_stats first = a.stats();
+    std::vector<double> prep;
+    for (long i = 0; i < o.integer("--prepares"); ++i) {
+      check(softdeca_avatar_prepare(a.handle), "prepare");
+      prep.push_back(a.stats().prepare_ms);
+    }
+    if (!user.empty())
+      check(softdeca_avatar_calibrate_landmarks(a.handle, user.neutral.vertices.data(), user.neutral.vertex_count()), "calibration");
+    const auto w = [&](std::size_t f) { return take.weights[f].data(); };
+    const double load_before = load_average();
+    const Times lin = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_linear(a.handle, w(f), 52, &output), "linear");
+    });
+    check(softdeca_avatar_set_dynamics(a.handle, 0), "dynamics");
+    const Times st = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
+    });
+    check(softdeca_avatar_set_dynamics(a.handle, 1), "dynamics");
+    const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
+    });
+    const Times sp = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
+    });
+    check(softdeca_avatar_set_dynamics(a.handle, 0), "dynamics");
+    const Times sp_static = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
+    });
+    const double load = std::max(load_before, load_average());
+    char load_text[96];
+    std::snprintf(load_text, sizeof load_text, "; machine load average %.1f during the run", load);
+    const std::string when = tag + "; " + how + load_text;
+    figures.raw("runtime.softdeca_static_ms" + suffix, figure(st.wall, "ms", "evaluate_weights, dynamics off, with normals, wall-clock" + when, 2.0));
+    figures.raw("runtime.softdeca_dynamic_ms" + suffix, figure(dy.wall, "ms", "evaluate_weights, dynamics on, with normals, wall-clock" + when, 2.0));
+    figures.raw("runtime.sparse_ms" + suffix, figure(sp.wall, "ms", "evaluate_landmarks, dynamics on, with normals, wall-clock" + when, 0.5));
+    figures.raw("runtime.sparse_static_ms" + suffix, figure(sp_static.wall, "ms", "evaluate_landmarks, dynamics off, wall-clock" + when, 0.5));
+    figures.raw("runtime.linear_blendshapes_ms" + suffix,
+                figure(lin.wall, "ms", "evaluate_linear: 52 sparse blendshapes over the whole head, with normals, wall-clock" + when));
+    figures.raw("runtime.softdeca_over_linear" + suffix,
+                figure(st.wall / lin.wall, "x", "softdeca_static_ms / linear_blendshapes_ms, same avatar, same run" + tag, 3.0));
+    if (threads == 1) {  // CPU time of the frame thread: the cost without other processes
+      figures.raw("runtime.softdeca_static_cpu_ms", figure(st.cpu, "ms", "as softdeca_static_ms, thread CPU time" + when, 2.0));
+      figures.raw("runtime.softdeca_dynamic_cpu_ms", figure(dy.cpu, "ms", "as softdeca_dynamic_ms, thread CPU time" + when, 2.0));
+      figures.raw("runtime.sparse_cpu_ms", figure(sp.cpu, "ms", "as sparse_ms, thread CPU time" + when, 0.5));
+      figures.raw("runtime.linear_blendshapes_cpu_ms", figure(lin.cpu, "ms", "as linear_blendshapes_ms, thread CPU time" + when));
+      figures.raw("runtime.softdeca_over_linear_cpu",
+                  figure(st.cpu / lin.cpu, "x", "softdeca_static_cpu_ms / linear_blendshapes_cpu_ms" + tag, 3.0));
+    }
+    std::fprintf(stderr,
+                 "%u thread(s), load %.1f: wall linear %.3f  softdeca %.3f / dynamic %.3f  sparse %.3f / static %.3f ms (x%.2f); "
+                 "cpu linear %.3f softdeca %.3f / %.3f sparse %.3f ms\n",
+                 threads, load, lin.wall, st.wall, dy.wall, sp.wall, sp_static.wall, st.wall / lin.wall, lin.cpu, st.cpu, dy.cpu,
+                 sp.cpu);
+    if (threads == 1) {
+      figures.raw("runtime.prepare_ms", figure(median(prep), "ms", "prepare after a parameter change: f_ph, f_ph_v, both f_dyn, "
+                                                                   "compact hyper-tensors; median of " +
+                                                                       std::to_string(prep.size()) + "; " + how));
+      figures.raw("runtime.first_prepare_ms",
+                  figure(first.prepare_ms, "ms", "the first prepare, including the DT assembly and factorisation (" +
+                                                     std::to_string(first.factorisation_ms) + " ms); " + how));
+      figures.raw("runtime.memory_per_avatar_mb",
+                  figure(static_cast<double>(a.stats().memory_bytes) / 1e6, "MB",
+                         "softdeca_stats.memory_bytes after prepare (both models' hyper-tensors in half precision, DT "
+                         "factor, blendshapes, buffers); " + how));
+      figures.raw("runtime.softdeca_static_us_per_face",
+                  figure(st.wall * 1000.0 / model.info.skin_triangle_count, "us/face",
+                         "softdeca_static_ms per skin triangle; paper: " + std::to_string(kPaperStaticMs * 1000 / kPaperFaces) +
+                             " us/face static, " + std::to_string(kPaperDynamicMs * 1000 / kPaperFaces) +
+                             " dynamic (7.45 / 9.87 ms for 71,358 faces, i5-12600K, PyTorch)"));
+    }
+  }
+
+  // Error of the compact storage: the same frames with float, half and int8 hyper-tensors.
+  {
+    const std::size_t n = std::min<std::size_t>(frames, 100);
+    std::vector<std::vector<float>> reference;
+    double worst[2] = {0, 0}, mean[2] = {0, 0}, worst_sp[2] = {0, 0};
+    const unsigned precisions[3] = {SOFTDECA_PRECISION_FLOAT, SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_INT8};
+    std::vector<std::vector<float>> ref_sd, ref_sp;
+    for (int p = 0; p < 3; ++p) {
+      Avatar a(model, rig.neutral, rig.deltas, 1, precisions[p]);
+      check(softdeca_avatar_prepare(a.handle), "prepare");
+      if (!user.empty())
+        check(softdeca_avatar_calibrate_landmarks(a.handle, user.neutral.vertices.data(), user.neutral.vertex_count()),
+              "calibration");
+      for (std::size_t f = 0; f < n; ++f) {
+        check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
+        std::vector<float> sd(vertices.begin(), vertices.begin() + 3 * model.info.skin_vertex_count);
+        check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
+        std::vector<float> sp(vertices.begin(), vertices.begin() + 3 * model.info.skin_vertex_count);
+        if (p == 0) {
+          ref_sd.push_back(std::move(sd));
+          ref_sp.push_back(std::move(sp));
+          continue;
+        }
+        for (std::size_t v = 0; v < model.info.skin_vertex_count; ++v) {
+          double d2 = 0, e2 = 0;
+          for (int c = 0; c < 3; ++c) {
+            d2 += std::pow(sd[3 * v + c] - ref_sd[f][3 * v + c], 2);
+            e2 += std::pow(sp[3 * v + c] - ref_sp[f][3 * v + c], 2);
+          }
+          worst[p - 1] = std::max(worst[p - 1], std::sqrt(d2) * 1e3);
+          mean[p - 1] += std::sqrt(d2) * 1e3 / static_cast<double>(n * model.info.skin_vertex_count);
+          worst_sp[p - 1] = std::max(worst_sp[p - 1], std::sqrt(e2) * 1e3);
+        }
+      }
+    }
+    const char* names[2] = {"half", "int8"};
+    for (int p = 0; p < 2; ++p) {
+      const std::string what = std::string(" storage of the hyper-tensors against float, over ") + std::to_string(n) +
+                               " frames of the take, all skin vertices (untrained networks: the size of their corrections sets this)";
+      figures.raw(std::string("runtime.") + names[p] + "_added_error_max_mm", figure(worst[p], "mm", std::string("SoftDECA: max |x - x_float|, ") + names[p] + what));
+      figures.raw(std::string("runtime.") + names[p] + "_added_error_mean_mm", figure(mean[p], "mm", std::string("SoftDECA: mean |x - x_float|, ") + names[p] + what));
+      figures.raw(std::string("runtime.") + names[p] + "_added_error_sparse_max_mm",
+                  figure(worst_sp[p], "mm", std::string("SparseSoftDECA: max |x - x_float|, ") + names[p] + what));
+      std::fprintf(stderr, "%s storage: SoftDECA max %.5f mm, mean %.6f mm; sparse max %.5f mm\n", names[p], worst[p], mean[p],
+                   worst_sp[p]);
+    }
+  }
+  const std::string path = o.text("--out");
+  const std::size_t slash = path.rfind('/');
+  if (slash != std::string::npos) make_directories(path.substr(0, slash));
+  write_text_file(path, figures.str(true) + "\n");
+  std::printf("wrote %s\n", path.c_str());
+  return 0;
+}
+
+}  // namespace softdeca::cli

@@ -1,0 +1,103 @@
+#include "mesh_io.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace softdeca::cli {
+
+ObjMesh read_obj(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open " + path);
+  ObjMesh m;
+  std::string line;
+  std::vector<std::int32_t> poly;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const char* s = line.c_str();
+    while (*s == ' ' || *s == '\t') ++s;
+    if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
+      char* end = nullptr;
+      const char* p = s + 2;
+      for (int k = 0; k < 3; ++k) {
+        const float v = std::strtof(p, &end);
+        if (end == p) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad vertex");
+        m.vertices.push_back(v);
+        p = end;
+      }
+    } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t')) {
+      poly.clear();
+      const char* p = s + 2;
+      for (;;) {
+        while (*p == ' ' || *p == '\t') ++p;
+        if (!*p || *p == '\r') break;
+        char* end = nullptr;
+        long idx = std::strtol(p, &end, 10);
+        if (end == p) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad face");
+        const long n = static_cast<long>(m.vertex_count());
+        idx = idx < 0 ? n + idx : idx - 1;
+        if (idx < 0) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": face index out of range");
+        poly.push_back(static_cast<std::int32_t>(idx));
+        p = end;
+        while (*p && *p != ' ' && *p != '\t') ++p;  // skip /vt/vn
+      }
+      for (std::size_t k = 1; k + 1 < poly.size(); ++k) m.triangles.insert(m.triangles.end(), {poly[0], poly[k], poly[k + 1]});
+    }
+  }
+  for (const std::int32_t i : m.triangles)
+    if (static_cast<std::size_t>(i) >= m.vertex_count()) throw std::runtime_error(path + ": face index beyond the vertices");
+  return m;
+}
+
+void write_obj(const std::string& path, const float* v, std::size_t nv, const float* n, const std::int32_t* t, std::size_t nt,
+               const std::string& comment) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) throw std::runtime_error("cannot write " + path);
+  std::fprintf(f, "# %s\n", comment.c_str());
+  for (std::size_t i = 0; i < nv; ++i) std::fprintf(f, "v %.6f %.6f %.6f\n", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+  if (n)
+    for (std::size_t i = 0; i < nv; ++i) std::fprintf(f, "vn %.5f %.5f %.5f\n", n[3 * i], n[3 * i + 1], n[3 * i + 2]);
+  for (std::size_t i = 0; i < nt; ++i) {
+    const long a = t[3 * i] + 1, b = t[3 * i + 1] + 1, c = t[3 * i + 2] + 1;
+    if (n) std::fprintf(f, "f %ld//%ld %ld//%ld %ld//%ld\n", a, a, b, b, c, c);
+    else std::fprintf(f, "f %ld %ld %ld\n", a, b, c);
+  }
+  if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + path);
+}
+
+Pc2Writer::Pc2Writer(const std::string& path, std::size_t points, float start_frame, float sample_rate)
+    : path_(path), points_(points) {
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) throw std::runtime_error("cannot write " + path);
+  char signature[12] = "POINTCACHE2";
+  const std::int32_t version = 1, n = static_cast<std::int32_t>(points), zero = 0;
+  std::fwrite(signature, 1, 12, file_);
+  std::fwrite(&version, 4, 1, file_);
+  std::fwrite(&n, 4, 1, file_);
+  std::fwrite(&start_frame, 4, 1, file_);
+  std::fwrite(&sample_rate, 4, 1, file_);
+  std::fwrite(&zero, 4, 1, file_);
+}
+
+Pc2Writer::~Pc2Writer() {
+  if (file_) std::fclose(file_);
+}
+
+void Pc2Writer::add(const float* xyz) {
+  if (std::fwrite(xyz, sizeof(float), points_ * 3, file_) != points_ * 3) throw std::runtime_error("cannot write " + path_);
+  ++frames_;
+}
+
+void Pc2Writer::close() {
+  if (!file_) return;
+  const std::int32_t n = static_cast<std::int32_t>(frames_);
+  const bool ok = std::fseek(file_, 28, SEEK_SET) == 0 && std::fwrite(&n, 4, 1, file_) == 1;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!ok || !closed) throw std::runtime_error("cannot finish " + path_);
+}
+
+}  // namespace softdeca::cli

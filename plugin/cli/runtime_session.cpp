@@ -1,0 +1,115 @@
+#include "runtime_session.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "runtime/manifest.h"
+
+namespace softdeca::cli {
+
+void check(softdeca_status status, const std::string& what) {
+  if (status != SOFTDECA_OK)
+    throw std::runtime_error(what + ": " + softdeca_status_name(status) + ": " + softdeca_last_error());
+}
+
+Model::Model(const std::string& bundle, unsigned prepare_threads) {
+  softdeca_model_options opts{sizeof(softdeca_model_options), prepare_threads};
+  check(softdeca_model_load(bundle.c_str(), &opts, &handle), "loading " + bundle);
+  info.size = sizeof info;
+  check(softdeca_model_get_info(handle, &info), "model info");
+}
+
+int Model::parameter(const std::string& name) const {
+  uint32_t i = 0;
+  check(softdeca_model_find_parameter(handle, name.c_str(), &i), "parameter " + name);
+  return static_cast<int>(i);
+}
+
+Avatar::Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads,
+               unsigned precision) {
+  softdeca_avatar_desc d{};
+  d.size = sizeof d;
+  d.neutral = neutral.vertices.data();
+  d.vertex_count = neutral.vertex_count();
+  d.triangles = neutral.triangles.data();
+  d.triangle_count = neutral.triangles.size() / 3;
+  d.blendshapes = deltas.empty() ? nullptr : deltas.data();
+  d.blendshape_count = deltas.empty() ? 0 : 52;
+  d.threads = threads;
+  d.precision = precision;
+  check(softdeca_avatar_create(model.handle, &d, &handle), "creating the avatar");
+}
+
+softdeca_stats Avatar::stats() const {
+  softdeca_stats s{};
+  s.size = sizeof s;
+  check(softdeca_avatar_get_stats(handle, &s), "stats");
+  return s;
+}
+
+void FaceRig::blend(const float* w, float* out) const {
+  const std::size_t n = neutral.vertices.size();
+  std::copy(neutral.vertices.begin(), neutral.vertices.end(), out);
+  for (std::size_t s = 0; s < 52; ++s) {
+    if (w[s] == 0.0f) continue;
+    const float* d = deltas.data() + s * n;
+    for (std::size_t i = 0; i < n; ++i) out[i] += w[s] * d[i];
+  }
+}
+
+bool file_exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+void make_directories(const std::string& path) {
+  std::string partial;
+  for (std::size_t i = 0; i <= path.size(); ++i) {
+    if (i == path.size() || path[i] == '/') {
+      if (!partial.empty() && !file_exists(partial) && ::mkdir(partial.c_str(), 0755) != 0 && !file_exists(partial))
+        throw std::runtime_error("cannot create " + partial);
+    }
+    if (i < path.size()) partial += path[i];
+  }
+}
+
+FaceRig read_rig(const std::string& dir, bool optional) {
+  FaceRig rig;
+  if (optional && !file_exists(dir + "/neutral.obj")) return rig;
+  rig.neutral = read_obj(dir + "/neutral.obj");
+  const std::size_t n = rig.neutral.vertices.size();
+  rig.deltas.assign(52 * n, 0.0f);
+  for (std::size_t s = 0; s < 52; ++s) {
+    const std::string path = dir + "/blendshapes/" + runtime::kArkitBlendshapes[s] + ".obj";
+    if (!file_exists(path)) continue;
+    const ObjMesh shape = read_obj(path);
+    if (shape.vertices.size() != n) throw std::runtime_error(path + ": vertex count differs from the neutral");
+    for (std::size_t i = 0; i < n; ++i) rig.deltas[s * n + i] = shape.vertices[i] - rig.neutral.vertices[i];
+    ++rig.present;
+  }
+  return rig;
+}
+
+void write_identity_avatar(long seed, const std::string& dir) {
+  const char* py = std::getenv("SOFTDECA_PYTHON");
+  const std::string cmd = std::string(py && *py ? py : "python3") + " -m softdeca_train avatar --seed " + std::to_string(seed) +
+                          " --out '" + dir + "'";
+  std::fprintf(stderr, "softdeca: %s\n", cmd.c_str());
+  if (std::system(cmd.c_str()) != 0)
+    throw std::runtime_error("the avatar helper failed (" + cmd +
+                             "); set SOFTDECA_PYTHON to the project's .venv/bin/python and PYTHONPATH to training/");
+}
+
+double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+}  // namespace softdeca::cli

@@ -1,0 +1,60 @@
+// What the runtime sub-commands share: C ABI handles with RAII, status checks that throw with
+// the library's message, and the avatar folder layout the replay tools read:
+//   <dir>/neutral.obj                 the avatar's neutral head in template topology
+//   <dir>/blendshapes/<name>.obj      its ARKit shapes as full meshes (missing: does not move)
+//   <dir>/user_face/neutral.obj       optional: an ARKit face mesh (1220 vertices) and its
+//   <dir>/user_face/blendshapes/*.obj shapes, whose blend stands in for a phone's tracked face
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mesh_io.h"
+#include "softdeca/softdeca.h"
+
+namespace softdeca::cli {
+
+// Throws std::runtime_error("<what>: <status>: <softdeca_last_error()>") unless OK.
+void check(softdeca_status status, const std::string& what);
+
+struct Model {
+  softdeca_model* handle = nullptr;
+  softdeca_model_info info{};
+  explicit Model(const std::string& bundle, unsigned prepare_threads = 1);
+  ~Model() { softdeca_model_destroy(handle); }
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
+  int parameter(const std::string& name) const;
+};
+
+struct Avatar {
+  softdeca_avatar* handle = nullptr;
+  Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads, unsigned precision);
+  ~Avatar() { softdeca_avatar_destroy(handle); }
+  Avatar(const Avatar&) = delete;
+  Avatar& operator=(const Avatar&) = delete;
+  softdeca_stats stats() const;
+};
+
+struct FaceRig {  // a neutral mesh and 52 blendshape deltas
+  ObjMesh neutral;
+  std::vector<float> deltas;  // 52 x V x 3, zeros for missing shapes
+  std::size_t present = 0;
+  bool empty() const { return neutral.vertices.empty(); }
+  void blend(const float* weights, float* out) const;
+};
+
+// Reads <dir>/neutral.obj and <dir>/blendshapes/*.obj; with `optional`, a missing folder gives
+// an empty rig instead of an error.
+FaceRig read_rig(const std::string& dir, bool optional = false);
+
+// Writes the avatar of an ICT identity into `dir` with the training package's helper
+// (`python -m softdeca_train avatar`, python from $SOFTDECA_PYTHON or python3).
+void write_identity_avatar(long seed, const std::string& dir);
+
+bool file_exists(const std::string& path);
+void make_directories(const std::string& path);
+double median(std::vector<double> v);
+double percentile(std::vector<double> v, double q);
+
+}  // namespace softdeca::cli

@@ -1,0 +1,499 @@
+#include "runtime/avatar.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "api/error.h"
+
+namespace softdeca::runtime {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+
+constexpr int kSoftDeca = 0, kSparse = 1;
+constexpr float kWeightSlack = 0.01f;  // weights may overshoot [0, 1] by this much (clamped)
+
+std::vector<float> run_identity_encoder(const Model& model, const float* skin, std::size_t vs) {
+  std::vector<float> h(static_cast<std::size_t>(model.manifest().identity));
+  model.identity_encoder().run({skin}, {h.data()}, 1);
+  (void)vs;
+  for (std::size_t i = 0; i < h.size(); ++i)
+    if (!std::isfinite(h[i])) throw Error(SOFTDECA_ERROR_NON_FINITE, "the identity encoder produced a non-finite code");
+  return h;
+}
+
+bool all_finite(const float* v, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(v[i])) return false;
+  return true;
+}
+}  // namespace
+
+std::size_t Preparation::bytes() const {
+  return face_l.bytes() + vertex_l.bytes() + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4;
+}
+
+class Avatar::FrameGuard {
+ public:
+  explicit FrameGuard(std::atomic<bool>& busy) : busy_(busy) {
+    if (busy_.exchange(true, std::memory_order_acquire))
+      throw Error(SOFTDECA_ERROR_BUSY, "the avatar is in use by a frame on another thread (one frame thread at a time)");
+  }
+  ~FrameGuard() { busy_.store(false, std::memory_order_release); }
+  FrameGuard(const FrameGuard&) = delete;
+  FrameGuard& operator=(const FrameGuard&) = delete;
+
+ private:
+  std::atomic<bool>& busy_;
+};
+
+Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
+    : model_(std::move(model)),
+      m_(model_->manifest()),
+      vh_(static_cast<std::size_t>(m_.head_vertices)),
+      vs_(static_cast<std::size_t>(m_.skin_vertices)),
+      nf_(static_cast<std::size_t>(m_.skin_triangles)),
+      precision_(d.precision),
+      neutral_(d.neutral, d.neutral + vh_ * 3),
+      triangles_(d.triangles, d.triangles + d.triangle_count * 3),
+      geometry_(SkinGeometry::measure(neutral_.data(), vs_, model_->skin_triangles())),
+      blendshapes_(d.blendshapes ? Blendshapes(d.blendshapes, d.blendshape_count, vh_, d.threads) : Blendshapes()),
+      worker_(d.threads),
+      params_(m_, model_->skin_triangles(), geometry_.face_area),
+      weights_(kBlendshapeCount),
+      z_(static_cast<std::size_t>(m_.latent)),
+      offsets_(3 * m_.landmarks.size()),
+      head_(vh_ * 3),
+      static_(vs_ * 3),
+      solve_work_(vs_ * 4),
+      dynamics_(vs_),
+      normals_(triangles_, vh_) {
+  for (std::size_t p = 0; p < worker_.parts(); ++p) {
+    rhs_.emplace_back(vs_ * 3);
+    rhs_parts_.push_back(rhs_.back().data());
+  }
+  // Landmarks on the avatar's neutral skin.
+  const auto& tri = model_->skin_triangles();
+  for (const LandmarkSpec& l : m_.landmarks) {
+    landmark_arkit_.push_back(l.arkit_vertex);
+    for (int c = 0; c < 3; ++c) {
+      double p = 0;
+      for (int k = 0; k < 3; ++k)
+        p += l.bary[k] * neutral_[3 * static_cast<std::size_t>(tri[3 * static_cast<std::size_t>(l.triangle) + static_cast<std::size_t>(k)]) +
+                                 static_cast<std::size_t>(c)];
+      neutral_landmarks_.push_back(p);
+    }
+  }
+  const auto& bones = model_->non_skin_bones();
+  for (std::size_t i = 0; i < bones.size(); ++i)
+    (bones[i] ? jaw_vertices_ : cranium_vertices_).push_back(static_cast<int>(vs_ + i));
+  identity_ = run_identity_encoder(*model_, neutral_.data(), vs_);
+  if (model_->has(false)) f_w_ = model_->encoder(false)->bind({weights_.data()}, {z_.data()}, 1);
+  if (model_->has(true)) f_l_ = model_->encoder(true)->bind({offsets_.data()}, {z_.data()}, 1);
+  stats_.threads = worker_.parts();
+}
+
+Avatar::~Avatar() = default;
+
+// ---- parameters and identity ------------------------------------------------------------------
+
+void Avatar::set_parameter(int index, double value) {
+  std::lock_guard<std::mutex> lock(params_mutex_);
+  params_.set_global(index, value);
+}
+
+void Avatar::set_parameter_faces(int index, const float* values, std::size_t count) {
+  std::lock_guard<std::mutex> lock(params_mutex_);
+  params_.set_faces(index, values, count);
+}
+
+void Avatar::set_parameter_vertices(int index, const float* values, std::size_t count) {
+  std::lock_guard<std::mutex> lock(params_mutex_);
+  params_.set_vertices(index, values, count);
+}
+
+void Avatar::reset_parameters() {
+  std::lock_guard<std::mutex> lock(params_mutex_);
+  params_.reset();
+}
+
+void Avatar::get_parameter(int index, float* value, std::uint32_t* localised) const {
+  std::lock_guard<std::mutex> lock(params_mutex_);
+  require(index >= 0 && static_cast<std::size_t>(index) < m_.parameters.size(), "parameter index out of range");
+  if (value) *value = static_cast<float>(params_.global(index));
+  if (localised) *localised = params_.kind(index) == ParameterState::Kind::Global ? 0u : 1u;
+}
+
+void Avatar::set_identity(const float* values, std::size_t count) {
+  require_not_null(values, "identity");
+  require(count == static_cast<std::size_t>(m_.identity), "identity has " + std::to_string(count) +
+                                                              " values, the bundle's identity size is " +
+                                                              std::to_string(m_.identity));
+  require_finite(values, count, "identity");
+  std::lock_guard<std::mutex> lock(params_mutex_);
+  identity_.assign(values, values + count);
+}
+
+void Avatar::get_identity(float* out, std::size_t capacity) const {
+  require_not_null(out, "out_identity");
+  require(capacity >= static_cast<std::size_t>(m_.identity),
+          "capacity " + std::to_string(capacity) + " is below the identity size " + std::to_string(m_.identity),
+          SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+  std::lock_guard<std::mutex> lock(params_mutex_);
+  std::copy(identity_.begin(), identity_.end(), out);
+}
+
+// ---- prepare ---------------------------------------------------------------------------------
+
+void Avatar::prepare() {
+  std::lock_guard<std::mutex> prepare_lock(prepare_mutex_);
+  const auto t0 = Clock::now();
+  std::vector<float> identity;
+  std::unique_ptr<ParameterState> params;
+  {
+    std::lock_guard<std::mutex> lock(params_mutex_);
+    params = std::make_unique<ParameterState>(params_);
+    identity = identity_;
+  }
+  double factorisation_ms = 0;
+  if (!dt_ && model_->has(false)) {
+    const auto f0 = Clock::now();
+    dt_ = std::make_shared<const DeformationTransfer>(geometry_, vs_, model_->skin_triangles(), m_.dt_regularisation,
+                                                      worker_.parts());
+    factorisation_ms = ms(f0, Clock::now());
+  }
+  auto prep = std::make_shared<Preparation>();
+  prep->dt = dt_;
+  prep->identity = identity;
+  const auto n0 = Clock::now();
+  const std::size_t latent = static_cast<std::size_t>(m_.latent);
+  for (const int model : {kSoftDeca, kSparse}) {
+    const bool sparse = model == kSparse;
+    if (!model_->has(sparse)) continue;
+    // Hyper-tensor: per face (SoftDECA) or per vertex (sparse).
+    const OnnxNetwork& hyper = *model_->hyper(sparse);
+    const auto& cols = hyper.spec().parameter_columns;
+    const std::size_t n = sparse ? vs_ : nf_, width = sparse ? 3 : 9;
+    std::vector<float> p(n * cols.size()), l(n * latent * width);
+    if (sparse) params->vertex_matrix(cols, p.data());
+    else params->face_matrix(cols, p.data());
+    hyper.run({p.data(), identity.data()}, {l.data()}, 1);
+    if (!all_finite(l.data(), l.size()))
+      throw Error(SOFTDECA_ERROR_FORMAT, hyper.spec().key + " produced non-finite values for these parameters");
+    HyperTensor tensor(l.data(), n, m_.latent, static_cast<int>(width), precision_);
+    (sparse ? prep->vertex_l : prep->face_l) = std::move(tensor);
+    // Dynamics coefficients per skin vertex.
+    const OnnxNetwork& dyn = *model_->dynamics(sparse);
+    const auto& dcols = dyn.spec().parameter_columns;
+    std::vector<float> pv(vs_ * dcols.size());
+    params->vertex_matrix(dcols, pv.data());
+    DynamicsCoefficients& c = prep->dynamics[model];
+    c.alpha.resize(vs_);
+    c.beta.resize(vs_);
+    c.gamma.resize(vs_);
+    dyn.run({pv.data(), identity.data()}, {c.alpha.data(), c.beta.data(), c.gamma.data()}, 1);
+    c.check(m_, dyn.spec().key.c_str());
+  }
+  const double networks_ms = ms(n0, Clock::now());
+  {
+    std::lock_guard<std::mutex> lock(current_mutex_);
+    prep->generation = ++generation_;
+    current_ = std::move(prep);
+  }
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  stats_.preparations += 1;
+  stats_.prepare_ms = ms(t0, Clock::now());
+  stats_.prepare_networks_ms = networks_ms;
+  if (factorisation_ms > 0) stats_.factorisation_ms = factorisation_ms;
+}
+
+std::shared_ptr<const Preparation> Avatar::current() const {
+  std::lock_guard<std::mutex> lock(current_mutex_);
+  return current_;
+}
+
+// ---- frames ----------------------------------------------------------------------------------
+
+void Avatar::check_output(const Output& out) const {
+  require_not_null(out.vertices, "output.vertices");
+  expect(out.vertex_capacity >= vh_, [&] {
+    return "output.vertex_capacity " + std::to_string(out.vertex_capacity) + " is below the head's " + std::to_string(vh_) +
+           " vertices";
+  }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+  if (out.normals)
+    expect(out.normal_capacity >= vh_, [&] {
+      return "output.normal_capacity " + std::to_string(out.normal_capacity) + " is below the head's " + std::to_string(vh_) +
+             " vertices";
+    }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+}
+
+void Avatar::read_weights(const float* weights, std::size_t count) {
+  require_not_null(weights, "weights");
+  expect(count == kBlendshapeCount,
+         [&] { return "expected 52 blendshape weights (canonical ARKit order), got " + std::to_string(count); });
+  require_finite(weights, count, "weights");
+  for (std::size_t i = 0; i < count; ++i) {
+    expect(weights[i] >= -kWeightSlack && weights[i] <= 1 + kWeightSlack, [&] {
+      return "weights[" + std::to_string(i) + "] (" + kArkitBlendshapes[i] + ") = " + std::to_string(weights[i]) +
+             " is outside [0, 1]";
+    });
+    weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
+  }
+}
+
+void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
+  auto t = Clock::now();
+  model_->encoder(false)->run(f_w_);
+  auto t1 = Clock::now();
+  st.encoder_ms = ms(t, t1);
+  const std::size_t blocks = prep.face_l.blocks();
+  auto pass = [&](std::size_t part, std::size_t n_parts) {
+    float* rhs = rhs_[part].data();
+    std::memset(rhs, 0, vs_ * 3 * sizeof(float));
+    dg_rhs(prep.face_l, prep.dt->faces(), z_.data(), head_.data(), blocks * part / n_parts, blocks * (part + 1) / n_parts,
+           rhs);
+  };
+  worker_.run(pass);
+  auto t2 = Clock::now();
+  st.hyper_ms = ms(t1, t2);
+  for (int phase = 0; phase < DeformationTransfer::kPhases; ++phase) {
+    auto solve = [&](std::size_t part, std::size_t n_parts) {
+      (void)n_parts;
+      prep.dt->solve_phase(phase, part, rhs_parts_.data(), rhs_parts_.size(), head_.data(), solve_work_.data(),
+                           static_.data());
+    };
+    worker_.run(solve);
+  }
+  st.solve_ms = ms(t2, Clock::now());
+}
+
+void Avatar::write_rigid_non_skin(const float* skin, float* head) const {
+  for (const int v : cranium_vertices_) std::memcpy(head + 3 * v, neutral_.data() + 3 * v, 3 * sizeof(float));
+  if (jaw_vertices_.empty()) return;
+  const Similarity r = fit_similarity(neutral_.data(), m_.jaw_anchors.data(), skin, m_.jaw_anchors.data(),
+                                      m_.jaw_anchors.size(), false);
+  for (const int v : jaw_vertices_) {
+    const float* n = neutral_.data() + 3 * v;
+    for (int i = 0; i < 3; ++i)
+      head[3 * v + i] = static_cast<float>(r.rotation[3 * i] * n[0] + r.rotation[3 * i + 1] * n[1] + r.rotation[3 * i + 2] * n[2] +
+                                           r.translation[i]);
+  }
+}
+
+void Avatar::compute_normals(const float* head, float* normals) {
+  auto faces = [&](std::size_t part, std::size_t parts) { normals_.faces(head, part, parts); };
+  worker_.run(faces);
+  auto vertices = [&](std::size_t part, std::size_t parts) { normals_.vertices(normals, part, parts); };
+  worker_.run(vertices);
+}
+
+void Avatar::finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
+                    AvatarStats& st) {
+  auto t = Clock::now();
+  if (reset_requested_.exchange(false)) dynamics_.invalidate();
+  const float* result = skin;
+  if (dynamics_enabled_.load()) {
+    const DynamicsCoefficients& c = prep.dynamics[model];
+    auto pass = [&](std::size_t part, std::size_t parts) {
+      dynamics_.step(c, model, skin, vs_ * part / parts, vs_ * (part + 1) / parts);
+    };
+    worker_.run(pass);
+    result = dynamics_.next();
+  }
+  if (!all_finite(result, vs_ * 3))
+    throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
+  if (dynamics_enabled_.load()) dynamics_.commit(model);
+  else dynamics_.invalidate();
+  auto t1 = Clock::now();
+  st.dynamics_ms = ms(t, t1);
+  float* head = out.vertices;
+  std::memcpy(head, result, vs_ * 3 * sizeof(float));
+  if (non_skin) std::memcpy(head + vs_ * 3, non_skin, (vh_ - vs_) * 3 * sizeof(float));
+  else write_rigid_non_skin(result, head);
+  auto t2 = Clock::now();
+  st.output_ms = ms(t1, t2);
+  if (out.normals) compute_normals(head, out.normals);
+  st.normals_ms = ms(t2, Clock::now());
+  st.generation = prep.generation;
+}
+
+namespace {
+void require_model(const Model& m, bool sparse) {
+  expect(m.has(sparse), [&] { return std::string("the bundle has no ") + (sparse ? "SparseSoftDECA" : "SoftDECA") + " model"; });
+}
+std::shared_ptr<const Preparation> require_prepared(std::shared_ptr<const Preparation> p) {
+  if (!p) throw Error(SOFTDECA_ERROR_NOT_READY, "the avatar is not prepared yet: call softdeca_avatar_prepare first");
+  return p;
+}
+}  // namespace
+
+void Avatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
+  FrameGuard guard(busy_);
+  const auto t0 = Clock::now();
+  require_model(*model_, false);
+  check_output(out);
+  expect(!blendshapes_.empty(),
+         [] { return std::string("the avatar was created without blendshapes: use softdeca_avatar_evaluate_surface"); });
+  read_weights(weights, count);
+  const auto prep = require_prepared(current());
+  AvatarStats st;
+  auto blend = [&](std::size_t part, std::size_t) { blendshapes_.blend(weights_.data(), neutral_.data(), head_.data(), part); };
+  worker_.run(blend);
+  st.blend_ms = ms(t0, Clock::now());
+  softdeca_frame(*prep, st);
+  finish(*prep, kSoftDeca, static_.data(), head_.data() + vs_ * 3, out, st);
+  st.frame_ms = ms(t0, Clock::now());
+  record(st);
+}
+
+void Avatar::evaluate_surface(const float* weights, std::size_t count, const float* surface, std::size_t vertices,
+                              const Output& out) {
+  FrameGuard guard(busy_);
+  const auto t0 = Clock::now();
+  require_model(*model_, false);
+  check_output(out);
+  read_weights(weights, count);
+  require_not_null(surface, "surface");
+  expect(vertices == vs_ || vertices == vh_, [&] {
+    return "surface has " + std::to_string(vertices) + " vertices; expected the skin's " + std::to_string(vs_) +
+           " or the head's " + std::to_string(vh_);
+  });
+  require_finite(surface, vertices * 3, "surface");
+  const auto prep = require_prepared(current());
+  std::memcpy(head_.data(), surface, vertices * 3 * sizeof(float));
+  AvatarStats st;
+  st.blend_ms = ms(t0, Clock::now());
+  softdeca_frame(*prep, st);
+  finish(*prep, kSoftDeca, static_.data(), vertices == vh_ ? head_.data() + vs_ * 3 : nullptr, out, st);
+  st.frame_ms = ms(t0, Clock::now());
+  record(st);
+}
+
+const float* Avatar::select_landmarks(const float* points, std::size_t count, const char* what) const {
+  require_not_null(points, what);
+  const std::size_t k = m_.landmarks.size(), a = static_cast<std::size_t>(m_.arkit_vertex_count);
+  expect(count == k || count == a, [&] {
+    return std::string(what) + " has " + std::to_string(count) + " points; expected the " + std::to_string(k) +
+           " landmarks or the " + std::to_string(a) + " vertices of ARKit's face mesh";
+  });
+  require_finite(points, count * 3, what);
+  return points;
+}
+
+void Avatar::calibrate_landmarks(const float* points, std::size_t count) {
+  FrameGuard guard(busy_);
+  select_landmarks(points, count, "points");
+  const std::size_t k = m_.landmarks.size();
+  const bool full = count != k;
+  std::vector<double> user(3 * k);
+  for (std::size_t i = 0; i < k; ++i)
+    for (int c = 0; c < 3; ++c)
+      user[3 * i + c] = points[3 * (full ? static_cast<std::size_t>(landmark_arkit_[i]) : i) + static_cast<std::size_t>(c)];
+  double centroid[3] = {0, 0, 0}, spread = 0;
+  for (std::size_t i = 0; i < k; ++i)
+    for (int c = 0; c < 3; ++c) centroid[c] += user[3 * i + static_cast<std::size_t>(c)] / static_cast<double>(k);
+  for (std::size_t i = 0; i < k; ++i)
+    for (int c = 0; c < 3; ++c) spread += std::pow(user[3 * i + static_cast<std::size_t>(c)] - centroid[c], 2) / static_cast<double>(k);
+  require(spread > 1e-6, "the calibration landmarks are degenerate (they span less than a millimetre)");
+  const Similarity s = fit_similarity(user.data(), neutral_landmarks_.data(), k, true);
+  require(std::isfinite(s.scale) && s.scale > 0, "the calibration landmarks give no usable similarity");
+  user_neutral_ = std::move(user);
+  calibration_ = s;
+  calibrated_ = true;
+}
+
+void Avatar::clear_calibration() {
+  FrameGuard guard(busy_);
+  calibrated_ = false;
+}
+
+void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Output& out) {
+  FrameGuard guard(busy_);
+  const auto t0 = Clock::now();
+  require_model(*model_, true);
+  check_output(out);
+  select_landmarks(points, count, "points");
+  const auto prep = require_prepared(current());
+  AvatarStats st;
+  // Retarget: offsets from the user's neutral mapped by the calibration similarity, or (not
+  // calibrated) the points taken as the avatar's own landmarks.
+  const std::size_t k = m_.landmarks.size();
+  const bool full = count != k;
+  for (std::size_t i = 0; i < k; ++i) {
+    const float* p = points + 3 * (full ? static_cast<std::size_t>(landmark_arkit_[i]) : i);
+    double d[3];
+    for (int c = 0; c < 3; ++c)
+      d[c] = calibrated_ ? p[c] - user_neutral_[3 * i + static_cast<std::size_t>(c)]
+                         : p[c] - neutral_landmarks_[3 * i + static_cast<std::size_t>(c)];
+    for (int c = 0; c < 3; ++c) {
+      double o = d[c];
+      if (calibrated_)
+        o = calibration_.scale * (calibration_.rotation[3 * c] * d[0] + calibration_.rotation[3 * c + 1] * d[1] +
+                                  calibration_.rotation[3 * c + 2] * d[2]);
+      offsets_[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(o);
+    }
+  }
+  auto t1 = Clock::now();
+  model_->encoder(true)->run(f_l_);
+  auto t2 = Clock::now();
+  st.encoder_ms = ms(t1, t2);
+  const std::size_t blocks = prep->vertex_l.blocks();
+  auto pass = [&](std::size_t part, std::size_t parts) {
+    vertex_offsets(prep->vertex_l, z_.data(), neutral_.data(), blocks * part / parts, blocks * (part + 1) / parts,
+                   static_.data());
+  };
+  worker_.run(pass);
+  st.hyper_ms = ms(t2, Clock::now());
+  finish(*prep, kSparse, static_.data(), nullptr, out, st);
+  st.frame_ms = ms(t0, Clock::now());
+  record(st);
+}
+
+void Avatar::evaluate_linear(const float* weights, std::size_t count, const Output& out) {
+  FrameGuard guard(busy_);
+  const auto t0 = Clock::now();
+  check_output(out);
+  expect(!blendshapes_.empty(), [] { return std::string("the avatar was created without blendshapes"); });
+  read_weights(weights, count);
+  AvatarStats st;
+  auto blend = [&](std::size_t part, std::size_t) { blendshapes_.blend(weights_.data(), neutral_.data(), out.vertices, part); };
+  worker_.run(blend);
+  const auto t1 = Clock::now();
+  st.blend_ms = ms(t0, t1);
+  if (out.normals) compute_normals(out.vertices, out.normals);
+  st.normals_ms = ms(t1, Clock::now());
+  st.frame_ms = ms(t0, Clock::now());
+  record(st);
+}
+
+void Avatar::record(AvatarStats st) {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  st.frames = stats_.frames + 1;
+  st.preparations = stats_.preparations;
+  st.threads = stats_.threads;
+  if (st.generation == 0) st.generation = stats_.generation;
+  st.prepare_ms = stats_.prepare_ms;
+  st.prepare_networks_ms = stats_.prepare_networks_ms;
+  st.factorisation_ms = stats_.factorisation_ms;
+  stats_ = st;
+}
+
+AvatarStats Avatar::stats() const {
+  AvatarStats s;
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    s = stats_;
+  }
+  std::size_t bytes = neutral_.size() * 4 + triangles_.size() * 4 + blendshapes_.bytes() + normals_.bytes() +
+                      dynamics_.bytes() + head_.bytes() + static_.bytes() + rhs_.size() * rhs_[0].bytes() +
+                      solve_work_.bytes() + geometry_.face_area.size() * 8 * 5;
+  if (const auto p = current()) bytes += p->bytes() + (p->dt ? p->dt->bytes() : 0);
+  s.memory_bytes = bytes;
+  return s;
+}
+
+}  // namespace softdeca::runtime

@@ -1,0 +1,155 @@
+// One avatar: the host's head (neutral, triangles, optional 52 blendshapes), its identity code,
+// material parameters, the current preparation and the per-frame state and buffers.
+//
+// Threads: evaluate_*, calibrate_landmarks run on one frame thread at a time (a second thread
+// gets Error(BUSY)); prepare, parameter and identity setters, set/reset dynamics and stats may
+// run on any thread, also while a frame runs. prepare builds a new Preparation and publishes it
+// atomically; a frame takes the current one at its start and uses only it, so an output is never
+// a mix of two preparations.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "runtime/aligned.h"
+#include "runtime/blendshapes.h"
+#include "runtime/deformation_transfer.h"
+#include "runtime/dynamics.h"
+#include "runtime/hypertensor.h"
+#include "runtime/model.h"
+#include "runtime/normals.h"
+#include "runtime/onnx_network.h"
+#include "runtime/parameters.h"
+#include "runtime/rigid.h"
+#include "runtime/worker.h"
+
+namespace softdeca::runtime {
+
+struct AvatarDesc {
+  const float* neutral = nullptr;  // head_vertices x 3
+  std::size_t vertex_count = 0;
+  const std::int32_t* triangles = nullptr;  // the host's triangles over the whole head
+  std::size_t triangle_count = 0;
+  const float* blendshapes = nullptr;  // 52 x head_vertices x 3 deltas, or null
+  std::size_t blendshape_count = 0;
+  std::size_t threads = 1;
+  Precision precision = Precision::Half;
+};
+
+struct Output {
+  float* vertices = nullptr;
+  std::size_t vertex_capacity = 0;  // vertices (3 floats each)
+  float* normals = nullptr;         // may be null
+  std::size_t normal_capacity = 0;
+};
+
+struct AvatarStats {
+  std::size_t threads = 1;
+  std::uint64_t frames = 0, preparations = 0, generation = 0;
+  double frame_ms = 0, encoder_ms = 0, blend_ms = 0, hyper_ms = 0, solve_ms = 0, dynamics_ms = 0, output_ms = 0,
+         normals_ms = 0;
+  double prepare_ms = 0, prepare_networks_ms = 0, factorisation_ms = 0;
+  std::uint64_t memory_bytes = 0;
+};
+
+// Everything a frame needs that prepare computes; immutable once published.
+struct Preparation {
+  std::uint64_t generation = 0;
+  std::shared_ptr<const DeformationTransfer> dt;
+  std::vector<float> identity;
+  HyperTensor face_l, vertex_l;       // SoftDECA: [F][latent][9]; sparse: [Vs][latent][3]
+  DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
+  std::size_t bytes() const;
+};
+
+class Avatar {
+ public:
+  Avatar(std::shared_ptr<const Model> model, const AvatarDesc& desc);
+  ~Avatar();
+
+  const Model& model() const { return *model_; }
+
+  void set_parameter(int index, double value);
+  void set_parameter_faces(int index, const float* values, std::size_t count);
+  void set_parameter_vertices(int index, const float* values, std::size_t count);
+  void reset_parameters();
+  void get_parameter(int index, float* value, std::uint32_t* localised) const;
+  void set_identity(const float* values, std::size_t count);
+  void get_identity(float* out, std::size_t capacity) const;
+
+  void prepare();
+
+  void evaluate_weights(const float* weights, std::size_t count, const Output& out);
+  void evaluate_surface(const float* weights, std::size_t count, const float* surface, std::size_t vertices,
+                        const Output& out);
+  void evaluate_landmarks(const float* points, std::size_t count, const Output& out);
+  void evaluate_linear(const float* weights, std::size_t count, const Output& out);
+  void calibrate_landmarks(const float* points, std::size_t count);
+  void clear_calibration();
+
+  void set_dynamics(bool enabled) { dynamics_enabled_.store(enabled); }
+  void reset_dynamics() { reset_requested_.store(true); }
+
+  AvatarStats stats() const;
+
+ private:
+  class FrameGuard;
+  std::shared_ptr<const Preparation> current() const;
+  void check_output(const Output& out) const;
+  void read_weights(const float* weights, std::size_t count);
+  const float* select_landmarks(const float* points, std::size_t count, const char* what) const;
+  // The shared tail of a frame: dynamics, checks, output of the head and normals.
+  void finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
+              AvatarStats& st);
+  void softdeca_frame(const Preparation& prep, AvatarStats& st);
+  void write_rigid_non_skin(const float* skin, float* head) const;
+  void compute_normals(const float* head, float* normals);
+  void record(AvatarStats st);  // a frame's timings, keeping the counters
+
+  std::shared_ptr<const Model> model_;
+  const Manifest& m_;
+  std::size_t vh_, vs_, nf_;
+  Precision precision_;
+  std::vector<float> neutral_;  // Vh x 3
+  std::vector<std::int32_t> triangles_;
+  SkinGeometry geometry_;
+  std::vector<double> neutral_landmarks_;  // K x 3, on the avatar's neutral skin
+  std::vector<int> landmark_arkit_;        // K ARKit vertex indices
+  std::vector<int> jaw_vertices_, cranium_vertices_;
+  Blendshapes blendshapes_;
+  Worker worker_;
+
+  // Staged inputs of prepare (any thread).
+  mutable std::mutex params_mutex_;
+  ParameterState params_;
+  std::vector<float> identity_;
+
+  std::mutex prepare_mutex_;
+  std::shared_ptr<const DeformationTransfer> dt_;  // built by the first prepare
+  std::uint64_t generation_ = 0;
+  mutable std::mutex current_mutex_;
+  std::shared_ptr<const Preparation> current_;
+
+  // Frame-thread state.
+  std::atomic<bool> busy_{false};
+  std::atomic<bool> dynamics_enabled_{false}, reset_requested_{false};
+  AlignedArray<float> weights_, z_, offsets_, head_, static_;
+  std::vector<AlignedArray<float>> rhs_;  // one right-hand side per thread
+  std::vector<const float*> rhs_parts_;
+  AlignedArray<double> solve_work_;
+  OnnxNetwork::Binding f_w_, f_l_;
+  DynamicsState dynamics_;
+  Normals normals_;
+  bool calibrated_ = false;
+  Similarity calibration_;
+  std::vector<double> user_neutral_;  // K x 3
+
+  mutable std::mutex stats_mutex_;
+  AvatarStats stats_;
+};
+
+}  // namespace softdeca::runtime

@@ -1,0 +1,42 @@
+// The avatar's 52 linear blendshapes S_t = neutral + sum_i w_i B_i (paper eq. 7), stored as
+// runs of consecutive vertices that a shape moves (gaps of up to kMaxGap unmoved vertices are
+// kept as zeros): a frame reads only what shapes move, each run is a contiguous axpy that
+// vectorises, and runs split at part boundaries so threads never write the same vertex.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace softdeca::runtime {
+
+class Blendshapes {
+ public:
+  static constexpr std::size_t kMaxGap = 4;
+
+  Blendshapes() = default;
+  // `deltas`: n_shapes x n_vertices x 3, shape-major. `parts`: how many vertex ranges frames
+  // are split into (threads).
+  Blendshapes(const float* deltas, std::size_t n_shapes, std::size_t n_vertices, std::size_t parts);
+
+  bool empty() const { return shapes_.empty(); }
+  std::size_t bytes() const;
+  std::size_t stored_vertices() const;  // vertices stored over all shapes (zeros in gaps included)
+
+  // out[v] = neutral[v] + sum_i w_i B_i[v] for the vertices of range `part`.
+  void blend(const float* weights, const float* neutral, float* out, std::size_t part) const;
+
+ private:
+  struct Run {
+    std::uint32_t first_vertex, count, offset;  // offset: first float in Shape::delta
+  };
+  struct Shape {
+    std::vector<Run> runs;
+    std::vector<float> delta;
+    std::vector<std::size_t> part_begin;  // first run of each part, plus the end
+  };
+  std::vector<Shape> shapes_;
+  std::vector<std::size_t> part_vertex_;  // vertex range bounds, parts + 1
+};
+
+}  // namespace softdeca::runtime

@@ -1,0 +1,288 @@
+#include "runtime/hypertensor.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "runtime/half.h"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define SOFTDECA_X86 1
+#endif
+
+namespace softdeca::runtime {
+
+HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision)
+    : n_(n), latent_(latent), width_(width), precision_(precision) {
+  const std::size_t stride = block_stride(), total = blocks() * stride;
+  const auto source_at = [&](std::size_t e, int k, int c) {
+    return source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
+                  static_cast<std::size_t>(c)];
+  };
+  if (precision == Precision::Int8) {
+    // One scale per block and latent: the largest magnitude of its width x 8 values maps to 127.
+    int8_.resize(total);
+    scales_.resize(blocks() * static_cast<std::size_t>(latent));
+    for (std::size_t b = 0; b < blocks(); ++b)
+      for (int k = 0; k < latent; ++k) {
+        float peak = 0;
+        for (std::size_t e = b * kLanes; e < std::min(n, (b + 1) * kLanes); ++e)
+          for (int c = 0; c < width; ++c) peak = std::max(peak, std::fabs(source_at(e, k, c)));
+        const float scale = peak > 0 ? peak / 127.0f : 1.0f;
+        scales_[b * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)] = scale;
+        for (std::size_t e = b * kLanes; e < std::min(n, (b + 1) * kLanes); ++e)
+          for (int c = 0; c < width; ++c)
+            int8_[b * stride + (static_cast<std::size_t>(k) * width + c) * kLanes + e % kLanes] =
+                static_cast<std::int8_t>(std::lround(source_at(e, k, c) / scale));
+      }
+    return;
+  }
+  if (precision == Precision::Half) half_.resize(total);
+  else float_.resize(total);
+  for (std::size_t e = 0; e < n; ++e) {
+    const std::size_t b = e / kLanes, lane = e % kLanes;
+    for (int k = 0; k < latent; ++k)
+      for (int c = 0; c < width; ++c) {
+        const float v = source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
+                               static_cast<std::size_t>(c)];
+        const std::size_t at = b * stride + (static_cast<std::size_t>(k) * width + c) * kLanes + lane;
+        if (precision == Precision::Half) half_[at] = float_to_half(v);
+        else float_[at] = v;
+      }
+  }
+}
+
+float HyperTensor::at(std::size_t e, int k, int c) const {
+  const std::size_t i = (e / kLanes) * block_stride() + (static_cast<std::size_t>(k) * width_ + c) * kLanes + e % kLanes;
+  switch (precision_) {
+    case Precision::Half: return half_to_float(half_[i]);
+    case Precision::Float: return float_[i];
+    case Precision::Int8: return int8_[i] * scales_[(e / kLanes) * static_cast<std::size_t>(latent_) + static_cast<std::size_t>(k)];
+  }
+  return 0;
+}
+
+namespace {
+
+// Value of the stored tensor at flat index `at` of block b, latent k, in float.
+auto portable_load(const HyperTensor& L) {
+  return [&L](std::size_t b, int k, std::size_t at) -> float {
+    switch (L.precision()) {
+      case Precision::Half: return half_to_float(L.half_data()[at]);
+      case Precision::Float: return L.float_data()[at];
+      case Precision::Int8: return L.int8_data()[at] * L.scales()[b * static_cast<std::size_t>(L.latent()) + static_cast<std::size_t>(k)];
+    }
+    return 0.0f;
+  };
+}
+
+// ---- portable kernels -----------------------------------------------------------------------
+
+template <class Load>
+void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
+                     std::size_t b1, float* rhs, Load load) {
+  const int K = L.latent();
+  for (std::size_t b = b0; b < b1; ++b) {
+    float d[9][kLanes] = {};
+    const std::size_t base = b * L.block_stride();
+    for (int k = 0; k < K; ++k)
+      for (int c = 0; c < 9; ++c)
+        for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += z[k] * load(b, k, base + (static_cast<std::size_t>(k) * 9 + c) * kLanes + l);
+    const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
+    const float* cf = faces.coeff.data() + b * 3 * kLanes;
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      const std::size_t i = static_cast<std::size_t>(idx[l]) * 3, j = static_cast<std::size_t>(idx[kLanes + l]) * 3,
+                        kk = static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
+      float e1[3], e2[3];
+      for (int c = 0; c < 3; ++c) {
+        e1[c] = skin[j + c] - skin[i + c];
+        e2[c] = skin[kk + c] - skin[i + c];
+      }
+      const float c00 = cf[l], c01 = cf[kLanes + l], c11 = cf[2 * kLanes + l];
+      for (int r = 0; r < 3; ++r) {
+        const float p0 = d[3 * r][l] * e1[0] + d[3 * r + 1][l] * e1[1] + d[3 * r + 2][l] * e1[2];
+        const float p1 = d[3 * r][l] * e2[0] + d[3 * r + 1][l] * e2[1] + d[3 * r + 2][l] * e2[2];
+        const float col0 = p0 * c00 + p1 * c01, col1 = p0 * c01 + p1 * c11;
+        rhs[j + r] += col0;
+        rhs[kk + r] += col1;
+        rhs[i + r] -= col0 + col1;
+      }
+    }
+  }
+}
+
+template <class Load>
+void vertex_offsets_portable(const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0, std::size_t b1,
+                             float* out, Load load) {
+  const int K = L.latent();
+  for (std::size_t b = b0; b < b1; ++b) {
+    float acc[3][kLanes] = {};
+    const std::size_t base = b * L.block_stride();
+    for (int k = 0; k < K; ++k)
+      for (int c = 0; c < 3; ++c)
+        for (std::size_t l = 0; l < kLanes; ++l) acc[c][l] += z[k] * load(b, k, base + (static_cast<std::size_t>(k) * 3 + c) * kLanes + l);
+    const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
+    for (std::size_t l = 0; l < end; ++l)
+      for (int c = 0; c < 3; ++c) {
+        const std::size_t v = (b * kLanes + l) * 3 + static_cast<std::size_t>(c);
+        out[v] = base_pos[v] + acc[c][l];
+      }
+  }
+}
+
+#ifdef SOFTDECA_X86
+// ---- AVX2 + FMA + F16C kernels ----------------------------------------------------------------
+
+template <Precision P>
+__attribute__((target("avx2,fma,f16c"))) inline __m256 load8(const HyperTensor& L, std::size_t at) {
+  if constexpr (P == Precision::Half)
+    return _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(L.half_data() + at)));
+  else if constexpr (P == Precision::Int8)
+    return _mm256_cvtepi32_ps(_mm256_cvtepi8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(L.int8_data() + at))));
+  else
+    return _mm256_loadu_ps(L.float_data() + at);
+}
+
+// z_k, times the block's scale for int8 storage.
+template <Precision P>
+__attribute__((target("avx2,fma,f16c"))) inline __m256 coefficient(const HyperTensor& L, const float* z, std::size_t b, int k) {
+  if constexpr (P == Precision::Int8)
+    return _mm256_set1_ps(z[k] * L.scales()[b * static_cast<std::size_t>(L.latent()) + static_cast<std::size_t>(k)]);
+  else
+    return _mm256_set1_ps(z[k]);
+}
+
+template <Precision P>
+__attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, const FaceBlocks& faces, const float* z,
+                                                         const float* skin, std::size_t b0, std::size_t b1, float* rhs) {
+  const int K = L.latent();
+  const std::size_t stride = L.block_stride();
+  alignas(32) float col[6][kLanes];
+  for (std::size_t b = b0; b < b1; ++b) {
+    const std::size_t base = b * stride;
+    __m256 d0 = _mm256_setzero_ps(), d1 = d0, d2 = d0, d3 = d0, d4 = d0, d5 = d0, d6 = d0, d7 = d0, d8 = d0;
+    for (int k = 0; k < K; ++k) {
+      const __m256 zk = coefficient<P>(L, z, b, k);
+      const std::size_t at = base + static_cast<std::size_t>(k) * 9 * kLanes;
+      d0 = _mm256_fmadd_ps(zk, load8<P>(L, at), d0);
+      d1 = _mm256_fmadd_ps(zk, load8<P>(L, at + 8), d1);
+      d2 = _mm256_fmadd_ps(zk, load8<P>(L, at + 16), d2);
+      d3 = _mm256_fmadd_ps(zk, load8<P>(L, at + 24), d3);
+      d4 = _mm256_fmadd_ps(zk, load8<P>(L, at + 32), d4);
+      d5 = _mm256_fmadd_ps(zk, load8<P>(L, at + 40), d5);
+      d6 = _mm256_fmadd_ps(zk, load8<P>(L, at + 48), d6);
+      d7 = _mm256_fmadd_ps(zk, load8<P>(L, at + 56), d7);
+      d8 = _mm256_fmadd_ps(zk, load8<P>(L, at + 64), d8);
+    }
+    const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
+    // Edge vectors of the 8 faces, transposed to one lane per face (scalar loads: AVX2 gathers
+    // are slow on several CPUs and these vertices are in cache).
+    alignas(32) float edge[6][kLanes];
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      const float* si = skin + 3 * static_cast<std::size_t>(idx[l]);
+      const float* sj = skin + 3 * static_cast<std::size_t>(idx[kLanes + l]);
+      const float* sk = skin + 3 * static_cast<std::size_t>(idx[2 * kLanes + l]);
+      for (int c = 0; c < 3; ++c) {
+        edge[c][l] = sj[c] - si[c];
+        edge[3 + c][l] = sk[c] - si[c];
+      }
+    }
+    const __m256 e1[3] = {_mm256_load_ps(edge[0]), _mm256_load_ps(edge[1]), _mm256_load_ps(edge[2])};
+    const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
+    const float* cf = faces.coeff.data() + b * 3 * kLanes;
+    const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
+    const __m256 rows[3][3] = {{d0, d1, d2}, {d3, d4, d5}, {d6, d7, d8}};
+    for (int r = 0; r < 3; ++r) {
+      const __m256 p0 = _mm256_fmadd_ps(rows[r][2], e1[2], _mm256_fmadd_ps(rows[r][1], e1[1], _mm256_mul_ps(rows[r][0], e1[0])));
+      const __m256 p1 = _mm256_fmadd_ps(rows[r][2], e2[2], _mm256_fmadd_ps(rows[r][1], e2[1], _mm256_mul_ps(rows[r][0], e2[0])));
+      _mm256_store_ps(col[r], _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00)));
+      _mm256_store_ps(col[3 + r], _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01)));
+    }
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      float* ri = rhs + static_cast<std::size_t>(idx[l]) * 3;
+      float* rj = rhs + static_cast<std::size_t>(idx[kLanes + l]) * 3;
+      float* rk = rhs + static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
+      for (int r = 0; r < 3; ++r) {
+        rj[r] += col[r][l];
+        rk[r] += col[3 + r][l];
+        ri[r] -= col[r][l] + col[3 + r][l];
+      }
+    }
+  }
+}
+
+template <Precision P>
+__attribute__((target("avx2,fma,f16c"))) void vertex_offsets_avx2(const HyperTensor& L, const float* z, const float* base_pos,
+                                                                 std::size_t b0, std::size_t b1, float* out) {
+  const int K = L.latent();
+  const std::size_t stride = L.block_stride();
+  alignas(32) float acc[3][kLanes];
+  for (std::size_t b = b0; b < b1; ++b) {
+    const std::size_t base = b * stride;
+    __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0;
+    for (int k = 0; k < K; ++k) {
+      const __m256 zk = coefficient<P>(L, z, b, k);
+      const std::size_t at = base + static_cast<std::size_t>(k) * 3 * kLanes;
+      a0 = _mm256_fmadd_ps(zk, load8<P>(L, at), a0);
+      a1 = _mm256_fmadd_ps(zk, load8<P>(L, at + 8), a1);
+      a2 = _mm256_fmadd_ps(zk, load8<P>(L, at + 16), a2);
+    }
+    _mm256_store_ps(acc[0], a0);
+    _mm256_store_ps(acc[1], a1);
+    _mm256_store_ps(acc[2], a2);
+    const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
+    for (std::size_t l = 0; l < end; ++l) {
+      const std::size_t v = (b * kLanes + l) * 3;
+      out[v] = base_pos[v] + acc[0][l];
+      out[v + 1] = base_pos[v + 1] + acc[1][l];
+      out[v + 2] = base_pos[v + 2] + acc[2][l];
+    }
+  }
+}
+
+bool cpu_has_avx2() {
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+  return has;
+}
+#endif
+
+}  // namespace
+
+bool simd_kernels() {
+#ifdef SOFTDECA_X86
+  return cpu_has_avx2();
+#else
+  return false;
+#endif
+}
+
+void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0, std::size_t b1,
+            float* rhs) {
+#ifdef SOFTDECA_X86
+  if (cpu_has_avx2()) {
+    switch (L.precision()) {
+      case Precision::Half: dg_rhs_avx2<Precision::Half>(L, faces, z, skin, b0, b1, rhs); break;
+      case Precision::Float: dg_rhs_avx2<Precision::Float>(L, faces, z, skin, b0, b1, rhs); break;
+      case Precision::Int8: dg_rhs_avx2<Precision::Int8>(L, faces, z, skin, b0, b1, rhs); break;
+    }
+    return;
+  }
+#endif
+  dg_rhs_portable(L, faces, z, skin, b0, b1, rhs, portable_load(L));
+}
+
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out) {
+#ifdef SOFTDECA_X86
+  if (cpu_has_avx2()) {
+    switch (L.precision()) {
+      case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, b0, b1, out); break;
+      case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, b0, b1, out); break;
+      case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, b0, b1, out); break;
+    }
+    return;
+  }
+#endif
+  vertex_offsets_portable(L, z, base, b0, b1, out, portable_load(L));
+}
+
+}  // namespace softdeca::runtime

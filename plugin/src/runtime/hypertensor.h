@@ -1,0 +1,68 @@
+// The hyper-tensor L(p, h) (paper eq. 18, 25), stored for the per-frame product z . L: elements
+// (faces for SoftDECA, vertices for SparseSoftDECA) in blocks of 8, each block laid out
+// [latent][width][8 lanes] so one SIMD lane is one element and z_k is a broadcast. The product
+// is bound by the bytes it reads, so the storage is compact: binary16, or int8 with one scale
+// per block and latent (a quarter of float); the error each adds is measured (docs/runtime.md).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "runtime/aligned.h"
+
+namespace softdeca::runtime {
+
+enum class Precision { Half, Float, Int8 };
+constexpr std::size_t kLanes = 8;
+
+class HyperTensor {
+ public:
+  HyperTensor() = default;
+  // `source` is the network output, row-major [n][latent][width].
+  HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision);
+
+  bool empty() const { return n_ == 0; }
+  std::size_t elements() const { return n_; }
+  std::size_t blocks() const { return (n_ + kLanes - 1) / kLanes; }
+  int latent() const { return latent_; }
+  int width() const { return width_; }
+  Precision precision() const { return precision_; }
+  std::size_t block_stride() const { return static_cast<std::size_t>(latent_) * width_ * kLanes; }
+  const std::uint16_t* half_data() const { return half_.data(); }
+  const float* float_data() const { return float_.data(); }
+  const std::int8_t* int8_data() const { return int8_.data(); }
+  const float* scales() const { return scales_.data(); }  // Int8: [block][latent]
+  std::size_t bytes() const { return half_.bytes() + float_.bytes() + int8_.bytes() + scales_.bytes(); }
+  // Element e, latent k, component c (for tests and the error measurement).
+  float at(std::size_t e, int k, int c) const;
+
+ private:
+  std::size_t n_ = 0;
+  int latent_ = 0, width_ = 0;
+  Precision precision_ = Precision::Half;
+  AlignedArray<std::uint16_t> half_;
+  AlignedArray<float> float_;
+  AlignedArray<std::int8_t> int8_;
+  AlignedArray<float> scales_;
+};
+
+// What the deformation-transfer right-hand side needs per skin triangle, in the same blocks:
+// corners (i, j, k) and a_f W_f as (w00, w01, w11); padding lanes have zero coefficients.
+struct FaceBlocks {
+  std::size_t blocks = 0;
+  AlignedArray<std::int32_t> corners;  // [blocks][3][8]
+  AlignedArray<float> coeff;           // [blocks][3][8]
+};
+
+// rhs (V x 3, accumulated) += sum over the faces of blocks [b0, b1) of
+//   D_f a_f W_f ((G_f - I) E_f(S))^T   with   G_f - I = sum_k z_k L[f, k] (row-major 3x3).
+void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
+            std::size_t b1, float* rhs);
+
+// out[v] = base[v] + sum_k z_k L[v, k] for the vertices of blocks [b0, b1) (width-3 tensor).
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out);
+
+// Whether the AVX2/F16C kernels run on this CPU (else the portable ones).
+bool simd_kernels();
+
+}  // namespace softdeca::runtime

@@ -1,0 +1,44 @@
+// A small JSON reader for the bundle manifest (no third-party dependency in the plugin).
+// Numbers are doubles; objects keep their members in file order.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace softdeca::runtime {
+
+class Json {
+ public:
+  enum class Type { Null, Bool, Number, String, Array, Object };
+
+  // Throws softdeca::Error(SOFTDECA_ERROR_FORMAT) with the byte offset of the first problem.
+  static Json parse(const std::string& text);
+
+  Type type() const { return type_; }
+  bool is_null() const { return type_ == Type::Null; }
+  bool is_number() const { return type_ == Type::Number; }
+  bool is_string() const { return type_ == Type::String; }
+  bool is_array() const { return type_ == Type::Array; }
+  bool is_object() const { return type_ == Type::Object; }
+
+  // Typed access; `what` names the value in error messages (e.g. "manifest.template").
+  double number(const std::string& what) const;
+  long long integer(const std::string& what) const;  // a number with no fractional part
+  bool boolean(const std::string& what) const;
+  const std::string& string(const std::string& what) const;
+  const std::vector<Json>& array(const std::string& what) const;
+  bool has(const std::string& key) const;
+  // The member `key` of an object; throws when absent.
+  const Json& at(const std::string& key, const std::string& what) const;
+
+ private:
+  Type type_ = Type::Null;
+  bool bool_ = false;
+  double number_ = 0.0;
+  std::string string_;
+  std::vector<Json> array_;
+  std::vector<std::pair<std::string, Json>> object_;
+  friend class JsonParser;
+};
+
+}  // namespace softdeca::runtime

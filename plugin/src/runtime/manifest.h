@@ -1,0 +1,72 @@
+// The bundle manifest (docs/bundle.md), parsed and checked for internal consistency: every
+// size, index and tensor shape the runtime relies on is verified here, once, at load.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace softdeca::runtime {
+
+constexpr int kBundleFormatVersion = 1;
+constexpr const char* kBundleFormat = "softdeca-bundle";
+constexpr const char* kDtFormulation = "cotangent-poisson-1";
+constexpr int kBlendshapeCount = 52;
+
+// Canonical ARKit order (alphabetical ARFaceAnchor.BlendShapeLocation names).
+extern const char* const kArkitBlendshapes[kBlendshapeCount];
+
+struct TensorSpec {
+  std::string name;
+  std::vector<std::int64_t> shape;  // -1: a free (batch) dimension
+};
+
+struct NetworkSpec {
+  std::string key;  // "softdeca.f_ph", ...
+  std::string file;
+  std::vector<TensorSpec> inputs, outputs;
+  std::vector<int> parameter_columns;  // indices into Manifest::parameters
+};
+
+struct ParameterSpec {
+  std::string name, symbol, unit, domain, description;
+  double default_value = 0, min = 0, max = 0;
+  bool log_scale = false, localisable = false;
+};
+
+struct LandmarkSpec {
+  std::string name;
+  int arkit_vertex = 0;
+  int triangle = 0;
+  double bary[3] = {0, 0, 0};
+};
+
+struct Manifest {
+  int format_version = 0;
+  bool untrained = false;
+  std::string description, template_name;
+  int head_vertices = 0, skin_vertices = 0, skin_triangles = 0;
+  int latent = 0, identity = 0;
+  std::vector<ParameterSpec> parameters;
+  int arkit_vertex_count = 0;
+  std::vector<LandmarkSpec> landmarks;
+  std::vector<int> jaw_anchors;
+  std::string skin_triangles_file, non_skin_bones_file;
+  double dt_regularisation = 0;
+  double frame_rate_hz = 0;
+  double beta_max = 0, gamma_min = 0, gamma_max = 0;
+  std::map<std::string, NetworkSpec> networks;
+  bool has_softdeca = false, has_sparse = false;
+
+  const NetworkSpec& network(const std::string& key) const;
+  int find_parameter(const std::string& name) const;  // -1 when absent
+};
+
+// Throws Error(SOFTDECA_ERROR_FORMAT) naming the first problem.
+Manifest parse_manifest(const std::string& json_text);
+
+// The shapes the runtime requires of each network, given the manifest's sizes.
+NetworkSpec expected_network(const Manifest& m, const std::string& key, int parameter_count);
+
+}  // namespace softdeca::runtime

@@ -1,0 +1,47 @@
+// A loaded model bundle: the checked manifest, the topology data and one ONNX Runtime session
+// per network. Immutable after loading and shared by every avatar made from it (sessions are
+// safe to run from several threads at once), so a model may be destroyed before its avatars.
+#pragma once
+
+#include <onnxruntime_cxx_api.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "runtime/bundle_files.h"
+#include "runtime/manifest.h"
+#include "runtime/onnx_network.h"
+
+namespace softdeca::runtime {
+
+struct ModelOptions {
+  int prepare_threads = 1;  // intra-op threads of the per-avatar networks (f_ph, f_ph_v, f_dyn)
+};
+
+class Model {
+ public:
+  static std::shared_ptr<const Model> load(const BundleFiles& files, const ModelOptions& options);
+
+  const Manifest& manifest() const { return manifest_; }
+  const std::vector<std::int32_t>& skin_triangles() const { return skin_triangles_; }  // F*3
+  const std::vector<std::uint8_t>& non_skin_bones() const { return non_skin_bones_; }  // Vh-Vs, 0 cranium 1 jaw
+
+  const OnnxNetwork& identity_encoder() const { return *networks_.at(0); }
+  // Per model ("softdeca" or "sparse"): the per-frame encoder, the hypernetwork and dynamics.
+  const OnnxNetwork* encoder(bool sparse) const { return networks_.at(sparse ? 4 : 1).get(); }
+  const OnnxNetwork* hyper(bool sparse) const { return networks_.at(sparse ? 5 : 2).get(); }
+  const OnnxNetwork* dynamics(bool sparse) const { return networks_.at(sparse ? 6 : 3).get(); }
+  bool has(bool sparse) const { return sparse ? manifest_.has_sparse : manifest_.has_softdeca; }
+
+ private:
+  Model() = default;
+  Manifest manifest_;
+  std::vector<std::int32_t> skin_triangles_;
+  std::vector<std::uint8_t> non_skin_bones_;
+  std::unique_ptr<Ort::Env> env_;  // before the sessions: they must go first
+  std::vector<std::unique_ptr<OnnxNetwork>> networks_;
+};
+
+}  // namespace softdeca::runtime

@@ -1,0 +1,128 @@
+// Shared inputs of the runtime tests: the folder the ctest fixture `runtime_test_data` writes
+// (python -m softdeca_train runtime-test-data), read into arrays, and RAII handles.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "softdeca/softdeca.h"
+
+namespace rt {
+
+inline std::string data_dir() {
+  const char* d = std::getenv("SOFTDECA_TEST_DATA");
+  return d ? d : "";
+}
+
+template <class T>
+std::vector<T> read_raw(const std::string& name) {
+  std::ifstream in(data_dir() + "/" + name, std::ios::binary | std::ios::ate);
+  if (!in) return {};
+  const auto size = static_cast<std::size_t>(in.tellg());
+  std::vector<T> out(size / sizeof(T));
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(size));
+  return out;
+}
+
+inline std::vector<char> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::vector<char> out(in ? static_cast<std::size_t>(in.tellg()) : 0);
+  in.seekg(0);
+  in.read(out.data(), static_cast<std::streamsize>(out.size()));
+  return out;
+}
+
+struct Head {
+  std::vector<float> neutral, blendshapes, user_neutral, user_deltas;
+  std::vector<int32_t> triangles;
+  std::size_t vertices() const { return neutral.size() / 3; }
+  std::size_t user_vertices() const { return user_neutral.size() / 3; }
+  static Head load() {
+    Head h;
+    h.neutral = read_raw<float>("neutral.f32");
+    h.blendshapes = read_raw<float>("blendshapes.f32");
+    h.user_neutral = read_raw<float>("user_neutral.f32");
+    h.user_deltas = read_raw<float>("user_deltas.f32");
+    h.triangles = read_raw<int32_t>("triangles.i32");
+    return h;
+  }
+  std::vector<float> user_face(const float* w) const {
+    std::vector<float> p = user_neutral;
+    for (std::size_t s = 0; s < 52; ++s)
+      for (std::size_t i = 0; i < p.size(); ++i) p[i] += w[s] * user_deltas[s * p.size() + i];
+    return p;
+  }
+};
+
+struct ModelPtr {
+  softdeca_model* p = nullptr;
+  ~ModelPtr() { softdeca_model_destroy(p); }
+};
+struct AvatarPtr {
+  softdeca_avatar* p = nullptr;
+  ~AvatarPtr() { softdeca_avatar_destroy(p); }
+};
+
+inline softdeca_avatar_desc describe(const Head& h, uint32_t threads = 1, uint32_t precision = SOFTDECA_PRECISION_HALF) {
+  softdeca_avatar_desc d{};
+  d.size = sizeof d;
+  d.neutral = h.neutral.data();
+  d.vertex_count = h.vertices();
+  d.triangles = h.triangles.data();
+  d.triangle_count = h.triangles.size() / 3;
+  d.blendshapes = h.blendshapes.data();
+  d.blendshape_count = 52;
+  d.threads = threads;
+  d.precision = precision;
+  return d;
+}
+
+struct Buffers {
+  std::vector<float> vertices, normals;
+  softdeca_output out{};
+  explicit Buffers(std::size_t n, float fill = 0.0f) : vertices(3 * n, fill), normals(3 * n, fill) {
+    out = {sizeof(softdeca_output), vertices.data(), n, normals.data(), n};
+  }
+};
+
+// A temporary copy of a bundle folder, removed at the end of the test.
+struct BundleCopy {
+  std::filesystem::path dir;
+  explicit BundleCopy(const std::string& source, const std::string& tag) {
+    dir = std::filesystem::temp_directory_path() /
+          ("softdeca-bundle-" + tag + "-" + std::to_string(reinterpret_cast<std::uintptr_t>(this)));
+    std::filesystem::remove_all(dir);
+    std::filesystem::copy(source, dir, std::filesystem::copy_options::recursive);
+  }
+  ~BundleCopy() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+  std::string path() const { return dir.string(); }
+  std::string file(const std::string& name) const { return (dir / name).string(); }
+  void replace_in(const std::string& name, const std::string& from, const std::string& to) const {
+    std::ifstream in(file(name));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    std::ofstream(file(name), std::ios::trunc) << text;
+  }
+  void write(const std::string& name, const std::string& bytes) const {
+    std::ofstream(file(name), std::ios::binary | std::ios::trunc) << bytes;
+  }
+};
+
+}  // namespace rt
+
+#define REQUIRE_TEST_DATA()                                                                     \
+  do {                                                                                          \
+    if (rt::data_dir().empty()) GTEST_FAIL() << "SOFTDECA_TEST_DATA is not set (ctest fixture)"; \
+  } while (0)

@@ -1,0 +1,343 @@
+// The runtime's building blocks against direct computations: half conversion, the compact
+// hyper-tensor kernels, the prefactored solve, blendshape runs, normals, rigid fits, dynamics,
+// the worker, and the manifest's JSON and tar readers.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "api/error.h"
+#include "runtime/blendshapes.h"
+#include "runtime/bundle_files.h"
+#include "runtime/deformation_transfer.h"
+#include "runtime/dynamics.h"
+#include "runtime/half.h"
+#include "runtime/hypertensor.h"
+#include "runtime/json.h"
+#include "runtime/normals.h"
+#include "runtime/rigid.h"
+#include "runtime/sparse_ldlt.h"
+#include "runtime/worker.h"
+
+namespace {
+using namespace softdeca::runtime;
+
+TEST(Half, RoundTripsAndRoundsToNearestEven) {
+  EXPECT_EQ(float_to_half(1.0f), 0x3C00);
+  EXPECT_EQ(float_to_half(-2.0f), 0xC000);
+  EXPECT_EQ(float_to_half(65504.0f), 0x7BFF);
+  EXPECT_EQ(float_to_half(1e6f), 0x7C00);  // overflow -> infinity
+  EXPECT_EQ(float_to_half(5.9604645e-8f), 0x0001);  // smallest subnormal
+  EXPECT_EQ(float_to_half(1.0f + 1.0f / 2048.0f), 0x3C00);  // halfway: to even
+  EXPECT_EQ(float_to_half(1.0f + 3.0f / 2048.0f), 0x3C02);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-4.0f, 4.0f);
+  for (int i = 0; i < 10000; ++i) {
+    const float x = u(rng) * std::pow(10.0f, static_cast<float>(i % 7) - 4.0f);
+    const float back = half_to_float(float_to_half(x));
+    EXPECT_LE(std::fabs(back - x), std::max(std::fabs(x) * (1.0f / 2048.0f), 6e-8f)) << x;
+  }
+  for (uint32_t h = 0; h < 0x7C00; ++h) EXPECT_EQ(float_to_half(half_to_float(static_cast<uint16_t>(h))), h);
+}
+
+// A small mesh: a triangulated grid bent into a cap.
+struct Grid {
+  std::vector<float> v;
+  std::vector<int32_t> t;
+  std::size_t n = 0;
+  explicit Grid(int k = 9) {
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; j < k; ++j) {
+        const float x = static_cast<float>(i) / (k - 1) - 0.5f, y = static_cast<float>(j) / (k - 1) - 0.5f;
+        v.insert(v.end(), {0.1f * x, 0.1f * y, 0.02f * std::cos(2.0f * x) * std::cos(2.0f * y)});
+      }
+    for (int i = 0; i + 1 < k; ++i)
+      for (int j = 0; j + 1 < k; ++j) {
+        const int a = i * k + j, b = a + 1, c = a + k, d = c + 1;
+        t.insert(t.end(), {a, c, b, b, c, d});
+      }
+    n = v.size() / 3;
+  }
+};
+
+TEST(DeformationTransfer, IdentityGradientsReturnTheInputAndTheSolveMatchesEigen) {
+  const Grid g;
+  const SkinGeometry geo = SkinGeometry::measure(g.v.data(), g.n, g.t);
+  const DeformationTransfer dt(geo, g.n, g.t, 1e-3);
+  std::vector<float> zero(3 * g.n, 0.0f), out(3 * g.n);
+  std::vector<double> work(dt.work_size());
+  const float* zero_parts[1] = {zero.data()};
+  dt.solve(zero_parts, 1, g.v.data(), work.data(), out.data());
+  for (std::size_t i = 0; i < out.size(); ++i) EXPECT_FLOAT_EQ(out[i], g.v[i]);
+  // K x = r against a dense solve of the same matrix.
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(g.n), static_cast<Eigen::Index>(g.n));
+  double mean_mass = 0;
+  for (double m : geo.vertex_mass) mean_mass += m / static_cast<double>(g.n);
+  for (std::size_t f = 0; f < g.t.size() / 3; ++f) {
+    const int i = g.t[3 * f], j = g.t[3 * f + 1], k = g.t[3 * f + 2];
+    const double c00 = geo.metric[3 * f], c01 = geo.metric[3 * f + 1], c11 = geo.metric[3 * f + 2];
+    K(j, j) += c00; K(k, k) += c11; K(j, k) += c01; K(k, j) += c01;
+    K(i, j) -= c00 + c01; K(j, i) -= c00 + c01; K(i, k) -= c01 + c11; K(k, i) -= c01 + c11;
+    K(i, i) += c00 + 2 * c01 + c11;
+  }
+  for (std::size_t v = 0; v < g.n; ++v) K(static_cast<Eigen::Index>(v), static_cast<Eigen::Index>(v)) += 1e-3 / mean_mass * geo.vertex_mass[v];
+  std::mt19937 rng(3);
+  std::normal_distribution<float> nd;
+  std::vector<float> r(3 * g.n), r2(3 * g.n);
+  for (auto& x : r) x = nd(rng);
+  for (std::size_t i = 0; i < r.size(); ++i) r2[i] = 0.25f * r[i];
+  const float* parts[2] = {r.data(), r2.data()};
+  dt.solve(parts, 2, zero.data(), work.data(), out.data());  // r + r/4 = 1.25 r
+  Eigen::MatrixXd rhs(static_cast<Eigen::Index>(g.n), 3);
+  for (std::size_t v = 0; v < g.n; ++v)
+    for (int c = 0; c < 3; ++c) rhs(static_cast<Eigen::Index>(v), c) = 1.25 * r[3 * v + c];
+  const Eigen::MatrixXd x = K.ldlt().solve(rhs);
+  for (std::size_t v = 0; v < g.n; ++v)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[3 * v + c], x(static_cast<Eigen::Index>(v), c), 1e-5 * x.cwiseAbs().maxCoeff());
+}
+
+TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
+  const Grid g;
+  const SkinGeometry geo = SkinGeometry::measure(g.v.data(), g.n, g.t);
+  const DeformationTransfer dt(geo, g.n, g.t, 1e-3);
+  const std::size_t nf = g.t.size() / 3;
+  const int K = 32;
+  std::mt19937 rng(7);
+  std::normal_distribution<float> nd;
+  std::vector<float> L(nf * K * 9), z(K), skin(g.v);
+  for (auto& x : L) x = 0.05f * nd(rng);
+  for (auto& x : z) x = nd(rng);
+  for (auto& x : skin) x += 0.003f * nd(rng);
+  // Direct: r = sum_f D_f a_f W_f ((G_f - I) E_f)^T with G_f - I = z . L_f.
+  std::vector<double> want(3 * g.n, 0.0);
+  for (std::size_t f = 0; f < nf; ++f) {
+    double d[9] = {};
+    for (int k = 0; k < K; ++k)
+      for (int c = 0; c < 9; ++c) d[c] += double(z[k]) * L[(f * K + k) * 9 + c];
+    const int i = g.t[3 * f], j = g.t[3 * f + 1], kk = g.t[3 * f + 2];
+    for (int r = 0; r < 3; ++r) {
+      double p0 = 0, p1 = 0;
+      for (int c = 0; c < 3; ++c) {
+        p0 += d[3 * r + c] * (skin[3 * j + c] - skin[3 * i + c]);
+        p1 += d[3 * r + c] * (skin[3 * kk + c] - skin[3 * i + c]);
+      }
+      const double col0 = p0 * geo.metric[3 * f] + p1 * geo.metric[3 * f + 1];
+      const double col1 = p0 * geo.metric[3 * f + 1] + p1 * geo.metric[3 * f + 2];
+      want[3 * j + r] += col0;
+      want[3 * kk + r] += col1;
+      want[3 * i + r] -= col0 + col1;
+    }
+  }
+  double scale = 0;
+  for (double w : want) scale = std::max(scale, std::fabs(w));
+  for (const Precision p : {Precision::Float, Precision::Half, Precision::Int8}) {
+    const HyperTensor tensor(L.data(), nf, K, 9, p);
+    std::vector<float> got(3 * g.n, 0.0f);
+    const std::size_t half = tensor.blocks() / 2;  // two ranges, as two threads would do
+    dg_rhs(tensor, dt.faces(), z.data(), skin.data(), 0, half, got.data());
+    dg_rhs(tensor, dt.faces(), z.data(), skin.data(), half, tensor.blocks(), got.data());
+    const double tol = p == Precision::Float ? 1e-5 : p == Precision::Half ? 2e-3 : 2e-2;
+    for (std::size_t i = 0; i < got.size(); ++i) EXPECT_NEAR(got[i], want[i], tol * scale) << static_cast<int>(p);
+    // Stored values read back within the precision's step.
+    for (std::size_t f = 0; f < nf; f += 5)
+      for (int k = 0; k < K; k += 3)
+        EXPECT_NEAR(tensor.at(f, k, 4), L[(f * K + k) * 9 + 4], p == Precision::Float ? 0.0 : 0.01 * 0.25);
+  }
+}
+
+TEST(HyperTensor, VertexOffsetsMatchTheDirectProduct) {
+  const std::size_t n = 29;  // not a multiple of the block size
+  const int K = 32;
+  std::mt19937 rng(5);
+  std::normal_distribution<float> nd;
+  std::vector<float> L(n * K * 3), z(K), base(3 * n), out(3 * n + 3, -7.0f);
+  for (auto& x : L) x = 0.001f * nd(rng);
+  for (auto& x : z) x = nd(rng);
+  for (auto& x : base) x = nd(rng);
+  const HyperTensor t(L.data(), n, K, 3, Precision::Float);
+  vertex_offsets(t, z.data(), base.data(), 0, t.blocks(), out.data());
+  for (std::size_t v = 0; v < n; ++v)
+    for (int c = 0; c < 3; ++c) {
+      double want = base[3 * v + c];
+      for (int k = 0; k < K; ++k) want += double(z[k]) * L[(v * K + k) * 3 + c];
+      EXPECT_NEAR(out[3 * v + c], want, 1e-5);
+    }
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[3 * n + c], -7.0f) << "wrote past the last vertex";
+}
+
+TEST(SparseLdlt, RefusesAMatrixThatIsNotPositiveDefinite) {
+  Eigen::SparseMatrix<double> K(3, 3);
+  K.insert(0, 0) = 1;
+  K.insert(1, 1) = -1;
+  K.insert(2, 2) = 1;
+  EXPECT_THROW(SparseLdlt{K}, softdeca::Error);
+}
+
+TEST(Blendshapes, RunsReproduceTheDenseBlendInEveryPart) {
+  const std::size_t n = 200, shapes = 52;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<float> deltas(shapes * n * 3, 0.0f), neutral(3 * n), w(shapes);
+  for (std::size_t s = 0; s < shapes; ++s)
+    for (std::size_t v = 0; v < n; ++v)
+      if ((v * 7 + s * 13) % 5 < 2 || (v > 50 && v < 60))  // scattered vertices, gaps, and one run
+        for (int c = 0; c < 3; ++c) deltas[(s * n + v) * 3 + c] = u(rng);
+  for (auto& x : neutral) x = u(rng);
+  for (std::size_t s = 0; s < shapes; ++s) w[s] = s % 4 == 0 ? 0.0f : (u(rng) + 1) / 2;
+  for (const std::size_t parts : {1u, 2u, 3u}) {
+    const Blendshapes b(deltas.data(), shapes, n, parts);
+    std::vector<float> out(3 * n, 0.0f);
+    for (std::size_t p = 0; p < parts; ++p) b.blend(w.data(), neutral.data(), out.data(), p);
+    for (std::size_t v = 0; v < n; ++v)
+      for (int c = 0; c < 3; ++c) {
+        double want = neutral[3 * v + c];
+        for (std::size_t s = 0; s < shapes; ++s) want += double(w[s]) * deltas[(s * n + v) * 3 + c];
+        EXPECT_NEAR(out[3 * v + c], want, 1e-5) << parts;
+      }
+  }
+}
+
+TEST(Normals, AreUnitAreaWeightedAndZeroWhereUndefined) {
+  // Two triangles of a unit square in the xy plane, plus an isolated vertex.
+  const std::vector<float> v = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 5, 5, 5};
+  const std::vector<int32_t> t = {0, 1, 2, 0, 2, 3};
+  Normals normals(t, 5);
+  std::vector<float> out(15, -1.0f);
+  for (std::size_t p = 0; p < 2; ++p) normals.faces(v.data(), p, 2);
+  for (std::size_t p = 0; p < 2; ++p) normals.vertices(out.data(), p, 2);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_FLOAT_EQ(out[3 * i + 2], 1.0f);
+    EXPECT_FLOAT_EQ(out[3 * i], 0.0f);
+  }
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[12 + c], 0.0f);
+}
+
+TEST(Rigid, RecoversAKnownSimilarity) {
+  std::mt19937 rng(2);
+  std::normal_distribution<double> nd;
+  std::vector<double> src(60), dst(60);
+  for (auto& x : src) x = nd(rng);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Vector3d t(0.1, -0.2, 0.3);
+  for (int i = 0; i < 20; ++i) {
+    const Eigen::Vector3d p = 1.3 * R * Eigen::Vector3d(src[3 * i], src[3 * i + 1], src[3 * i + 2]) + t;
+    for (int c = 0; c < 3; ++c) dst[3 * i + c] = p[c];
+  }
+  const Similarity s = fit_similarity(src.data(), dst.data(), 20, true);
+  EXPECT_NEAR(s.scale, 1.3, 1e-9);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(s.translation[i], t[i], 1e-9);
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(s.rotation[3 * i + j], R(i, j), 1e-9);
+  }
+  const Similarity k = fit_similarity(src.data(), dst.data(), 20, false);
+  EXPECT_EQ(k.scale, 1.0);
+  // A mirror image still gets a proper rotation.
+  for (int i = 0; i < 20; ++i) dst[3 * i] = -src[3 * i], dst[3 * i + 1] = src[3 * i + 1], dst[3 * i + 2] = src[3 * i + 2];
+  const Similarity m = fit_similarity(src.data(), dst.data(), 20, false);
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 9; ++i) r(i / 3, i % 3) = m.rotation[i];
+  EXPECT_NEAR(r.determinant(), 1.0, 1e-9);
+}
+
+TEST(Dynamics, StartAtRestAndFollowTheRecursion) {
+  const std::size_t n = 3;
+  DynamicsCoefficients c;
+  c.alpha.resize(n);
+  c.beta.resize(n);
+  c.gamma.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    c.gamma[v] = 0.5f;
+    c.beta[v] = 0.2f;
+    c.alpha[v] = 0.5f * (1.0f - 0.5f + 0.2f);
+  }
+  DynamicsState s(n);
+  std::vector<float> y0(9, 1.0f), y1(9, 2.0f);
+  s.step(c, 0, y0.data(), 0, n);
+  EXPECT_EQ(std::vector<float>(s.next(), s.next() + 9), y0);
+  s.commit(0);
+  s.step(c, 0, y1.data(), 0, n);  // 0.5*2 + 2*0.35*1 - 0.2*1 = 1.5
+  EXPECT_FLOAT_EQ(s.next()[4], 1.5f);
+  s.commit(0);
+  s.step(c, 0, y1.data(), 0, n);  // 0.5*2 + 0.7*1.5 - 0.2*1 = 1.85
+  EXPECT_FLOAT_EQ(s.next()[0], 1.85f);
+  // Another model starts at rest again.
+  s.step(c, 1, y1.data(), 0, n);
+  EXPECT_FLOAT_EQ(s.next()[0], 2.0f);
+}
+
+TEST(Worker, RunsEveryPartOnce) {
+  for (const std::size_t threads : {1u, 2u, 4u}) {
+    Worker w(threads);
+    for (int round = 0; round < 200; ++round) {
+      std::vector<std::atomic<int>> hits(w.parts());
+      auto f = [&](std::size_t part, std::size_t parts) {
+        EXPECT_EQ(parts, w.parts());
+        hits[part].fetch_add(1);
+      };
+      w.run(f);
+      for (auto& h : hits) ASSERT_EQ(h.load(), 1);
+    }
+  }
+}
+
+TEST(Json, ParsesTheSubsetManifestsUse) {
+  const Json j = Json::parse(R"({"a": [1, -2.5e3, true, false, null], "s": "x\"y\\n\u00e9", "o": {}})");
+  ASSERT_EQ(j.at("a", "").array("").size(), 5u);
+  EXPECT_EQ(j.at("a", "").array("")[1].number(""), -2500.0);
+  EXPECT_TRUE(j.at("a", "").array("")[2].boolean(""));
+  EXPECT_TRUE(j.at("a", "").array("")[4].is_null());
+  EXPECT_EQ(j.at("s", "").string(""), "x\"y\\n\xc3\xa9");
+  EXPECT_TRUE(j.at("o", "").is_object());
+  for (const char* bad : {"", "{", "[1,]", "{\"a\" 1}", "\"unterminated", "[1] x", "nul", "{\"a\": 1e999}"})
+    EXPECT_THROW(Json::parse(bad), softdeca::Error) << bad;
+  EXPECT_THROW(j.at("missing", "doc"), softdeca::Error);
+  EXPECT_THROW(j.at("s", "doc").number("s"), softdeca::Error);
+  EXPECT_THROW(Json::parse("[1.5]").array("")[0].integer("x"), softdeca::Error);
+  std::string deep(200, '[');
+  EXPECT_THROW(Json::parse(deep), softdeca::Error);
+}
+
+// A ustar member header (name, size, checksum) followed by its data padded to 512 bytes.
+std::vector<uint8_t> tar_member(const std::string& name, const std::string& data) {
+  std::vector<uint8_t> h(512, 0);
+  std::memcpy(h.data(), name.data(), name.size());
+  std::snprintf(reinterpret_cast<char*>(h.data() + 100), 8, "%07o", 0644);
+  std::snprintf(reinterpret_cast<char*>(h.data() + 124), 12, "%011zo", data.size());
+  h[156] = '0';
+  std::memcpy(h.data() + 257, "ustar", 6);
+  std::memset(h.data() + 148, ' ', 8);
+  unsigned sum = 0;
+  for (uint8_t b : h) sum += b;
+  std::snprintf(reinterpret_cast<char*>(h.data() + 148), 8, "%06o", sum);
+  std::vector<uint8_t> out(512 + (data.size() + 511) / 512 * 512, 0);
+  std::memcpy(out.data(), h.data(), 512);
+  if (!data.empty()) std::memcpy(out.data() + 512, data.data(), data.size());
+  return out;
+}
+
+TEST(BundleFiles, ReadsTarArchivesAndRejectsDamage) {
+  auto tar = tar_member("top/manifest.json", "{}");
+  const auto second = tar_member("top/x.bin", std::string("\x01\x02\x03", 3));
+  tar.insert(tar.end(), second.begin(), second.end());
+  tar.resize(tar.size() + 1024, 0);
+  const BundleFiles files = BundleFiles::from_tar(tar.data(), tar.size());
+  EXPECT_EQ(files.get("manifest.json").size(), 2u);  // the top folder is stripped
+  EXPECT_EQ(files.get("x.bin").size(), 3u);
+  EXPECT_THROW(files.get("missing"), softdeca::Error);
+  EXPECT_THROW(files.get("../etc/passwd"), softdeca::Error);
+  auto bad = tar;
+  bad[130] = '9';  // not octal
+  EXPECT_THROW(BundleFiles::from_tar(bad.data(), bad.size()), softdeca::Error);
+  EXPECT_THROW(BundleFiles::from_tar(tar.data(), 700), softdeca::Error);
+  std::vector<uint8_t> zeros(1024, 0);
+  EXPECT_THROW(BundleFiles::from_tar(zeros.data(), zeros.size()), softdeca::Error);
+}
+
+}  // namespace

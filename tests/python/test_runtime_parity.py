@@ -1,0 +1,204 @@
+"""Parity of the native runtime (through its C ABI, as a host calls it) with the torch reference
+of the same bundle, for both models, static and dynamic, global and localised parameters.
+
+Bounds (max over all head vertices of all test frames; the untrained networks correct S_t by
+up to ~1 mm, so storage errors are relative to that):
+  float hyper-tensors: 1e-4 mm  (float32 networks and output against the float64 reference)
+  half  hyper-tensors: 1e-3 mm  (binary16 storage of L)
+  int8  hyper-tensors: 0.02 mm  (int8 with a scale per 8 elements and latent)
+Measured values are printed (pytest -s) and recorded in docs/runtime.md."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from softdeca_train.models import (
+    TEST_SIZES,
+    BundleInfo,
+    ReferenceAvatar,
+    TorchNetworks,
+    build_random,
+    export_bundle,
+    load_parameter_specs,
+)
+from softdeca_train.models.synthetic import TEST_PARAMETERS, synthetic_head
+from softdeca_train.runtime.native import NativeAvatar, NativeError, NativeModel
+
+BOUND_MM = {"float": 1e-4, "half": 1e-3, "int8": 0.02}
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    head = synthetic_head()
+    specs = load_parameter_specs(TEST_PARAMETERS)
+    nets = build_random(head.definition, specs, TEST_SIZES, seed=7)
+    folder = tmp_path_factory.mktemp("parity") / "bundle"
+    export_bundle(folder, head.definition, nets, BundleInfo(True, "parity"))
+    return head, nets, NativeModel(folder)
+
+
+def frames(n: int, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    w = np.zeros((n, 52))
+    for row in w:
+        idx = rng.choice(52, 30, replace=False)
+        row[idx] = rng.uniform(0, 1, 30)
+    return w
+
+
+def pair(setup, precision: str, localise: bool = False):
+    head, nets, model = setup
+    ref = ReferenceAvatar(
+        TorchNetworks(nets),
+        head.definition,
+        head.neutral,
+        head.head_triangles,
+        head.blendshapes,
+    )
+    nat = NativeAvatar(
+        model, head.neutral, head.head_triangles, head.blendshapes, precision=precision
+    )
+    assert np.allclose(nat.identity(), ref.identity, atol=1e-6)
+    if localise:  # a per-face map, a per-vertex map and a global change
+        nf, nv = head.definition.n_faces, head.definition.skin_vertices
+        faces = np.where(np.arange(nf) % 3 == 0, 60.0, 0.5)
+        verts = np.linspace(0.6, 1.4, nv)
+        ref.params.set_faces("w_skin_strain", faces)
+        nat.set_parameter_faces("w_skin_strain", faces)
+        ref.params.set_vertices("target_volume", verts)
+        nat.set_parameter_vertices("target_volume", verts)
+        ref.params.set_global("gravity_strength", 1.7)
+        nat.set_parameter("gravity_strength", 1.7)
+        ref.params.set_vertices("dyn_beta", np.linspace(0.0, 0.9, nv))
+        nat.set_parameter_vertices("dyn_beta", np.linspace(0.0, 0.9, nv))
+    ref.prepare()
+    nat.prepare()
+    return ref, nat
+
+
+def err_mm(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.abs(np.asarray(a, float) - b).max() * 1e3)
+
+
+@pytest.mark.parametrize("precision", ["float", "half", "int8"])
+@pytest.mark.parametrize("localise", [False, True])
+def test_softdeca_static_and_dynamic(setup, precision, localise):
+    ref, nat = pair(setup, precision, localise)
+    worst = {"static": 0.0, "dynamic": 0.0, "surface": 0.0, "normals": 0.0}
+    correction = 0.0
+    for w in frames(6, 1):
+        x, n = nat.evaluate_weights(w)
+        xr, nr = ref.evaluate_weights(w)
+        worst["static"] = max(worst["static"], err_mm(x, xr))
+        worst["normals"] = max(worst["normals"], float(np.abs(n - nr).max()))
+        correction = max(correction, err_mm(xr, ref.blend(w)))
+        # Caller-supplied S_t: skin only (non-skin follows the jaw rule) and the whole head.
+        s = ref.blend(w)
+        for surface in (s, s[: ref.d.skin_vertices]):
+            x, _ = nat.evaluate_surface(w, surface)
+            xr, _ = ref.evaluate_surface(w, surface)
+            worst["surface"] = max(worst["surface"], err_mm(x, xr))
+    nat.set_dynamics(True)
+    ref.dynamics = True
+    for w in frames(12, 2):
+        x, _ = nat.evaluate_weights(w)
+        xr, _ = ref.evaluate_weights(w)
+        worst["dynamic"] = max(worst["dynamic"], err_mm(x, xr))
+    print(
+        f"\nSoftDECA {precision} localised={localise}: {worst} mm; correction up to {correction:.3f} mm"
+    )
+    assert correction > 0.05, (
+        "the untrained model must correct S_t visibly for the test to mean anything"
+    )
+    for key in ("static", "dynamic", "surface"):
+        assert worst[key] < BOUND_MM[precision], key
+    assert worst["normals"] < 1e-3 * (10 if precision == "int8" else 1)
+
+
+@pytest.mark.parametrize("precision", ["float", "half", "int8"])
+@pytest.mark.parametrize("localise", [False, True])
+def test_sparse_static_dynamic_and_retargeted(setup, precision, localise):
+    head = setup[0]
+    ref, nat = pair(setup, precision, localise)
+    worst = {"uncalibrated": 0.0, "calibrated": 0.0, "dynamic": 0.0}
+    for w in frames(5, 3):  # uncalibrated: the points are the avatar's own landmarks
+        pts = head.definition.landmarks.evaluate(
+            ref.blend(w)[: head.definition.skin_vertices],
+            head.definition.skin_triangles,
+        )
+        x, _ = nat.evaluate_landmarks(pts)
+        xr, _ = ref.evaluate_landmarks(pts)
+        worst["uncalibrated"] = max(worst["uncalibrated"], err_mm(x, xr))
+    nat.calibrate_landmarks(head.user_neutral)
+    ref.calibrate(head.user_neutral)
+    for w in frames(5, 4):
+        face = head.user_face(
+            w
+        )  # the whole "ARKit" mesh: the runtime picks the landmark vertices
+        x, _ = nat.evaluate_landmarks(face)
+        xr, _ = ref.evaluate_landmarks(face)
+        worst["calibrated"] = max(worst["calibrated"], err_mm(x, xr))
+    nat.set_dynamics(True)
+    ref.dynamics = True
+    for w in frames(10, 5):
+        face = head.user_face(w)
+        x, _ = nat.evaluate_landmarks(face)
+        xr, _ = ref.evaluate_landmarks(face)
+        worst["dynamic"] = max(worst["dynamic"], err_mm(x, xr))
+    print(f"\nSparse {precision} localised={localise}: {worst} mm")
+    for key, v in worst.items():
+        assert v < BOUND_MM[precision], key
+
+
+def test_linear_blendshapes_are_exact(setup):
+    ref, nat = pair(setup, "half")
+    for w in frames(4, 6):
+        x, n = nat.evaluate_linear(w)
+        xr, nr = ref.evaluate_linear(w)
+        assert err_mm(x, xr) < 1e-4
+        assert np.abs(n - nr).max() < 1e-4
+
+
+def test_native_errors_reach_python(setup):
+    head, _, model = setup
+    nat = NativeAvatar(model, head.neutral, head.head_triangles, head.blendshapes)
+    with pytest.raises(NativeError, match="prepare"):
+        nat.evaluate_weights(np.zeros(52))
+    nat.prepare()
+    with pytest.raises(NativeError, match="not finite"):
+        nat.evaluate_weights(np.full(52, np.nan))
+
+
+def test_parity_on_the_template_topology(tmp_path, template):
+    """The real S (28,068 triangles, sockets and all) with small networks."""
+    from softdeca_train.models.topology import from_template
+
+    d = from_template(template)
+    specs = load_parameter_specs(TEST_PARAMETERS)
+    nets = build_random(d, specs, TEST_SIZES, seed=3)
+    export_bundle(tmp_path / "b", d, nets, BundleInfo(True, "template parity"))
+    model = NativeModel(tmp_path / "b")
+    h = template.sample_identity(2)
+    neutral = template.identity_neutral(h)
+    deltas = (
+        template.arkit_to_ict.T @ template.expression_deltas.reshape(53, -1)
+    ).reshape(52, -1, 3)
+    ref = ReferenceAvatar(TorchNetworks(nets), d, neutral, template.triangles, deltas)
+    nat = NativeAvatar(model, neutral, template.triangles, deltas)
+    ref.prepare()
+    nat.prepare()
+    nat.set_dynamics(True)
+    ref.dynamics = True
+    worst = 0.0
+    for w in frames(4, 8):
+        x, _ = nat.evaluate_weights(w)
+        xr, _ = ref.evaluate_weights(w)
+        worst = max(worst, err_mm(x, xr))
+    pts = d.landmarks.evaluate(neutral[: d.skin_vertices], d.skin_triangles) + 0.002
+    xs, _ = nat.evaluate_landmarks(pts)
+    xsr, _ = ref.evaluate_landmarks(pts)
+    print(
+        f"\ntemplate topology: SoftDECA dynamic {worst:.5f} mm, sparse {err_mm(xs, xsr):.5f} mm"
+    )
+    assert worst < BOUND_MM["half"]
+    assert err_mm(xs, xsr) < BOUND_MM["half"]

@@ -1,0 +1,374 @@
+"""The model bundle: writing it (ONNX export + manifest), packing it into one tar for hosts
+that ship it as an asset, and reading it back (manifest, topology, networks through
+onnxruntime). The format is specified in docs/bundle.md; the native runtime reads the same."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import tarfile
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from softdeca_train.models.dt import DEFAULT_REGULARISATION
+from softdeca_train.models.networks import (
+    BETA_MAX,
+    GAMMA_MAX,
+    GAMMA_MIN,
+    BundleNetworks,
+)
+from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.reference import Model
+from softdeca_train.models.topology import LandmarkSet, TemplateDefinition
+
+FORMAT = "softdeca-bundle"
+FORMAT_VERSION = 1
+OPSET = 17
+MANIFEST = "manifest.json"
+SKIN_TRIANGLES_FILE = "skin_triangles.i32"
+NON_SKIN_BONES_FILE = "non_skin_bones.u8"
+
+
+@dataclass(frozen=True)
+class BundleInfo:
+    """What a bundle says about where it came from. `training` and `errors` are filled by the
+    training issue; random bundles leave them None and set `untrained`."""
+
+    untrained: bool
+    description: str
+    training: dict[str, Any] | None = None
+    errors: dict[str, Any] | None = None
+    dt_regularisation: float = DEFAULT_REGULARISATION
+    dynamics_frame_rate_hz: float = 30.0
+
+
+def _tensor(name: str, shape: list[int | str]) -> dict[str, Any]:
+    return {"name": name, "dtype": "float32", "shape": shape}
+
+
+def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dict[str, Any]]:
+    f, v, k = d.n_faces, d.skin_vertices, len(d.landmarks)
+    lat, h = nets.sizes.latent, nets.sizes.identity
+    p = len(nets.specs)
+    cols = [s.name for s in nets.specs]
+    per_vertex = [_tensor("parameters", [v, p]), _tensor("identity", [1, h])]
+    dyn_out = [_tensor("alpha", [v]), _tensor("beta", [v]), _tensor("gamma", [v])]
+    specs: dict[str, dict[str, Any]] = {
+        "identity_encoder": {
+            "inputs": [_tensor("neutral", [1, v, 3])],
+            "outputs": [_tensor("identity", [1, h])],
+        }
+    }
+    if nets.softdeca is not None:
+        specs["softdeca.f_w"] = {
+            "inputs": [_tensor("weights", ["batch", len(d.blendshapes)])],
+            "outputs": [_tensor("z", ["batch", lat])],
+        }
+        specs["softdeca.f_ph"] = {
+            "inputs": [_tensor("parameters", [f, p]), _tensor("identity", [1, h])],
+            "outputs": [_tensor("L", [f, lat, 9])],
+            "parameter_columns": cols,
+        }
+        specs["softdeca.f_dyn"] = {
+            "inputs": per_vertex,
+            "outputs": dyn_out,
+            "parameter_columns": cols,
+        }
+    if nets.sparse is not None:
+        specs["sparse.f_l"] = {
+            "inputs": [_tensor("landmark_offsets", ["batch", 3 * k])],
+            "outputs": [_tensor("z", ["batch", lat])],
+        }
+        specs["sparse.f_ph_v"] = {
+            "inputs": per_vertex,
+            "outputs": [_tensor("L", [v, lat, 3])],
+            "parameter_columns": cols,
+        }
+        specs["sparse.f_dyn"] = {
+            "inputs": per_vertex,
+            "outputs": dyn_out,
+            "parameter_columns": cols,
+        }
+    for name, spec in specs.items():
+        spec["file"] = name.replace(".", "_") + ".onnx"
+    return specs
+
+
+def _modules(nets: BundleNetworks) -> dict[str, nn.Module]:
+    out: dict[str, nn.Module] = {"identity_encoder": nets.identity_encoder}
+    if nets.softdeca is not None:
+        out |= {f"softdeca.{k}": m for k, m in vars(nets.softdeca).items()}
+    if nets.sparse is not None:
+        out |= {f"sparse.{k}": m for k, m in vars(nets.sparse).items()}
+    return out
+
+
+def _example(spec: dict[str, Any]) -> tuple[torch.Tensor, ...]:
+    out = []
+    for t in spec["inputs"]:
+        shape = [1 if isinstance(s, str) else s for s in t["shape"]]
+        x = torch.rand(*shape)
+        if t["name"] == "parameters":
+            x = x * 0  # replaced by in-range values in export_bundle
+        out.append(x)
+    return tuple(out)
+
+
+def _export_onnx(
+    module: nn.Module, spec: dict[str, Any], example: tuple[torch.Tensor, ...]
+) -> bytes:
+    buf = io.BytesIO()
+    names_in = [t["name"] for t in spec["inputs"]]
+    names_out = [t["name"] for t in spec["outputs"]]
+    dynamic = {
+        t["name"]: {i: s for i, s in enumerate(t["shape"]) if isinstance(s, str)}
+        for t in spec["inputs"] + spec["outputs"]
+    }
+    dynamic = {k: v for k, v in dynamic.items() if v}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        torch.onnx.export(
+            module,
+            example,
+            buf,
+            input_names=names_in,
+            output_names=names_out,
+            dynamic_axes=dynamic or None,
+            opset_version=OPSET,
+            dynamo=False,
+        )
+    return buf.getvalue()
+
+
+def _default_parameters(specs: tuple[ParameterSpec, ...], n: int) -> torch.Tensor:
+    return torch.tensor([[s.default for s in specs]], dtype=torch.float32).repeat(n, 1)
+
+
+def export_bundle(
+    folder: str | Path,
+    definition: TemplateDefinition,
+    nets: BundleNetworks,
+    info: BundleInfo,
+    check: bool = True,
+) -> Path:
+    """Write a bundle folder: manifest.json, the skin triangulation, the non-skin bone labels
+    and one ONNX file per network. With `check`, every ONNX file is run in onnxruntime against
+    its torch module and the largest deviation is recorded in the manifest."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    specs = _network_specs(definition, nets)
+    modules = _modules(nets)
+    deviations: dict[str, float] = {}
+    for name, spec in specs.items():
+        example = list(_example(spec))
+        for i, t in enumerate(spec["inputs"]):
+            if t["name"] == "parameters":
+                example[i] = _default_parameters(nets.specs, t["shape"][0])
+        data = _export_onnx(modules[name], spec, tuple(example))
+        (folder / spec["file"]).write_bytes(data)
+        spec["sha256"] = hashlib.sha256(data).hexdigest()
+        if check:
+            deviations[name] = _check_onnx(data, modules[name], spec, tuple(example))
+    tri = np.ascontiguousarray(definition.skin_triangles, dtype="<i4")
+    bones = np.ascontiguousarray(definition.non_skin_bones, dtype=np.uint8)
+    (folder / SKIN_TRIANGLES_FILE).write_bytes(tri.tobytes())
+    (folder / NON_SKIN_BONES_FILE).write_bytes(bones.tobytes())
+    lm = definition.landmarks
+    manifest: dict[str, Any] = {
+        "format": FORMAT,
+        "format_version": FORMAT_VERSION,
+        "untrained": info.untrained,
+        "description": info.description,
+        "units": "metre",
+        "frame": "right-handed, +Y up, +Z out of the face, +X the subject's own left "
+        "(ARKit face anchor)",
+        "template": {
+            "name": definition.name,
+            "head_vertices": definition.head_vertices,
+            "skin_vertices": definition.skin_vertices,
+            "skin_triangles": definition.n_faces,
+        },
+        "latent_size": nets.sizes.latent,
+        "identity_size": nets.sizes.identity,
+        "blendshapes": list(definition.blendshapes),
+        "parameters": [s.manifest() for s in nets.specs],
+        "landmarks": {
+            "count": len(lm),
+            "arkit_vertex_count": lm.arkit_vertex_count,
+            "points": [
+                {
+                    "name": lm.names[k],
+                    "region": lm.regions[k],
+                    "arkit_vertex": int(lm.arkit_vertex[k]),
+                    "triangle": int(lm.triangle[k]),
+                    "bary": [float(b) for b in lm.bary[k]],
+                }
+                for k in range(len(lm))
+            ],
+        },
+        "files": {
+            "skin_triangles": {
+                "path": SKIN_TRIANGLES_FILE,
+                "dtype": "int32",
+                "shape": [definition.n_faces, 3],
+                "sha256": hashlib.sha256(tri.tobytes()).hexdigest(),
+            },
+            "non_skin_bones": {
+                "path": NON_SKIN_BONES_FILE,
+                "dtype": "uint8",
+                "shape": [definition.head_vertices - definition.skin_vertices],
+                "sha256": hashlib.sha256(bones.tobytes()).hexdigest(),
+            },
+        },
+        "non_skin": {
+            "labels": {"0": "cranium (stays at the neutral)", "1": "jaw (follows jaw_anchors)"},
+            "jaw_anchors": [int(a) for a in definition.jaw_anchors],
+        },
+        "deformation_transfer": {
+            "formulation": "cotangent-poisson-1",
+            "regularisation": info.dt_regularisation,
+        },
+        "dynamics": {
+            "frame_rate_hz": info.dynamics_frame_rate_hz,
+            "constraint": "gamma + 2 alpha - beta = 1",
+            "beta_max": BETA_MAX,
+            "gamma_range": [GAMMA_MIN, GAMMA_MAX],
+        },
+        "networks": specs,
+        "export_check_max_abs": deviations or None,
+        "training": info.training,
+        "errors": info.errors,
+    }
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+    return folder
+
+
+def _check_onnx(
+    data: bytes, module: nn.Module, spec: dict[str, Any], example: tuple[torch.Tensor, ...]
+) -> float:
+    import onnxruntime as ort
+
+    so = ort.SessionOptions()
+    so.log_severity_level = 3
+    sess = ort.InferenceSession(data, so, providers=["CPUExecutionProvider"])
+    feeds = {t["name"]: x.numpy() for t, x in zip(spec["inputs"], example, strict=True)}
+    got = sess.run(None, feeds)
+    with torch.no_grad():
+        want = module(*example)
+    want = want if isinstance(want, tuple) else (want,)
+    return float(max(np.abs(g - w.numpy()).max() for g, w in zip(got, want, strict=True)))
+
+
+def pack_bundle(folder: str | Path) -> bytes:
+    """The bundle folder as one uncompressed ustar archive (what softdeca_model_load_memory
+    and a Unity TextAsset take)."""
+    folder = Path(folder)
+    buf = io.BytesIO()
+    with tarfile.open(fileobj=buf, mode="w", format=tarfile.USTAR_FORMAT) as tar:
+        for p in sorted(folder.iterdir()):
+            if p.is_file():
+                tar.add(p, arcname=p.name, recursive=False)
+    return buf.getvalue()
+
+
+# ---- reading ---------------------------------------------------------------------------------
+
+
+def read_manifest(folder: str | Path) -> dict[str, Any]:
+    m = json.loads((Path(folder) / MANIFEST).read_text())
+    if m.get("format") != FORMAT or m.get("format_version") != FORMAT_VERSION:
+        raise ValueError(
+            f"{folder}: not a {FORMAT} version {FORMAT_VERSION} bundle "
+            f"({m.get('format')!r} version {m.get('format_version')!r})"
+        )
+    return m
+
+
+def read_definition(folder: str | Path) -> TemplateDefinition:
+    """The topology part of a bundle."""
+    folder = Path(folder)
+    m = read_manifest(folder)
+    t = m["template"]
+    tri = np.frombuffer((folder / SKIN_TRIANGLES_FILE).read_bytes(), dtype="<i4").reshape(-1, 3)
+    bones = np.frombuffer((folder / NON_SKIN_BONES_FILE).read_bytes(), dtype=np.uint8)
+    pts = m["landmarks"]["points"]
+    return TemplateDefinition(
+        name=t["name"],
+        head_vertices=t["head_vertices"],
+        skin_triangles=tri.astype(np.int32),
+        skin_vertices=t["skin_vertices"],
+        landmarks=LandmarkSet(
+            names=tuple(p["name"] for p in pts),
+            regions=tuple(p["region"] for p in pts),
+            arkit_vertex=np.array([p["arkit_vertex"] for p in pts], dtype=np.int64),
+            triangle=np.array([p["triangle"] for p in pts], dtype=np.int64),
+            bary=np.array([p["bary"] for p in pts], dtype=np.float64),
+            arkit_vertex_count=m["landmarks"]["arkit_vertex_count"],
+        ),
+        non_skin_bones=bones.copy(),
+        jaw_anchors=np.array(m["non_skin"]["jaw_anchors"], dtype=np.int64),
+    )
+
+
+class OnnxNetworks:
+    """A bundle's networks run by onnxruntime (the reference for trained bundles)."""
+
+    def __init__(self, folder: str | Path) -> None:
+        import onnxruntime as ort
+
+        folder = Path(folder)
+        self.manifest = read_manifest(folder)
+        self.specs = tuple(ParameterSpec.from_dict(p) for p in self.manifest["parameters"])
+        so = ort.SessionOptions()
+        so.log_severity_level = 3
+        self.sessions = {
+            name: ort.InferenceSession(
+                str(folder / spec["file"]), so, providers=["CPUExecutionProvider"]
+            )
+            for name, spec in self.manifest["networks"].items()
+        }
+
+    def has(self, model: Model) -> bool:
+        return f"{model}.f_dyn" in self.sessions
+
+    def _run(self, name: str, **inputs: np.ndarray) -> list[np.ndarray]:
+        feeds = {k: np.ascontiguousarray(v, dtype=np.float32) for k, v in inputs.items()}
+        return self.sessions[name].run(None, feeds)
+
+    def _columns(self, name: str, parameters: np.ndarray) -> np.ndarray:
+        cols = self.manifest["networks"][name]["parameter_columns"]
+        index = [[s.name for s in self.specs].index(c) for c in cols]
+        return parameters[:, index]
+
+    def identity(self, neutral_skin: np.ndarray) -> np.ndarray:
+        return self._run("identity_encoder", neutral=neutral_skin[None])[0][0]
+
+    def f_w(self, weights: np.ndarray) -> np.ndarray:
+        return self._run("softdeca.f_w", weights=weights)[0]
+
+    def f_l(self, offsets: np.ndarray) -> np.ndarray:
+        return self._run("sparse.f_l", landmark_offsets=offsets)[0]
+
+    def f_ph(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray:
+        p = self._columns("softdeca.f_ph", parameters)
+        return self._run("softdeca.f_ph", parameters=p, identity=identity[None])[0]
+
+    def f_ph_v(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray:
+        p = self._columns("sparse.f_ph_v", parameters)
+        return self._run("sparse.f_ph_v", parameters=p, identity=identity[None])[0]
+
+    def f_dyn(
+        self, model: Model, parameters: np.ndarray, identity: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        name = f"{model}.f_dyn"
+        a, b, g = self._run(
+            name, parameters=self._columns(name, parameters), identity=identity[None]
+        )
+        return a, b, g

@@ -1,0 +1,293 @@
+"""The networks of a model bundle (paper eq. 17-21, 25) as torch modules, and builders of
+random-weight instances. Shapes are the bundle contract (docs/bundle.md):
+
+  f_w      weights [B, 52]                            -> z [B, latent]
+  f_l      landmark_offsets [B, 3K]                   -> z [B, latent]
+  f_ph     parameters [F, P], identity [1, H]         -> L [F, latent, 9]   (per skin triangle)
+  f_ph_v   parameters [V, P], identity [1, H]         -> L [V, latent, 3]   (per skin vertex)
+  f_dyn    parameters [V, P], identity [1, H]         -> alpha, beta, gamma [V]
+  identity_encoder  neutral [1, V, 3]                 -> identity [1, H]
+
+Parameters enter as raw values; each network normalises them itself (log or linear to [-1, 1])
+so the runtime never needs to know how. The positional encodings pi(i) are trainable tables
+inside f_ph, f_ph_v and f_dyn."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import nn
+
+from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.topology import TemplateDefinition
+
+# The stable, equilibrium-preserving dynamics set (eq. 21 with gamma + 2 alpha - beta = 1):
+# beta in [0, BETA_MAX], gamma in [GAMMA_MIN, GAMMA_MAX] keep both roots of
+# r^2 - 2 alpha r + beta inside the unit circle, and a constant input stays constant.
+BETA_MAX = 0.99
+GAMMA_MIN, GAMMA_MAX = 0.01, 1.99
+
+
+@dataclass(frozen=True)
+class NetworkSizes:
+    """Layer widths. `latent` is the 32 of the paper; the rest are ours (Appendix D is lost)."""
+
+    latent: int = 32
+    identity: int = 100
+    f_w_hidden: tuple[int, ...] = (128, 128)
+    f_l_hidden: tuple[int, ...] = (256, 256)
+    hyper_hidden: tuple[int, ...] = (128, 128)
+    dynamics_hidden: tuple[int, ...] = (32,)
+    positional: int = 32
+    encoder_points: int = 1024
+    encoder_hidden: tuple[int, ...] = (256,)
+
+
+FULL_SIZES = NetworkSizes()
+TEST_SIZES = NetworkSizes(
+    latent=32,
+    identity=8,
+    f_w_hidden=(32,),
+    f_l_hidden=(32,),
+    hyper_hidden=(24,),
+    dynamics_hidden=(8,),
+    positional=8,
+    encoder_points=64,
+    encoder_hidden=(16,),
+)
+
+
+class Normalise(nn.Module):
+    """Raw parameter values -> [-1, 1] (log scale where the spec says so)."""
+
+    def __init__(self, specs: Sequence[ParameterSpec]) -> None:
+        super().__init__()
+        log = torch.tensor([s.scale == "log" for s in specs])
+        lo = torch.tensor([np.log(s.min) if s.scale == "log" else s.min for s in specs])
+        hi = torch.tensor([np.log(s.max) if s.scale == "log" else s.max for s in specs])
+        self.register_buffer("log", log)
+        self.register_buffer("lo", lo.float())
+        self.register_buffer("span", (hi - lo).float())
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        x = torch.where(self.log, torch.log(torch.clamp(x, min=1e-30)), x)
+        return 2.0 * (x - self.lo) / self.span - 1.0
+
+
+def mlp(sizes: Sequence[int], out_scale: float = 1.0) -> nn.Sequential:
+    layers: list[nn.Module] = []
+    for i in range(len(sizes) - 1):
+        layers.append(nn.Linear(sizes[i], sizes[i + 1]))
+        if i < len(sizes) - 2:
+            layers.append(nn.ELU())
+    last = layers[-1]
+    assert isinstance(last, nn.Linear)
+    with torch.no_grad():
+        last.weight.mul_(out_scale)
+        last.bias.mul_(out_scale)
+    return nn.Sequential(*layers)
+
+
+class WeightEncoder(nn.Module):
+    """f_w: blendshape weights -> latent code z (per frame)."""
+
+    def __init__(self, n_weights: int, sizes: NetworkSizes) -> None:
+        super().__init__()
+        self.net = mlp([n_weights, *sizes.f_w_hidden, sizes.latent])
+
+    def forward(self, weights: torch.Tensor) -> torch.Tensor:
+        return self.net(weights)
+
+
+class LandmarkEncoder(nn.Module):
+    """f_L: landmark offsets from the avatar's neutral landmarks (metres) -> z (per frame)."""
+
+    def __init__(self, n_landmarks: int, sizes: NetworkSizes, offset_scale: float = 100.0) -> None:
+        super().__init__()
+        self.offset_scale = offset_scale  # metres -> centimetres: inputs of order one
+        self.net = mlp([3 * n_landmarks, *sizes.f_l_hidden, sizes.latent])
+
+    def forward(self, landmark_offsets: torch.Tensor) -> torch.Tensor:
+        return self.net(landmark_offsets * self.offset_scale)
+
+
+class ElementMLP(nn.Module):
+    """An MLP evaluated for every element (face or vertex) on [p_i, h, pi(i)]. The first layer
+    is split so that the identity's share is computed once, not once per element."""
+
+    def __init__(
+        self,
+        n_elements: int,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        hidden: Sequence[int],
+        n_out: int,
+        out_scale: float,
+    ) -> None:
+        super().__init__()
+        self.normalise = Normalise(specs)
+        self.positional = nn.Parameter(torch.randn(n_elements, sizes.positional))
+        h0 = hidden[0]
+        self.from_parameters = nn.Linear(len(specs), h0, bias=False)
+        self.from_positional = nn.Linear(sizes.positional, h0, bias=False)
+        self.from_identity = nn.Linear(sizes.identity, h0)
+        self.rest = nn.Sequential(nn.ELU(), mlp([*hidden, n_out], out_scale))
+
+    def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:
+        x = (
+            self.from_parameters(self.normalise(parameters))
+            + self.from_positional(self.positional)
+            + self.from_identity(identity)
+        )
+        return self.rest(x)
+
+
+class HyperNetwork(nn.Module):
+    """f_ph (k = 9: a 3x3 deformation-gradient block per face and latent) or f_ph_v (k = 3: a
+    vertex offset per latent). Output [n, latent, k]."""
+
+    def __init__(
+        self,
+        n_elements: int,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        k: int,
+        out_scale: float,
+    ) -> None:
+        super().__init__()
+        self.latent, self.k = sizes.latent, k
+        self.body = ElementMLP(
+            n_elements, specs, sizes, sizes.hyper_hidden, sizes.latent * k, out_scale
+        )
+
+    def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:
+        return self.body(parameters, identity).reshape(-1, self.latent, self.k)
+
+
+class DynamicsNetwork(nn.Module):
+    """f_dyn: per-vertex alpha, beta, gamma of eq. 21 inside the stable set. f_gamma and f_beta
+    are separate MLPs; alpha = (1 - gamma + beta) / 2 is not free: it keeps constants fixed."""
+
+    def __init__(
+        self,
+        n_vertices: int,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        gamma0: float = 0.7,
+        beta0: float = 0.3,
+    ) -> None:
+        super().__init__()
+        hidden = sizes.dynamics_hidden
+        self.f_gamma = ElementMLP(n_vertices, specs, sizes, hidden, 1, 0.1)
+        self.f_beta = ElementMLP(n_vertices, specs, sizes, hidden, 1, 0.1)
+        with torch.no_grad():  # start near (gamma0, beta0): visibly dynamic, clearly stable
+            g = (gamma0 - GAMMA_MIN) / (GAMMA_MAX - GAMMA_MIN)
+            self._last(self.f_gamma).bias.fill_(float(np.log(g / (1 - g))))
+            b = beta0 / BETA_MAX
+            self._last(self.f_beta).bias.fill_(float(np.log(b / (1 - b))))
+
+    @staticmethod
+    def _last(m: ElementMLP) -> nn.Linear:
+        last = m.rest[-1][-1]
+        assert isinstance(last, nn.Linear)
+        return last
+
+    def forward(
+        self, parameters: torch.Tensor, identity: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        gamma = GAMMA_MIN + (GAMMA_MAX - GAMMA_MIN) * torch.sigmoid(
+            self.f_gamma(parameters, identity)[:, 0]
+        )
+        beta = BETA_MAX * torch.sigmoid(self.f_beta(parameters, identity)[:, 0])
+        alpha = 0.5 * (1.0 - gamma + beta)
+        return alpha, beta, gamma
+
+
+class IdentityEncoder(nn.Module):
+    """Neutral skin vertices -> identity code h. Reads a fixed subset of vertices, centred."""
+
+    def __init__(self, n_skin: int, sizes: NetworkSizes, seed: int = 0) -> None:
+        super().__init__()
+        rng = np.random.default_rng(seed)
+        n = min(sizes.encoder_points, n_skin)
+        self.register_buffer("points", torch.from_numpy(np.sort(rng.choice(n_skin, n, False))))
+        self.net = mlp([3 * n, *sizes.encoder_hidden, sizes.identity])
+        self.scale = 10.0  # metres -> decimetres
+
+    def forward(self, neutral: torch.Tensor) -> torch.Tensor:
+        x = neutral[:, self.points, :]
+        x = (x - x.mean(dim=1, keepdim=True)) * self.scale
+        return self.net(x.reshape(x.shape[0], -1))
+
+
+@dataclass
+class SoftDecaNetworks:
+    f_w: WeightEncoder
+    f_ph: HyperNetwork
+    f_dyn: DynamicsNetwork
+
+
+@dataclass
+class SparseNetworks:
+    f_l: LandmarkEncoder
+    f_ph_v: HyperNetwork
+    f_dyn: DynamicsNetwork
+
+
+@dataclass
+class BundleNetworks:
+    """Everything a bundle holds besides the manifest; either model may be absent."""
+
+    sizes: NetworkSizes
+    specs: tuple[ParameterSpec, ...]
+    identity_encoder: IdentityEncoder
+    softdeca: SoftDecaNetworks | None
+    sparse: SparseNetworks | None
+
+    def modules(self) -> list[nn.Module]:
+        out: list[nn.Module] = [self.identity_encoder]
+        for m in (self.softdeca, self.sparse):
+            if m is not None:
+                out += list(vars(m).values())
+        return out
+
+    def eval(self) -> BundleNetworks:
+        for m in self.modules():
+            m.eval()
+        return self
+
+
+def build_random(
+    definition: TemplateDefinition,
+    specs: Sequence[ParameterSpec],
+    sizes: NetworkSizes = FULL_SIZES,
+    seed: int = 0,
+    softdeca: bool = True,
+    sparse: bool = True,
+    dg_scale: float = 0.02,
+    offset_scale: float = 1e-3,
+) -> BundleNetworks:
+    """Random-weight networks (untrained). `dg_scale` sets the size of the deformation-gradient
+    corrections (G - I) and `offset_scale` that of the vertex offsets (metres), so that an
+    untrained bundle stays close to its input instead of producing noise."""
+    torch.manual_seed(seed)
+    specs = tuple(specs)
+    nf, nv = definition.n_faces, definition.skin_vertices
+    sd = sp = None
+    if softdeca:
+        sd = SoftDecaNetworks(
+            f_w=WeightEncoder(len(definition.blendshapes), sizes),
+            f_ph=HyperNetwork(nf, specs, sizes, 9, dg_scale),
+            f_dyn=DynamicsNetwork(nv, specs, sizes),
+        )
+    if sparse:
+        sp = SparseNetworks(
+            f_l=LandmarkEncoder(len(definition.landmarks), sizes),
+            f_ph_v=HyperNetwork(nv, specs, sizes, 3, offset_scale),
+            f_dyn=DynamicsNetwork(nv, specs, sizes, gamma0=0.6, beta0=0.25),
+        )
+    enc = IdentityEncoder(nv, sizes, seed)
+    return BundleNetworks(sizes, specs, enc, sd, sp).eval()

@@ -1,0 +1,300 @@
+"""The reference forward pass of SoftDECA and SparseSoftDECA for one avatar: the exact math the
+native runtime implements (docs/bundle.md), in float64 around float32 networks. Training uses
+the same pieces (dt.py, parameters.py); parity tests compare the runtime against this.
+
+Per frame, SoftDECA: S_t = neutral + sum_i w_i B_i (whole head), z = f_w(w),
+G_f = I + sum_k z_k L[f, k], X = DT(S_t, G) on the skin. SparseSoftDECA: offsets of the
+retargeted landmarks from the avatar's neutral landmarks, z = f_l(offsets),
+X = neutral_skin + sum_k z_k L_v[v, k]. Then, if enabled, dynamics per skin vertex
+X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, the non-skin vertices, and normals."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Literal, Protocol
+
+import numpy as np
+import torch
+
+from softdeca_train.models.dt import DtSystem, deformation_transfer, dt_system
+from softdeca_train.models.networks import BundleNetworks
+from softdeca_train.models.parameters import ParameterSpec, ParameterState
+from softdeca_train.models.topology import JAW, TemplateDefinition
+
+Model = Literal["softdeca", "sparse"]
+
+
+class Networks(Protocol):
+    """What the reference needs from a bundle's networks (torch modules or ONNX sessions)."""
+
+    specs: tuple[ParameterSpec, ...]
+
+    def has(self, model: Model) -> bool: ...
+    def identity(self, neutral_skin: np.ndarray) -> np.ndarray: ...
+    def f_w(self, weights: np.ndarray) -> np.ndarray: ...
+    def f_l(self, offsets: np.ndarray) -> np.ndarray: ...
+    def f_ph(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray: ...
+    def f_ph_v(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray: ...
+    def f_dyn(
+        self, model: Model, parameters: np.ndarray, identity: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+class TorchNetworks:
+    """Networks from torch modules (float32, no gradient)."""
+
+    def __init__(self, nets: BundleNetworks) -> None:
+        self.nets = nets
+        self.specs = nets.specs
+
+    def has(self, model: Model) -> bool:
+        return (self.nets.softdeca if model == "softdeca" else self.nets.sparse) is not None
+
+    @staticmethod
+    def _t(a: np.ndarray) -> torch.Tensor:
+        return torch.as_tensor(np.asarray(a, dtype=np.float32))
+
+    @torch.no_grad()
+    def identity(self, neutral_skin: np.ndarray) -> np.ndarray:
+        return self.nets.identity_encoder(self._t(neutral_skin)[None]).numpy()[0]
+
+    @torch.no_grad()
+    def f_w(self, weights: np.ndarray) -> np.ndarray:
+        assert self.nets.softdeca is not None
+        return self.nets.softdeca.f_w(self._t(weights)).numpy()
+
+    @torch.no_grad()
+    def f_l(self, offsets: np.ndarray) -> np.ndarray:
+        assert self.nets.sparse is not None
+        return self.nets.sparse.f_l(self._t(offsets)).numpy()
+
+    @torch.no_grad()
+    def f_ph(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray:
+        assert self.nets.softdeca is not None
+        return self.nets.softdeca.f_ph(self._t(parameters), self._t(identity)[None]).numpy()
+
+    @torch.no_grad()
+    def f_ph_v(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray:
+        assert self.nets.sparse is not None
+        return self.nets.sparse.f_ph_v(self._t(parameters), self._t(identity)[None]).numpy()
+
+    @torch.no_grad()
+    def f_dyn(
+        self, model: Model, parameters: np.ndarray, identity: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        m = self.nets.softdeca if model == "softdeca" else self.nets.sparse
+        assert m is not None
+        a, b, g = m.f_dyn(self._t(parameters), self._t(identity)[None])
+        return a.numpy(), b.numpy(), g.numpy()
+
+
+def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Area-weighted vertex normals, unit length; zero where no triangle has area."""
+    v = np.asarray(vertices, dtype=np.float64)
+    t = np.asarray(triangles, dtype=np.int64)
+    fn = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
+    n = np.zeros_like(v)
+    for c in range(3):
+        np.add.at(n, t[:, c], fn)
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.where(length > 0, n / np.where(length > 0, length, 1.0), 0.0)
+
+
+def kabsch(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation R (det +1) and translation t with dst ≈ R src + t."""
+    ms, md = src.mean(axis=0), dst.mean(axis=0)
+    u, _, vt = np.linalg.svd((dst - md).T @ (src - ms))
+    d = np.ones(3)
+    d[2] = np.sign(np.linalg.det(u @ vt)) or 1.0
+    r = u @ np.diag(d) @ vt
+    return r, md - r @ ms
+
+
+def similarity(src: np.ndarray, dst: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """Umeyama: s, R, t with dst ≈ s R src + t."""
+    ms, md = src.mean(axis=0), dst.mean(axis=0)
+    a, b = src - ms, dst - md
+    u, sig, vt = np.linalg.svd(b.T @ a / len(src))
+    d = np.ones(3)
+    d[2] = np.sign(np.linalg.det(u @ vt)) or 1.0
+    r = u @ np.diag(d) @ vt
+    s = float((sig * d).sum() / ((a**2).sum() / len(src)))
+    return s, r, md - s * r @ ms
+
+
+@dataclass
+class Preparation:
+    identity: np.ndarray
+    face_l: np.ndarray | None  # (F, latent, 9)
+    vertex_l: np.ndarray | None  # (Vs, latent, 3)
+    dynamics: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]  # model -> alpha, beta, gamma
+
+
+class ReferenceAvatar:
+    """One avatar, mirroring softdeca_avatar of the C ABI."""
+
+    def __init__(
+        self,
+        nets: Networks,
+        definition: TemplateDefinition,
+        neutral: np.ndarray,
+        head_triangles: np.ndarray,
+        blendshapes: np.ndarray | None = None,
+        regularisation: float = 1e-3,
+        identity: np.ndarray | None = None,
+    ) -> None:
+        self.nets = nets
+        self.d = definition
+        self.neutral = np.asarray(neutral, dtype=np.float64)
+        if self.neutral.shape != (definition.head_vertices, 3):
+            raise ValueError("neutral must be (head_vertices, 3)")
+        self.head_triangles = np.asarray(head_triangles, dtype=np.int64)
+        self.blendshapes = None if blendshapes is None else np.asarray(blendshapes, np.float64)
+        vs = definition.skin_vertices
+        self.dt: DtSystem = dt_system(self.neutral[:vs], definition.skin_triangles, regularisation)
+        self.params = ParameterState(nets.specs, definition.skin_triangles, self.dt.area)
+        self.identity = (
+            np.asarray(identity, np.float64)
+            if identity is not None
+            else nets.identity(self.neutral[:vs]).astype(np.float64)
+        )
+        self.neutral_landmarks = definition.landmarks.evaluate(
+            self.neutral[:vs], definition.skin_triangles
+        )
+        self.calibration: tuple[float, np.ndarray, np.ndarray] | None = None
+        self.dynamics = False
+        self._state: tuple[Model, np.ndarray, np.ndarray] | None = None
+        self.prep: Preparation | None = None
+
+    # ---- per avatar ------------------------------------------------------------------------
+    def prepare(self) -> Preparation:
+        names = [s.name for s in self.nets.specs]
+        pf, pv = self.params.face_matrix(names), self.params.vertex_matrix(names)
+        h = self.identity
+        face_l = vertex_l = None
+        dyn = {}
+        if self.nets.has("softdeca"):
+            face_l = self.nets.f_ph(pf, h).astype(np.float64)
+            dyn["softdeca"] = tuple(
+                x.astype(np.float64) for x in self.nets.f_dyn("softdeca", pv, h)
+            )
+        if self.nets.has("sparse"):
+            vertex_l = self.nets.f_ph_v(pv, h).astype(np.float64)
+            dyn["sparse"] = tuple(x.astype(np.float64) for x in self.nets.f_dyn("sparse", pv, h))
+        self.prep = Preparation(h.copy(), face_l, vertex_l, dyn)  # type: ignore[arg-type]
+        return self.prep
+
+    def calibrate(self, user_neutral: np.ndarray) -> None:
+        """The user's neutral landmarks (K, 3): similarity user -> avatar neutral landmarks."""
+        self.calibration = similarity(self._select(user_neutral), self.neutral_landmarks)
+        self._user_neutral = self._select(user_neutral)
+
+    def _select(self, points: np.ndarray) -> np.ndarray:
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        lm = self.d.landmarks
+        if len(p) == lm.arkit_vertex_count and len(p) != len(lm):
+            return p[lm.arkit_vertex]
+        if len(p) != len(lm):
+            raise ValueError(f"expected {len(lm)} landmarks or {lm.arkit_vertex_count} vertices")
+        return p
+
+    # ---- per frame -------------------------------------------------------------------------
+    def blend(self, weights: np.ndarray) -> np.ndarray:
+        if self.blendshapes is None:
+            raise ValueError("the avatar has no blendshapes")
+        return self.neutral + np.tensordot(np.asarray(weights, np.float64), self.blendshapes, 1)
+
+    def _need(self) -> Preparation:
+        if self.prep is None:
+            raise RuntimeError("prepare() first")
+        return self.prep
+
+    def softdeca_static(self, weights: np.ndarray, skin: np.ndarray) -> np.ndarray:
+        prep = self._need()
+        assert prep.face_l is not None
+        z = self.nets.f_w(np.asarray(weights, np.float32)[None])[0].astype(np.float64)
+        g = np.einsum("k,fkc->fc", z, prep.face_l).reshape(-1, 3, 3)
+        x = deformation_transfer(self.dt, torch.from_numpy(skin[None]), torch.from_numpy(g[None]))
+        return x[0].numpy()
+
+    def landmark_offsets(self, points: np.ndarray) -> np.ndarray:
+        u = self._select(points)
+        if self.calibration is None:
+            return u - self.neutral_landmarks
+        s, r, _ = self.calibration
+        return s * (u - self._user_neutral) @ r.T
+
+    def sparse_static(self, points: np.ndarray) -> np.ndarray:
+        prep = self._need()
+        assert prep.vertex_l is not None
+        off = self.landmark_offsets(points).reshape(1, -1)
+        z = self.nets.f_l(off.astype(np.float32))[0].astype(np.float64)
+        vs = self.d.skin_vertices
+        return self.neutral[:vs] + np.einsum("k,vkc->vc", z, prep.vertex_l)
+
+    def _dynamics(self, model: Model, y: np.ndarray) -> np.ndarray:
+        if not self.dynamics:
+            self._state = None
+            return y
+        alpha, beta, gamma = self._need().dynamics[model]
+        if self._state is None or self._state[0] != model:
+            self._state = (model, y, y)
+        _, x1, x2 = self._state
+        x = gamma[:, None] * y + 2 * alpha[:, None] * x1 - beta[:, None] * x2
+        self._state = (model, x, x1)
+        return x
+
+    def reset_dynamics(self) -> None:
+        self._state = None
+
+    def _finish(
+        self, skin: np.ndarray, non_skin: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        vs = self.d.skin_vertices
+        head = self.neutral.copy()
+        head[:vs] = skin
+        if non_skin is not None:
+            head[vs:] = non_skin
+        else:  # cranium stays, jaw follows the rigid motion of its skin anchors
+            jaw = np.nonzero(self.d.non_skin_bones == JAW)[0] + vs
+            if len(jaw):
+                a = self.d.jaw_anchors
+                r, t = kabsch(self.neutral[a], skin[a])
+                head[jaw] = self.neutral[jaw] @ r.T + t
+        return head, vertex_normals(head, self.head_triangles)
+
+    def evaluate_weights(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        s = self.blend(weights)
+        vs = self.d.skin_vertices
+        x = self._dynamics("softdeca", self.softdeca_static(weights, s[:vs]))
+        return self._finish(x, s[vs:])
+
+    def evaluate_surface(
+        self, weights: np.ndarray, surface: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        s = np.asarray(surface, dtype=np.float64)
+        vs = self.d.skin_vertices
+        x = self._dynamics("softdeca", self.softdeca_static(weights, s[:vs]))
+        return self._finish(x, s[vs:] if len(s) == self.d.head_vertices else None)
+
+    def evaluate_landmarks(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = self._dynamics("sparse", self.sparse_static(points))
+        return self._finish(x, None)
+
+    def evaluate_linear(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        head = self.blend(weights)
+        return head, vertex_normals(head, self.head_triangles)
+
+
+def random_weights(n: int, rng: np.random.Generator, active: int = 12) -> np.ndarray:
+    """Test frames: `n` weight vectors with `active` random shapes each, in [0, 1]."""
+    w = np.zeros((n, 52))
+    for row in w:
+        idx = rng.choice(52, active, replace=False)
+        row[idx] = rng.uniform(0.0, 1.0, active)
+    return w
+
+
+def to_float32(points: Sequence[np.ndarray]) -> list[np.ndarray]:
+    return [np.ascontiguousarray(p, dtype=np.float32) for p in points]

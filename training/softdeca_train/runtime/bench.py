@@ -1,0 +1,58 @@
+"""`make bench`'s runtime figures: a full-size untrained bundle on the template topology, the
+avatar of identity seed 1, and `softdeca bench-runtime` on the frames of a real take
+-> build/bench/runtime.json (DESIGN §3)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from softdeca_train.paths import REPO_ROOT
+
+DEFAULT_TAKE = (
+    REPO_ROOT.parent / "shared" / "recordings" / "livelinkface-alexdjulin" / "S07-001.csv"
+)
+CLI = REPO_ROOT / "build" / "release" / "plugin" / "cli" / "softdeca"
+
+
+def bench_runtime(
+    out: Path,
+    ict: str | None = None,
+    take: Path = DEFAULT_TAKE,
+    frames: int = 600,
+    parameters: str | None = None,
+) -> Path:
+    from softdeca_train.models import FULL_SIZES, BundleInfo, build_random, export_bundle
+    from softdeca_train.models.parameters import specs_or_test_list
+    from softdeca_train.models.topology import from_template
+    from softdeca_train.runtime.files import write_identity_avatar
+    from softdeca_train.template import Template
+
+    work = out / "runtime-inputs"
+    specs = specs_or_test_list(parameters)
+    definition = from_template(Template.load(ict))
+    nets = build_random(definition, specs, FULL_SIZES, seed=0)
+    info = BundleInfo(True, "UNTRAINED full-size random networks for the runtime benchmark")
+    bundle = export_bundle(work / "bundle", definition, nets, info, check=False)
+    avatar = work / "avatar-seed1"
+    if not (avatar / "neutral.obj").is_file():
+        write_identity_avatar(1, avatar, ict)
+    path = out / "runtime.json"
+    how = (
+        f"make bench (softdeca bench-runtime, {len(specs)} parameters, "
+        f"{FULL_SIZES.latent} latents, hyper hidden {FULL_SIZES.hyper_hidden})"
+    )
+    cmd = [
+        str(CLI), "bench-runtime", "--bundle", str(bundle), "--avatar", str(avatar),
+        "--take", str(take), "--frames", str(frames), "--out", str(path), "--how", how,
+    ]  # fmt: skip
+    print("running", " ".join(cmd), file=sys.stderr)
+    subprocess.run(cmd, check=True, env=os.environ.copy())
+    figures = json.loads(path.read_text())
+    for name, f in figures.items():
+        target = "" if f["target"] is None else f"(target {f['target']})"
+        print(f"  {name:44s} {f['value']:>10.4g} {f['unit']:7s} {target}")
+    return path

@@ -1,0 +1,359 @@
+"""ctypes binding of the runtime's C ABI (plugin/include/softdeca/softdeca.h): what Unity's
+P/Invoke layer does, from Python, for the parity tests, the benchmarks and the replay tools.
+Every call checks its status and raises NativeError with the library's message."""
+
+from __future__ import annotations
+
+import ctypes as C
+import os
+from pathlib import Path
+
+import numpy as np
+
+from softdeca_train.paths import REPO_ROOT
+
+SOFTDECA_OK = 0
+PRECISIONS = {"half": 0, "float": 1, "int8": 2}  # softdeca_precision
+STATUS_NAMES = {
+    0: "ok",
+    1: "invalid argument",
+    2: "non-finite input",
+    3: "buffer too small",
+    4: "i/o error",
+    5: "format error",
+    6: "internal error",
+    7: "busy",
+    8: "not ready",
+}
+
+
+class NativeError(RuntimeError):
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(f"[{STATUS_NAMES.get(status, status)}] {message}")
+        self.status = status
+        self.message = message
+
+
+class ModelOptions(C.Structure):
+    _fields_ = [("size", C.c_uint32), ("prepare_threads", C.c_uint32)]
+
+
+class ModelInfo(C.Structure):
+    _fields_ = [
+        (n, C.c_uint32)
+        for n in (
+            "size",
+            "format_version",
+            "head_vertex_count",
+            "skin_vertex_count",
+            "skin_triangle_count",
+            "latent_size",
+            "identity_size",
+            "blendshape_count",
+            "parameter_count",
+            "landmark_count",
+            "arkit_vertex_count",
+            "has_softdeca",
+            "has_sparse",
+            "untrained",
+        )
+    ] + [("dynamics_frame_rate_hz", C.c_float)]
+
+
+class ParameterInfo(C.Structure):
+    """softdeca_parameter_info (shared with the simulator's compiled-in list)."""
+
+    _fields_ = [
+        ("struct_size", C.c_size_t),
+        ("name", C.c_char_p),
+        ("unit", C.c_char_p),
+        ("domain", C.c_char_p),
+        ("description", C.c_char_p),
+        ("default_value", C.c_double),
+        ("lo", C.c_double),
+        ("hi", C.c_double),
+        ("log_scale", C.c_int32),
+    ]
+
+
+class AvatarDesc(C.Structure):
+    _fields_ = [
+        ("size", C.c_uint32),
+        ("neutral", C.POINTER(C.c_float)),
+        ("vertex_count", C.c_size_t),
+        ("triangles", C.POINTER(C.c_int32)),
+        ("triangle_count", C.c_size_t),
+        ("blendshapes", C.POINTER(C.c_float)),
+        ("blendshape_count", C.c_size_t),
+        ("threads", C.c_uint32),
+        ("precision", C.c_uint32),
+    ]
+
+
+class Output(C.Structure):
+    _fields_ = [
+        ("size", C.c_uint32),
+        ("vertices", C.POINTER(C.c_float)),
+        ("vertex_capacity", C.c_size_t),
+        ("normals", C.POINTER(C.c_float)),
+        ("normal_capacity", C.c_size_t),
+    ]
+
+
+class Stats(C.Structure):
+    _fields_ = [
+        ("size", C.c_uint32),
+        ("threads", C.c_uint32),
+        ("frames", C.c_uint64),
+        ("preparations", C.c_uint64),
+        ("generation", C.c_uint64),
+        *[
+            (n, C.c_double)
+            for n in (
+                "frame_ms",
+                "encoder_ms",
+                "blend_ms",
+                "hyper_ms",
+                "solve_ms",
+                "dynamics_ms",
+                "output_ms",
+                "normals_ms",
+                "prepare_ms",
+                "prepare_networks_ms",
+                "factorisation_ms",
+            )
+        ],
+        ("memory_bytes", C.c_uint64),
+    ]
+
+
+def library_path() -> Path:
+    """$SOFTDECA_LIBRARY, else the release build's libsoftdeca.so."""
+    env = os.environ.get("SOFTDECA_LIBRARY")
+    return Path(env) if env else REPO_ROOT / "build" / "release" / "plugin" / "libsoftdeca.so"
+
+
+_lib: C.CDLL | None = None
+
+
+def lib() -> C.CDLL:
+    global _lib
+    if _lib is None:
+        path = library_path()
+        if not path.is_file():
+            raise FileNotFoundError(f"{path} not found: run `make build`")
+        _lib = C.CDLL(str(path))
+        _lib.softdeca_last_error.restype = C.c_char_p
+        _lib.softdeca_version.restype = C.c_char_p
+    return _lib
+
+
+def check(status: int) -> None:
+    if status != SOFTDECA_OK:
+        raise NativeError(status, lib().softdeca_last_error().decode())
+
+
+def _f32(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float32)
+
+
+def _ptr(a: np.ndarray | None, ctype: type = C.c_float) -> C._Pointer | None:  # type: ignore[name-defined]
+    return None if a is None else a.ctypes.data_as(C.POINTER(ctype))
+
+
+class NativeModel:
+    """softdeca_model: a loaded bundle."""
+
+    def __init__(self, path: str | os.PathLike[str] | bytes, prepare_threads: int = 1) -> None:
+        self.handle = C.c_void_p()
+        opts = ModelOptions(C.sizeof(ModelOptions), prepare_threads)
+        if isinstance(path, bytes):
+            self._data = path
+            check(
+                lib().softdeca_model_load_memory(
+                    C.c_char_p(path), C.c_size_t(len(path)), C.byref(opts), C.byref(self.handle)
+                )
+            )
+        else:
+            check(
+                lib().softdeca_model_load(str(path).encode(), C.byref(opts), C.byref(self.handle))
+            )
+        info = ModelInfo()
+        info.size = C.sizeof(ModelInfo)
+        check(lib().softdeca_model_get_info(self.handle, C.byref(info)))
+        self.info = info
+
+    def close(self) -> None:
+        if self.handle:
+            check(lib().softdeca_model_destroy(self.handle))
+            self.handle = C.c_void_p()
+
+    def __del__(self) -> None:
+        if getattr(self, "handle", None):
+            lib().softdeca_model_destroy(self.handle)
+
+    def parameter(self, index: int) -> ParameterInfo:
+        p = ParameterInfo()
+        p.struct_size = C.sizeof(ParameterInfo)
+        check(lib().softdeca_model_get_parameter(self.handle, C.c_uint32(index), C.byref(p)))
+        return p
+
+    def find_parameter(self, name: str) -> int:
+        i = C.c_uint32()
+        check(lib().softdeca_model_find_parameter(self.handle, name.encode(), C.byref(i)))
+        return i.value
+
+    def landmark_vertices(self) -> np.ndarray:
+        out = np.zeros(self.info.landmark_count, dtype=np.int32)
+        check(
+            lib().softdeca_model_get_landmark_vertices(
+                self.handle, _ptr(out, C.c_int32), C.c_size_t(len(out))
+            )
+        )
+        return out
+
+    def skin_triangles(self) -> np.ndarray:
+        out = np.zeros((self.info.skin_triangle_count, 3), dtype=np.int32)
+        check(
+            lib().softdeca_model_get_skin_triangles(
+                self.handle, _ptr(out, C.c_int32), C.c_size_t(len(out))
+            )
+        )
+        return out
+
+    def evaluate_landmarks(self, vertices: np.ndarray) -> np.ndarray:
+        v = _f32(vertices)
+        out = np.zeros((self.info.landmark_count, 3), dtype=np.float32)
+        check(
+            lib().softdeca_model_evaluate_landmarks(
+                self.handle, _ptr(v), len(v), _ptr(out), C.c_size_t(len(out))
+            )
+        )
+        return out
+
+
+class NativeAvatar:
+    """softdeca_avatar: one head and its per-frame state."""
+
+    def __init__(
+        self,
+        model: NativeModel,
+        neutral: np.ndarray,
+        triangles: np.ndarray,
+        blendshapes: np.ndarray | None = None,
+        threads: int = 1,
+        precision: str = "half",
+    ) -> None:
+        self.model = model
+        self.vh = model.info.head_vertex_count
+        n = _f32(neutral)
+        t = np.ascontiguousarray(triangles, dtype=np.int32)
+        b = None if blendshapes is None else _f32(blendshapes)
+        desc = AvatarDesc(
+            C.sizeof(AvatarDesc),
+            _ptr(n),
+            len(n),
+            _ptr(t, C.c_int32),
+            len(t),
+            _ptr(b),
+            0 if b is None else len(b),
+            threads,
+            PRECISIONS[precision],
+        )
+        self.handle = C.c_void_p()
+        check(lib().softdeca_avatar_create(model.handle, C.byref(desc), C.byref(self.handle)))
+        self.vertices = np.zeros((self.vh, 3), dtype=np.float32)
+        self.normals = np.zeros((self.vh, 3), dtype=np.float32)
+        self._out = Output(
+            C.sizeof(Output), _ptr(self.vertices), self.vh, _ptr(self.normals), self.vh
+        )
+
+    def close(self) -> None:
+        if self.handle:
+            check(lib().softdeca_avatar_destroy(self.handle))
+            self.handle = C.c_void_p()
+
+    def __del__(self) -> None:
+        if getattr(self, "handle", None):
+            lib().softdeca_avatar_destroy(self.handle)
+
+    # ---- parameters -----------------------------------------------------------------------
+    def set_parameter(self, name: str, value: float) -> None:
+        i = self.model.find_parameter(name)
+        check(lib().softdeca_avatar_set_parameter(self.handle, C.c_uint32(i), C.c_float(value)))
+
+    def set_parameter_faces(self, name: str, values: np.ndarray) -> None:
+        v = _f32(values)
+        i = self.model.find_parameter(name)
+        check(lib().softdeca_avatar_set_parameter_faces(self.handle, i, _ptr(v), len(v)))
+
+    def set_parameter_vertices(self, name: str, values: np.ndarray) -> None:
+        v = _f32(values)
+        i = self.model.find_parameter(name)
+        check(lib().softdeca_avatar_set_parameter_vertices(self.handle, i, _ptr(v), len(v)))
+
+    def identity(self) -> np.ndarray:
+        out = np.zeros(self.model.info.identity_size, dtype=np.float32)
+        check(lib().softdeca_avatar_get_identity(self.handle, _ptr(out), len(out)))
+        return out
+
+    def set_identity(self, h: np.ndarray) -> None:
+        v = _f32(h)
+        check(lib().softdeca_avatar_set_identity(self.handle, _ptr(v), len(v)))
+
+    def prepare(self) -> None:
+        check(lib().softdeca_avatar_prepare(self.handle))
+
+    def set_dynamics(self, on: bool) -> None:
+        check(lib().softdeca_avatar_set_dynamics(self.handle, int(on)))
+
+    def reset_dynamics(self) -> None:
+        check(lib().softdeca_avatar_reset_dynamics(self.handle))
+
+    # ---- frames: each returns (vertices, normals), copies of the output buffers -----------
+    def _result(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.vertices.copy(), self.normals.copy()
+
+    def evaluate_weights(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        w = _f32(weights)
+        check(
+            lib().softdeca_avatar_evaluate_weights(self.handle, _ptr(w), len(w), C.byref(self._out))
+        )
+        return self._result()
+
+    def evaluate_surface(
+        self, weights: np.ndarray, surface: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        w, s = _f32(weights), _f32(surface)
+        check(
+            lib().softdeca_avatar_evaluate_surface(
+                self.handle, _ptr(w), len(w), _ptr(s), len(s), C.byref(self._out)
+            )
+        )
+        return self._result()
+
+    def calibrate_landmarks(self, points: np.ndarray) -> None:
+        p = _f32(points)
+        check(lib().softdeca_avatar_calibrate_landmarks(self.handle, _ptr(p), len(p)))
+
+    def evaluate_landmarks(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        p = _f32(points)
+        check(
+            lib().softdeca_avatar_evaluate_landmarks(
+                self.handle, _ptr(p), len(p), C.byref(self._out)
+            )
+        )
+        return self._result()
+
+    def evaluate_linear(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        w = _f32(weights)
+        check(
+            lib().softdeca_avatar_evaluate_linear(self.handle, _ptr(w), len(w), C.byref(self._out))
+        )
+        return self._result()
+
+    def stats(self) -> Stats:
+        s = Stats()
+        s.size = C.sizeof(Stats)
+        check(lib().softdeca_avatar_get_stats(self.handle, C.byref(s)))
+        return s
