@@ -28,7 +28,7 @@ namespace {
 using stream::percentile;
 using stream::steady_seconds;
 
-constexpr std::size_t kLandmarks = 68;  // the ARKit 68-point profile: a typical frame
+constexpr std::size_t kLandmarks = 149;  // SparseSoftDECA's landmark profile (softdeca149)
 
 // The 1-minute load average (Linux), to tell the reader how busy the machine was.
 double load_average() {
