@@ -5,9 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <sys/resource.h>
 
 #include "command.h"
 #include "json.h"
@@ -24,7 +28,15 @@ namespace {
 using stream::percentile;
 using stream::steady_seconds;
 
-constexpr std::size_t kLandmarks = 68;  // the ARKit 68-point profile: a typical frame
+constexpr std::size_t kLandmarks = 149;  // SparseSoftDECA's landmark profile (softdeca149)
+
+// The 1-minute load average (Linux), to tell the reader how busy the machine was.
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double load = -1;
+  in >> load;
+  return load;
+}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -84,10 +96,19 @@ stream::ReceiverConfig loopback() {
 struct Throughput {
   double per_second;       // frames delivered per second
   double delivered_ratio;  // of the frames sent (the rest overflowed the socket's buffer)
+  double cpu_us;           // process CPU time (all threads: sender, receiver, consumer) per frame
 };
+
+// User plus system CPU seconds of this process so far.
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 // Frames sent as fast as the socket takes them; the rate at which the receiver delivers them.
 Throughput throughput_run(std::size_t frames) {
+  const double cpu_start = process_cpu_seconds();
   Receiving r(loopback());
   stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.receiver.port()), stream::Format::softdeca, 7);
   const double start = steady_seconds();
@@ -104,7 +125,9 @@ Throughput throughput_run(std::size_t frames) {
   }
   r.finish();
   if (r.popped < 2) throw std::runtime_error("the throughput run delivered no frames");
-  return {double(r.popped) / (r.last_pop - start), double(r.popped) / double(frames)};
+  // The 0.2 s of polling at the end costs next to no CPU: the figure is the streaming work.
+  const double cpu = process_cpu_seconds() - cpu_start;
+  return {double(r.popped) / (r.last_pop - start), double(r.popped) / double(frames), 1e6 * cpu / double(r.popped)};
 }
 
 // Frames paced at `rate`; send -> available latencies of every frame.
@@ -182,6 +205,8 @@ int run_bench_streaming(const Args& args) {
       .option("--recording-frames", "N", "frames per recording run", "20000")
       .option("--scratch", "DIR", "where the recording runs write their file", "build/bench");
   if (!o.parse(args)) return 0;
+  for (const std::string& dir : {std::filesystem::path(o.text("--out")).parent_path().string(), o.text("--scratch")})
+    if (!dir.empty()) std::filesystem::create_directories(dir);
   const long runs = o.integer("--runs"), tp = o.integer("--throughput-frames"), lat = o.integer("--latency-frames"),
              recf = o.integer("--recording-frames");
   const double lat_rate = o.number("--latency-rate");
@@ -190,13 +215,15 @@ int run_bench_streaming(const Args& args) {
   std::vector<uint8_t> probe;
   stream::wire::encode_frame(sample_frame(0), probe);
 
-  std::vector<double> tput, delivered, p50, p99, decode_ns, write_fps, read_fps;
+  std::vector<double> tput, delivered, cpu_us, p50, p99, decode_ns, write_fps, read_fps;
+  double load = load_average();
   double bytes_per_frame = 0;
   for (long run = 0; run < runs; ++run) {
     std::fprintf(stderr, "\rbench-streaming: run %ld/%ld: throughput", run + 1, runs);
     const Throughput t = throughput_run(static_cast<std::size_t>(tp));
     tput.push_back(t.per_second);
     delivered.push_back(t.delivered_ratio);
+    cpu_us.push_back(t.cpu_us);
     std::fprintf(stderr, ", latency");
     const auto l = latency_run(static_cast<std::size_t>(lat), lat_rate);
     if (l.size() < static_cast<std::size_t>(lat) / 2) throw std::runtime_error("most latency frames were lost");
@@ -209,10 +236,13 @@ int run_bench_streaming(const Args& args) {
     write_fps.push_back(r.write_fps);
     read_fps.push_back(r.read_fps);
     bytes_per_frame = r.bytes_per_frame;
+    load = std::max(load, load_average());
   }
   std::fputc('\n', stderr);
 
-  const std::string cmd = "softdeca bench-streaming --runs " + std::to_string(runs);
+  char load_text[80];
+  std::snprintf(load_text, sizeof load_text, " (2-core machine load average up to %.1f during the runs)", load);
+  const std::string cmd = "softdeca bench-streaming --runs " + std::to_string(runs) + load_text;
   const std::string frame = std::to_string(probe.size()) + "-byte frame datagrams (52 weights, head and eye poses, " +
                             std::to_string(kLandmarks) + " landmarks)";
   JsonObject out;
@@ -221,6 +251,11 @@ int run_bench_streaming(const Args& args) {
                  cmd + ": median of " + std::to_string(runs) + " runs; " + std::to_string(tp) + " " + frame +
                      " sent as fast as possible to a receiver on 127.0.0.1 (no jitter delay); frames delivered per "
                      "second from the first send to the last delivery"));
+  out.raw("streaming.cpu_us_per_datagram",
+          figure(median(cpu_us), "us", "null", "lower",
+                 cmd + ": in the throughput runs, the process's CPU time (sender, receiver and consumer "
+                       "threads, user + system) per frame delivered; unlike the rate, it does not depend on "
+                       "what else the machine runs"));
   out.raw("streaming.blast_delivered_ratio",
           figure(median(delivered), "ratio", "null", "higher",
                  cmd + ": in the throughput runs, the share of frames delivered (the rest overflowed the "

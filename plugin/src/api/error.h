@@ -53,6 +53,12 @@ inline void require(bool condition, const std::string& message,
   if (!condition) throw Error(status, message);
 }
 
+// A literal message: no string is built unless the check fails (checks on per-frame paths).
+inline void require(bool condition, const char* message,
+                    softdeca_status status = SOFTDECA_ERROR_INVALID_ARGUMENT) {
+  if (!condition) throw Error(status, message);
+}
+
 inline void require_not_null(const void* p, const char* name) {
   if (p == nullptr) throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, std::string(name) + " is null");
 }

@@ -21,7 +21,8 @@ stream::Pose pose_in(const softdeca_pose& in, const char* name) {
   std::copy(in.rotation, in.rotation + 4, p.rotation.begin());
   require_finite(p.position.data(), 3, name);
   require_finite(p.rotation.data(), 4, name);
-  require(stream::normalize_rotation(p.rotation), std::string(name) + ".rotation is not a unit quaternion");
+  if (!stream::normalize_rotation(p.rotation))
+    throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, std::string(name) + ".rotation is not a unit quaternion");
   return p;
 }
 
@@ -59,8 +60,8 @@ stream::Frame frame_from_abi(const softdeca_frame* in) {
     require(std::isfinite(t), "frame times must be finite", SOFTDECA_ERROR_NON_FINITE);
   require_finite(in->weights, SOFTDECA_BLENDSHAPE_COUNT, "frame->weights");
   for (std::size_t i = 0; i < SOFTDECA_BLENDSHAPE_COUNT; ++i)
-    require(in->weights[i] >= 0 && in->weights[i] <= 1,
-            "frame->weights[" + std::to_string(i) + "] is outside [0, 1]");
+    if (!(in->weights[i] >= 0 && in->weights[i] <= 1))
+      throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, "frame->weights[" + std::to_string(i) + "] is outside [0, 1]");
   require_finite(in->landmarks, 3u * in->landmark_count, "frame->landmarks");
   f.has_head = in->flags & SOFTDECA_FRAME_HAS_HEAD;
   f.has_eyes = in->flags & SOFTDECA_FRAME_HAS_EYES;

@@ -19,8 +19,9 @@ namespace softdeca::abi {
 template <class T>
 void require_struct(const T* s, const char* name) {
   require_not_null(s, name);
-  require(s->size >= sizeof(T), std::string(name) + "->size is smaller than sizeof(" + name +
-                                    "): set it to sizeof the struct");
+  if (s->size < sizeof(T))
+    throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT,
+                std::string(name) + "->size is smaller than sizeof(" + name + "): set it to sizeof the struct");
 }
 
 void frame_to_abi(const stream::Frame& in, softdeca_frame* out);

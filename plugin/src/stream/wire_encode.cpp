@@ -25,7 +25,7 @@ void header(ByteWriter& w, MessageType type, uint32_t session_id, uint32_t seque
 
 void require_finite_values(const float* v, std::size_t n, const char* what) {
   for (std::size_t i = 0; i < n; ++i)
-    require(std::isfinite(v[i]), std::string(what) + " is not finite", SOFTDECA_ERROR_NON_FINITE);
+    if (!std::isfinite(v[i])) throw Error(SOFTDECA_ERROR_NON_FINITE, std::string(what) + " is not finite");
 }
 
 // Starts a block; returns where its length goes, patched by end_block.
@@ -40,8 +40,9 @@ void end_block(ByteWriter& w, std::size_t length_at) {
 }
 
 void check_size(const std::vector<uint8_t>& out) {
-  require(out.size() < kDatagramLimit, "datagram of " + std::to_string(out.size()) +
-                                           " bytes exceeds the 1,199-byte limit");
+  if (out.size() >= kDatagramLimit)
+    throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT,
+                "datagram of " + std::to_string(out.size()) + " bytes exceeds the 1,199-byte limit");
 }
 
 }  // namespace
@@ -81,8 +82,7 @@ std::vector<NeutralChunk> split_neutral(const float* xyz, std::size_t vertex_cou
 void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
   require(std::isfinite(f.capture_time) && std::isfinite(f.send_time),
           "frame times must be finite", SOFTDECA_ERROR_NON_FINITE);
-  require(f.landmark_count <= kMaxLandmarks,
-          "a frame carries at most " + std::to_string(kMaxLandmarks) + " landmarks");
+  require(f.landmark_count <= kMaxLandmarks, "a frame carries at most 150 landmarks");
   require_finite_values(f.weights.data(), f.weights.size(), "weight");
   require_finite_values(f.landmarks.data(), 3u * f.landmark_count, "landmark");
   out.clear();
@@ -127,8 +127,9 @@ void encode_frame(const Frame& f, std::vector<uint8_t>& out) {
     w.u16le(0);
     for (std::size_t i = 0; i < 3u * f.landmark_count; ++i) {
       const long q = std::lround(f.landmarks[i] / kLandmarkStep);
-      require(q >= -32768 && q <= 32767, "landmark coordinate " + std::to_string(f.landmarks[i]) +
-                                             " m is outside the [-0.32768, 0.32767] m the format carries");
+      if (q < -32768 || q > 32767)
+        throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, "landmark coordinate " + std::to_string(f.landmarks[i]) +
+                                                         " m is outside the [-0.32768, 0.32767] m the format carries");
       w.i16le(static_cast<int16_t>(q));
     }
     end_block(w, at);
