@@ -261,12 +261,12 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   auto t2 = Clock::now();
   st.hyper_ms = ms(t1, t2);
   for (int phase = 0; phase < DeformationTransfer::kPhases; ++phase) {
-    auto solve = [&](std::size_t part, std::size_t n_parts) {
-      (void)n_parts;
+    auto solve = [&](std::size_t part, std::size_t) {
       prep.dt->solve_phase(phase, part, rhs_parts_.data(), rhs_parts_.size(), head_.data(), solve_work_.data(),
                            static_.data());
     };
-    worker_.run(solve);
+    if (phase == 1) solve(0, worker_.parts());  // the serial top part: on this thread, no hand-off
+    else worker_.run(solve);
   }
   st.solve_ms = ms(t2, Clock::now());
 }
