@@ -21,7 +21,7 @@ export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
 
 help:
 	@echo "make demo    render the template, its layers, sampled identities, landmarks -> $(OUT)/demo"
-	@echo "make test    run every test (ctest release + ASan/UBSan, pytest)"
+	@echo "make test    run every test (ctest release + ASan/UBSan, pytest, short fuzzing)"
 	@echo "make bench   run the benchmarks -> build/bench/<area>.json"
 	@echo "make setup   install what is missing (apt, .venv, ONNX Runtime root); idempotent"
 	@echo "variables:   ICT=<ICT-FaceKit checkout or archive folder> (default $(ICT)), OUT=$(OUT)"
@@ -47,13 +47,15 @@ test-native: build build-asan
 test-python: build
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python
 
-test: lint test-native test-python
+test: lint test-native test-fuzz test-python
 
 demo: build
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo
 
 bench: build
 	@mkdir -p build/bench
+	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
+	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
 
 lint: setup
@@ -61,6 +63,37 @@ lint: setup
 
 clean:
 	rm -rf build $(OUT)
+
+# ---- Streaming and recorded takes (issue 7): fuzzing -------------------------------------------
+# libFuzzer targets of the streaming parsers (tests/fuzz), built by clang in build/fuzz.
+# test-fuzz: a few seconds each on the committed corpus; fuzz-long: the long runs of
+# docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
+FUZZ         := build/fuzz
+FUZZ_TARGETS := softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader
+FUZZ_SECONDS ?= 620
+
+.PHONY: fuzz-build test-fuzz fuzz-long
+
+fuzz-build: setup
+	@mkdir -p build; CXX=clang++ cmake -S tests/fuzz -B $(FUZZ) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  > $(FUZZ).configure.log 2>&1 || { cat $(FUZZ).configure.log; exit 1; }
+	@cmake --build $(FUZZ) -j $(JOBS)
+
+test-fuzz: fuzz-build
+	@echo "== fuzzing (3 s per target on tests/fuzz/corpus)"
+	@for t in $(FUZZ_TARGETS); do \
+	  tmp=$$(mktemp -d); \
+	  $(FUZZ)/fuzz_$$t -max_total_time=3 -rss_limit_mb=2048 -artifact_prefix=$$tmp/ $$tmp tests/fuzz/corpus/$$t \
+	    > $$tmp/log 2>&1 || { tail -40 $$tmp/log; echo "fuzz_$$t failed: input in $$tmp"; exit 1; }; \
+	  echo "fuzz_$$t: $$(grep -o 'Done [0-9]* runs' $$tmp/log), no crash"; rm -rf $$tmp; \
+	done
+
+fuzz-long: fuzz-build
+	@mkdir -p build/fuzz-long
+	@echo "$(FUZZ_TARGETS)" | tr ' ' '\n' | xargs -P 2 -I{} sh -c 'mkdir -p build/fuzz-long/{}/corpus && \
+	  nice -n 10 $(FUZZ)/fuzz_{} -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 -rss_limit_mb=2048 \
+	  -artifact_prefix=build/fuzz-long/{}/ build/fuzz-long/{}/corpus tests/fuzz/corpus/{} \
+	  > build/fuzz-long/{}.log 2>&1; echo "fuzz_{}: exit $$?, $$(grep -o "Done [0-9]* runs in [0-9]* second(s)" build/fuzz-long/{}.log)"'
 
 # ---- Runtime (issue 6) -----------------------------------------------------------------------
 # `make bench` also measures the native runtime (build/bench/runtime.json). `make replay-demo`

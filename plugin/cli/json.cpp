@@ -24,16 +24,21 @@ std::string json_string(const std::string& text) {
   return out + "\"";
 }
 
-std::string json_number(double v) {
+namespace {
+std::string format(double v, const char* spec) {
   if (!std::isfinite(v)) return "null";
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
+  std::snprintf(buf, sizeof buf, spec, v);
   return buf;
 }
+}  // namespace
+
+// 17 significant digits give a double back exactly, 9 a float.
+std::string json_number(double v) { return format(v, "%.17g"); }
 
 std::string json_array(const float* values, std::size_t count) {
   std::string out = "[";
-  for (std::size_t i = 0; i < count; ++i) out += (i ? "," : "") + json_number(values[i]);
+  for (std::size_t i = 0; i < count; ++i) out += (i ? "," : "") + format(values[i], "%.9g");
   return out + "]";
 }
 

@@ -49,6 +49,7 @@ nb::dict stats_dict(const SolveStats& s) {
   d["contacts"] = s.contacts;
   d["collision_rounds"] = s.collision_rounds;
   d["max_contact_gap"] = s.max_contact_gap;
+  d["collision_seconds"] = s.collision_seconds;
   return d;
 }
 
@@ -212,6 +213,18 @@ void bind_sim(nb::module_& m) {
       .def("embed_skin", [](const SimulationMesh& m, const Positions& x) { return embed(m.skin, x); }, nb::arg("vertices"),
            "Skin point positions for simulated vertex positions.");
 
+  m.def(
+      "find_penetrations",
+      [](const SimulationMesh& mesh, const Positions& skin, const Positions& vertices, double tolerance) {
+        if (skin.rows() != mesh.skin_count() || vertices.rows() != mesh.vertex_count())
+          throw nb::value_error("skin and vertices must match the mesh's skin and vertex counts");
+        nb::list out;
+        for (const Contact& c : find_penetrations(mesh, skin, vertices, tolerance))
+          out.append(nb::make_tuple(mesh.collisions[static_cast<std::size_t>(c.set)].name, c.point, c.depth));
+        return out;
+      },
+      nb::arg("mesh"), nb::arg("skin"), nb::arg("vertices"), nb::arg("tolerance") = 1e-5,
+      "Skin points behind their collision surface: [(set name, skin point, depth in m)].");
   m.def(
       "skin_embedding_from_tets",
       [](const Idx4& tets, const std::vector<int32_t>& tet_index, const W4& bary) {

@@ -452,6 +452,257 @@ SOFTDECA_API softdeca_status softdeca_sim_get_vertices(const softdeca_sim* sim, 
                                                        size_t vertex_count);
 SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, float* out_skin, size_t skin_count);
 
+/* ==== Streaming and recorded takes (issue 7) ============================================
+ * Face frames arrive live over UDP (our protocol, docs/protocol.md; Epic's Live Link Face app;
+ * iFacialMocap) or from recording files (docs/recording.md), and all come out as one canonical
+ * frame: 52 weights in canonical ARKit order (softdeca_blendshape_name), poses and landmarks in
+ * metres in ARKit's face-anchor frame.
+ * Structs with a `size` field: set it to sizeof(the struct) before the call; the library reads
+ * and writes only the fields of the size it knows and rejects a smaller size.
+ * The receiver's functions may be called from any thread, concurrently, except
+ * softdeca_receiver_destroy, which must follow every other call on that receiver; a recorder or
+ * player handle must be used by one thread at a time. */
+
+#define SOFTDECA_BLENDSHAPE_COUNT 52
+#define SOFTDECA_MAX_LANDMARKS 150     /* landmarks per frame (a profile names at most this many) */
+#define SOFTDECA_ARKIT_VERTEX_COUNT 1220 /* vertices of ARKit's face mesh */
+
+/* Canonical name of blendshape `index` ("browDownLeft" = 0 ... "tongueOut" = 51), or NULL when
+ * index >= 52. Static strings. */
+SOFTDECA_API const char* softdeca_blendshape_name(uint32_t index);
+
+typedef enum softdeca_tracking {
+  SOFTDECA_TRACKING_LOST = 0,
+  SOFTDECA_TRACKING_TRACKED = 1,
+  SOFTDECA_TRACKING_LIMITED = 2
+} softdeca_tracking;
+
+/* softdeca_frame.flags */
+#define SOFTDECA_FRAME_HAS_HEAD 1u     /* head pose present */
+#define SOFTDECA_FRAME_HAS_EYES 2u     /* eye poses present */
+#define SOFTDECA_FRAME_HAS_SEQUENCE 4u /* the sender numbers its datagrams (our protocol) */
+
+/* A rigid pose: position in metres, rotation as a unit quaternion (x, y, z, w). */
+typedef struct softdeca_pose {
+  float position[3];
+  float rotation[4];
+} softdeca_pose;
+
+typedef struct softdeca_frame {
+  uint32_t size;          /* sizeof(softdeca_frame) */
+  uint32_t flags;         /* SOFTDECA_FRAME_HAS_* */
+  uint32_t session_id;    /* the sender's stream */
+  uint32_t sequence;      /* the sender's datagram number, with SOFTDECA_FRAME_HAS_SEQUENCE */
+  int32_t tracking;       /* softdeca_tracking */
+  uint32_t profile_id;    /* landmark profile naming the landmarks' vertices; 0: none */
+  double capture_time;    /* seconds, sender's clock (ARKit timestamp, or timecode since midnight) */
+  double send_time;       /* seconds, sender's clock; 0: unknown */
+  double receive_time;    /* seconds, this host's monotonic clock; 0: not received live */
+  float weights[SOFTDECA_BLENDSHAPE_COUNT]; /* [0, 1], canonical ARKit order */
+  softdeca_pose head;      /* the face anchor's pose in ARKit's world frame */
+  softdeca_pose left_eye;  /* relative to the face anchor */
+  softdeca_pose right_eye;
+  uint32_t landmark_count;
+  uint32_t reserved;
+  float landmarks[SOFTDECA_MAX_LANDMARKS * 3]; /* xyz per landmark, face-anchor frame */
+} softdeca_frame;
+
+/* ---- Receiver: a background thread reading one UDP port --------------------------------- */
+
+typedef enum softdeca_stream_format {
+  SOFTDECA_FORMAT_AUTO = 0,         /* recognise each datagram's format */
+  SOFTDECA_FORMAT_SOFTDECA = 1,     /* ours (default port 50110) */
+  SOFTDECA_FORMAT_LIVELINKFACE = 2, /* Live Link Face UDP, version 6 (default port 11111) */
+  SOFTDECA_FORMAT_IFACIALMOCAP = 3  /* iFacialMocap text (default port 49983) */
+} softdeca_stream_format;
+
+typedef struct softdeca_receiver_config {
+  uint32_t size;
+  int32_t format;           /* softdeca_stream_format */
+  const char* bind_address; /* numeric IPv4 or IPv6 address; NULL: "0.0.0.0" (all IPv4) */
+  uint32_t port;            /* 0: any free port (softdeca_receiver_port tells which) */
+  uint32_t queue_capacity;  /* delivered frames kept for softdeca_receiver_next, 1 to 65536 */
+  double jitter_delay;      /* seconds in [0, 5] that frames wait to be put in order; 0: none */
+} softdeca_receiver_config;
+
+/* Fills a config with the defaults: auto format, 0.0.0.0:50110, 256 frames, no delay. */
+SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_config* config);
+
+typedef struct softdeca_receiver softdeca_receiver;
+
+/* Binds the socket and starts the thread (SOFTDECA_ERROR_IO when the port is taken). */
+SOFTDECA_API softdeca_status softdeca_receiver_create(const softdeca_receiver_config* config,
+                                                      softdeca_receiver** out_receiver);
+/* Stops the thread and frees the receiver (and ends its recording). NULL is ignored. */
+SOFTDECA_API void softdeca_receiver_destroy(softdeca_receiver* receiver);
+SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* receiver,
+                                                    uint32_t* out_port);
+/* The oldest delivered frame not yet taken, waiting up to `timeout` seconds (0: do not wait).
+ * *out_received is 1 when a frame was written, else 0. */
+SOFTDECA_API softdeca_status softdeca_receiver_next(softdeca_receiver* receiver, double timeout,
+                                                    softdeca_frame* out_frame,
+                                                    int32_t* out_received);
+/* The newest delivered frame, taken or not (what an avatar shows now). */
+SOFTDECA_API softdeca_status softdeca_receiver_latest(const softdeca_receiver* receiver,
+                                                      softdeca_frame* out_frame,
+                                                      int32_t* out_received);
+
+typedef struct softdeca_receiver_stats {
+  uint32_t size;
+  uint32_t reserved;
+  uint64_t datagrams;        /* read from the socket */
+  uint64_t frames;           /* well-formed frames */
+  uint64_t control_messages; /* well-formed profile, neutral and request messages */
+  uint64_t delivered;        /* frames out of the jitter buffer */
+  uint64_t malformed;        /* dropped as malformed: the sum of the six below */
+  uint64_t undersized;
+  uint64_t oversized;
+  uint64_t bad_magic;
+  uint64_t incompatible_version;
+  uint64_t bad_length;       /* a length or count that disagrees with the datagram */
+  uint64_t bad_value;        /* NaN, out-of-range index, mismatching id */
+  uint64_t unknown_type;     /* messages of a newer protocol minor version: ignored */
+  uint64_t duplicates;       /* dropped */
+  uint64_t reordered;        /* arrived after a newer datagram */
+  uint64_t late;             /* dropped: a newer frame had already been delivered */
+  uint64_t lost;             /* sequence numbers never received */
+  uint64_t expected;         /* sequence numbers the senders used */
+  uint64_t overflowed;       /* delivered frames dropped because nobody took them */
+  uint64_t session_changes;
+  uint64_t clock_resyncs;    /* the sender's capture clock jumped */
+  uint64_t requests_sent;    /* profile or neutral requests sent to the sender */
+  double frame_rate_hz;      /* delivered frames per second over the last ~2 s */
+  double loss_ratio;         /* lost / expected */
+  double latency_p50_ms;     /* arrival at the socket -> frame available, recent frames */
+  double latency_p99_ms;
+} softdeca_receiver_stats;
+
+SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver* receiver,
+                                                         softdeca_receiver_stats* out_stats);
+/* The landmark profile of the newest landmark frames (else the newest profile received):
+ * its id and ARKit vertex indices. *out_count is always set to the profile's size (0 and id 0
+ * when there is none yet); SOFTDECA_ERROR_BUFFER_TOO_SMALL when capacity is smaller. */
+SOFTDECA_API softdeca_status softdeca_receiver_profile(const softdeca_receiver* receiver,
+                                                       uint32_t* out_id, uint16_t* out_indices,
+                                                       size_t capacity, size_t* out_count);
+/* The sender's neutral face mesh (calibration), xyz per vertex; *out_vertex_count as above. */
+SOFTDECA_API softdeca_status softdeca_receiver_neutral(const softdeca_receiver* receiver,
+                                                       float* out_xyz, size_t vertex_capacity,
+                                                       size_t* out_vertex_count);
+/* Asks the current sender (our protocol) for its neutral mesh; *out_sent 0 without a sender. */
+SOFTDECA_API softdeca_status softdeca_receiver_request_neutral(softdeca_receiver* receiver,
+                                                               int32_t* out_sent);
+
+/* ---- Recordings ----------------------------------------------------------------------------- */
+
+typedef struct softdeca_recording_header {
+  uint32_t size;
+  uint32_t reserved;
+  const char* device;     /* capturing device or app; NULL: "" */
+  const char* subject;    /* performer or take; NULL: "" */
+  const char* source;     /* where frames come from; NULL: "" */
+  double start_unix_time; /* seconds since 1970-01-01 UTC; 0: unknown */
+  double timecode_rate;   /* frames per second of a timecode clock; 0: none */
+} softdeca_recording_header;
+
+/* Records every frame the receiver delivers from now on into a new file at `path`, with the
+ * profiles and neutral meshes the stream carries. */
+SOFTDECA_API softdeca_status softdeca_receiver_start_recording(
+    softdeca_receiver* receiver, const char* path, const softdeca_recording_header* header);
+/* Ends the recording; *out_frames (may be NULL) gets the frames written. SOFTDECA_ERROR_IO when
+ * a write failed on the way (the file then holds every frame before the failure). */
+SOFTDECA_API softdeca_status softdeca_receiver_stop_recording(softdeca_receiver* receiver,
+                                                              uint64_t* out_frames);
+
+typedef struct softdeca_recorder softdeca_recorder;
+
+/* Creates (replaces) a recording file and writes its header. */
+SOFTDECA_API softdeca_status softdeca_recorder_create(const char* path,
+                                                      const softdeca_recording_header* header,
+                                                      softdeca_recorder** out_recorder);
+/* Appends a frame; each is flushed to the operating system at once. */
+SOFTDECA_API softdeca_status softdeca_recorder_write(softdeca_recorder* recorder,
+                                                     const softdeca_frame* frame);
+/* Appends a landmark profile (name may be NULL) and returns its id for frames to name. */
+SOFTDECA_API softdeca_status softdeca_recorder_write_profile(softdeca_recorder* recorder,
+                                                             const char* name,
+                                                             const uint16_t* indices, size_t count,
+                                                             uint32_t* out_id);
+SOFTDECA_API softdeca_status softdeca_recorder_write_neutral(softdeca_recorder* recorder,
+                                                             const float* xyz,
+                                                             size_t vertex_count);
+/* Closes the file. NULL is ignored. */
+SOFTDECA_API void softdeca_recorder_destroy(softdeca_recorder* recorder);
+
+typedef struct softdeca_recording_info {
+  uint32_t size;
+  uint32_t frame_count;
+  double duration;         /* seconds from the first to the last frame */
+  double start_unix_time;
+  double timecode_rate;
+  uint32_t damaged_regions; /* stretches of the file skipped as damaged */
+  uint32_t truncated_bytes; /* an incomplete record at the end (a cut-off write) */
+  char device[64];          /* NUL-terminated, cut to 63 bytes */
+  char subject[64];
+  char source[64];
+} softdeca_recording_info;
+
+typedef struct softdeca_player softdeca_player;
+
+/* Reads a recording, recovering what a damaged file still holds (info tells what was lost);
+ * SOFTDECA_ERROR_FORMAT when its header is unreadable or it has no frame. */
+SOFTDECA_API softdeca_status softdeca_player_open(const char* path, softdeca_player** out_player);
+SOFTDECA_API void softdeca_player_destroy(softdeca_player* player);
+SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player,
+                                                  softdeca_recording_info* out_info);
+/* Frame `index` as recorded (frames sorted by capture time). */
+SOFTDECA_API softdeca_status softdeca_player_frame(const softdeca_player* player, uint32_t index,
+                                                   softdeca_frame* out_frame);
+/* The frame `time` seconds after the first (clamped to the recording), interpolated. */
+SOFTDECA_API softdeca_status softdeca_player_frame_at(const softdeca_player* player, double time,
+                                                      softdeca_frame* out_frame);
+SOFTDECA_API softdeca_status softdeca_player_seek(softdeca_player* player, double time);
+/* Playback speed in [0, 1000]; 1 is real time, 0 pauses. */
+SOFTDECA_API softdeca_status softdeca_player_set_speed(softdeca_player* player, double speed);
+SOFTDECA_API softdeca_status softdeca_player_set_loop(softdeca_player* player, int32_t loop);
+/* Moves the playhead by dt * speed seconds (wrapping when looping) and returns the frame there;
+ * *out_ended (may be NULL) is 1 when playback reached the end without looping. */
+SOFTDECA_API softdeca_status softdeca_player_advance(softdeca_player* player, double dt,
+                                                     softdeca_frame* out_frame,
+                                                     int32_t* out_ended);
+SOFTDECA_API softdeca_status softdeca_player_position(const softdeca_player* player,
+                                                      double* out_time);
+/* The recording's newest landmark profile and neutral mesh, as for the receiver. */
+SOFTDECA_API softdeca_status softdeca_player_profile(const softdeca_player* player,
+                                                     uint32_t* out_id, uint16_t* out_indices,
+                                                     size_t capacity, size_t* out_count);
+SOFTDECA_API softdeca_status softdeca_player_neutral(const softdeca_player* player,
+                                                     float* out_xyz, size_t vertex_capacity,
+                                                     size_t* out_vertex_count);
+
+/* ---- Live Link Face CSV takes --------------------------------------------------------------- */
+
+typedef struct softdeca_convert_report {
+  uint32_t size;
+  uint32_t frames;         /* frames written */
+  uint32_t rows;           /* CSV data rows read (CSV -> recording) */
+  uint32_t face_lost_rows; /* rows where the app had lost the face: skipped */
+  uint32_t malformed_rows; /* rows that did not parse: skipped */
+} softdeca_convert_report;
+
+/* A Live Link Face CSV take into a recording. Columns are found by name; timecode_rate is the
+ * take's timecode clock (0: the app's default, 60). out_report may be NULL. */
+SOFTDECA_API softdeca_status softdeca_convert_livelinkface_csv(const char* csv_path,
+                                                               const char* recording_path,
+                                                               double timecode_rate,
+                                                               softdeca_convert_report* out_report);
+/* A recording into a Live Link Face CSV take; timecode_rate 0: the recording's, else 60. */
+SOFTDECA_API softdeca_status softdeca_export_livelinkface_csv(const char* recording_path,
+                                                              const char* csv_path,
+                                                              double timecode_rate,
+                                                              softdeca_convert_report* out_report);
+/* ==== end of streaming and recorded takes ================================================= */
+
 #ifdef __cplusplus
 }
 #endif

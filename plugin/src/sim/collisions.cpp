@@ -1,55 +1,115 @@
 #include "sim/collisions.h"
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
+#include <algorithm>
+#include <map>
 
-#include "sim/parameters.h"
+#include "sim/constraints_surface.h"
+#include "sim/constraints_target.h"
+#include "sim/model.h"
+#include "sim/system.h"
 
 namespace softdeca::sim {
 namespace {
 using Vec3 = Eigen::Vector3d;
 
-// Positions and rows (as combinations of simulated vertices) of a set's surface vertices.
-const Positions& surface_positions(const CollisionSet& set, const Positions& skin, const Positions& x) {
-  return set.surface_on_skin ? skin : x;
+std::pair<int32_t, int32_t> edge_key(int32_t a, int32_t b) { return a < b ? std::make_pair(a, b) : std::make_pair(b, a); }
+
+// Pseudo-normal of the closest feature (face; edge: sum of its faces' normals; vertex:
+// angle-weighted normal) from the surface's topology and the current positions; false on the
+// boundary, where inside and outside are undefined.
+bool feature_normal(const SurfaceTopology& topo, const TriIndices& tris, const Positions& x, Eigen::Index t,
+                    const Vec3& b, Vec3& n) {
+  auto face_normal = [&](Eigen::Index f) {
+    const Vec3 p0 = x.row(tris(f, 0)), p1 = x.row(tris(f, 1)), p2 = x.row(tris(f, 2));
+    const Vec3 m = (p1 - p0).cross(p2 - p0);
+    return m.norm() > 0 ? Vec3(m.normalized()) : Vec3::Zero();
+  };
+  int nonzero[3], count = 0;
+  for (int k = 0; k < 3; ++k)
+    if (b[k] > 0) nonzero[count++] = k;
+  if (count == 3) {
+    n = face_normal(t);
+    return true;
+  }
+  if (count == 2) {
+    const auto key = edge_key(tris(t, nonzero[0]), tris(t, nonzero[1]));
+    const auto range = std::equal_range(topo.edges.begin(), topo.edges.end(), std::make_pair(key, Eigen::Index{-1}),
+                                        [](const auto& l, const auto& r) { return l.first < r.first; });
+    if (range.second - range.first < 2) return false;
+    n.setZero();
+    for (auto it = range.first; it != range.second; ++it) n += face_normal(it->second);
+    return true;
+  }
+  const int32_t v = tris(t, nonzero[0]);
+  if (topo.boundary.count(v)) return false;
+  n.setZero();
+  const auto range = topo.vertex_faces.equal_range(v);
+  for (auto it = range.first; it != range.second; ++it) {
+    const Eigen::Index f = it->second;
+    int k = 0;
+    while (tris(f, k) != v) ++k;
+    const Vec3 p = x.row(v), e1 = Vec3(x.row(tris(f, (k + 1) % 3))) - p, e2 = Vec3(x.row(tris(f, (k + 2) % 3))) - p;
+    n += std::atan2(e1.cross(e2).norm(), e1.dot(e2)) * face_normal(f);
+  }
+  return true;
 }
 
-PointRow skin_point_row(const SimulationMesh& mesh, int32_t p) {
-  PointRow r;
-  for (int k = 0; k < 4; ++k)
-    if (mesh.skin.weight(p, k) != 0) {
-      r.vertex.push_back(mesh.skin.vertex(p, k));
-      r.weight.push_back(mesh.skin.weight(p, k));
-    }
-  return r;
+const Positions& surface_positions(const CollisionSet& set, const Positions& skin, const Positions& vertices) {
+  return set.surface_on_skin ? skin : vertices;
 }
 
-PointRow surface_vertex_row(const SimulationMesh& mesh, const CollisionSet& set, int32_t v) {
-  return set.surface_on_skin ? skin_point_row(mesh, v) : PointRow{{v}, {1.0}};
-}
-
-void add_scaled(PointRow& into, const PointRow& r, double s) {
-  for (std::size_t k = 0; k < r.vertex.size(); ++k) {
-    bool merged = false;
-    for (std::size_t e = 0; e < into.vertex.size() && !merged; ++e)
-      if (into.vertex[e] == r.vertex[k]) {
-        into.weight[e] += s * r.weight[k];
-        merged = true;
-      }
-    if (!merged) {
-      into.vertex.push_back(r.vertex[k]);
-      into.weight.push_back(s * r.weight[k]);
+// The contact as a constraint row over S (unknowns of the surface step) and its target: for
+// a surface on S the row is point - surface point with target 0; for a surface on simulated
+// vertices (teeth, fixed in this step) the row is the point and the target the surface point.
+TargetElement contact_element(const SimulationMesh& mesh, const Contact& c, const Positions& vertices, double weight,
+                              Eigen::RowVector3d& target) {
+  const CollisionSet& set = mesh.collisions[static_cast<std::size_t>(c.set)];
+  TargetElement e{PointRow{{c.point}, {1.0}}, weight};
+  target.setZero();
+  for (int k = 0; k < 3; ++k) {
+    const int32_t v = set.surface(c.triangle, k);
+    if (set.surface_on_skin) {
+      e.point.vertex.push_back(v);
+      e.point.weight.push_back(-c.bary[k]);
+    } else {
+      target += c.bary[k] * vertices.row(v);
     }
   }
+  return e;
 }
 
-PointRow contact_row(const SimulationMesh& mesh, const Contact& c) {
+double contact_gap(const SimulationMesh& mesh, const Contact& c, const Positions& skin, const Positions& vertices) {
   const CollisionSet& set = mesh.collisions[static_cast<std::size_t>(c.set)];
-  PointRow row;
-  add_scaled(row, skin_point_row(mesh, c.point), 1.0);
-  for (int k = 0; k < 3; ++k)
-    add_scaled(row, surface_vertex_row(mesh, set, set.surface(c.triangle, k)), -c.bary[k]);
-  return row;
+  const Positions& sv = surface_positions(set, skin, vertices);
+  Eigen::RowVector3d q = Eigen::RowVector3d::Zero();
+  for (int k = 0; k < 3; ++k) q += c.bary[k] * sv.row(set.surface(c.triangle, k));
+  return (skin.row(c.point) - q).norm();
+}
+
+// Skin points the surface step may move: the collision sets' points and skin surfaces, and
+// two rings of S around them so the correction fades out smoothly.
+std::vector<char> active_points(const SimulationMesh& mesh) {
+  const auto ns = static_cast<std::size_t>(mesh.skin_count());
+  std::vector<char> active(ns, 0);
+  for (const CollisionSet& set : mesh.collisions) {
+    for (int32_t p : set.points) active[static_cast<std::size_t>(p)] = 1;
+    if (set.surface_on_skin)
+      for (Eigen::Index i = 0; i < set.surface.size(); ++i) active[static_cast<std::size_t>(set.surface.data()[i])] = 1;
+  }
+  for (int ring = 0; ring < 2; ++ring) {
+    std::vector<char> next = active;
+    for (Eigen::Index t = 0; t < mesh.skin_triangles.rows(); ++t) {
+      bool touches = false;
+      for (int k = 0; k < 3; ++k) touches = touches || active[static_cast<std::size_t>(mesh.skin_triangles(t, k))];
+      if (touches)
+        for (int k = 0; k < 3; ++k) next[static_cast<std::size_t>(mesh.skin_triangles(t, k))] = 1;
+    }
+    active.swap(next);
+  }
+  return active;
 }
 }  // namespace
 
@@ -83,25 +143,50 @@ Vec3 closest_point_barycentric(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return {1 - v - w, v, w};
 }
 
-std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Positions& x, double tolerance) {
+SurfaceTopology::SurfaceTopology(const TriIndices& tris) {
+  for (Eigen::Index t = 0; t < tris.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      edges.emplace_back(edge_key(tris(t, k), tris(t, (k + 1) % 3)), t);
+      vertex_faces.emplace(tris(t, k), t);
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 1) boundary.insert(edges[i].first.first), boundary.insert(edges[i].first.second);
+    i = j;
+  }
+}
+
+CollisionTopology::CollisionTopology(const SimulationMesh& mesh) {
+  for (const CollisionSet& set : mesh.collisions) sets.emplace_back(set.surface);
+}
+
+std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Positions& skin, const Positions& vertices,
+                                       double tolerance) {
+  return find_penetrations(mesh, CollisionTopology(mesh), skin, vertices, tolerance);
+}
+
+std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const CollisionTopology& topology,
+                                       const Positions& skin, const Positions& vertices, double tolerance) {
   std::vector<Contact> out;
-  if (mesh.collisions.empty()) return out;
-  const Positions skin = embed(mesh.skin, x);
   for (std::size_t si = 0; si < mesh.collisions.size(); ++si) {
     const CollisionSet& set = mesh.collisions[si];
-    const Positions& sv = surface_positions(set, skin, x);
-    // Area-weighted vertex normals of the surface (only its own vertices are touched).
-    Positions normal = Positions::Zero(sv.rows(), 3);
+    const Positions& sv = surface_positions(set, skin, vertices);
+    // Triangle bounding boxes grown by max_distance: a cheap reject before the exact test.
+    std::vector<Eigen::AlignedBox3d> boxes(static_cast<std::size_t>(set.surface.rows()));
     for (Eigen::Index t = 0; t < set.surface.rows(); ++t) {
-      const Vec3 a = sv.row(set.surface(t, 0)), b = sv.row(set.surface(t, 1)), c = sv.row(set.surface(t, 2));
-      const Eigen::RowVector3d n = (b - a).cross(c - a).transpose();
-      for (int k = 0; k < 3; ++k) normal.row(set.surface(t, k)) += n;
+      auto& box = boxes[static_cast<std::size_t>(t)];
+      for (int k = 0; k < 3; ++k) box.extend(Vec3(sv.row(set.surface(t, k)).transpose()));
+      box.min().array() -= set.max_distance;
+      box.max().array() += set.max_distance;
     }
     for (int32_t p : set.points) {
       const Vec3 q = skin.row(p).transpose();
       Contact best{static_cast<int>(si), p, -1, Vec3::Zero(), 0};
       double best_d2 = set.max_distance * set.max_distance;
       for (Eigen::Index t = 0; t < set.surface.rows(); ++t) {
+        if (!boxes[static_cast<std::size_t>(t)].contains(q)) continue;
         if (set.surface_on_skin && (set.surface(t, 0) == p || set.surface(t, 1) == p || set.surface(t, 2) == p))
           continue;  // a point never collides with its own triangles
         const Vec3 a = sv.row(set.surface(t, 0)), b = sv.row(set.surface(t, 1)), c = sv.row(set.surface(t, 2));
@@ -114,12 +199,10 @@ std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Positio
         }
       }
       if (best.triangle < 0) continue;
-      Vec3 point = Vec3::Zero(), n = Vec3::Zero();
-      for (int k = 0; k < 3; ++k) {
-        point += best.bary[k] * sv.row(set.surface(best.triangle, k)).transpose();
-        n += best.bary[k] * normal.row(set.surface(best.triangle, k)).normalized().transpose();
-      }
-      if (!(n.norm() > 0)) continue;
+      Vec3 n;
+      if (!feature_normal(topology.sets[si], set.surface, sv, best.triangle, best.bary, n) || !(n.norm() > 0)) continue;
+      Vec3 point = Vec3::Zero();
+      for (int k = 0; k < 3; ++k) point += best.bary[k] * sv.row(set.surface(best.triangle, k)).transpose();
       best.depth = -(q - point).dot(n.normalized());
       if (best.depth > tolerance) out.push_back(best);
     }
@@ -127,21 +210,86 @@ std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Positio
   return out;
 }
 
-std::unique_ptr<TargetGroup> contact_group(const SimulationMesh& mesh, const std::vector<Contact>& contacts,
-                                           const Eigen::VectorXd& skin_area, double collision_weight) {
+CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
+                                   const Positions& vertices, const Eigen::VectorXd& skin_area,
+                                   const SolverSettings& settings, ThreadPool* pool) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CollisionResult r;
+  r.skin = skin;
+  std::vector<Contact> found = find_penetrations(mesh, topology, skin, vertices, settings.penetration_tolerance);
+  r.penetrating_before = static_cast<int>(found.size());
+  if (found.empty() || settings.collision_rounds == 0) {
+    r.penetrating_after = r.penetrating_before;
+    return r;
+  }
   const PhysicalConstants& k = physical_constants();
-  std::vector<TargetElement> el;
-  el.reserve(contacts.size());
-  for (const Contact& c : contacts)
-    el.push_back(TargetElement{contact_row(mesh, c), k.pascal_per_weight_unit * collision_weight * skin_area[c.point] /
-                                                         k.target_layer_thickness_m});
-  return std::make_unique<TargetGroup>("contacts", std::move(el));
-}
+  const double pa = k.pascal_per_weight_unit;
+  const std::vector<char> active = active_points(mesh);
+  const double length = (skin.colwise().maxCoeff() - skin.colwise().minCoeff()).norm();
+  // Shape of the solved skin (strain relative to it), a weak pull back to it, stiff contacts.
+  constexpr double kShapeKpa = 1.0, kAnchorKpa = 0.01;
+  std::vector<TriangleElement> shape;
+  for (Eigen::Index t = 0; t < mesh.skin_triangles.rows(); ++t) {
+    TriangleElement e;
+    bool touches = false;
+    for (int c = 0; c < 3; ++c) {
+      const int32_t p = mesh.skin_triangles(t, c);
+      e.corner[static_cast<std::size_t>(c)] = PointRow{{p}, {1.0}};
+      touches = touches || active[static_cast<std::size_t>(p)];
+    }
+    if (!touches) continue;
+    TriangleStrainGroup::set_rest(e, skin.row(mesh.skin_triangles(t, 0)).transpose(),
+                                  skin.row(mesh.skin_triangles(t, 1)).transpose(),
+                                  skin.row(mesh.skin_triangles(t, 2)).transpose());
+    e.weight = kShapeKpa * k.skin_thickness_m;
+    shape.push_back(std::move(e));
+  }
+  std::vector<TargetElement> anchor;
+  std::vector<int32_t> anchored;
+  for (std::size_t p = 0; p < active.size(); ++p)
+    if (active[p]) {
+      const auto i = static_cast<Eigen::Index>(p);
+      anchor.push_back({PointRow{{static_cast<int32_t>(p)}, {1.0}}, pa * kAnchorKpa * skin_area[i] / k.target_layer_thickness_m});
+      anchored.push_back(static_cast<int32_t>(p));
+    }
 
-double max_contact_gap(const SimulationMesh& mesh, const std::vector<Contact>& contacts, const Positions& x) {
-  double gap = 0;
-  for (const Contact& c : contacts) gap = std::max(gap, contact_row(mesh, c).apply(x).norm());
-  return gap;
+  std::map<std::pair<int, int32_t>, Contact> contacts;  // one per (set, point)
+  while (!found.empty() && r.rounds < settings.collision_rounds) {
+    for (const Contact& c : found) contacts[{c.set, c.point}] = c;
+    Model m;
+    m.pinned.resize(active.size());
+    for (std::size_t p = 0; p < active.size(); ++p) m.pinned[p] = !active[p];
+    add_group(m, std::make_unique<TriangleStrainGroup>("lip shape", shape, pa));
+    const Eigen::Index anchor_row = m.rows;
+    add_group(m, std::make_unique<TargetGroup>("lip anchor", anchor));
+    std::vector<TargetElement> ties;
+    Positions tie_targets(static_cast<Eigen::Index>(contacts.size()), 3);
+    for (const auto& [key, c] : contacts) {
+      Eigen::RowVector3d target;
+      ties.push_back(contact_element(mesh, c, vertices, pa * settings.collision_weight * skin_area[c.point] /
+                                                            k.target_layer_thickness_m, target));
+      tie_targets.row(static_cast<Eigen::Index>(ties.size()) - 1) = target;
+    }
+    const Eigen::Index tie_row = m.rows;
+    add_group(m, std::make_unique<TargetGroup>("contacts", std::move(ties)));
+    const System sys(m);
+    Positions P = Positions::Zero(sys.rows(), 3);
+    for (std::size_t i = 0; i < anchored.size(); ++i)
+      P.row(anchor_row + static_cast<Eigen::Index>(i)) = skin.row(anchored[i]);
+    P.middleRows(tie_row, tie_targets.rows()) = tie_targets;
+    SolveStats stats;
+    SolverSettings s = settings;
+    s.record_energy = false;
+    run_projective_dynamics(FrameProblem{&m, &sys, nullptr, nullptr, length}, P, r.skin, s, pool, stats);
+    r.iterations += stats.iterations;
+    ++r.rounds;
+    found = find_penetrations(mesh, topology, r.skin, vertices, settings.penetration_tolerance);
+  }
+  r.penetrating_after = static_cast<int>(found.size());
+  r.contacts = static_cast<int>(contacts.size());
+  for (const auto& [key, c] : contacts) r.max_contact_gap = std::max(r.max_contact_gap, contact_gap(mesh, c, r.skin, vertices));
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
 }
 
 }  // namespace softdeca::sim

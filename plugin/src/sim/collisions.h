@@ -1,36 +1,72 @@
-// Lip and teeth collisions (paper 3.3.2), resolved after the solve by a further projective
-// step as in Komaritzan and Botsch's projective skinning: each penetrating point is tied to
-// the closest point of the surface it went through by a stiff constraint whose target is
-// zero distance, so the two coincide and no gap opens between upper and lower lip.
+// Lip and teeth collisions (paper 3.3.2), resolved after the volumetric solve by a further
+// projective step on the skin surface S itself, as in Komaritzan and Botsch's projective
+// skinning: each penetrating point is tied to the closest point of the surface it went
+// through by a stiff constraint whose target is zero distance, so the two coincide and no gap
+// opens between upper and lower lip; the rest of the lip region follows through strain
+// constraints that keep the shape the volumetric solve produced.
+//
+// Why on S and not through the tets: S rides in the outer tet layer, and where the layer is
+// thick (the layered head model closes its wraps over the mouth, so one tet can span both
+// lips and the mouth cavity) the embedding cannot move an upper-lip point independently of
+// the lower-lip point next to it. On S the resolution is the skin's own.
 #pragma once
 
-#include <memory>
+#include <map>
+#include <set>
+#include <utility>
 #include <vector>
 
-#include "sim/constraints_target.h"
 #include "sim/mesh.h"
+#include "sim/solver.h"
+#include "sim/thread_pool.h"
 
 namespace softdeca::sim {
 
 struct Contact {
-  int set;                  // index into mesh.collisions
-  int32_t point;            // skin point
-  int32_t triangle;         // row of the set's surface
-  Eigen::Vector3d bary;     // closest point on that triangle
-  double depth;             // how far behind the surface (m), positive when penetrating
+  int set;               // index into mesh.collisions
+  int32_t point;         // skin point
+  int32_t triangle;      // row of the set's surface
+  Eigen::Vector3d bary;  // closest point on that triangle
+  double depth;          // how far behind the surface (m), positive when penetrating
 };
 
-// Points of every collision set that lie behind their surface by more than `tolerance`
-// (closest point within the set's max_distance; side from the interpolated vertex normal).
-std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Positions& x, double tolerance);
+// Adjacency of a collision surface (fixed with the mesh): sorted (edge, triangle) pairs, the
+// triangles around each vertex, and the boundary vertices.
+struct SurfaceTopology {
+  explicit SurfaceTopology(const TriIndices& triangles);
+  std::vector<std::pair<std::pair<int32_t, int32_t>, Eigen::Index>> edges;
+  std::multimap<int32_t, Eigen::Index> vertex_faces;
+  std::set<int32_t> boundary;
+};
+struct CollisionTopology {
+  explicit CollisionTopology(const SimulationMesh& mesh);
+  std::vector<SurfaceTopology> sets;  // one per mesh.collisions entry
+};
 
-// Contact rows: point minus surface point, pulled to zero with weight
-// collision_weight (kPa) * area of the point / target layer thickness.
-std::unique_ptr<TargetGroup> contact_group(const SimulationMesh& mesh, const std::vector<Contact>& contacts,
-                                           const Eigen::VectorXd& skin_area, double collision_weight);
+// Points of every collision set that lie behind their surface by more than `tolerance`.
+// skin: S's positions; vertices: the simulated vertices (for surfaces on vertices, teeth).
+// A point counts when its closest surface point lies within the set's max_distance and
+// inside the surface (not on a boundary edge), and the vector to it points against the
+// closest feature's pseudo-normal (face, edge or angle-weighted vertex normal: exact
+// inside/outside for closed surfaces, Baerentzen and Aanaes 2005).
+std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const CollisionTopology& topology,
+                                       const Positions& skin, const Positions& vertices, double tolerance);
+// The same, building the topology first.
+std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Positions& skin, const Positions& vertices,
+                                       double tolerance);
 
-// Largest distance between the two sides of the contacts at x (m).
-double max_contact_gap(const SimulationMesh& mesh, const std::vector<Contact>& contacts, const Positions& x);
+struct CollisionResult {
+  Positions skin;  // S after resolution
+  int penetrating_before = 0, penetrating_after = 0, contacts = 0, rounds = 0, iterations = 0;
+  double max_contact_gap = 0;  // largest distance between the two sides of a contact (m)
+  double seconds = 0;
+};
+
+// Detect, tie, solve on S, repeat (at most settings.collision_rounds times). Contacts persist
+// across rounds, one per (set, point), moved to the newest closest point.
+CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
+                                   const Positions& vertices, const Eigen::VectorXd& skin_area,
+                                   const SolverSettings& settings, ThreadPool* pool);
 
 // Closest point of triangle (a, b, c) to p as barycentric coordinates (Ericson 2004, 5.1.5).
 Eigen::Vector3d closest_point_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,

@@ -50,14 +50,15 @@ std::vector<TetElement> tet_elements(const Positions& rest, const TetIndices& te
   return kept;
 }
 
-void add(Model& m, std::unique_ptr<ConstraintGroup> g) {
+}  // namespace
+
+void add_group(Model& m, std::unique_ptr<ConstraintGroup> g) {
   if (g->elements() == 0) return;
   m.row_offset.push_back(m.rows);
   m.rows += g->rows();
   if (!g->constant_projection()) m.variable_rows = m.rows;
   m.groups.push_back(std::move(g));
 }
-}  // namespace
 
 Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, StrainLimit strain) {
   const PhysicalConstants& k = physical_constants();
@@ -69,17 +70,17 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
 
   // Projecting groups (their rows come first).
   const Param soft_det = Param::target_volume, soft_eps = Param::max_strain;
-  add(m, std::make_unique<TetGroup>(
+  add_group(m, std::make_unique<TetGroup>(
              "soft tissue",
              tet_elements(mesh.rest, mesh.soft_tets, false, m.pinned, p, Param::w_soft_volume,
                           Param::w_soft_strain, &soft_det, &soft_eps, true),
              strain, pa));
-  add(m, std::make_unique<TetGroup>(
+  add_group(m, std::make_unique<TetGroup>(
              "muscle", tet_elements(mesh.rest, mesh.muscle_tets, false, m.pinned, p, Param::w_muscle_volume,
                                     Param::w_muscle_strain, nullptr, nullptr, false),
              strain, pa));
   // Connecting tets keep their unscaled rest: a scaled skull pushes the tissue it holds.
-  add(m, std::make_unique<TetGroup>(
+  add_group(m, std::make_unique<TetGroup>(
              "connecting", tet_elements(mesh.rest, mesh.connecting_tets, true, m.pinned, p,
                                         Param::w_connect_volume, Param::w_connect_strain, nullptr, nullptr, true),
              strain, pa));
@@ -98,7 +99,7 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
       e.weight = p.at(Param::w_skin_strain, t) * k.skin_thickness_m;
       tris.push_back(std::move(e));
     }
-    add(m, std::make_unique<TriangleStrainGroup>("skin strain", std::move(tris), pa));
+    add_group(m, std::make_unique<TriangleStrainGroup>("skin strain", std::move(tris), pa));
   }
   {
     std::vector<TriangleElement> tris;
@@ -116,7 +117,7 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
       e.weight = p.at(Param::w_skull_strain, t) * k.skull_shell_thickness_m;
       tris.push_back(std::move(e));
     }
-    add(m, std::make_unique<TriangleStrainGroup>("skull strain", std::move(tris), pa));
+    add_group(m, std::make_unique<TriangleStrainGroup>("skull strain", std::move(tris), pa));
   }
   {
     Eigen::VectorXd w(n);
@@ -126,7 +127,7 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
     std::vector<BendingElement> kept;
     for (auto& e : bend)
       if (!all_pinned(m.pinned, e.laplacian)) kept.push_back(std::move(e));
-    add(m, std::make_unique<BendingGroup>(std::move(kept), pa));
+    add_group(m, std::make_unique<BendingGroup>(std::move(kept), pa));
   }
 
   // Targets: weight w * area / layer thickness (eq. 14 and 22), divided by gamma when dynamic.
@@ -156,7 +157,7 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
       if (dynamic) e.weight /= m.skin_gamma[i];
     }
     m.skin_row = m.rows;
-    add(m, std::make_unique<TargetGroup>("skin targets", std::move(el)));
+    add_group(m, std::make_unique<TargetGroup>("skin targets", std::move(el)));
   }
   m.landmark_rows.clear();
   if (nl > 0) {
@@ -172,7 +173,7 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
       m.landmark_rows.push_back(e.point);
     }
     m.landmark_row = m.rows;
-    add(m, std::make_unique<TargetGroup>("landmarks", std::move(el)));
+    add_group(m, std::make_unique<TargetGroup>("landmarks", std::move(el)));
   }
 
   // Lumped masses of the tissue tets, for gravity.

@@ -37,6 +37,10 @@ struct Model {
 
 Model build_model(const SimulationMesh& mesh, const ParameterSet& params, TargetMode mode, StrainLimit strain);
 
+// Appends a group's rows (projecting groups must come before constant ones); empty groups are
+// skipped.
+void add_group(Model& model, std::unique_ptr<ConstraintGroup> group);
+
 // Gravity load per vertex for the current parameters: m (s g d - g0 d0), where d0 is the
 // capture direction (-Y at 1 g): the neutral already hangs under earth's gravity.
 Positions gravity_forces(const Model& model, const ParameterSet& params);

@@ -42,8 +42,7 @@ DomainSizes domain_sizes(const SimulationMesh& m) {
 }
 
 Simulator::Simulator(SimulationMesh mesh, const SolverSettings& settings)
-    : mesh_(std::move(mesh)), params_(domain_sizes(mesh_)) {
-  validate(mesh_);
+    : mesh_((validate(mesh), std::move(mesh))), collision_topology_(mesh_), params_(domain_sizes(mesh_)) {
   set_settings(settings);
   length_scale_ = (mesh_.rest.colwise().maxCoeff() - mesh_.rest.colwise().minCoeff()).norm();
 }
@@ -99,28 +98,18 @@ FrameResult Simulator::solve_frame(const Prepared& prep, const FrameInput& in, c
   FrameProblem problem{&prep.model, prep.system.get(), nullptr, &prep.force, length_scale_};
   run_projective_dynamics(problem, P, x, settings_, pool, r.stats);
 
-  // Collisions: a further projective step with contacts, until none penetrates (3.3.2).
-  if (!mesh_.collisions.empty() && settings_.collision_rounds > 0) {
-    std::vector<Contact> found = find_penetrations(mesh_, x, settings_.penetration_tolerance), contacts;
-    r.stats.penetrating_before = static_cast<int>(found.size());
-    while (!found.empty() && r.stats.collision_rounds < settings_.collision_rounds) {
-      contacts.insert(contacts.end(), found.begin(), found.end());
-      const auto group = contact_group(mesh_, contacts, prep.model.skin_area, settings_.collision_weight);
-      const System with_contacts(prep.model, group.get());
-      r.stats.factor_seconds += with_contacts.factor_seconds();
-      Positions Pc = Positions::Zero(with_contacts.rows(), 3);
-      Pc.topRows(P.rows()) = P;  // contacts' targets are zero
-      FrameProblem pc{&prep.model, &with_contacts, group.get(), &prep.force, length_scale_};
-      run_projective_dynamics(pc, Pc, x, settings_, pool, r.stats);
-      ++r.stats.collision_rounds;
-      found = find_penetrations(mesh_, x, settings_.penetration_tolerance);
-    }
-    r.stats.penetrating_after = static_cast<int>(found.size());
-    r.stats.contacts = static_cast<int>(contacts.size());
-    r.stats.max_contact_gap = max_contact_gap(mesh_, contacts, x);
-  }
-
   r.skin = embed(mesh_.skin, x);
+  // Collisions: a further projective step on S, until no point penetrates (3.3.2).
+  if (!mesh_.collisions.empty()) {
+    CollisionResult c = resolve_collisions(mesh_, collision_topology_, r.skin, x, prep.model.skin_area, settings_, pool);
+    r.skin = std::move(c.skin);
+    r.stats.penetrating_before = c.penetrating_before;
+    r.stats.penetrating_after = c.penetrating_after;
+    r.stats.contacts = c.contacts;
+    r.stats.collision_rounds = c.rounds;
+    r.stats.max_contact_gap = c.max_contact_gap;
+    r.stats.collision_seconds = c.seconds;
+  }
   if (skin_targets.rows() > 0)
     r.stats.target_rms = std::sqrt((r.skin - skin_targets).rowwise().squaredNorm().mean());
   r.vertices = std::move(x);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/bones.h"
+#include "sim/collisions.h"
 #include "sim/dynamics.h"
 #include "sim/mesh.h"
 #include "sim/model.h"
@@ -82,6 +83,7 @@ class Simulator {
                            DynamicsHistory& history, ThreadPool* pool) const;
 
   SimulationMesh mesh_;
+  CollisionTopology collision_topology_;
   ParameterSet params_;
   SolverSettings settings_;
   std::unique_ptr<ThreadPool> pool_;

@@ -25,11 +25,11 @@ struct SolverSettings {
   StrainLimit strain_limit = StrainLimit::kNearestInSet;
   int threads = 0;  // 0: all hardware threads
   bool record_energy = true;
-  // Collision resolution (paper 3.3.2): contact weight (kPa, far above the material weights so
-  // the two points coincide), rounds of detect-and-resolve, and the depth below which a point
-  // no longer counts as penetrating (metres).
+  // Collision resolution on S (paper 3.3.2): contact weight (kPa, far above the material
+  // weights so the two points coincide), rounds of detect-and-resolve (0: off), and the depth
+  // below which a point no longer counts as penetrating (metres).
   double collision_weight = 1e6;
-  int collision_rounds = 4;
+  int collision_rounds = 30;
   double penetration_tolerance = 1e-5;
 };
 
@@ -50,6 +50,7 @@ struct SolveStats {
   // Collisions: penetrating points before and after resolution, contacts used, rounds.
   int penetrating_before = 0, penetrating_after = 0, contacts = 0, collision_rounds = 0;
   double max_contact_gap = 0;  // largest distance between the two points of a contact (m)
+  double collision_seconds = 0;
 };
 
 // One frame's problem over a model and a factorised system: P holds the constant rows'

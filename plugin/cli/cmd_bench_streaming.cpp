@@ -1,0 +1,251 @@
+// softdeca bench-streaming: receiver throughput and latency on loopback, decoder cost, and
+// recording write and read rates, as medians over repeated runs -> build/bench/streaming.json.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "command.h"
+#include "json.h"
+#include "options.h"
+#include "recording/recording_reader.h"
+#include "recording/recording_writer.h"
+#include "stream/frame_sender.h"
+#include "stream/percentile.h"
+#include "stream/receiver.h"
+#include "stream/steady_clock.h"
+
+namespace softdeca::cli {
+namespace {
+using stream::percentile;
+using stream::steady_seconds;
+
+constexpr std::size_t kLandmarks = 68;  // the ARKit 68-point profile: a typical frame
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A plausible full frame: every weight, both poses, 68 landmarks in a face-sized box.
+stream::Frame sample_frame(std::size_t i) {
+  stream::Frame f;
+  f.capture_time = 1000.0 + double(i) / 60.0;
+  for (std::size_t k = 0; k < f.weights.size(); ++k) f.weights[k] = float(0.5 + 0.5 * std::sin(0.1 * double(i + k)));
+  f.has_head = f.has_eyes = true;
+  f.head.position = {0.01f, -0.02f, -0.4f};
+  f.profile_id = 0x12345678;
+  f.landmark_count = kLandmarks;
+  for (std::size_t k = 0; k < 3 * kLandmarks; ++k) f.landmarks[k] = float(0.08 * std::sin(double(k) + 0.01 * double(i)));
+  return f;
+}
+
+struct Receiving {
+  stream::Receiver receiver;
+  std::atomic<bool> done{false};
+  std::vector<double> latencies;  // send -> available, seconds
+  double last_pop = 0;
+  std::size_t popped = 0;
+  std::thread consumer;
+
+  explicit Receiving(const stream::ReceiverConfig& c) : receiver(c) {
+    consumer = std::thread([this] {
+      stream::Frame f;
+      while (!done.load()) {
+        if (!receiver.next(0.01, f)) continue;
+        const double now = steady_seconds();
+        latencies.push_back(now - f.send_time);
+        last_pop = now;
+        ++popped;
+      }
+    });
+  }
+  void finish() {
+    done.store(true);
+    consumer.join();
+  }
+};
+
+stream::ReceiverConfig loopback() {
+  stream::ReceiverConfig c;
+  c.bind_address = "127.0.0.1";
+  c.port = 0;
+  c.format = stream::Format::softdeca;
+  c.delay = 0;
+  c.queue_capacity = 65536;
+  return c;
+}
+
+struct Throughput {
+  double per_second;       // frames delivered per second
+  double delivered_ratio;  // of the frames sent (the rest overflowed the socket's buffer)
+};
+
+// Frames sent as fast as the socket takes them; the rate at which the receiver delivers them.
+Throughput throughput_run(std::size_t frames) {
+  Receiving r(loopback());
+  stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.receiver.port()), stream::Format::softdeca, 7);
+  const double start = steady_seconds();
+  for (std::size_t i = 0; i < frames; ++i) sender.send(sample_frame(i));
+  // Done when nothing more arrives for 0.2 s.
+  std::size_t seen = 0;
+  for (double quiet_since = steady_seconds(); steady_seconds() - quiet_since < 0.2;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const std::size_t now_popped = r.receiver.stats().delivered;
+    if (now_popped != seen) {
+      seen = now_popped;
+      quiet_since = steady_seconds();
+    }
+  }
+  r.finish();
+  if (r.popped < 2) throw std::runtime_error("the throughput run delivered no frames");
+  return {double(r.popped) / (r.last_pop - start), double(r.popped) / double(frames)};
+}
+
+// Frames paced at `rate`; send -> available latencies of every frame.
+std::vector<double> latency_run(std::size_t frames, double rate) {
+  Receiving r(loopback());
+  stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.receiver.port()), stream::Format::softdeca, 9);
+  const double start = steady_seconds();
+  for (std::size_t i = 0; i < frames; ++i) {
+    const double due = start + double(i) / rate;
+    while (steady_seconds() < due) std::this_thread::sleep_for(std::chrono::microseconds(50));
+    sender.send(sample_frame(i));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  r.finish();
+  return r.latencies;
+}
+
+double decode_run(std::size_t n) {
+  std::vector<uint8_t> bytes;
+  stream::Frame f = sample_frame(1);
+  stream::wire::encode_frame(f, bytes);
+  stream::wire::Message m;
+  std::size_t ok = 0;
+  const double start = steady_seconds();
+  for (std::size_t i = 0; i < n; ++i) ok += stream::wire::decode(bytes.data(), bytes.size(), m).reason == stream::DropReason::none;
+  const double ns = (steady_seconds() - start) * 1e9 / double(n);
+  if (ok != n) throw std::runtime_error("the decoder rejected the benchmark's own frames");
+  return ns;
+}
+
+struct RecordingRates {
+  double write_fps, read_fps, bytes_per_frame;
+};
+
+RecordingRates recording_run(const std::string& path, std::size_t frames) {
+  recording::Header h;
+  h.device = "bench";
+  double start = steady_seconds();
+  {
+    recording::RecordingWriter w(path, h);
+    for (std::size_t i = 0; i < frames; ++i) w.write(sample_frame(i));
+  }
+  const double write_s = steady_seconds() - start;
+  start = steady_seconds();
+  const recording::Recording rec = recording::read_recording(path);
+  const double read_s = steady_seconds() - start;
+  if (rec.frames.size() != frames) throw std::runtime_error("the benchmark recording did not read back whole");
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  std::fseek(f, 0, SEEK_END);
+  const double bytes = double(std::ftell(f));
+  std::fclose(f);
+  std::remove(path.c_str());
+  return {double(frames) / write_s, double(frames) / read_s, bytes / double(frames)};
+}
+
+std::string figure(double value, const char* unit, const std::string& target, const char* better,
+                   const std::string& how) {
+  return JsonObject().number("value", value).text("unit", unit).raw("target", target).text("better", better)
+      .text("how", how).str();
+}
+
+}  // namespace
+
+int run_bench_streaming(const Args& args) {
+  Options o("bench-streaming",
+            "Measure the streaming path on this machine: receiver throughput on 127.0.0.1 (frames blasted\n"
+            "as fast as the socket takes them), latency from send to frame available (frames paced),\n"
+            "decoder cost, recording write and read rates. Medians over --runs runs; writes the figures\n"
+            "as JSON (DESIGN §3's benchmark format).");
+  o.option("--out", "FILE", "JSON output", "build/bench/streaming.json")
+      .option("--runs", "N", "repetitions of each measurement", "5")
+      .option("--throughput-frames", "N", "frames blasted per throughput run", "100000")
+      .option("--latency-frames", "N", "frames per latency run", "2000")
+      .option("--latency-rate", "HZ", "send rate of the latency runs", "1000")
+      .option("--recording-frames", "N", "frames per recording run", "20000")
+      .option("--scratch", "DIR", "where the recording runs write their file", "build/bench");
+  if (!o.parse(args)) return 0;
+  const long runs = o.integer("--runs"), tp = o.integer("--throughput-frames"), lat = o.integer("--latency-frames"),
+             recf = o.integer("--recording-frames");
+  const double lat_rate = o.number("--latency-rate");
+  if (runs < 1 || tp < 100 || lat < 100 || recf < 100 || !(lat_rate > 0))
+    throw UsageError("runs >= 1, frame counts >= 100 and a positive rate, please");
+  std::vector<uint8_t> probe;
+  stream::wire::encode_frame(sample_frame(0), probe);
+
+  std::vector<double> tput, delivered, p50, p99, decode_ns, write_fps, read_fps;
+  double bytes_per_frame = 0;
+  for (long run = 0; run < runs; ++run) {
+    std::fprintf(stderr, "\rbench-streaming: run %ld/%ld: throughput", run + 1, runs);
+    const Throughput t = throughput_run(static_cast<std::size_t>(tp));
+    tput.push_back(t.per_second);
+    delivered.push_back(t.delivered_ratio);
+    std::fprintf(stderr, ", latency");
+    const auto l = latency_run(static_cast<std::size_t>(lat), lat_rate);
+    if (l.size() < static_cast<std::size_t>(lat) / 2) throw std::runtime_error("most latency frames were lost");
+    p50.push_back(1000 * percentile(l, 0.5));
+    p99.push_back(1000 * percentile(l, 0.99));
+    std::fprintf(stderr, ", decode");
+    decode_ns.push_back(decode_run(200000));
+    std::fprintf(stderr, ", recording   ");
+    const auto r = recording_run(o.text("--scratch") + "/bench-streaming.sdrec", static_cast<std::size_t>(recf));
+    write_fps.push_back(r.write_fps);
+    read_fps.push_back(r.read_fps);
+    bytes_per_frame = r.bytes_per_frame;
+  }
+  std::fputc('\n', stderr);
+
+  const std::string cmd = "softdeca bench-streaming --runs " + std::to_string(runs);
+  const std::string frame = std::to_string(probe.size()) + "-byte frame datagrams (52 weights, head and eye poses, " +
+                            std::to_string(kLandmarks) + " landmarks)";
+  JsonObject out;
+  out.raw("streaming.datagrams_per_s",
+          figure(median(tput), "datagrams/s", "1000", "higher",
+                 cmd + ": median of " + std::to_string(runs) + " runs; " + std::to_string(tp) + " " + frame +
+                     " sent as fast as possible to a receiver on 127.0.0.1 (no jitter delay); frames delivered per "
+                     "second from the first send to the last delivery"));
+  out.raw("streaming.blast_delivered_ratio",
+          figure(median(delivered), "ratio", "null", "higher",
+                 cmd + ": in the throughput runs, the share of frames delivered (the rest overflowed the "
+                       "socket's receive buffer while the receiver was behind)"));
+  const std::string lat_how = cmd + ": median over " + std::to_string(runs) + " runs of the percentile over " +
+                              std::to_string(lat) + " " + frame + " sent at " + json_number(lat_rate) +
+                              " Hz to 127.0.0.1; from the sender's clock reading before encoding to the consumer "
+                              "thread holding the frame (no jitter delay)";
+  out.raw("streaming.latency_p50_ms", figure(median(p50), "ms", "0.5", "lower", lat_how));
+  out.raw("streaming.latency_p99_ms", figure(median(p99), "ms", "1.0", "lower", lat_how));
+  out.raw("streaming.decode_ns_per_datagram",
+          figure(median(decode_ns), "ns", "null", "lower",
+                 cmd + ": median of " + std::to_string(runs) + " runs of decoding one " + frame + " 200000 times"));
+  const std::string rec_how = cmd + ": median of " + std::to_string(runs) + " runs; " + std::to_string(recf) +
+                              " frames with " + std::to_string(kLandmarks) + " landmarks (" +
+                              json_number(bytes_per_frame) + " bytes each on disk)";
+  out.raw("streaming.recording_write_frames_per_s",
+          figure(median(write_fps), "frames/s", "null", "higher", rec_how + ", each record flushed to the OS"));
+  out.raw("streaming.recording_write_mb_per_s",
+          figure(median(write_fps) * bytes_per_frame / 1e6, "MB/s", "null", "higher", rec_how));
+  out.raw("streaming.recording_read_frames_per_s",
+          figure(median(read_fps), "frames/s", "null", "higher", rec_how + ", read and checked back"));
+  write_text_file(o.text("--out"), out.str(true) + "\n");
+  std::printf("%s\n", out.str(true).c_str());
+  return 0;
+}
+
+}  // namespace softdeca::cli

@@ -1,0 +1,58 @@
+// softdeca info: what a recording holds and what a damaged one lost.
+#include <cstdio>
+#include <string>
+
+#include "command.h"
+#include "json.h"
+#include "options.h"
+#include "recording/recording_reader.h"
+
+namespace softdeca::cli {
+
+int run_info(const Args& args) {
+  Options o("info", "Describe a recording: its header, frames, duration and rate, landmark profile, and the\n"
+                    "damage recovered from (skipped stretches, a cut-off last record).");
+  o.positional("RECORDING", "a .sdrec file").flag("--json", "print JSON instead of text");
+  if (!o.parse(args)) return 0;
+  const recording::Recording rec = recording::read_recording(o.arg(0));
+  const auto& h = rec.header;
+  const std::size_t n = rec.frames.size();
+  const double duration = n > 1 ? rec.frames.back().capture_time - rec.frames.front().capture_time : 0;
+  std::size_t tracked = 0, with_landmarks = 0;
+  for (const auto& f : rec.frames) {
+    tracked += f.tracking == stream::Tracking::tracked;
+    with_landmarks += f.landmark_count > 0;
+  }
+  JsonObject j;
+  j.text("device", h.device).text("subject", h.subject).text("source", h.source).text("clock", h.clock);
+  j.number("start_unix_time", h.start_unix_time).number("timecode_rate", h.timecode_rate).text("units", h.units);
+  j.number("frames", double(n)).number("tracked_frames", double(tracked));
+  j.number("frames_with_landmarks", double(with_landmarks)).number("duration_s", duration);
+  j.number("rate_hz", duration > 0 ? double(n - 1) / duration : 0);
+  j.number("profiles", double(rec.profiles.size()));
+  j.number("profile_landmarks", rec.profiles.empty() ? 0 : double(rec.profiles.back().indices.size()));
+  j.number("neutral_vertices", double(rec.neutral.size() / 3));
+  j.number("records", double(rec.recovery.records)).number("damaged_regions", double(rec.recovery.damaged_regions));
+  j.number("skipped_bytes", double(rec.recovery.skipped_bytes));
+  j.number("truncated_bytes", double(rec.recovery.truncated_bytes));
+  j.number("unknown_records", double(rec.recovery.unknown_records));
+  if (o.on("--json")) {
+    std::printf("%s\n", j.str(true).c_str());
+    return 0;
+  }
+  std::printf("%s\n  device %s, subject %s, source %s\n  %zu frames (%zu tracked, %zu with landmarks) over %.3f s",
+              o.arg(0).c_str(), h.device.c_str(), h.subject.c_str(), h.source.c_str(), n, tracked, with_landmarks,
+              duration);
+  if (duration > 0) std::printf(", %.2f Hz", double(n - 1) / duration);
+  std::printf("\n  capture clock: %s; units %s\n", h.clock.c_str(), h.units.c_str());
+  if (!rec.profiles.empty())
+    std::printf("  landmark profile '%s': %zu vertices (id %08x)\n", rec.profiles.back().name.c_str(),
+                rec.profiles.back().indices.size(), rec.profiles.back().id);
+  if (!rec.neutral.empty()) std::printf("  neutral mesh: %zu vertices\n", rec.neutral.size() / 3);
+  std::printf("  %zu records; damage: %zu regions (%zu bytes) skipped, %zu bytes cut off at the end\n",
+              rec.recovery.records, rec.recovery.damaged_regions, rec.recovery.skipped_bytes,
+              rec.recovery.truncated_bytes);
+  return 0;
+}
+
+}  // namespace softdeca::cli

@@ -1,0 +1,147 @@
+#include "recording/livelinkface_csv.h"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
+#include "api/error.h"
+#include "recording/timecode.h"
+#include "stream/livelinkface_layout.h"
+
+namespace softdeca::recording {
+namespace {
+namespace llf = stream::livelinkface;
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> fields;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', begin);
+    fields.push_back(line.substr(begin, comma == std::string_view::npos ? std::string_view::npos : comma - begin));
+    if (comma == std::string_view::npos) return fields;
+    begin = comma + 1;
+  }
+}
+
+bool parse_float(std::string_view s, float& out) {
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return false;
+  out = static_cast<float>(v);
+  return true;
+}
+
+// The app's CSV column order: its packet order with JawLeft/JawRight and MouthLeft/MouthRight
+// swapped (as in every take of ../shared/recordings).
+std::array<std::size_t, llf::kValueCount> csv_order() {
+  std::array<std::size_t, llf::kValueCount> order{};
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::swap(order[15], order[16]);  // JawLeft, JawRight
+  std::swap(order[21], order[22]);  // MouthLeft, MouthRight
+  return order;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+CsvTake parse_livelinkface_csv(std::string_view text, double rate) {
+  require(rate > 0 && rate <= 1000, "timecode rate must be in (0, 1000]");
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // a UTF-8 byte-order mark
+  CsvTake take;
+  int timecode_col = -1, count_col = -1;
+  std::array<int, llf::kValueCount> value_col;
+  value_col.fill(-1);
+  std::size_t columns = 0;
+  bool header = true;
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(begin, end - begin);
+    begin = end + 1;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty()) continue;
+    const auto fields = split(line);
+    if (header) {
+      header = false;
+      columns = fields.size();
+      for (std::size_t c = 0; c < fields.size(); ++c) {
+        const std::string_view name = fields[c];
+        if (name == "Timecode") timecode_col = static_cast<int>(c);
+        else if (name == "BlendShapeCount" || name == "BlendshapeCount") count_col = static_cast<int>(c);
+        for (std::size_t i = 0; i < llf::kValueCount; ++i)
+          if (name == llf::value_name(i)) value_col[i] = static_cast<int>(c);
+      }
+      require(timecode_col >= 0, "Live Link Face CSV without a Timecode column", SOFTDECA_ERROR_FORMAT);
+      for (std::size_t i = 0; i < llf::kHeadYaw; ++i)
+        require(value_col[i] >= 0, std::string("Live Link Face CSV without a ") + llf::value_name(i) + " column",
+                SOFTDECA_ERROR_FORMAT);
+      continue;
+    }
+    ++take.rows;
+    // The app writes a lost face as the timecode and a zero count, nothing else.
+    const bool zero_count = count_col >= 0 && static_cast<std::size_t>(count_col) < fields.size() &&
+                            fields[static_cast<std::size_t>(count_col)] == "0";
+    if (fields.size() != columns) {
+      ++(zero_count ? take.face_lost_rows : take.malformed_rows);
+      continue;
+    }
+    stream::Frame f;
+    llf::Values values{};
+    bool ok = parse_timecode(fields[static_cast<std::size_t>(timecode_col)], rate, f.capture_time);
+    for (std::size_t i = 0; ok && i < llf::kValueCount; ++i)
+      if (value_col[i] >= 0) ok = parse_float(fields[static_cast<std::size_t>(value_col[i])], values[i]);
+    if (!ok) {
+      ++take.malformed_rows;
+      continue;
+    }
+    llf::values_to_frame(values, f);
+    f.has_head = value_col[llf::kHeadYaw] >= 0 && value_col[llf::kHeadYaw + 1] >= 0 && value_col[llf::kHeadYaw + 2] >= 0;
+    f.has_eyes = value_col[llf::kLeftEyeYaw] >= 0 && value_col[llf::kRightEyeYaw + 2] >= 0;
+    take.frames.push_back(f);
+  }
+  require(!header, "empty Live Link Face CSV", SOFTDECA_ERROR_FORMAT);
+  return take;
+}
+
+CsvTake read_livelinkface_csv(const std::string& path, double rate) {
+  return parse_livelinkface_csv(read_file(path), rate);
+}
+
+std::string format_livelinkface_csv(const std::vector<stream::Frame>& frames, int rate) {
+  require(rate > 0 && rate <= 1000, "timecode rate must be an integer in [1, 1000]");
+  const auto order = csv_order();
+  std::string out = "Timecode,BlendShapeCount";
+  for (std::size_t i : order) out += std::string(",") + llf::value_name(i);
+  out += '\n';
+  char buf[32];
+  for (const stream::Frame& f : frames) {
+    if (f.tracking != stream::Tracking::tracked) continue;
+    require(std::isfinite(f.capture_time) && f.capture_time >= 0, "capture time not a time of day");
+    out += format_timecode(f.capture_time, rate) + ",61";
+    const llf::Values values = llf::frame_to_values(f);
+    for (std::size_t i : order) {
+      // + 0.0 turns -0 (from the angle conversions) into 0.
+      std::snprintf(buf, sizeof buf, ",%.10f", double(values[i]) + 0.0);
+      out += buf;
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+void write_livelinkface_csv(const std::string& path, const std::vector<stream::Frame>& frames, int rate) {
+  const std::string text = format_livelinkface_csv(frames, rate);
+  std::ofstream out(path, std::ios::binary);
+  if (!out || !out.write(text.data(), static_cast<std::streamsize>(text.size())))
+    throw Error(SOFTDECA_ERROR_IO, "cannot write " + path);
+}
+
+}  // namespace softdeca::recording

@@ -1,0 +1,306 @@
+#include "stream/receiver.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "api/error.h"
+#include "stream/crc32.h"
+#include "stream/percentile.h"
+#include "stream/steady_clock.h"
+
+namespace softdeca::stream {
+namespace {
+
+constexpr std::size_t kReceiveBuffer = 65536;  // any UDP datagram fits: sizes are exact
+constexpr int kMaxWaitMs = 20;                 // how soon the thread notices stop()
+constexpr std::size_t kRateWindow = 64;
+constexpr double kRateHorizon = 2.0;
+constexpr std::size_t kLatencyWindow = 2048;
+constexpr std::size_t kMaxProfiles = 16;
+constexpr double kRequestInterval = 1.0;  // at most one profile request per second
+
+const ReceiverConfig& checked(const ReceiverConfig& c) {
+  require(std::isfinite(c.delay) && c.delay >= 0 && c.delay <= 5, "jitter delay must be in [0, 5] seconds");
+  require(c.queue_capacity >= 1 && c.queue_capacity <= 65536, "queue capacity must be in [1, 65536]");
+  require(c.format == Format::automatic || c.format == Format::softdeca || c.format == Format::livelinkface ||
+              c.format == Format::ifacialmocap,
+          "unknown stream format");
+  return c;
+}
+
+}  // namespace
+
+Receiver::Receiver(const ReceiverConfig& config)
+    : config_(checked(config)), socket_(config.bind_address, config.port), jitter_(config.delay) {
+  port_ = socket_.local_port();
+  thread_ = std::thread([this] { run(); });
+}
+
+Receiver::~Receiver() { stop(); }
+
+void Receiver::stop() {
+  if (stopping_.exchange(true)) return;
+  if (thread_.joinable()) thread_.join();
+}
+
+void Receiver::run() {
+  std::vector<uint8_t> buffer(kReceiveBuffer);
+  while (!stopping_.load()) {
+    double due;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      release_due(steady_seconds());
+      due = jitter_.next_due();
+    }
+    const double wait = std::clamp((due - steady_seconds()) * 1000.0, 0.0, double(kMaxWaitMs));
+    if (!socket_.wait_readable(static_cast<int>(std::ceil(wait)))) continue;
+    std::size_t size = 0;
+    Endpoint from;
+    for (int i = 0; i < 256 && socket_.receive(buffer.data(), buffer.size(), size, from); ++i)
+      handle(buffer.data(), std::min(size, buffer.size()), from, steady_seconds());
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  Frame f;
+  while (jitter_.pop_any(f)) deliver(f, steady_seconds());
+  recorder_.reset();
+}
+
+void Receiver::count_drop(DropReason reason) {
+  switch (reason) {
+    case DropReason::none: return;
+    case DropReason::unknown_type: ++stats_.unknown_type; return;
+    case DropReason::undersized: ++stats_.undersized; break;
+    case DropReason::oversized: ++stats_.oversized; break;
+    case DropReason::bad_magic: ++stats_.bad_magic; break;
+    case DropReason::incompatible_version: ++stats_.incompatible_version; break;
+    case DropReason::bad_length: ++stats_.bad_length; break;
+    case DropReason::bad_value: ++stats_.bad_value; break;
+  }
+  ++stats_.malformed;
+}
+
+void Receiver::handle(const uint8_t* data, std::size_t size, const Endpoint& from, double now) {
+  Datagram d;
+  const wire::Verdict verdict = decode_datagram(data, size, config_.format, d);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++stats_.datagrams;
+  if (verdict.reason != DropReason::none) {
+    count_drop(verdict.reason);
+    return;
+  }
+  // Only our protocol names its session; the others are told apart by device (Live Link Face)
+  // or by the sender's address (iFacialMocap).
+  uint32_t session = d.message.envelope.session_id;
+  if (d.format == Format::livelinkface) session = d.message.frame.session_id;
+  if (d.format == Format::ifacialmocap) session = crc32(&from.address, from.length);
+  if (!have_session_ || session != session_) start_session(session);
+  session_format_ = d.format;
+  sender_ = from;
+  have_sender_ = true;
+  if (d.format == Format::softdeca) {
+    switch (sequence_.observe(d.message.envelope.sequence)) {
+      case Arrival::duplicate: ++stats_.duplicates; return;
+      case Arrival::stale: ++stats_.late; return;
+      case Arrival::reordered: ++stats_.reordered; break;
+      case Arrival::in_order:
+      case Arrival::restart: break;
+    }
+  }
+  switch (d.message.envelope.type) {
+    case wire::MessageType::frame:
+      ++stats_.frames;
+      on_frame(d.message.frame, d, now);
+      break;
+    case wire::MessageType::profile: {
+      ++stats_.control_messages;
+      const wire::Profile& p = d.message.profile;
+      if (profiles_.size() >= kMaxProfiles && !profiles_.count(p.id)) profiles_.erase(profiles_.begin());
+      const bool fresh = profiles_.find(p.id) == profiles_.end();
+      profiles_[p.id] = p;
+      newest_profile_ = p.id;
+      if (fresh) record([&](recording::RecordingWriter& w) { w.write_profile(p); });
+      break;
+    }
+    case wire::MessageType::neutral_chunk: {
+      ++stats_.control_messages;
+      std::vector<float> xyz;
+      if (assembler_.add(d.message.neutral, xyz) && xyz != neutral_) {
+        neutral_ = std::move(xyz);
+        record([&](recording::RecordingWriter& w) { w.write_neutral(neutral_); });
+      }
+      break;
+    }
+    case wire::MessageType::request:
+      ++stats_.control_messages;  // senders answer requests; a receiver has nothing to send
+      break;
+  }
+  release_due(now);
+}
+
+void Receiver::start_session(uint32_t session) {
+  if (have_session_) {
+    ++stats_.session_changes;
+    Frame f;
+    while (jitter_.pop_any(f)) deliver(f, steady_seconds());
+  }
+  lost_before_ += sequence_.lost();
+  expected_before_ += sequence_.expected();
+  sequence_ = SequenceTracker();
+  jitter_ = JitterBuffer(config_.delay);
+  previous_weights_.fill(0);
+  have_session_ = true;
+  session_ = session;
+}
+
+void Receiver::on_frame(Frame f, const Datagram& d, double now) {
+  f.session_id = session_;
+  f.receive_time = now;
+  if (d.format == Format::ifacialmocap) {
+    f.capture_time = now;  // the format has no clock of its own
+    for (std::size_t i = 0; i < kBlendshapeCount; ++i)
+      if (!d.present[i]) f.weights[i] = previous_weights_[i];
+  }
+  previous_weights_ = f.weights;
+  switch (jitter_.insert(f, now)) {
+    case JitterBuffer::Outcome::late: ++stats_.late; return;
+    case JitterBuffer::Outcome::duplicate: ++stats_.duplicates; return;
+    case JitterBuffer::Outcome::resync: ++stats_.clock_resyncs; break;
+    case JitterBuffer::Outcome::queued: break;
+  }
+  if (f.landmark_count > 0) {
+    profile_in_use_ = f.profile_id;
+    if (!profiles_.count(f.profile_id) && d.format == Format::softdeca && now - last_profile_request_ >= kRequestInterval) {
+      last_profile_request_ = now;
+      send_request(wire::RequestKind::profile, f.profile_id);
+    }
+  }
+}
+
+void Receiver::release_due(double now) {
+  Frame f;
+  while (jitter_.pop_due(now, f)) deliver(f, now);
+}
+
+void Receiver::deliver(const Frame& f, double now) {
+  if (queue_.size() >= config_.queue_capacity) {
+    queue_.pop_front();
+    ++stats_.overflowed;
+  }
+  queue_.push_back(f);
+  latest_ = f;
+  have_latest_ = true;
+  ++stats_.delivered;
+  latencies_.push_back(now - f.receive_time);
+  if (latencies_.size() > kLatencyWindow) latencies_.pop_front();
+  delivery_times_.push_back(now);
+  if (delivery_times_.size() > kRateWindow) delivery_times_.pop_front();
+  record([&](recording::RecordingWriter& w) {
+    w.write(f);
+    ++frames_recorded_;
+  });
+  delivered_cv_.notify_all();
+}
+
+template <class F>
+void Receiver::record(F&& write) {
+  if (!recorder_) return;
+  try {
+    write(*recorder_);
+  } catch (const std::exception& e) {  // a full disk ends the recording, not the stream
+    recording_error_ = e.what();
+    recorder_.reset();
+  }
+}
+
+void Receiver::send_request(wire::RequestKind what, uint32_t id) {
+  if (!have_sender_ || session_format_ != Format::softdeca) return;
+  std::vector<uint8_t> bytes;
+  wire::encode_request(session_, request_sequence_++, wire::Request{what, id}, bytes);
+  if (socket_.send(bytes.data(), bytes.size(), sender_)) ++stats_.requests_sent;
+}
+
+bool Receiver::next(double timeout, Frame& out) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto ready = [&] { return !queue_.empty(); };
+  if (!ready() && timeout > 0)
+    delivered_cv_.wait_for(lock, std::chrono::duration<double>(std::min(timeout, 3600.0)), ready);
+  if (queue_.empty()) return false;
+  out = queue_.front();
+  queue_.pop_front();
+  return true;
+}
+
+bool Receiver::latest(Frame& out) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (have_latest_) out = latest_;
+  return have_latest_;
+}
+
+ReceiverStats Receiver::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ReceiverStats s = stats_;
+  s.lost = lost_before_ + sequence_.lost();
+  s.expected = expected_before_ + sequence_.expected();
+  s.loss_ratio = s.expected ? double(s.lost) / double(s.expected) : 0.0;
+  const double now = steady_seconds();
+  if (delivery_times_.size() >= 2 && now - delivery_times_.back() < kRateHorizon) {
+    std::size_t first = 0;
+    while (delivery_times_[first] < now - kRateHorizon) ++first;
+    const double span = delivery_times_.back() - delivery_times_[first];
+    const std::size_t n = delivery_times_.size() - first;
+    if (n >= 2 && span > 0) s.frame_rate_hz = double(n - 1) / span;
+  }
+  const std::vector<double> lat(latencies_.begin(), latencies_.end());
+  s.latency_p50_ms = 1000.0 * percentile(lat, 0.5);
+  s.latency_p99_ms = 1000.0 * percentile(lat, 0.99);
+  return s;
+}
+
+bool Receiver::profile(wire::Profile& out) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = profiles_.find(profile_in_use_);
+  if (it == profiles_.end()) it = profiles_.find(newest_profile_);
+  if (it == profiles_.end()) return false;
+  out = it->second;
+  return true;
+}
+
+bool Receiver::neutral(std::vector<float>& out) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (neutral_.empty()) return false;
+  out = neutral_;
+  return true;
+}
+
+bool Receiver::request_neutral() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!have_sender_ || session_format_ != Format::softdeca) return false;
+  const uint64_t before = stats_.requests_sent;
+  send_request(wire::RequestKind::neutral, 0);
+  return stats_.requests_sent > before;
+}
+
+void Receiver::start_recording(const std::string& path, const recording::Header& header) {
+  auto writer = std::make_unique<recording::RecordingWriter>(path, header);  // may throw: no lock held
+  std::lock_guard<std::mutex> lock(mutex_);
+  // What the stream already told us goes in first, so that the file is complete on its own.
+  if (!header.has_profile)
+    for (const auto& [id, p] : profiles_) writer->write_profile(p);
+  if (header.neutral.empty() && !neutral_.empty()) writer->write_neutral(neutral_);
+  recorder_ = std::move(writer);
+  recording_error_.clear();
+  frames_recorded_ = 0;
+}
+
+std::string Receiver::stop_recording() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  recorder_.reset();
+  return recording_error_;
+}
+
+std::size_t Receiver::frames_recorded() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return frames_recorded_;
+}
+
+}  // namespace softdeca::stream

@@ -1,0 +1,113 @@
+// The stream receiver: a background thread reads datagrams from a UDP socket, decodes them
+// (datagram_decoder.h), drops and counts what is malformed, duplicated or late, tracks loss
+// per sender session, orders frames in a jitter buffer, and hands them out in capture order.
+// Optionally it records every delivered frame (recording_writer.h) from the same thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "recording/recording_writer.h"
+#include "stream/datagram_decoder.h"
+#include "stream/jitter_buffer.h"
+#include "stream/neutral_assembler.h"
+#include "stream/receiver_stats.h"
+#include "stream/sequence_tracker.h"
+#include "stream/udp_socket.h"
+
+namespace softdeca::stream {
+
+struct ReceiverConfig {
+  std::string bind_address = "0.0.0.0";
+  uint16_t port = 50110;  // 0: any free port (see Receiver::port)
+  Format format = Format::automatic;
+  double delay = 0;                  // jitter buffer delay in seconds, [0, 5]; 0: at once
+  std::size_t queue_capacity = 256;  // delivered frames kept for next()
+};
+
+class Receiver {
+ public:
+  // Binds the socket and starts the thread. Throws softdeca::Error.
+  explicit Receiver(const ReceiverConfig& config);
+  ~Receiver();  // stop()
+  Receiver(const Receiver&) = delete;
+  Receiver& operator=(const Receiver&) = delete;
+
+  uint16_t port() const { return port_; }
+  // The oldest delivered frame not yet taken, waiting up to timeout seconds for one.
+  bool next(double timeout, Frame& out);
+  // The newest delivered frame (taken or not).
+  bool latest(Frame& out) const;
+  ReceiverStats stats() const;
+  // The profile named by the newest frame with landmarks, else the newest profile received.
+  bool profile(wire::Profile& out) const;
+  bool neutral(std::vector<float>& out) const;
+  // Asks the current sender (our protocol only) for its neutral mesh; false without a sender.
+  bool request_neutral();
+  // Records every frame delivered from now on (and profiles and neutral meshes as they come).
+  void start_recording(const std::string& path, const recording::Header& header);
+  // Stops recording; returns the error that stopped it early, "" if none.
+  std::string stop_recording();
+  // Frames written by the current or last recording.
+  std::size_t frames_recorded() const;
+  // Stops the thread and delivers what the jitter buffer still holds. Idempotent.
+  void stop();
+
+ private:
+  void run();
+  void handle(const uint8_t* data, std::size_t size, const Endpoint& from, double now);
+  void count_drop(DropReason reason);
+  void start_session(uint32_t session);
+  void on_frame(Frame frame, const Datagram& datagram, double now);
+  void release_due(double now);
+  void deliver(const Frame& frame, double now);
+  void send_request(wire::RequestKind what, uint32_t id);
+  template <class F>
+  void record(F&& write);
+
+  ReceiverConfig config_;
+  UdpSocket socket_;
+  uint16_t port_ = 0;
+  std::atomic<bool> stopping_{false};
+  std::thread thread_;
+
+  mutable std::mutex mutex_;  // everything below
+  std::condition_variable delivered_cv_;
+  ReceiverStats stats_;
+  bool have_session_ = false;
+  uint32_t session_ = 0;
+  Format session_format_ = Format::softdeca;
+  SequenceTracker sequence_;
+  uint64_t lost_before_ = 0;      // earlier sessions' losses
+  uint64_t expected_before_ = 0;
+  JitterBuffer jitter_;
+  std::array<float, kBlendshapeCount> previous_weights_{};  // for sources that omit weights
+  std::deque<Frame> queue_;
+  bool have_latest_ = false;
+  Frame latest_;
+  std::map<uint32_t, wire::Profile> profiles_;
+  uint32_t newest_profile_ = 0;
+  uint32_t profile_in_use_ = 0;
+  NeutralAssembler assembler_;
+  std::vector<float> neutral_;
+  bool have_sender_ = false;
+  Endpoint sender_;
+  uint32_t request_sequence_ = 0;
+  double last_profile_request_ = -1e9;
+  std::deque<double> delivery_times_;  // recent, for the rate
+  std::deque<double> latencies_;       // recent, seconds
+  std::unique_ptr<recording::RecordingWriter> recorder_;
+  std::string recording_error_;
+  std::size_t frames_recorded_ = 0;
+};
+
+}  // namespace softdeca::stream

@@ -1,0 +1,17 @@
+"""Where the streaming tests find the native `softdeca` CLI and the shared takes."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+CLI = os.environ.get(
+    "SOFTDECA_CLI", str(REPO / "build" / "release" / "plugin" / "cli" / "softdeca")
+)
+TAKES = REPO.parent / "shared" / "recordings" / "livelinkface-alexdjulin"
+
+if not Path(CLI).is_file():
+    raise FileNotFoundError(
+        f"{CLI} is missing: run `make build` (make test does) or set SOFTDECA_CLI"
+    )
