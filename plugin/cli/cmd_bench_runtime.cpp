@@ -213,6 +213,23 @@ int run_bench_runtime(const Args& args) {
     }
   }
 
+  // The other storages' speed, single thread (same frames, same run).
+  for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) {
+    const char* name = precision == SOFTDECA_PRECISION_INT8 ? "int8" : "float";
+    Avatar a(model, rig.neutral, rig.deltas, 1, precision);
+    check(softdeca_avatar_prepare(a.handle), "prepare");
+    const Times st = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
+    });
+    char load_text[64];
+    std::snprintf(load_text, sizeof load_text, "; machine load average %.1f", load_average());
+    figures.raw(std::string("runtime.softdeca_static_ms_") + name,
+                figure(st.wall, "ms", std::string("as softdeca_static_ms with ") + name + " hyper-tensors (1 thread); " + how + load_text));
+    figures.raw(std::string("runtime.softdeca_static_cpu_ms_") + name,
+                figure(st.cpu, "ms", std::string("as softdeca_static_cpu_ms with ") + name + " hyper-tensors; " + how + load_text));
+    std::fprintf(stderr, "%s storage: softdeca wall %.3f cpu %.3f ms\n", name, st.wall, st.cpu);
+  }
+
   // Error of the compact storage: the same frames with float, half and int8 hyper-tensors.
   {
     const std::size_t n = std::min<std::size_t>(frames, 100);

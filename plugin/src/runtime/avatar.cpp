@@ -17,10 +17,10 @@ double ms(Clock::time_point a, Clock::time_point b) { return std::chrono::durati
 constexpr int kSoftDeca = 0, kSparse = 1;
 constexpr float kWeightSlack = 0.01f;  // weights may overshoot [0, 1] by this much (clamped)
 
-std::vector<float> run_identity_encoder(const Model& model, const float* skin, std::size_t vs) {
+// h from the neutral skin (the first skin_vertices of the head).
+std::vector<float> run_identity_encoder(const Model& model, const float* skin) {
   std::vector<float> h(static_cast<std::size_t>(model.manifest().identity));
   model.identity_encoder().run({skin}, {h.data()}, 1);
-  (void)vs;
   for (std::size_t i = 0; i < h.size(); ++i)
     if (!std::isfinite(h[i])) throw Error(SOFTDECA_ERROR_NON_FINITE, "the identity encoder produced a non-finite code");
   return h;
@@ -91,7 +91,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
   const auto& bones = model_->non_skin_bones();
   for (std::size_t i = 0; i < bones.size(); ++i)
     (bones[i] ? jaw_vertices_ : cranium_vertices_).push_back(static_cast<int>(vs_ + i));
-  identity_ = run_identity_encoder(*model_, neutral_.data(), vs_);
+  identity_ = run_identity_encoder(*model_, neutral_.data());
   if (model_->has(false)) f_w_ = model_->encoder(false)->bind({weights_.data()}, {z_.data()}, 1);
   if (model_->has(true)) f_l_ = model_->encoder(true)->bind({offsets_.data()}, {z_.data()}, 1);
   stats_.threads = worker_.parts();
@@ -261,12 +261,12 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   auto t2 = Clock::now();
   st.hyper_ms = ms(t1, t2);
   for (int phase = 0; phase < DeformationTransfer::kPhases; ++phase) {
-    auto solve = [&](std::size_t part, std::size_t n_parts) {
-      (void)n_parts;
+    auto solve = [&](std::size_t part, std::size_t) {
       prep.dt->solve_phase(phase, part, rhs_parts_.data(), rhs_parts_.size(), head_.data(), solve_work_.data(),
                            static_.data());
     };
-    worker_.run(solve);
+    if (phase == 1) solve(0, worker_.parts());  // the serial top part: on this thread, no hand-off
+    else worker_.run(solve);
   }
   st.solve_ms = ms(t2, Clock::now());
 }

@@ -124,17 +124,6 @@ def specs_or_test_list(source: str | None) -> tuple[ParameterSpec, ...]:
     return load_parameter_specs(source)
 
 
-def normalise(values: np.ndarray, specs: Sequence[ParameterSpec]) -> np.ndarray:
-    """Raw values (..., P) -> [-1, 1] per the spec's scale (what the networks do first)."""
-    lo = np.array([s.min for s in specs])
-    hi = np.array([s.max for s in specs])
-    log = np.array([s.scale == "log" for s in specs])
-    v = np.where(log, np.log(np.maximum(values, 1e-30)), values)
-    lo = np.where(log, np.log(np.where(log, lo, 1.0)), lo)
-    hi = np.where(log, np.log(np.where(log, hi, 1.0)), hi)
-    return 2.0 * (v - lo) / (hi - lo) - 1.0
-
-
 @dataclass
 class _Value:
     kind: Literal["global", "faces", "vertices"]

@@ -10,7 +10,6 @@ X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, the non-skin vertices, and nor
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
@@ -285,16 +284,3 @@ class ReferenceAvatar:
     def evaluate_linear(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         head = self.blend(weights)
         return head, vertex_normals(head, self.head_triangles)
-
-
-def random_weights(n: int, rng: np.random.Generator, active: int = 12) -> np.ndarray:
-    """Test frames: `n` weight vectors with `active` random shapes each, in [0, 1]."""
-    w = np.zeros((n, 52))
-    for row in w:
-        idx = rng.choice(52, active, replace=False)
-        row[idx] = rng.uniform(0.0, 1.0, active)
-    return w
-
-
-def to_float32(points: Sequence[np.ndarray]) -> list[np.ndarray]:
-    return [np.ascontiguousarray(p, dtype=np.float32) for p in points]

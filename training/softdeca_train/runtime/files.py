@@ -39,11 +39,18 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def write_rig(
-    folder: Path, neutral: np.ndarray, deltas: np.ndarray, triangles: np.ndarray | None
+    folder: Path,
+    neutral: np.ndarray,
+    deltas: np.ndarray,
+    triangles: np.ndarray | None,
+    progress: bool = False,
 ) -> None:
     """neutral.obj and blendshapes/<name>.obj (shapes that move nothing are left out)."""
+    from tqdm import tqdm
+
     write_obj(folder / "neutral.obj", neutral, triangles)
-    for name, d in zip(ARKIT_BLENDSHAPES, deltas, strict=True):
+    shapes = zip(ARKIT_BLENDSHAPES, deltas, strict=True)
+    for name, d in tqdm(shapes, total=len(deltas), desc=folder.name, disable=not progress):
         if np.any(d != 0):
             write_obj(folder / "blendshapes" / f"{name}.obj", neutral + d)
 
@@ -59,9 +66,9 @@ def write_identity_avatar(seed: int, out: Path, ict: str | None = None) -> Path:
     deltas = (t.arkit_to_ict.T @ t.expression_deltas.reshape(len(t.expression_names), -1)).reshape(
         52, -1, 3
     )
-    write_rig(out, neutral, deltas, t.triangles)
+    write_rig(out, neutral, deltas, t.triangles, progress=True)
     face = ArkitFace.load()
-    write_rig(out / "user_face", face.neutral, face.deltas, face.triangles)
+    write_rig(out / "user_face", face.neutral, face.deltas, face.triangles, progress=True)
     return out
 
 
