@@ -77,6 +77,10 @@ def run_ray(
         raise ValueError("--ray-address needs the ray package (pip install ray)") from e
     keep = ("PYTHONPATH", "SOFTDECA_ICT", "SOFTDECA_CACHE")
     env = {k: os.environ[k] for k in keep if k in os.environ}
+    if "PYTHONPATH" in env:  # Ray's workers start elsewhere: relative entries would break
+        env["PYTHONPATH"] = os.pathsep.join(
+            os.path.abspath(p) for p in env["PYTHONPATH"].split(os.pathsep) if p
+        )
     kw: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
     if address == "local":
         ray.init(num_cpus=max(1, workers), runtime_env={"env_vars": env}, **kw)

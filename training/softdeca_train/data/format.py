@@ -26,6 +26,11 @@ FRAME = {
     ),
     "iterations": ("int16", "(n,)", "solver iterations"),
     "converged": ("bool", "(n,)", "solver reached the tolerance"),
+    "estimated_error": (
+        "float32",
+        "(n,)",
+        "solver's estimated RMS distance to the fixed point / bounding-box diagonal",
+    ),
 }
 SPARSE = {
     "landmarks": (

@@ -165,13 +165,18 @@ def summarise(m: Manifest) -> dict:
     return out
 
 
+def _frames(spec: ShardSpec) -> int:
+    return sum(len(g.frames.weights) for g in spec.groups)
+
+
 def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
     """Generate (or resume) the dataset in run.out; returns the manifest's summary."""
     m, plan, header = _prepare(cfg, run)
     digest = _digest(header)
     done = {k: m.done(k) for k in KINDS}
     todo = [s for s in plan if s.index not in done[s.kind]]
-    total = sum(s.instances for s in plan)
+    # Progress in solved frames: a dynamic instance costs lead-in + sequence frames.
+    total = sum(_frames(s) for s in plan)
     started = time.time()
     record = {
         "code_version": code_version(),
@@ -186,8 +191,8 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
     m.doc["runs"].append(record)
     bar = tqdm(
         total=total,
-        initial=total - sum(s.instances for s in todo),
-        unit="inst",
+        initial=total - sum(_frames(s) for s in todo),
+        unit="frame",
         desc=f"generate {Path(run.out).name}",
         disable=not run.progress,
         smoothing=0.1,
@@ -201,7 +206,7 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
             record["instances"][spec.kind] += spec.instances
             record["wall_seconds"] = round(time.time() - started, 2)
             m.add(entry)  # saves the manifest: the shard counts from here on
-            bar.update(spec.instances)
+            bar.update(_frames(spec))
     finally:
         bar.close()
         record["wall_seconds"] = round(time.time() - started, 2)

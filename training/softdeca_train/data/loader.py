@@ -28,7 +28,9 @@ class ShardDataset(IterableDataset):
     float32), `p_norm` (p mapped to [0, 1] on each parameter's scale), and with
     `targets=True` also `S` (S_t) and `T` (the simulated skin), float32, metres. Dynamic
     instances carry whole sequences (L frames, plus `prev_S`/`prev_T` of the two lead-in
-    frames)."""
+    frames). Instances whose solver's estimated error (any frame, for sequences) exceeds
+    `max_error` ("auto": 3x the dataset's tolerance; None keeps all) are skipped: extreme
+    parameters can stall just above the tolerance (kept) or far from it (skipped)."""
 
     def __init__(
         self,
@@ -40,6 +42,7 @@ class ShardDataset(IterableDataset):
         buffer_shards: int = 2,
         targets: bool = True,
         ict: str | None = None,
+        max_error: float | str | None = "auto",
     ) -> None:
         if kind not in KINDS:
             raise ValueError(f"kind must be one of {KINDS}, not {kind!r}")
@@ -53,12 +56,15 @@ class ShardDataset(IterableDataset):
             for s in manifest["shards"]
             if s["kind"] == kind and s.get("split", TRAIN) in want
         ]
+        # All listed instances; with only_converged fewer are yielded (see the report).
         self.instances = sum(
             s["instances"] for s in manifest["shards"] if s["file"] in set(self.files)
         )
         self.kind, self.split, self.shuffle, self.seed = kind, split, shuffle, seed
         self.buffer_shards = max(1, buffer_shards)
         self.targets, self.ict = targets, ict
+        tol = manifest["header"]["config"]["tolerance"]
+        self.max_error = 3 * tol if max_error == "auto" else max_error
         self.epoch = 0
         self._blend: SkinBlend | None = None
         self._template: Template | None = None
@@ -119,5 +125,8 @@ class ShardDataset(IterableDataset):
             a = {k: np.concatenate([s[k] for s in shards]) for k in shards[0]}
             n = len(a["instance_id"])
             order = rng.permutation(n) if self.shuffle else np.arange(n)
+            if self.max_error is not None:
+                ok = (a["estimated_error"].reshape(n, -1) <= self.max_error).all(axis=1)
+                order = order[ok[order]]
             for i in order:
                 yield self._item(a, int(i))

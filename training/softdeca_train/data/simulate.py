@@ -103,6 +103,7 @@ def _stats(stats: list[dict]) -> dict[str, np.ndarray]:
     return {
         "iterations": np.array([s["iterations"] for s in stats], np.int16),
         "converged": np.array([s["converged"] for s in stats], bool),
+        "estimated_error": np.array([s["estimated_error"] for s in stats], np.float32),
     }
 
 
@@ -194,8 +195,7 @@ def _dynamic_group(
         prev_weights=w[None, lead - 2 : lead],
         prev_offsets=offsets[None, lead - 2 : lead],
         prev_source_index=g.frames.source_index[None, lead - 2 : lead],
-        iterations=st["iterations"][None],
-        converged=st["converged"][None],
+        **{k: v[None] for k, v in st.items()},
     )
     out.frames += len(w)
 
