@@ -97,7 +97,8 @@ def test_quantisation_error_is_measured_and_small(small) -> None:
     # float16 keeps 11 significant bits: half a unit in the last place of the largest offset.
     bound = summary["max_offset_mm"] * 2.0**-11
     assert 0 < summary["max_quantisation_error_mm"] <= bound + 1e-9
-    assert summary["max_quantisation_error_mm"] < 0.05
+    # Typical offsets are millimetres: the typical rounding error is far below a micrometre.
+    assert 0 < summary["rms_quantisation_error_mm"] < 1e-3
 
 
 def test_train_and_test_share_no_identity_parameters_or_expressions(small) -> None:

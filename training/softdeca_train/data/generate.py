@@ -160,6 +160,9 @@ def summarise(m: Manifest) -> dict:
     errs = [s["max_quantisation_error_m"] for s in shards if "max_quantisation_error_m" in s]
     mags = [s["max_offset_m"] for s in shards if "max_offset_m" in s]
     out["max_quantisation_error_mm"] = round(max(errs) * 1e3, 6) if errs else None
+    sq = sum(s.get("quantisation_sq_sum_m2", 0.0) for s in shards)
+    nq = sum(s.get("quantisation_values", 0) for s in shards)
+    out["rms_quantisation_error_mm"] = float(f"{np.sqrt(sq / nq) * 1e3:.3g}") if nq else None
     out["max_offset_mm"] = round(max(mags) * 1e3, 3) if mags else None
     out["bytes"] = sum(s["bytes"] for s in shards)
     return out

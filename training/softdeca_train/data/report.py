@@ -289,9 +289,10 @@ def write_report(
         f"test {', '.join(sp['test']['takes'])}; coverage draws: "
         f"{sp['train']['coverage_draws']} train, {sp['test']['coverage_draws']} test.",
         "",
-        f"Storage: {summary.get('bytes', 0) / 1e6:.1f} MB; offsets T - S_t as float16, largest "
-        f"rounding error {summary.get('max_quantisation_error_mm')} mm (largest offset "
-        f"{summary.get('max_offset_mm')} mm).",
+        f"Storage: {summary.get('bytes', 0) / 1e6:.1f} MB; offsets T - S_t as float16: "
+        f"rounding error RMS {summary.get('rms_quantisation_error_mm')} mm, largest "
+        f"{summary.get('max_quantisation_error_mm')} mm (float16 keeps 11 significant bits: "
+        f"the largest error sits on the largest offset, {summary.get('max_offset_mm')} mm).",
         "",
         f"Solver (tolerance {cfg['tolerance']:g}, at most {cfg['max_iterations']} iterations; "
         "estimated error = estimated RMS distance to the fixed point / bounding-box diagonal; "

@@ -62,13 +62,13 @@ def without_collisions(m: native.SimulationMesh) -> native.SimulationMesh:
     )
 
 
-def quantise(skin: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """float16 offsets T - S_t, their largest rounding error and largest magnitude (m)."""
+def quantise(skin: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """float16 offsets T - S_t, their rounding errors (m) and largest magnitude (m)."""
     off = np.asarray(skin, np.float64) - targets
     if not np.isfinite(off).all() or np.abs(off).max() >= F16_MAX:
         raise FloatingPointError("simulated skin is not finite or out of float16 range")
     q = off.astype(np.float16)
-    return q, float(np.abs(q.astype(np.float64) - off).max()), float(np.abs(off).max())
+    return q, q.astype(np.float64) - off, float(np.abs(off).max())
 
 
 class _Shard:
@@ -77,6 +77,8 @@ class _Shard:
     def __init__(self) -> None:
         self.cols: dict[str, list[np.ndarray]] = {}
         self.quant_error = 0.0
+        self.quant_sq_sum = 0.0
+        self.quant_values = 0
         self.max_offset = 0.0
         self.frames = 0
 
@@ -86,7 +88,9 @@ class _Shard:
 
     def offsets(self, skin: np.ndarray, targets: np.ndarray) -> np.ndarray:
         q, err, mag = quantise(skin, targets)
-        self.quant_error = max(self.quant_error, err)
+        self.quant_error = max(self.quant_error, float(np.abs(err).max()))
+        self.quant_sq_sum += float((err**2).sum())
+        self.quant_values += err.size
         self.max_offset = max(self.max_offset, mag)
         return q
 
@@ -240,6 +244,8 @@ def simulate_shard(
         "seconds": round(time.perf_counter() - t0, 3),
         "build_seconds": round(t_build, 3),
         "max_quantisation_error_m": out.quant_error,
+        "quantisation_sq_sum_m2": out.quant_sq_sum,
+        "quantisation_values": out.quant_values,
         "max_offset_m": out.max_offset,
         "simulated_vertices": int(mesh.vertex_count),
         "factorizations": int(sim.factorizations),
