@@ -92,7 +92,7 @@ class ShardDataset(IterableDataset):
             return {k: z[k] for k in z.files if k not in PER_INSTANCE_SKIP}
 
     def _item(self, a: dict[str, np.ndarray], i: int) -> dict[str, torch.Tensor]:
-        item = {k: torch.from_numpy(np.ascontiguousarray(v[i])) for k, v in a.items()}
+        item = {k: torch.from_numpy(np.array(v[i])) for k, v in a.items()}  # 0-d stays 0-d
         for k in ("offsets", "prev_offsets"):
             if k in item:
                 item[k] = item[k].float()
