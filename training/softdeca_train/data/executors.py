@@ -18,6 +18,24 @@ from softdeca_train.data.plan import ShardSpec
 from softdeca_train.data.simulate import simulate_shard
 
 Result = tuple[ShardSpec, dict, dict]
+# Workers run numpy's BLAS on one thread: a multi-threaded GEMM may round differently, and a
+# shard must be bit-identical whichever executor made it (Ray does the same by default).
+SINGLE_THREADED = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _environment(values: dict[str, str]) -> Iterator[None]:
+    """os.environ with `values` while the block runs (spawned children inherit it)."""
+    saved = {k: os.environ.get(k) for k in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 def _die_with_parent() -> None:
@@ -27,7 +45,11 @@ def _die_with_parent() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
-def run_inline(specs: list[ShardSpec], cfg: GenerateConfig, ict: str | None, threads: int):
+def run_inline(
+    specs: list[ShardSpec], cfg: GenerateConfig, ict: str | None, threads: int
+) -> Iterator[Result]:
+    """In this process (debugging, tiny runs). numpy's BLAS keeps this process's threads, so
+    the last bits may differ from shards made by worker processes or Ray."""
     for spec in specs:
         arrays, info = simulate_shard(spec, cfg, ict, threads)
         yield spec, arrays, info
@@ -39,7 +61,10 @@ def run_processes(
     """A pool of `workers` processes (spawned: no inherited native state), at most two shards
     queued per worker so a kill loses little."""
     ctx = mp.get_context("spawn")
-    with ProcessPoolExecutor(workers, mp_context=ctx, initializer=_die_with_parent) as pool:
+    with (
+        _environment(SINGLE_THREADED),
+        ProcessPoolExecutor(workers, mp_context=ctx, initializer=_die_with_parent) as pool,
+    ):
         todo = iter(specs)
         pending: dict[Future, ShardSpec] = {}
 
@@ -76,7 +101,7 @@ def run_ray(
     except ImportError as e:
         raise ValueError("--ray-address needs the ray package (pip install ray)") from e
     keep = ("PYTHONPATH", "SOFTDECA_ICT", "SOFTDECA_CACHE")
-    env = {k: os.environ[k] for k in keep if k in os.environ}
+    env = {k: os.environ[k] for k in keep if k in os.environ} | SINGLE_THREADED
     if "PYTHONPATH" in env:  # Ray's workers start elsewhere: relative entries would break
         env["PYTHONPATH"] = os.pathsep.join(
             os.path.abspath(p) for p in env["PYTHONPATH"].split(os.pathsep) if p
