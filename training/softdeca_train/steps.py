@@ -479,3 +479,61 @@ STEPS["runtime-bench"] = (
     _runtime_bench_args,
     _runtime_bench_run,
 )
+
+
+# ---- Training data (issue 4): generation, report, benchmark --------------------------------
+
+
+def _generate_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.data.cli import add_generate_args
+
+    add_generate_args(p)
+
+
+def _generate_run(args: argparse.Namespace) -> int:
+    from softdeca_train.data.cli import run_generate
+
+    return run_generate(args)
+
+
+def _report_data_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.data.cli import add_report_args
+
+    add_report_args(p)
+
+
+def _report_data_run(args: argparse.Namespace) -> int:
+    from softdeca_train.data.cli import run_report
+
+    return run_report(args)
+
+
+def _bench_datagen_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.data.cli import add_bench_args
+
+    add_bench_args(p)
+
+
+def _bench_datagen_run(args: argparse.Namespace) -> int:
+    from softdeca_train.data.cli import run_bench
+
+    return run_bench(args)
+
+
+STEPS["generate"] = (
+    "Generate (or resume) the training dataset: static, dynamic and sparse instances "
+    "simulated by the physics, in parallel (processes or Ray), as shards + manifest.",
+    _generate_args,
+    _generate_run,
+)
+STEPS["report-data"] = (
+    "Report on a generated dataset: markdown + plots (parameter, weight and identity "
+    "distributions; |T - S| per region).",
+    _report_data_args,
+    _report_data_run,
+)
+STEPS["bench-datagen"] = (
+    "Benchmark data generation on this machine into build/bench/datagen.json.",
+    _bench_datagen_args,
+    _bench_datagen_run,
+)

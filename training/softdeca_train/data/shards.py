@@ -137,5 +137,6 @@ def iter_shards(
             keep = arrays["split"] == (1 if split == "test" else 0)
             if not keep.any():
                 continue
-            arrays = {k: v[keep] for k, v in arrays.items()}
+            # Per-instance arrays are filtered; 0-d ones (the shard's `meta`) kept as they are.
+            arrays = {k: v[keep] if v.ndim else v for k, v in arrays.items()}
         yield arrays

@@ -1,0 +1,134 @@
+"""The plan: every shard of a dataset, fixed by the configuration alone, before anything is
+simulated. A shard is one identity with a few (identity, p) groups of frames; its instance
+ids, identity seed, parameter vectors and expression frames (with their sources) are all in
+its spec, so any worker on any machine produces the same shard, and a resumed run regenerates
+exactly the missing ones.
+
+Splits: each kind's shards (identities) are split by a seeded choice of `test_share` of
+them. Parameter vectors are drawn per group and numbered (param_id), identities are numbered
+(identity_id, including the sparse donors), so train and test share no identity and no
+parameter set; test frames come from the held-out take and the test coverage stream only."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdeca_train.data.config import KINDS, TEST, TRAIN, GenerateConfig
+from softdeca_train.data.expressions import Draws, ExpressionSource
+from softdeca_train.parameters import ParameterSet
+
+KIND_CODE = {k: i for i, k in enumerate(KINDS)}
+# Parameters that do not act in a kind keep their defaults there (paper 4.2.1: static
+# instances sample everything but the dynamics): the networks then see no noise inputs.
+FIXED = {
+    "static": ("dyn_gamma", "dyn_beta", "w_regularisation", "w_landmark"),
+    "dynamic": ("w_regularisation", "w_landmark"),
+    "sparse": ("dyn_gamma", "dyn_beta", "w_target"),
+}
+
+
+def derived_seed(*key: int) -> int:
+    """A 32-bit seed for one item (e.g. identity k of dataset seed s): independent streams."""
+    return int(np.random.SeedSequence(list(key)).generate_state(1)[0])
+
+
+@dataclass(frozen=True)
+class GroupSpec:
+    """Frames that share (identity, p): simulated in a row over one factorisation."""
+
+    param_id: int
+    p: np.ndarray  # (n_params,) float64
+    frames: Draws  # static/sparse: the instances' frames; dynamic: lead-in + sequence
+    donor_id: int = -1  # sparse: identity whose expression landmarks are personalised
+    donor_seed: int = -1
+    noise_seed: int = -1
+
+
+@dataclass(frozen=True)
+class ShardSpec:
+    kind: str
+    index: int
+    split: int
+    identity_id: int
+    identity_seed: int
+    first_instance: int
+    groups: tuple[GroupSpec, ...]
+
+    @property
+    def instances(self) -> int:
+        per = 1 if self.kind == "dynamic" else None
+        return sum(per or len(g.frames.weights) for g in self.groups)
+
+    @property
+    def instance_ids(self) -> np.ndarray:
+        return self.first_instance + np.arange(self.instances, dtype=np.int64)
+
+
+def sample_parameters(params: ParameterSet, kind: str, rng: np.random.Generator) -> np.ndarray:
+    p = params.sample(rng)
+    # exp(log(hi)) may round past hi: keep every value inside its range exactly.
+    p = np.clip(p, [s.lo for s in params.specs], [s.hi for s in params.specs])
+    defaults = params.defaults()
+    for name in FIXED[kind]:
+        k = params.names.index(name)
+        p[k] = defaults[k]
+    return p
+
+
+def _test_shards(n_shards: int, share: float, rng: np.random.Generator) -> set[int]:
+    if share <= 0 or n_shards < 2:
+        return set()
+    n_test = min(n_shards - 1, max(1, round(share * n_shards)))
+    return {int(i) for i in rng.choice(n_shards, n_test, replace=False)}
+
+
+def make_plan(
+    cfg: GenerateConfig, params: ParameterSet, sources: dict[int, ExpressionSource]
+) -> list[ShardSpec]:
+    shards: list[ShardSpec] = []
+    next_instance = next_identity = next_param = 0
+    for kind in KINDS:
+        n, per_group = cfg.count(kind), cfg.per_group(kind)
+        per_shard = per_group * cfg.groups_per_shard(kind)
+        n_shards = math.ceil(n / per_shard)
+        code = KIND_CODE[kind]
+        test = _test_shards(n_shards, cfg.test_share, np.random.default_rng([cfg.seed, 20, code]))
+        rng_p = np.random.default_rng([cfg.seed, 21, code])
+        for s in range(n_shards):
+            split = TEST if s in test else TRAIN
+            left = min(per_shard, n - s * per_shard)
+            identity_id = next_identity
+            next_identity += 1
+            groups = []
+            while left > 0:
+                k = min(per_group, left) if kind != "dynamic" else 1
+                left -= k
+                p = sample_parameters(params, kind, rng_p)
+                src = sources[split]
+                if kind == "dynamic":
+                    frames = src.window(cfg.lead_in + cfg.sequence_length)
+                else:
+                    frames = src.frames(k, cfg.real_share)
+                donor_id = donor_seed = noise_seed = -1
+                if kind == "sparse":
+                    donor_id = next_identity
+                    next_identity += 1
+                    donor_seed = derived_seed(cfg.seed, 1, donor_id)
+                    noise_seed = derived_seed(cfg.seed, 3, next_param)
+                groups.append(GroupSpec(next_param, p, frames, donor_id, donor_seed, noise_seed))
+                next_param += 1
+            spec = ShardSpec(
+                kind=kind,
+                index=s,
+                split=split,
+                identity_id=identity_id,
+                identity_seed=derived_seed(cfg.seed, 1, identity_id),
+                first_instance=next_instance,
+                groups=tuple(groups),
+            )
+            next_instance += spec.instances
+            shards.append(spec)
+    return shards

@@ -1,0 +1,340 @@
+"""The dataset report: report.md + PNGs, computed by streaming the shards once.
+
+- parameters: histogram of every entry of p on its own scale (normalised to [0, 1]) against
+  the target (uniform on that scale, paper Appendix A); fixed entries are marked;
+- weights: histogram of every ARKit weight against the target mix (real_share of the train
+  takes' frames, the rest from the fitted coverage sampler);
+- identities: the coefficients h against N(0, 1), and the spread of the neutral heads;
+- |T - S| (mm) per region and kind: mean and percentiles. This is the yardstick the
+  networks' errors are read against: an error near it means the network learnt nothing."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from softdeca_train.data.config import KINDS, GenerateConfig
+from softdeca_train.data.expressions import expression_sources, load_takes
+from softdeca_train.data.regions import REGIONS, region_labels
+from softdeca_train.data.shards import iter_shards
+from softdeca_train.parameters import load_parameters
+from softdeca_train.template import ARKIT_BLENDSHAPES, Template
+from softdeca_train.template.model import N_SKIN
+
+BIN_MM = 0.01
+MAX_MM = 200.0
+PERCENTILES = (50, 90, 99)
+
+
+class Displacements:
+    """Streaming mean and histogram percentiles of |T - S| per region (mm)."""
+
+    def __init__(self, labels: np.ndarray) -> None:
+        self.labels = labels
+        self.nbins = int(MAX_MM / BIN_MM) + 1  # the last bin holds everything beyond
+        self.hist = np.zeros((len(REGIONS) + 1, self.nbins), np.int64)  # + "all of S"
+        self.sum = np.zeros(len(REGIONS) + 1)
+        self.max = np.zeros(len(REGIONS) + 1)
+        self.frames = 0
+
+    def add(self, offsets: np.ndarray) -> None:
+        d = np.linalg.norm(offsets.astype(np.float32).reshape(-1, N_SKIN, 3), axis=2) * 1e3
+        self.frames += len(d)
+        bins = np.minimum((d / BIN_MM).astype(np.int64), self.nbins - 1)
+        for r in range(len(REGIONS) + 1):
+            sel = slice(None) if r == len(REGIONS) else self.labels == r
+            b, v = bins[:, sel].ravel(), d[:, sel]
+            self.hist[r] += np.bincount(b, minlength=self.nbins)
+            self.sum[r] += float(v.sum())
+            self.max[r] = max(self.max[r], float(v.max()))
+
+    def table(self) -> list[dict]:
+        rows = []
+        for r, name in enumerate((*REGIONS, "all of S")):
+            n = self.hist[r].sum()
+            if n == 0:
+                continue
+            cdf = np.cumsum(self.hist[r]) / n
+            row = {
+                "region": name,
+                "vertices": int((self.labels == r).sum()) if r < len(REGIONS) else N_SKIN,
+                "mean": self.sum[r] / n,
+            }
+            for q in PERCENTILES:
+                row[f"p{q}"] = (np.searchsorted(cdf, q / 100) + 1) * BIN_MM
+            row["max"] = self.max[r]
+            rows.append(row)
+        return rows
+
+
+def _target_weights(manifest: dict, takes_dir: Path | None, n: int = 20000) -> np.ndarray | None:
+    """Samples of the intended weight distribution of the train split's static frames."""
+    cfg = GenerateConfig.from_dict(manifest["header"]["config"])
+    try:
+        takes = load_takes(takes_dir) if takes_dir else None
+    except FileNotFoundError:
+        takes = None
+    if takes is None:
+        return None
+    sources, sampler = expression_sources(takes, cfg.test_take, cfg.seed + 1, 0.0)
+    src = sources[0]
+    real = src.pool[np.random.default_rng(0).integers(len(src.pool), size=n)]
+    w_real = np.stack([takes[t].weights[i] for t, i in real])
+    w_cov = sampler.sample(np.random.default_rng(1), n)
+    pick = np.random.default_rng(2).random(n) < cfg.real_share
+    return np.where(pick[:, None], w_real, w_cov)
+
+
+def _plot_parameters(p_norm: dict[str, np.ndarray], manifest: dict, path: Path) -> None:
+    params = load_parameters()
+    fixed = {k: set(v["fixed_parameters"]) for k, v in manifest["dataset"]["kinds"].items()}
+    fig, axes = plt.subplots(5, 5, figsize=(17, 14))
+    for k, (ax, spec) in enumerate(zip(axes.ravel(), params.specs, strict=True)):
+        for kind, values in p_norm.items():
+            if len(values) and spec.name not in fixed[kind]:
+                ax.hist(
+                    values[:, k], bins=20, range=(0, 1), density=True, histtype="step", label=kind
+                )
+        ax.axhline(1.0, color="k", ls="--", lw=1, label="target (uniform)")
+        fixed_in = [kind for kind in p_norm if spec.name in fixed[kind]]
+        note = f"\nfixed in {', '.join(fixed_in)}" if fixed_in else ""
+        ax.set_title(f"{spec.name} [{spec.lo:g}, {spec.hi:g}] {spec.scale}{note}", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle("parameters p, normalised on their sampling scale (density)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def _plot_weights(w: np.ndarray, target: np.ndarray | None, path: Path) -> None:
+    fig, axes = plt.subplots(6, 9, figsize=(22, 14))
+    for k, ax in enumerate(axes.ravel()):
+        if k >= 52:
+            ax.axis("off")
+            continue
+        ax.hist(w[:, k], bins=20, range=(0, 1), density=True, histtype="step", label="dataset")
+        if target is not None:
+            ax.hist(
+                target[:, k],
+                bins=20,
+                range=(0, 1),
+                density=True,
+                histtype="step",
+                ls="--",
+                color="k",
+                label="target",
+            )
+        ax.set_yscale("log")
+        ax.set_title(ARKIT_BLENDSHAPES[k], fontsize=8)
+        ax.tick_params(labelsize=6)
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle(
+        "ARKit weights of all frames (density, log): dataset vs target mix of real "
+        "train takes and coverage sampler"
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=70)
+    plt.close(fig)
+
+
+def _plot_identities(h: np.ndarray, split: np.ndarray, spread_mm: np.ndarray, path: Path) -> None:
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.5))
+    x = np.linspace(-3.5, 3.5, 200)
+    axes[0].hist(h.ravel(), bins=40, density=True, histtype="step", label="h (all modes)")
+    axes[0].plot(x, np.exp(-(x**2) / 2) / np.sqrt(2 * np.pi), "k--", label="N(0, 1)")
+    axes[0].set_title("identity coefficients")
+    axes[0].legend()
+    for s, name in ((0, "train"), (1, "test")):
+        axes[1].scatter(h[split == s, 0], h[split == s, 1], s=10, label=name)
+    axes[1].set_xlabel("h[0]")
+    axes[1].set_ylabel("h[1]")
+    axes[1].set_title("first two identity modes")
+    axes[1].legend()
+    axes[2].hist(spread_mm, bins=20)
+    axes[2].set_title("RMS distance of each neutral S to the template (mm)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def _plot_displacements(tables: dict[str, list[dict]], path: Path) -> None:
+    fig, ax = plt.subplots(figsize=(14, 5))
+    names = [r["region"] for r in next(iter(tables.values()))]
+    width = 0.8 / max(1, len(tables))
+    for j, (kind, rows) in enumerate(tables.items()):
+        x = np.arange(len(rows)) + j * width
+        ax.bar(x, [r["mean"] for r in rows], width, label=f"{kind} mean")
+        ax.scatter(x, [r["p99"] for r in rows], marker="_", s=200, color="k")
+    ax.set_xticks(np.arange(len(names)) + 0.4 - width / 2, names, rotation=30)
+    ax.set_ylabel("|T - S| (mm); dash: 99th percentile")
+    ax.set_yscale("log")
+    ax.legend()
+    ax.set_title("how much the physics moves S, per region")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def _fmt_table(rows: list[dict]) -> list[str]:
+    out = [
+        "| region | vertices | mean | p50 | p90 | p99 | max |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for r in rows:
+        out.append(
+            f"| {r['region']} | {r['vertices']} | {r['mean']:.3f} | {r['p50']:.2f} | "
+            f"{r['p90']:.2f} | {r['p99']:.2f} | {r['max']:.2f} |"
+        )
+    return out
+
+
+def write_report(
+    folder: Path, out: Path, ict: str | None = None, takes_dir: Path | None = None
+) -> Path:
+    from softdeca_train.data.config import default_takes_path
+
+    folder, out = Path(folder), Path(out)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    template = Template.load(ict)
+    labels = region_labels(template)
+    params = load_parameters()
+    out.mkdir(parents=True, exist_ok=True)
+    disp: dict[str, Displacements] = {}
+    p_norm: dict[str, list[np.ndarray]] = {}
+    weights, h_rows, h_split, h_seen = [], [], [], set()
+    conv: dict[str, list[np.ndarray]] = {}
+    its: dict[str, list[np.ndarray]] = {}
+    errs: dict[str, list[np.ndarray]] = {}
+    for kind in KINDS:
+        disp[kind] = Displacements(labels)
+        p_norm[kind], conv[kind], its[kind], errs[kind] = [], [], [], []
+        for a in iter_shards(folder, kind):
+            disp[kind].add(a["offsets"])
+            p_norm[kind].append(np.asarray(params.normalise(a["p"])))
+            weights.append(a["weights"].reshape(-1, 52))
+            conv[kind].append(a["converged"].ravel())
+            its[kind].append(a["iterations"].ravel())
+            errs[kind].append(a["estimated_error"].ravel())
+            ids = [(a["identity_id"], a["h"])]
+            if "donor_id" in a:
+                ids.append((a["donor_id"], a["donor_h"]))
+            for id_col, h_col in ids:
+                for i, hid in enumerate(id_col):
+                    if int(hid) not in h_seen:
+                        h_seen.add(int(hid))
+                        h_rows.append(h_col[i])
+                        h_split.append(int(a["split"][i]))
+    kinds = [k for k in KINDS if disp[k].frames]
+    tables = {k: disp[k].table() for k in kinds}
+    pn = {k: np.concatenate(p_norm[k]) for k in kinds}
+    w = np.concatenate(weights)
+    h = np.stack(h_rows)
+    spread = np.array(
+        [
+            np.sqrt(
+                (
+                    (
+                        template.identity_neutral(x.astype(np.float64))[:N_SKIN]
+                        - template.neutral[:N_SKIN]
+                    )
+                    ** 2
+                )
+                .sum(axis=1)
+                .mean()
+            )
+            * 1e3
+            for x in h
+        ]
+    )
+    takes_dir = takes_dir or default_takes_path()
+    _plot_parameters(pn, manifest, out / "parameters.png")
+    _plot_weights(w, _target_weights(manifest, takes_dir), out / "weights.png")
+    _plot_identities(h, np.array(h_split), spread, out / "identities.png")
+    _plot_displacements(tables, out / "displacement.png")
+
+    cfg = manifest["header"]["config"]
+    summary = manifest.get("summary", {})
+    ds = manifest["dataset"]
+    lines = [
+        f"# Dataset report: {folder.name}",
+        "",
+        f"Generated by `python -m softdeca_train generate` ({manifest['runs'][-1]['code_version']}"
+        f" at the last run); LHM level {cfg['level']}, collisions "
+        f"{'on' if cfg['collisions'] else 'off'}, solver tolerance {cfg['tolerance']:g}.",
+        "",
+        "## Contents",
+        "",
+        "| kind | shards | train | test | frames per instance | bytes per instance |",
+        "| --- | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for k in KINDS:
+        kd, sk = ds["kinds"][k], summary.get("kinds", {}).get(k, {})
+        lines.append(
+            f"| {k} | {kd['shards']} | {kd['instances']['train']} | {kd['instances']['test']} "
+            f"| {kd['frames_per_instance']} | {sk.get('bytes_per_instance')} |"
+        )
+    sp = ds["splits"]
+    lines += [
+        "",
+        f"Identities: {len(sp['train']['identities'])} train, {len(sp['test']['identities'])} "
+        f"test (sparse donors included); parameter sets: {sp['train']['parameter_sets']} train, "
+        f"{sp['test']['parameter_sets']} test; takes: train {', '.join(sp['train']['takes'])}; "
+        f"test {', '.join(sp['test']['takes'])}; coverage draws: "
+        f"{sp['train']['coverage_draws']} train, {sp['test']['coverage_draws']} test.",
+        "",
+        f"Storage: {summary.get('bytes', 0) / 1e6:.1f} MB; offsets T - S_t as float16: "
+        f"rounding error RMS {summary.get('rms_quantisation_error_mm')} mm, largest "
+        f"{summary.get('max_quantisation_error_mm')} mm (float16 keeps 11 significant bits: "
+        f"the largest error sits on the largest offset, {summary.get('max_offset_mm')} mm).",
+        "",
+        f"Solver (tolerance {cfg['tolerance']:g}, at most {cfg['max_iterations']} iterations; "
+        "estimated error = estimated RMS distance to the fixed point / bounding-box diagonal; "
+        "the loader skips frames above 3x the tolerance by default): "
+        + "; ".join(
+            f"{k} {100 * np.concatenate(conv[k]).mean():.1f} % converged, "
+            f"{100 * (np.concatenate(errs[k]) <= 3 * cfg['tolerance']).mean():.1f} % within 3x, "
+            f"median {np.median(np.concatenate(its[k])):.0f} iterations, estimated error "
+            f"median {np.median(np.concatenate(errs[k])):.1e} / p99 "
+            f"{np.percentile(np.concatenate(errs[k]), 99):.1e}"
+            for k in kinds
+        )
+        + ".",
+        "",
+        "## How much the physics moves S: |T - S| in mm",
+        "",
+        "Per vertex and frame (dynamic: all sequence frames). Regions: data/regions.py. "
+        "This is the yardstick for the networks' errors.",
+        "",
+    ]
+    for k in kinds:
+        lines += [f"### {k} ({disp[k].frames} frames)", "", *_fmt_table(tables[k]), ""]
+    lines += [
+        "![displacement](displacement.png)",
+        "",
+        "## Distributions",
+        "",
+        "Parameters on their sampling scale against the uniform target (Appendix A):",
+        "",
+        "![parameters](parameters.png)",
+        "",
+        "ARKit weights of all frames against the target mix (real train takes and coverage):",
+        "",
+        "![weights](weights.png)",
+        "",
+        f"Identities ({len(h)}): coefficients against N(0, 1) (the sampler keeps only "
+        "plausible heads, so the tails are thinner), first two modes by split, and the spread "
+        f"of the neutral heads (RMS distance to the template: median {np.median(spread):.1f} mm).",
+        "",
+        "![identities](identities.png)",
+        "",
+    ]
+    (out / "report.md").write_text("\n".join(lines))
+    (out / "displacement.json").write_text(json.dumps(tables, indent=1) + "\n")
+    return out / "report.md"
