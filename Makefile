@@ -56,6 +56,7 @@ bench: build
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
+	@$(PY) -m softdeca_train bench-datagen --ict "$(SOFTDECA_ICT)" --out build/bench
 
 lint: setup
 	@$(VENV)/bin/ruff check training tests/python && $(VENV)/bin/ruff format --check training tests/python
