@@ -199,8 +199,8 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
     }
     m.doc["runs"].append(record)
     # SIGTERM ends the run like Ctrl-C: the finally below still records its wall time.
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _terminate)
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if main else None
     bar = tqdm(
         total=total,
         initial=total - sum(_frames(s) for s in todo),
@@ -220,6 +220,8 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
             m.add(entry)  # saves the manifest: the shard counts from here on
             bar.update(_frames(spec))
     finally:
+        if main:
+            signal.signal(signal.SIGTERM, previous)
         bar.close()
         record["wall_seconds"] = round(time.time() - started, 2)
         n = sum(record["instances"].values())
