@@ -258,7 +258,7 @@ def test_report_writes_markdown_and_plots(small, tmp_path) -> None:
     for name in ("parameters.png", "weights.png", "identities.png", "displacement.png"):
         assert (tmp_path / name).stat().st_size > 10_000
         assert name in text
-    tables = json.loads((tmp_path / "displacement.json").read_text())
+    tables = json.loads((tmp_path / "displacement.json").read_text())["all"]
     assert set(tables) == set(KINDS)
     for rows in tables.values():
         assert [r["region"] for r in rows] == [*REGIONS, "all of S"]

@@ -73,7 +73,10 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         help=f"dynamic sequences per identity ({D.sequences_per_identity})",
     )
     g.add_argument(
-        "--sequence-length", type=int, default=D.sequence_length, help=f"({D.sequence_length})"
+        "--sequence-length",
+        type=int,
+        default=D.sequence_length,
+        help=f"frames per dynamic sequence ({D.sequence_length})",
     )
     g.add_argument(
         "--lead-in",
@@ -103,6 +106,12 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
     )
     g.add_argument(
         "--tolerance", type=float, default=D.tolerance, help=f"solver tolerance ({D.tolerance})"
+    )
+    g.add_argument(
+        "--max-iterations",
+        type=int,
+        default=D.max_iterations,
+        help=f"solver iterations per frame at most; slower frames are flagged ({D.max_iterations})",
     )
     r = p.add_argument_group("how to run (free to change on resume)")
     r.add_argument(
@@ -136,6 +145,7 @@ def config_from_args(args: argparse.Namespace) -> GenerateConfig:
         "landmark_noise_mm": args.noise_mm,
         "collisions": args.collisions,
         "tolerance": args.tolerance,
+        "max_iterations": args.max_iterations,
     }
     if args.instances is not None:
         return GenerateConfig.from_total(args.instances, args.sparse, **kw)
@@ -189,9 +199,8 @@ def add_bench_args(p: argparse.ArgumentParser) -> None:
 
 
 def run_bench(args: argparse.Namespace) -> int:
-    from softdeca_train.data.bench import bench_datagen
-
     from softdeca_train.bench import machine, write_area
+    from softdeca_train.data.bench import bench_datagen
 
     figures = bench_datagen(args.ict, args.level, args.workers, args.shards)
     path = write_area(Path(args.out), "datagen", figures)

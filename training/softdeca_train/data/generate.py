@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import signal
 import subprocess
+import threading
 import time
 from collections.abc import Iterator
 from datetime import datetime, timezone
@@ -168,6 +170,10 @@ def summarise(m: Manifest) -> dict:
     return out
 
 
+def _terminate(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
 def _frames(spec: ShardSpec) -> int:
     return sum(len(g.frames.weights) for g in spec.groups)
 
@@ -192,6 +198,9 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
         "wall_seconds": 0.0,
     }
     m.doc["runs"].append(record)
+    # SIGTERM ends the run like Ctrl-C: the finally below still records its wall time.
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if main else None
     bar = tqdm(
         total=total,
         initial=total - sum(_frames(s) for s in todo),
@@ -211,6 +220,8 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
             m.add(entry)  # saves the manifest: the shard counts from here on
             bar.update(_frames(spec))
     finally:
+        if main:
+            signal.signal(signal.SIGTERM, previous)
         bar.close()
         record["wall_seconds"] = round(time.time() - started, 2)
         n = sum(record["instances"].values())

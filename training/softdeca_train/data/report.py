@@ -44,6 +44,8 @@ class Displacements:
         self.frames = 0
 
     def add(self, offsets: np.ndarray) -> None:
+        if offsets.size == 0:
+            return
         d = np.linalg.norm(offsets.astype(np.float32).reshape(-1, N_SKIN, 3), axis=2) * 1e3
         self.frames += len(d)
         bins = np.minimum((d / BIN_MM).astype(np.int64), self.nbins - 1)
@@ -106,7 +108,7 @@ def _plot_parameters(p_norm: dict[str, np.ndarray], manifest: dict, path: Path) 
         note = f"\nfixed in {', '.join(fixed_in)}" if fixed_in else ""
         ax.set_title(f"{spec.name} [{spec.lo:g}, {spec.hi:g}] {spec.scale}{note}", fontsize=8)
         ax.tick_params(labelsize=7)
-    axes[0, 0].legend(fontsize=7)
+    axes[0, 2].legend(fontsize=7)
     fig.suptitle("parameters p, normalised on their sampling scale (density)")
     fig.tight_layout()
     fig.savefig(path, dpi=80)
@@ -212,11 +214,22 @@ def write_report(
     conv: dict[str, list[np.ndarray]] = {}
     its: dict[str, list[np.ndarray]] = {}
     errs: dict[str, list[np.ndarray]] = {}
+    tol = manifest["header"]["config"]["tolerance"]
+    kept: dict[str, Displacements] = {}  # the frames the loader yields by default
+    drivers: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = {}
     for kind in KINDS:
         disp[kind] = Displacements(labels)
+        kept[kind] = Displacements(labels)
+        drivers[kind] = []
         p_norm[kind], conv[kind], its[kind], errs[kind] = [], [], [], []
         for a in iter_shards(folder, kind):
             disp[kind].add(a["offsets"])
+            n = len(a["p"])
+            ok = (a["estimated_error"].reshape(n, -1) <= 3 * tol).all(axis=1)
+            kept[kind].add(a["offsets"][ok])
+            worst = np.abs(a["offsets"].reshape(n, -1)).max(axis=1).astype(np.float64)
+            err = a["estimated_error"].reshape(n, -1).max(axis=1).astype(np.float64)
+            drivers[kind].append((np.asarray(params.normalise(a["p"])), err, worst))
             p_norm[kind].append(np.asarray(params.normalise(a["p"])))
             weights.append(a["weights"].reshape(-1, 52))
             conv[kind].append(a["converged"].ravel())
@@ -232,7 +245,8 @@ def write_report(
                         h_rows.append(h_col[i])
                         h_split.append(int(a["split"][i]))
     kinds = [k for k in KINDS if disp[k].frames]
-    tables = {k: disp[k].table() for k in kinds}
+    tables = {k: kept[k].table() for k in kinds if kept[k].frames}
+    tables_all = {k: disp[k].table() for k in kinds}
     pn = {k: np.concatenate(p_norm[k]) for k in kinds}
     w = np.concatenate(weights)
     h = np.stack(h_rows)
@@ -313,8 +327,46 @@ def write_report(
         "This is the yardstick for the networks' errors.",
         "",
     ]
+    for k in tables:
+        lines += [
+            f"### {k}: {kept[k].frames} of {disp[k].frames} frames (estimated error <= 3x tol)",
+            "",
+            *_fmt_table(tables[k]),
+            "",
+        ]
+    lines += [
+        "All frames, including those the solver left above 3x the tolerance:",
+        "",
+    ]
     for k in kinds:
-        lines += [f"### {k} ({disp[k].frames} frames)", "", *_fmt_table(tables[k]), ""]
+        lines += [f"### {k}, all {disp[k].frames} frames", "", *_fmt_table(tables_all[k]), ""]
+    lines += [
+        "## What drives |T - S| and slow convergence",
+        "",
+        "Correlation (over instances) of each normalised parameter with log(largest |T - S| "
+        "of the instance) and with log(solver's estimated error); the three strongest each way:",
+        "",
+        "| kind | largest offset grows with | shrinks with | error grows with | shrinks with |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for k in kinds:
+        pn_k = np.concatenate([d[0] for d in drivers[k]])
+        cols = []
+        for y in (
+            np.concatenate([d[2] for d in drivers[k]]),
+            np.concatenate([d[1] for d in drivers[k]]),
+        ):
+            ly = np.log(np.maximum(y, 1e-12))
+            c = [
+                (float(np.corrcoef(pn_k[:, j], ly)[0, 1]), params.names[j])
+                for j in range(pn_k.shape[1])
+                if pn_k[:, j].std() > 0 and ly.std() > 0
+            ]
+            c.sort()
+            cols.append(", ".join(f"{n} {v:+.2f}" for v, n in reversed(c[-3:])))
+            cols.append(", ".join(f"{n} {v:+.2f}" for v, n in c[:3]))
+        lines.append(f"| {k} | " + " | ".join(cols) + " |")
+    lines.append("")
     lines += [
         "![displacement](displacement.png)",
         "",
@@ -336,5 +388,7 @@ def write_report(
         "",
     ]
     (out / "report.md").write_text("\n".join(lines))
-    (out / "displacement.json").write_text(json.dumps(tables, indent=1) + "\n")
+    (out / "displacement.json").write_text(
+        json.dumps({"kept": tables, "all": tables_all}, indent=1) + "\n"
+    )
     return out / "report.md"
