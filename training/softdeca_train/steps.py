@@ -164,33 +164,6 @@ def _landmarks_run(args: argparse.Namespace) -> int:
     return run(args.ict, args.arkit, args.out, args.write_definition)
 
 
-def _landmarks_args(p: argparse.ArgumentParser) -> None:
-    _ict_arg(p)
-    p.add_argument(
-        "--arkit",
-        default=None,
-        help="folder with ARKit_reference_blendshapes.zip and ARKit_landmarks68.txt "
-        "(default: $SOFTDECA_ARKIT_REFERENCE or ../shared/arkit-reference)",
-    )
-    p.add_argument(
-        "--out",
-        default="out/landmarks",
-        help="folder for registration.png and landmarks_report.{json,md}",
-    )
-    p.add_argument(
-        "--write-definition",
-        action="store_true",
-        help="regenerate the committed landmark definition (definition.json) from "
-        "its rules before registering",
-    )
-
-
-def _landmarks_run(args: argparse.Namespace) -> int:
-    from softdeca_train.landmarks.cli import run
-
-    return run(args.ict, args.arkit, args.out, args.write_definition)
-
-
 STEPS = {
     "template": (
         "Load ICT-FaceKit into the cache and summarise the template.",
