@@ -16,7 +16,7 @@
 #include "json.h"
 #include "options.h"
 #include "runtime_session.h"
-#include "take_csv.h"
+#include "take.h"
 
 namespace softdeca::cli {
 
@@ -89,7 +89,7 @@ int run_bench_runtime(const Args& args) {
                              "and write the benchmark JSON (DESIGN §3).");
   o.option("--bundle", "DIR", "model bundle folder or .tar")
       .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
-      .option("--take", "CSV", "Live Link Face CSV take whose frames drive the measurement")
+      .option("--take", "FILE", "Live Link Face CSV or recording whose frames drive the measurement")
       .option("--frames", "N", "frames measured per figure", "600")
       .option("--warmup", "N", "frames run before measuring", "30")
       .option("--prepares", "N", "prepares measured", "5")
@@ -100,7 +100,7 @@ int run_bench_runtime(const Args& args) {
     if (!o.given(req)) throw UsageError(std::string(req) + " is required");
   const std::size_t n_frames = static_cast<std::size_t>(o.integer("--frames"));
   const std::size_t warmup = static_cast<std::size_t>(o.integer("--warmup"));
-  const Take take = read_livelinkface_csv(o.text("--take"), n_frames);
+  const Take take = read_take(o.text("--take"), n_frames);
   const std::size_t frames = take.weights.size();
   const FaceRig rig = read_rig(o.text("--avatar"));
   const FaceRig user = read_rig(o.text("--avatar") + "/user_face", true);

@@ -1,4 +1,4 @@
-// softdeca replay: a take through plain linear blendshapes, SoftDECA (from the weights) and
+// softdeca replay: a take (Live Link Face CSV or recording) through plain linear blendshapes, SoftDECA (from the weights) and
 // SparseSoftDECA (from landmarks) onto one avatar. Writes per model a PC2 point cache over the
 // avatar's neutral OBJ (Blender: import neutral.obj, add a Mesh Cache modifier; Unity: the OBJ
 // sequence of --obj-every), replay.json with the timing summary, and (--preview) a contact
@@ -16,7 +16,7 @@
 #include "mesh_io.h"
 #include "options.h"
 #include "runtime_session.h"
-#include "take_csv.h"
+#include "take.h"
 
 namespace softdeca::cli {
 
@@ -133,11 +133,11 @@ unsigned precision_of(const std::string& p) {
 }  // namespace
 
 int run_replay(const Args& args) {
-  Options o("replay", "Replay a Live Link Face CSV take through linear blendshapes, SoftDECA and SparseSoftDECA onto\n"
-                      "one avatar; writes <out>/neutral.obj, <model>.pc2 point caches, replay.json (timings) and,\n"
+  Options o("replay", "Replay a take (Live Link Face CSV or a recording) through linear blendshapes, SoftDECA and\n"
+                      "SparseSoftDECA onto one avatar; writes <out>/neutral.obj, <model>.pc2 point caches, replay.json (timings) and,\n"
                       "with --preview, preview.png. SparseSoftDECA reads landmarks of a tracked face: the avatar's\n"
                       "user_face rig blended with the take (as a phone would track it), else the avatar's own.");
-  o.positional("TAKE", "Live Link Face CSV take")
+  o.positional("TAKE", "Live Link Face CSV (.csv) or a recording of the streaming format")
       .option("--bundle", "DIR", "model bundle folder or .tar")
       .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
       .option("--seed", "N", "instead of --avatar: the ICT identity of this seed, written to <out>/avatar by the Python helper")
@@ -160,7 +160,7 @@ int run_replay(const Args& args) {
   const unsigned precision = precision_of(o.text("--precision"));
   const long obj_every = o.integer("--obj-every");
 
-  const Take take = read_livelinkface_csv(o.arg(0), static_cast<std::size_t>(o.integer("--frames")));
+  const Take take = read_take(o.arg(0), static_cast<std::size_t>(o.integer("--frames")));
   std::fprintf(stderr, "take %s: %zu rows, %zu frames, %zu face-lost rows skipped, %zu unreadable\n", take.path.c_str(),
                take.rows, take.weights.size(), take.face_lost, take.invalid);
   std::string avatar_dir = o.text("--avatar");

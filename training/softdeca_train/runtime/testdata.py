@@ -44,7 +44,7 @@ def write_take(path: Path, weights: np.ndarray, face_lost: tuple[int, ...] = ())
     for i, w in enumerate(weights):
         tc = f"10:00:{i // 30:02d}:{(2 * i) % 60:02d}.000"
         if i in face_lost:
-            rows.append(f"{tc},61")
+            rows.append(f"{tc},0")  # what the app writes when it lost the face
             continue
         rows.append(",".join([tc, "61", *(f"{w[j]:.6f}" for j in order), "0", "0", "0"]))
     path.write_text("\n".join(rows) + "\n")

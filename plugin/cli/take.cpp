@@ -1,0 +1,51 @@
+#include "take.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "recording/livelinkface_csv.h"
+#include "recording/recording_reader.h"
+
+namespace softdeca::cli {
+
+Take read_take(const std::string& path, std::size_t max_frames) {
+  Take take;
+  take.path = path;
+  std::vector<stream::Frame> frames;
+  const bool csv = path.size() >= 4 && path.compare(path.size() - 4, 4, ".csv") == 0;
+  if (csv) {
+    recording::CsvTake t = recording::read_livelinkface_csv(path, recording::kLiveLinkFaceTimecodeRate);
+    take.rows = t.rows;
+    take.face_lost = t.face_lost_rows;
+    take.invalid = t.malformed_rows;
+    frames = std::move(t.frames);
+  } else {
+    recording::Recording r = recording::read_recording(path);
+    take.rows = r.frames.size();
+    frames = std::move(r.frames);
+  }
+  std::vector<double> times;
+  for (const stream::Frame& f : frames) {
+    if (f.tracking == stream::Tracking::lost) {
+      ++take.face_lost;
+      continue;
+    }
+    std::array<float, 52> w{};
+    for (std::size_t i = 0; i < 52; ++i) w[i] = std::min(1.0f, std::max(0.0f, f.weights[i]));
+    take.weights.push_back(w);
+    times.push_back(f.capture_time);
+    if (max_frames && take.weights.size() >= max_frames) break;
+  }
+  if (take.weights.empty()) throw std::runtime_error(path + ": no usable frame");
+  std::vector<double> dt;
+  for (std::size_t i = 1; i < times.size(); ++i)
+    if (times[i] > times[i - 1]) dt.push_back(times[i] - times[i - 1]);
+  if (!dt.empty()) {
+    std::nth_element(dt.begin(), dt.begin() + static_cast<long>(dt.size() / 2), dt.end());
+    take.median_frame_s = dt[dt.size() / 2];
+  }
+  return take;
+}
+
+}  // namespace softdeca::cli
