@@ -165,7 +165,11 @@ def run_generate(args: argparse.Namespace) -> int:
         takes=Path(args.takes) if args.takes else default_takes_path(),
         progress=not args.no_progress,
     )
-    summary = generate(cfg, run)
+    try:
+        summary = generate(cfg, run)
+    except KeyboardInterrupt:
+        print(f"interrupted: finished shards are kept; run the same command to resume {run.out}")
+        return 130
     print(json.dumps(summary, indent=1))
     if args.report:
         from softdeca_train.data.report import write_report

@@ -18,7 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from softdeca_train.data import executors
-from softdeca_train.data.config import KINDS, TEST, TRAIN, GenerateConfig, RunSettings
+from softdeca_train.data.config import KINDS, TEST, GenerateConfig, RunSettings
 from softdeca_train.data.expressions import Take, expression_sources, load_takes
 from softdeca_train.data.format import describe, shard_meta
 from softdeca_train.data.plan import FIXED, ShardSpec, make_plan
@@ -229,7 +229,3 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
         m.doc["summary"] = summarise(m)
         m.save()
     return m.doc["summary"]
-
-
-def split_name(split: int) -> str:
-    return "test" if split == TEST else "train" if split == TRAIN else str(split)

@@ -19,10 +19,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import KINDS, GenerateConfig
 from softdeca_train.data.expressions import expression_sources, load_takes
 from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.data.shards import iter_shards
+from softdeca_train.landmarks import SurfaceLandmarks, template_landmarks
 from softdeca_train.parameters import load_parameters
 from softdeca_train.template import ARKIT_BLENDSHAPES, Template
 from softdeca_train.template.model import N_SKIN
@@ -197,6 +199,24 @@ def _fmt_table(rows: list[dict]) -> list[str]:
     return out
 
 
+def _landmark_distances(
+    template: Template, lms: SurfaceLandmarks, blend: SkinBlend, a: dict[str, np.ndarray]
+) -> np.ndarray:
+    """(4, n * 149) distances (m) of one sparse shard: expression motion, personalisation
+    error, with noise, and noise against the simulated T."""
+    neutral = template.identity_neutral(a["h"][0].astype(np.float64))[:N_SKIN]
+    s = blend.targets(neutral, a["weights"])
+    l_s, l_0 = lms.evaluate(s), lms.evaluate(neutral)
+    l_t = lms.evaluate(s + a["offsets"].astype(np.float64))
+    d = [
+        l_s - l_0[None],
+        a["landmarks_clean"] - l_s,
+        a["landmarks"] - l_s,
+        a["landmarks"] - l_t,
+    ]
+    return np.stack([np.linalg.norm(x, axis=-1).ravel() for x in d])
+
+
 def write_report(
     folder: Path, out: Path, ict: str | None = None, takes_dir: Path | None = None
 ) -> Path:
@@ -215,6 +235,8 @@ def write_report(
     its: dict[str, list[np.ndarray]] = {}
     errs: dict[str, list[np.ndarray]] = {}
     tol = manifest["header"]["config"]["tolerance"]
+    lms, blend = template_landmarks(template), SkinBlend.of(template)
+    landmark_stats: list[np.ndarray] = []
     kept: dict[str, Displacements] = {}  # the frames the loader yields by default
     drivers: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = {}
     for kind in KINDS:
@@ -230,6 +252,8 @@ def write_report(
             worst = np.abs(a["offsets"].reshape(n, -1)).max(axis=1).astype(np.float64)
             err = a["estimated_error"].reshape(n, -1).max(axis=1).astype(np.float64)
             drivers[kind].append((np.asarray(params.normalise(a["p"])), err, worst))
+            if kind == "sparse":
+                landmark_stats.append(_landmark_distances(template, lms, blend, a))
             p_norm[kind].append(np.asarray(params.normalise(a["p"])))
             weights.append(a["weights"].reshape(-1, 52))
             conv[kind].append(a["converged"].ravel())
@@ -367,6 +391,26 @@ def write_report(
             cols.append(", ".join(f"{n} {v:+.2f}" for v, n in c[:3]))
         lines.append(f"| {k} | " + " | ".join(cols) + " |")
     lines.append("")
+    if landmark_stats:
+        ls = np.concatenate(landmark_stats, axis=1) * 1e3
+        names = (  # pipes escaped: these sit in a markdown table
+            "expression motion of the landmarks on S (\\|L(S_t) - L(S_0)\\|)",
+            "personalised donor landmarks vs the head's own (\\|L_clean - L(S_t)\\|)",
+            "noisy landmarks vs the head's own (\\|L - L(S_t)\\|)",
+            "noisy landmarks vs the simulated result (\\|L - L(T)\\|)",
+        )
+        lines += [
+            "### Sparse landmarks (mm, per landmark and frame)",
+            "",
+            "| distance | mean | p50 | p95 | max |",
+            "| --- | ---: | ---: | ---: | ---: |",
+            *(
+                f"| {name} | {row.mean():.2f} | {np.median(row):.2f} | "
+                f"{np.percentile(row, 95):.2f} | {row.max():.2f} |"
+                for name, row in zip(names, ls, strict=True)
+            ),
+            "",
+        ]
     lines += [
         "![displacement](displacement.png)",
         "",
