@@ -13,6 +13,7 @@ import json
 import numpy as np
 import pytest
 import torch
+from conftest import SMALL
 from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import KINDS, TEST, TRAIN, GenerateConfig, RunSettings
 from softdeca_train.data.expressions import COVERAGE, expression_sources, load_takes
@@ -26,27 +27,6 @@ from softdeca_train.data.shards import iter_shards, verify
 from softdeca_train.landmarks import template_landmarks
 from softdeca_train.parameters import load_parameters
 from softdeca_train.template.model import N_SKIN
-
-SMALL = GenerateConfig(
-    static=16,
-    dynamic=2,
-    sparse=16,
-    level=2,
-    frames_per_params=4,
-    params_per_identity=2,
-    sequences_per_identity=1,
-    sequence_length=4,
-    lead_in=2,
-    test_share=0.3,
-    seed=7,
-)
-
-
-@pytest.fixture(scope="module")
-def small(tmp_path_factory) -> tuple:
-    out = tmp_path_factory.mktemp("small")
-    summary = generate(SMALL, RunSettings(out=out, workers=2, progress=False))
-    return out, summary
 
 
 def _all(folder, kind: str) -> dict[str, np.ndarray]:
@@ -291,3 +271,23 @@ def test_resuming_with_another_configuration_is_refused(small) -> None:
     # The same configuration resumes to a no-op: nothing left to do, nothing duplicated.
     summary = generate(SMALL, RunSettings(out=out, workers=0, progress=False))
     assert summary["kinds"]["static"]["instances"] == SMALL.static
+
+
+def test_parameters_are_sampled_in_the_range_profile(small) -> None:
+    from softdeca_train.data.ranges import PROFILES, sampling_parameters
+
+    out, _ = small
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["dataset"]["range_profile"] == "plausible"
+    params = sampling_parameters(load_parameters(), "plausible")
+    for kind in KINDS:
+        p = _all(out, kind)["p"]
+        params.validate(p)  # inside the narrowed ranges, not only the physics' own
+    lo, hi = PROFILES["plausible"]["w_target"]
+    k = params.names.index("w_target")
+    assert params.specs[k].lo == lo and params.specs[k].hi == hi
+    # datasets written before range profiles sampled the physics' ranges
+    legacy = {k: v for k, v in SMALL.as_dict().items() if k != "ranges"}
+    assert GenerateConfig.from_dict(legacy).ranges == "appendix-a"
+    with pytest.raises(ValueError, match="unknown range profile"):
+        sampling_parameters(load_parameters(), "nonsense")

@@ -510,3 +510,30 @@ STEPS["bench-datagen"] = (
     _bench_datagen_args,
     _bench_datagen_run,
 )
+
+
+def _train_cli():  # the training's command lines, imported only when used (torch is slow)
+    from softdeca_train.train import cli
+
+    return cli
+
+
+STEPS |= {
+    "train-bundle": (
+        "Train every network of a model bundle (identity encoder, SoftDECA, SparseSoftDECA, "
+        "their dynamics) on a generated dataset, resumably, and export the bundle.",
+        lambda p: _train_cli().add_bundle_args(p),
+        lambda a: _train_cli().run_bundle(a),
+    ),
+    "train-model": (
+        "Train one model of the registry in a run folder (e.g. a Table 1 baseline).",
+        lambda p: _train_cli().add_model_args(p),
+        lambda a: _train_cli().run_model(a),
+    ),
+    "evaluate": (
+        "Evaluate a training run and its bundle on the test split: report (markdown, plots, "
+        "error heat maps) and build/bench/models.json.",
+        lambda p: _train_cli().add_evaluate_args(p),
+        lambda a: _train_cli().run_evaluate(a),
+    ),
+}

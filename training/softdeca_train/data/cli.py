@@ -9,6 +9,7 @@ import os
 from pathlib import Path
 
 from softdeca_train.data.config import GenerateConfig, RunSettings, default_takes_path
+from softdeca_train.data.ranges import PROFILES
 
 D = GenerateConfig()
 
@@ -113,6 +114,12 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         default=D.max_iterations,
         help=f"solver iterations per frame at most; slower frames are flagged ({D.max_iterations})",
     )
+    g.add_argument(
+        "--ranges",
+        choices=sorted(PROFILES),
+        default=D.ranges,
+        help=f"parameter sampling ranges (data/ranges.py; {D.ranges})",
+    )
     r = p.add_argument_group("how to run (free to change on resume)")
     r.add_argument(
         "--workers",
@@ -146,6 +153,7 @@ def config_from_args(args: argparse.Namespace) -> GenerateConfig:
         "collisions": args.collisions,
         "tolerance": args.tolerance,
         "max_iterations": args.max_iterations,
+        "ranges": args.ranges,
     }
     if args.instances is not None:
         return GenerateConfig.from_total(args.instances, args.sparse, **kw)

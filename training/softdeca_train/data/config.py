@@ -8,6 +8,7 @@ import os
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
+from softdeca_train.data.ranges import LEGACY_PROFILE, PROFILES
 from softdeca_train.paths import REPO_ROOT
 
 KINDS = ("static", "dynamic", "sparse")
@@ -59,6 +60,9 @@ class GenerateConfig:
     # estimated error ~1.2e-4 after 300 iterations): past this the frame is kept with its
     # `converged` flag and `estimated_error` (the loader filters on them).
     max_iterations: int = 200
+    # Parameter sampling ranges (data/ranges.py): "plausible" narrows the weakest constraint
+    # weights of Appendix A, "appendix-a" samples the physics' own ranges.
+    ranges: str = "plausible"
 
     def __post_init__(self) -> None:
         problems = []
@@ -88,6 +92,8 @@ class GenerateConfig:
             problems.append("lead-in dynamics need gamma in (0, 1], beta in [0, 1)")
         if self.dynamic and self.lead_in < 2:
             problems.append("dynamic sequences need lead_in >= 2 (the two previous frames)")
+        if self.ranges not in PROFILES:
+            problems.append(f"ranges must be one of {sorted(PROFILES)}")
         if problems:
             raise ValueError("bad generate configuration: " + "; ".join(problems))
 
@@ -115,6 +121,7 @@ class GenerateConfig:
     @classmethod
     def from_dict(cls, d: dict) -> GenerateConfig:
         names = {f.name for f in fields(cls)}
+        d = {"ranges": LEGACY_PROFILE, **d}  # written before range profiles existed
         return cls(**{k: v for k, v in d.items() if k in names})
 
 

@@ -22,6 +22,7 @@ from softdeca_train.data.config import KINDS, TEST, GenerateConfig, RunSettings
 from softdeca_train.data.expressions import Take, expression_sources, load_takes
 from softdeca_train.data.format import describe, shard_meta
 from softdeca_train.data.plan import FIXED, ShardSpec, make_plan
+from softdeca_train.data.ranges import sampling_parameters
 from softdeca_train.data.shards import Manifest, write_shard
 from softdeca_train.parameters import DEFINITION, load_parameters
 from softdeca_train.paths import REPO_ROOT
@@ -62,7 +63,7 @@ def _digest(header: dict) -> str:
 def describe_plan(cfg: GenerateConfig, plan: list[ShardSpec], takes: list[Take]) -> dict:
     """The dataset as planned: counts, splits (identities, parameter sets, expression
     sources) and the parameter definition, written before anything is simulated."""
-    params = load_parameters()
+    params = sampling_parameters(load_parameters(), cfg.ranges)
     test_take = [t.name for t in takes].index(cfg.test_take)
     per_kind: dict[str, dict] = {}
     splits: dict[str, dict] = {
@@ -109,6 +110,7 @@ def describe_plan(cfg: GenerateConfig, plan: list[ShardSpec], takes: list[Take])
         },
         "lhm_level": cfg.level,
         "collisions": cfg.collisions,
+        "range_profile": cfg.ranges,
     }
 
 
@@ -120,7 +122,7 @@ def _prepare(cfg: GenerateConfig, run: RunSettings) -> tuple[Manifest, list[Shar
         raise ValueError(f"{out} is not empty and holds no dataset manifest: use a new folder")
     takes = load_takes(run.takes)
     sources, _ = expression_sources(takes, cfg.test_take, cfg.seed, cfg.test_share)
-    plan = make_plan(cfg, load_parameters(), sources)
+    plan = make_plan(cfg, sampling_parameters(load_parameters(), cfg.ranges), sources)
     out.mkdir(parents=True, exist_ok=True)
     header = make_header(cfg, takes)
     m = Manifest.open(out, header)

@@ -22,10 +22,11 @@ import numpy as np
 from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import KINDS, GenerateConfig
 from softdeca_train.data.expressions import expression_sources, load_takes
+from softdeca_train.data.ranges import sampling_parameters
 from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.data.shards import iter_shards
 from softdeca_train.landmarks import SurfaceLandmarks, template_landmarks
-from softdeca_train.parameters import load_parameters
+from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.template import ARKIT_BLENDSHAPES, Template
 from softdeca_train.template.model import N_SKIN
 
@@ -95,8 +96,14 @@ def _target_weights(manifest: dict, takes_dir: Path | None, n: int = 20000) -> n
     return np.where(pick[:, None], w_real, w_cov)
 
 
+def dataset_parameters(manifest: dict) -> ParameterSet:
+    """The parameters with the ranges this dataset sampled (its range profile)."""
+    cfg = GenerateConfig.from_dict(manifest["header"]["config"])
+    return sampling_parameters(load_parameters(), cfg.ranges)
+
+
 def _plot_parameters(p_norm: dict[str, np.ndarray], manifest: dict, path: Path) -> None:
-    params = load_parameters()
+    params = dataset_parameters(manifest)
     fixed = {k: set(v["fixed_parameters"]) for k, v in manifest["dataset"]["kinds"].items()}
     fig, axes = plt.subplots(5, 5, figsize=(17, 14))
     for k, (ax, spec) in enumerate(zip(axes.ravel(), params.specs, strict=True)):
@@ -226,7 +233,7 @@ def write_report(
     manifest = json.loads((folder / "manifest.json").read_text())
     template = Template.load(ict)
     labels = region_labels(template)
-    params = load_parameters()
+    params = dataset_parameters(manifest)
     out.mkdir(parents=True, exist_ok=True)
     disp: dict[str, Displacements] = {}
     p_norm: dict[str, list[np.ndarray]] = {}

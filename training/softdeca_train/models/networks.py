@@ -147,7 +147,12 @@ class ElementMLP(nn.Module):
 
 class HyperNetwork(nn.Module):
     """f_ph (k = 9: a 3x3 deformation-gradient block per face and latent) or f_ph_v (k = 3: a
-    vertex offset per latent). Output [n, latent, k]."""
+    vertex offset per latent). Output [n, latent, k]. `unit` is a fixed factor on the output
+    (part of the exported graph): vertex offsets are learned in centimetres (unit 0.01) so
+    that the weights, not the optimiser's step size, carry the metre scale. With `base`, a
+    trainable per-element table L0 is added: L = L0 + MLP(p_i, h, pi(i)), the mean tensor
+    held directly (initialised from data by the training) and the hypernetwork its change
+    with parameters and identity."""
 
     def __init__(
         self,
@@ -156,15 +161,21 @@ class HyperNetwork(nn.Module):
         sizes: NetworkSizes,
         k: int,
         out_scale: float,
+        unit: float = 1.0,
+        base: bool = False,
     ) -> None:
         super().__init__()
-        self.latent, self.k = sizes.latent, k
+        self.latent, self.k, self.unit = sizes.latent, k, unit
+        self.base = nn.Parameter(torch.zeros(n_elements, sizes.latent, k)) if base else None
         self.body = ElementMLP(
-            n_elements, specs, sizes, sizes.hyper_hidden, sizes.latent * k, out_scale
+            n_elements, specs, sizes, sizes.hyper_hidden, sizes.latent * k, out_scale / unit
         )
 
     def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:
-        return self.body(parameters, identity).reshape(-1, self.latent, self.k)
+        out = self.body(parameters, identity).reshape(-1, self.latent, self.k)
+        if self.base is not None:
+            out = out + self.base
+        return out * self.unit if self.unit != 1.0 else out
 
 
 class DynamicsNetwork(nn.Module):

@@ -108,7 +108,8 @@ def _build_cache(source: Path, target: Path) -> None:
     # ICT modes and expressions are full meshes: store differences to the neutral, in metres.
     expr = np.stack([shapes[e] - neutral for e in expressions]) * CM_TO_M
     ident = np.stack([shapes[f"identity{k:03d}"] - neutral for k in range(N_IDENTITY_MODES)])
-    tmp = target.with_suffix(".tmp.npz")
+    # One temporary per process: worker processes that start together may all build it.
+    tmp = target.with_suffix(f".{os.getpid()}.tmp.npz")
     np.savez(
         tmp,
         format=np.int32(CACHE_FORMAT),

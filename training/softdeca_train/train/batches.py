@@ -1,0 +1,155 @@
+"""Batches for training and evaluation, read shard by shard from a generated dataset
+(data/generate.py). A static or sparse batch is frames of one (identity, p) group: the
+hypernetwork's per-element pass (the expensive part) then runs once per batch, as at run time
+once per avatar. A dynamic batch is one sequence. Each batch carries its identity's neutral
+skin and deformation-transfer system (cached per identity: K depends only on the neutral)."""
+
+from __future__ import annotations
+
+import json
+from collections import OrderedDict
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from softdeca_train.data.blend import SkinBlend
+from softdeca_train.data.config import TEST, TRAIN
+from softdeca_train.models.dt import DtSystem, dt_system
+from softdeca_train.template import Template
+from softdeca_train.template.model import N_SKIN
+
+
+@dataclass
+class Batch:
+    """One group of frames. Shapes: B frames (static/sparse) or L sequence frames (dynamic);
+    V = skin vertices, K = landmarks; metres, float32."""
+
+    kind: str
+    identity_id: int
+    param_id: int
+    p: torch.Tensor  # (1, P) raw parameter values
+    h: torch.Tensor  # (1, H)
+    neutral: torch.Tensor  # (V, 3) the identity's neutral skin
+    weights: torch.Tensor  # (B, 52)
+    S: torch.Tensor  # (B, V, 3) linear blend S_t
+    T: torch.Tensor  # (B, V, 3) simulated
+    dt: DtSystem
+    landmarks: torch.Tensor | None = None  # sparse: (B, K, 3) sigma(L), noisy, personalised
+    landmarks_clean: torch.Tensor | None = None  # sparse: the same without the noise
+    prev_S: torch.Tensor | None = None  # dynamic: (2, V, 3) frames t-2, t-1 before the sequence
+    prev_T: torch.Tensor | None = None
+    source_take: np.ndarray | None = None  # (B,) take index or -1 (coverage)
+
+    @property
+    def frames(self) -> int:
+        return len(self.weights)
+
+
+class IdentityCache:
+    """Neutral skins and DT systems per identity, least recently used out."""
+
+    def __init__(self, template: Template, triangles: np.ndarray, size: int = 48) -> None:
+        self.template, self.triangles, self.size = template, triangles, size
+        self._items: OrderedDict[int, tuple[np.ndarray, DtSystem]] = OrderedDict()
+
+    def get(self, identity_id: int, h: np.ndarray) -> tuple[np.ndarray, DtSystem]:
+        if identity_id in self._items:
+            self._items.move_to_end(identity_id)
+            return self._items[identity_id]
+        neutral = self.template.identity_neutral(h)[:N_SKIN].astype(np.float64)
+        item = (neutral, dt_system(neutral, self.triangles))
+        self._items[identity_id] = item
+        if len(self._items) > self.size:
+            self._items.popitem(last=False)
+        return item
+
+
+class Dataset:
+    """A generated dataset: its manifest and the shards of one kind and split."""
+
+    def __init__(self, folder: str | Path, template: Template | None = None) -> None:
+        self.folder = Path(folder)
+        path = self.folder / "manifest.json"
+        if not path.is_file():
+            raise FileNotFoundError(f"no dataset at {self.folder} (manifest.json missing)")
+        self.manifest = json.loads(path.read_text())
+        self._path = path
+        self.template = template or Template.load()
+        self.blend = SkinBlend.of(self.template)
+        self.cache = IdentityCache(self.template, self.template.skin_triangles)
+        self.tolerance = float(self.manifest["header"]["config"]["tolerance"])
+
+    def refresh(self) -> None:
+        """Re-read the manifest: a dataset still being generated lists more finished shards."""
+        self.manifest = json.loads(self._path.read_text())
+
+    def shards(self, kind: str, split: str) -> list[str]:
+        want = {"train": {TRAIN}, "test": {TEST}, "all": {TRAIN, TEST}}[split]
+        return [
+            s["file"]
+            for s in self.manifest["shards"]
+            if s["kind"] == kind and s.get("split", TRAIN) in want
+        ]
+
+    def batches(
+        self,
+        kind: str,
+        split: str,
+        rng: np.random.Generator | None = None,
+        max_frames: int = 8,
+        max_error: float | None = None,
+    ) -> Iterator[Batch]:
+        """Every batch of one pass (shuffled with `rng`, in order without). Frames whose
+        solver error exceeds `max_error` (default 3x the dataset's tolerance) are left out."""
+        limit = 3 * self.tolerance if max_error is None else max_error
+        files = self.shards(kind, split)
+        if rng is not None:
+            files = [files[k] for k in rng.permutation(len(files))]
+        for f in files:
+            with np.load(self.folder / f) as z:
+                a = {k: z[k] for k in z.files if k != "meta"}
+            n = len(a["instance_id"])
+            ok = (a["estimated_error"].reshape(n, -1) <= limit).all(axis=1)
+            groups = [np.flatnonzero(ok & (a["param_id"] == g)) for g in np.unique(a["param_id"])]
+            if rng is not None:
+                groups = [groups[k] for k in rng.permutation(len(groups))]
+            for idx in groups:
+                if kind == "dynamic":
+                    for i in idx:
+                        yield self._batch(kind, a, np.array([i]))
+                else:
+                    for b in range(0, len(idx), max_frames):
+                        if len(idx[b : b + max_frames]):
+                            yield self._batch(kind, a, idx[b : b + max_frames])
+
+    def _batch(self, kind: str, a: dict[str, np.ndarray], idx: np.ndarray) -> Batch:
+        i0 = int(idx[0])
+        neutral, system = self.cache.get(int(a["identity_id"][i0]), a["h"][i0])
+        w = a["weights"][idx].reshape(-1, 52)  # dynamic: the sequence's frames
+        s = self.blend.targets(neutral, w)
+        t = s + a["offsets"][idx].reshape(-1, N_SKIN, 3).astype(np.float64)
+        f32 = lambda x: torch.from_numpy(np.ascontiguousarray(x, dtype=np.float32))  # noqa: E731
+        batch = Batch(
+            kind=kind,
+            identity_id=int(a["identity_id"][i0]),
+            param_id=int(a["param_id"][i0]),
+            p=f32(a["p"][i0][None]),
+            h=f32(a["h"][i0][None]),
+            neutral=f32(neutral),
+            weights=f32(w),
+            S=f32(s),
+            T=f32(t),
+            dt=system,
+            source_take=a["source_take"][idx].reshape(-1),
+        )
+        if "landmarks" in a:
+            batch.landmarks = f32(a["landmarks"][idx])
+            batch.landmarks_clean = f32(a["landmarks_clean"][idx])
+        if "prev_weights" in a:
+            ps = self.blend.targets(neutral, a["prev_weights"][i0])
+            batch.prev_S = f32(ps)
+            batch.prev_T = f32(ps + a["prev_offsets"][i0].astype(np.float64))
+        return batch

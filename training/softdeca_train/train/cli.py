@@ -1,0 +1,104 @@
+"""Command lines of the training: `train-bundle` (every bundle network, then the bundle),
+`train-model` (one model of the registry, e.g. a baseline), `evaluate` (the report)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from softdeca_train.train.registry import MODELS
+
+DEFAULT_RUN = "out/train/default"
+DEFAULT_BUNDLE = "models/softdeca-default"
+
+
+def _run_args(p: argparse.ArgumentParser, dataset_required: bool = True) -> None:
+    p.add_argument("--run", default=DEFAULT_RUN, help=f"training run folder ({DEFAULT_RUN})")
+    p.add_argument(
+        "--dataset",
+        required=False,
+        help="generated dataset folder (needed when the run folder is new)",
+    )
+    p.add_argument("--sizes", choices=["full", "test"], default="full", help="network sizes")
+    p.add_argument("--seed", type=int, default=0, help="training seed (0)")
+    p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+
+
+def _open_run(args: argparse.Namespace):  # -> Run
+    import torch
+
+    from softdeca_train.train.run import Run, RunConfig
+
+    if args.threads:
+        torch.set_num_threads(args.threads)
+    if args.dataset:
+        return Run(args.run, RunConfig(str(Path(args.dataset)), args.sizes, args.seed))
+    return Run(args.run)
+
+
+def add_bundle_args(p: argparse.ArgumentParser) -> None:
+    _run_args(p)
+    p.add_argument("--bundle", default=DEFAULT_BUNDLE, help=f"bundle folder ({DEFAULT_BUNDLE})")
+    p.add_argument(
+        "--scale",
+        type=float,
+        default=1.0,
+        help="multiply every stage's minutes (1.0: about 2 h on 2 cores; 0.25: a quick run)",
+    )
+    p.add_argument("--identity-steps", type=int, default=1500, help="identity encoder steps")
+
+
+def run_bundle(args: argparse.Namespace) -> int:
+    from softdeca_train.train.bundle import BundleBudget, default_command, train_bundle
+
+    run = _open_run(args)
+    budget = BundleBudget(identity_steps=args.identity_steps).scaled(args.scale)
+    out = train_bundle(run, Path(args.bundle), budget, default_command(), not args.no_progress)
+    print(f"bundle written to {out}")
+    return 0
+
+
+def add_model_args(p: argparse.ArgumentParser) -> None:
+    _run_args(p)
+    p.add_argument("model", choices=sorted(MODELS), help="which model to train")
+    p.add_argument("--minutes", type=float, default=None, help="time budget")
+    p.add_argument("--steps", type=int, default=1_000_000, help="step budget")
+    p.add_argument("--lr", type=float, default=1e-3, help="initial learning rate (1e-3)")
+    p.add_argument("--lr-end", type=float, default=5e-5, help="final learning rate (5e-5)")
+    p.add_argument("--frames", type=int, default=8, help="frames per batch (8)")
+
+
+def run_model(args: argparse.Namespace) -> int:
+    from softdeca_train.train.loop import LoopConfig
+
+    if args.minutes is None and args.steps >= 1_000_000:
+        raise ValueError("give a budget: --minutes and/or --steps")
+    run = _open_run(args)
+    cfg = LoopConfig(
+        steps=args.steps,
+        minutes=args.minutes,
+        lr=args.lr,
+        lr_end=args.lr_end,
+        frames=args.frames,
+        seed=args.seed,
+    )
+    summary = run.train(args.model, cfg, not args.no_progress)
+    print(f"{args.model}: {summary}")
+    return 0
+
+
+def add_evaluate_args(p: argparse.ArgumentParser) -> None:
+    _run_args(p)
+    p.add_argument("--bundle", default=DEFAULT_BUNDLE, help=f"bundle to check ({DEFAULT_BUNDLE})")
+    p.add_argument("--out", default="docs/evaluation", help="report folder (docs/evaluation)")
+    p.add_argument("--bench", default="build/bench", help="folder for models.json (build/bench)")
+
+
+def run_evaluate(args: argparse.Namespace) -> int:
+    from softdeca_train.train.report import write_report
+
+    run = _open_run(args)
+    path = write_report(run, Path(args.bundle), Path(args.out), Path(args.bench))
+    print(f"report written to {path}")
+    return 0

@@ -1,0 +1,197 @@
+"""Errors of trained models against the physics on a dataset's test split (identities,
+parameter sets and expression frames none of them trained on), split by expression source
+(the held-out real take against the coverage sampler), and per vertex for heat maps; and the
+time per frame of each model's per-frame work (single thread, batch 1, what the runtime
+repeats every frame once the per-avatar part is prepared)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from softdeca_train.models.dt import deformation_transfer
+from softdeca_train.train.batches import Batch
+from softdeca_train.train.models import (
+    Dynamics,
+    FaceMlp,
+    GlobalMlp,
+    LatentDynamics,
+    NoCorrection,
+    SoftDeca,
+    SoftDecaVertex,
+    SparseSoftDeca,
+    Trainable,
+    expand,
+    vertex_error,
+)
+from softdeca_train.train.run import Run
+
+# SparseSoftDECA inputs for Table 2: the simulated head's own landmarks (on its S_t), another
+# head's expression personalised to it (clean), and the same with the augmentation's noise.
+SPARSE_INPUTS = ("same_head", "other_head", "other_head_noise")
+
+
+@dataclass
+class ErrorSum:
+    total: float = 0.0
+    count: int = 0
+    per_vertex: np.ndarray | None = None
+    frames: int = 0
+    by_source: dict[str, list[float]] = field(default_factory=dict)
+
+    def add(self, err: torch.Tensor, sources: np.ndarray, test_take: int) -> None:
+        e = err.detach().double().numpy().reshape(-1, err.shape[-1])  # (frames, V) metres
+        self.total += float(e.sum())
+        self.count += e.size
+        self.frames += len(e)
+        pv = e.sum(0)
+        self.per_vertex = pv if self.per_vertex is None else self.per_vertex + pv
+        src = np.asarray(sources).reshape(-1)
+        for f in range(len(e)):
+            key = "real_take" if src[f] == test_take else "coverage"
+            self.by_source.setdefault(key, []).append(float(e[f].mean()))
+
+    def summary(self) -> dict:
+        out = {"mean_mm": 1e3 * self.total / max(self.count, 1), "frames": self.frames}
+        for k, v in sorted(self.by_source.items()):
+            out[f"{k}_mm"] = 1e3 * float(np.mean(v))
+            out[f"{k}_frames"] = len(v)
+        return out
+
+    def vertex_mm(self) -> np.ndarray:
+        assert self.per_vertex is not None
+        return 1e3 * self.per_vertex / self.frames
+
+
+def _with_landmarks(batch: Batch, which: str, model: SparseSoftDeca) -> Batch:
+    from dataclasses import replace
+
+    if which == "same_head":
+        own = model.landmarks_on(batch.S)
+        return replace(batch, landmarks=own, landmarks_clean=own)
+    if which == "other_head":
+        return replace(batch, landmarks=batch.landmarks_clean)
+    return batch
+
+
+def _test_take(run: Run) -> int:
+    header = run.data.manifest["header"]
+    names = [t["name"] if isinstance(t, dict) else t for t in header["takes"]]
+    return names.index(header["config"]["test_take"])
+
+
+@torch.no_grad()
+def measure(run: Run, name: str, model: Trainable, which: str | None = None) -> ErrorSum:
+    acc = ErrorSum()
+    take = _test_take(run)
+    for batch in run.data.batches(model.kind, "test", None, 8):
+        if isinstance(model, SparseSoftDeca) and which:
+            batch = _with_landmarks(batch, which, model)
+        acc.add(vertex_error(model.predict(batch), batch.T), batch.source_take, take)
+    if acc.frames == 0:
+        raise ValueError(f"no {model.kind} test frames in {run.config.dataset} for {name}")
+    return acc
+
+
+def test_errors(
+    run: Run, models: dict[str, Trainable], progress: bool = True
+) -> dict[str, dict | float]:
+    """Mean test errors (mm) of the bundle's models and of "no correction", keyed as the
+    manifest's `errors` and the benchmark figures name them."""
+    out: dict[str, dict | float] = {}
+    jobs: list[tuple[str, Trainable, str | None]] = [
+        ("no_correction_static", NoCorrection(), None),
+        ("no_correction_dynamic", _NoCorrectionDynamic(), None),
+    ]
+    for name, m in models.items():
+        if isinstance(m, SparseSoftDeca):
+            jobs += [(f"{name}_{w}", m, w) for w in SPARSE_INPUTS]
+        elif isinstance(m, (Dynamics, LatentDynamics)):
+            jobs.append((name, m, None))
+            if isinstance(m.static, SoftDeca):  # the static model on the same sequences
+                jobs.append((f"{name}_without", _AsDynamic(m.static), None))
+        else:
+            jobs.append((f"{name}_static", m, None))
+    for key, m, which in tqdm(jobs, desc="test errors", disable=not progress):
+        out[key] = measure(run, key, m, which).summary()
+    return out
+
+
+class _NoCorrectionDynamic(NoCorrection):
+    kind = "dynamic"
+
+
+class _AsDynamic(Trainable):
+    """A static model evaluated on sequence frames (what dynamics add, by difference)."""
+
+    kind = "dynamic"
+
+    def __init__(self, static: Trainable) -> None:
+        super().__init__()
+        self.static = static
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        return self.static.predict(batch)
+
+
+# --- time per frame -------------------------------------------------------------------------
+
+
+def frame_function(model: Trainable, batch: Batch) -> Callable[[], object]:
+    """The per-frame work of `model` for one frame of `batch`, with everything per avatar
+    (hypernetwork outputs, the DT factorisation) prepared beforehand, as the runtime runs it."""
+    one = Batch(**{**batch.__dict__, "weights": batch.weights[:1], "S": batch.S[:1]})
+    if isinstance(model, SoftDeca):
+        hyper = model.f_ph(expand(batch.p, model.n_faces), batch.h)
+
+        def softdeca() -> object:
+            z = model.f_w(one.weights)
+            dg = torch.einsum("bk,fkn->bfn", z, hyper).reshape(1, -1, 3, 3)
+            return deformation_transfer(one.dt, one.S, dg)
+
+        return softdeca
+    if isinstance(model, SoftDecaVertex):
+        hyper = model.f_ph_v(expand(batch.p, model.n_vertices), batch.h)
+        return lambda: one.S + torch.einsum("bk,vkn->bvn", model.f_w(one.weights), hyper)
+    if isinstance(model, SparseSoftDeca):
+        hyper = model.f_ph_v(expand(batch.p, model.n_vertices), batch.h)
+        off = (model.inputs(one) - model.neutral_landmarks(one.neutral)).reshape(1, -1)
+        return lambda: one.neutral + torch.einsum("bk,vkn->bvn", model.f_l(off), hyper)
+    if isinstance(model, FaceMlp):
+        p = expand(batch.p, model.n_faces)
+        b = model.body
+        base = b.from_parameters(b.normalise(p)) + b.from_positional(b.positional)
+        base = base + b.from_identity(batch.h)
+
+        def face_mlp() -> object:
+            x = base[None] + model.from_weights(one.weights)[:, None]
+            dg = b.rest(x).reshape(1, model.n_faces, 3, 3)
+            return deformation_transfer(one.dt, one.S, dg)
+
+        return face_mlp
+    if isinstance(model, (GlobalMlp, NoCorrection)):
+        return lambda: model.predict(one)
+    raise TypeError(f"no per-frame timing for {type(model).__name__}")
+
+
+@torch.no_grad()
+def time_per_frame(model: Trainable, batch: Batch, repeats: int = 20) -> float:
+    """Median milliseconds of the per-frame work, single thread."""
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        fn = frame_function(model, batch)
+        fn()
+        times = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            fn()
+            times.append(time.perf_counter() - t0)
+    finally:
+        torch.set_num_threads(threads)
+    return 1e3 * float(np.median(times))

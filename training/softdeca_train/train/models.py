@@ -1,0 +1,386 @@
+"""The trainable models, each as `loss(batch)` and `predict(batch)` over a Batch: SoftDECA
+(deformation gradients through the differentiable deformation transfer, eq. 16-19), its
+vertex-position variant, SparseSoftDECA (eq. 25), the dynamics stage (eq. 21) over a frozen
+static model, and the Table 1 baselines. Errors are per-vertex Euclidean distances on S."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import torch
+from torch import nn
+
+from softdeca_train.models.dt import deformation_transfer
+from softdeca_train.models.networks import (
+    DynamicsNetwork,
+    ElementMLP,
+    HyperNetwork,
+    LandmarkEncoder,
+    NetworkSizes,
+    Normalise,
+    WeightEncoder,
+    mlp,
+)
+from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.topology import TemplateDefinition
+from softdeca_train.train.batches import Batch
+
+EPS = 1e-12
+CM = 0.01  # vertex offsets are learned in centimetres (HyperNetwork.unit)
+
+
+def vertex_error(x: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+    """Per-vertex Euclidean distance (..., V)."""
+    return torch.sqrt(((x - t) ** 2).sum(-1) + EPS)
+
+
+class Trainable(nn.Module):
+    """A model trained on one kind of batch. Subclasses implement `predict` (B, V, 3)."""
+
+    kind = "static"
+
+    def init_from_data(self, batches: Sequence[Batch]) -> None:
+        """Data-driven initialisation before the first step (default: none)."""
+
+    def lr_scales(self) -> dict[str, float]:
+        """Learning-rate factors by parameter-name prefix (default: none). Adam moves every
+        weight by about the learning rate per step whatever its gradient, so the per-element
+        hypernetworks, whose outputs are small corrections, take smaller steps than the
+        per-frame encoders."""
+        return {}
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        raise NotImplementedError
+
+    def loss(self, batch: Batch) -> tuple[torch.Tensor, dict[str, float]]:
+        err = vertex_error(self.predict(batch), batch.T)
+        mm = float(err.detach().mean()) * 1e3
+        # the batch's "no correction" error: groups differ tenfold in how far the physics
+        # moves S, so progress reads better as the ratio of the two
+        base = float(vertex_error(batch.S, batch.T).mean()) * 1e3
+        return err.mean(), {"error_mm": mm, "no_correction_mm": base}
+
+
+def frame_gradients(s: torch.Tensor, t: torch.Tensor, triangles: torch.Tensor) -> torch.Tensor:
+    """Per frame and face the 3x3 G with G [e1, e2, n](S) = [e1, e2, n](T), n the normal
+    scaled by 1/sqrt(|e1 x e2|) (Sumner and Popovic): (B, F, 3, 3)."""
+
+    def frames(x: torch.Tensor) -> torch.Tensor:
+        x = x.double()
+        e1 = x[:, triangles[:, 1]] - x[:, triangles[:, 0]]
+        e2 = x[:, triangles[:, 2]] - x[:, triangles[:, 0]]
+        n = torch.linalg.cross(e1, e2)
+        n = n / torch.sqrt(n.norm(dim=-1, keepdim=True).clamp_min(1e-20))
+        return torch.stack([e1, e2, n], dim=-1)  # columns
+
+    vs, vt = frames(s), frames(t)
+    return torch.linalg.solve(vs.transpose(-1, -2), vt.transpose(-1, -2)).transpose(-1, -2).float()
+
+
+@torch.no_grad()
+def init_basis(
+    hyper: HyperNetwork,
+    encoder: nn.Sequential,
+    inputs: torch.Tensor,
+    targets: torch.Tensor,
+    unit: float,
+    ridge_scale: float = 0.1,
+    readout: bool = True,
+) -> None:
+    """Start a model "output = z(inputs) . L" at the data's principal components: L's base
+    table = the leading modes of `targets` (n, elements * k, in `unit`s), and the encoder's
+    last layer = the ridge least-squares readout of the mode coefficients from its (random)
+    features. Training then refines both instead of discovering the modes from noise."""
+    assert hyper.base is not None
+    n, k = len(targets), hyper.latent
+    m = targets.reshape(n, -1).double() / unit
+    u, s, vt = torch.linalg.svd(m, full_matrices=False)
+    k_data = min(k, len(s))
+    base = torch.zeros_like(hyper.base)
+    modes = (vt[:k_data] * (s[:k_data, None] / np.sqrt(n))).reshape(k_data, -1, hyper.k)
+    base[:, :k_data] = modes.permute(1, 0, 2).float()
+    hyper.base.copy_(base)
+    last = encoder[-1]
+    assert isinstance(last, nn.Linear)
+    if not readout:  # z = 0: the model starts exactly at its input (no correction)
+        last.weight.zero_()
+        last.bias.zero_()
+        return
+    target = torch.zeros(n, k, dtype=torch.float64)
+    target[:, :k_data] = u[:, :k_data] * np.sqrt(n)
+    feats = encoder[:-1](inputs).double()
+    a = torch.cat([feats, torch.ones(n, 1, dtype=torch.float64)], 1)
+    # a strong ridge (relative to the features' scale): the readout must generalise from a
+    # few hundred frames, and the coefficients also vary with p and h, which it cannot see
+    ridge = ridge_scale * float((a * a).sum(0).mean()) * torch.eye(a.shape[1], dtype=torch.float64)
+    w = torch.linalg.solve(a.T @ a + ridge, a.T @ target)  # (hidden + 1, k)
+    last.weight.copy_(w[:-1].T.float())
+    last.bias.copy_(w[-1].float())
+
+
+def expand(p: torch.Tensor, n: int) -> torch.Tensor:
+    """One global parameter vector (1, P) as a per-element map (n, P)."""
+    return p.expand(n, p.shape[-1])
+
+
+class NoCorrection(Trainable):
+    """The trivial baseline: the linear blend S_t itself."""
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        return batch.S
+
+
+class SoftDeca(Trainable):
+    """f(S_t, w, p, h) = DT(S_t, I + z(w) . L(p, h)) (eq. 17-19; the residual form of
+    docs/bundle.md)."""
+
+    def __init__(self, d: TemplateDefinition, specs: Sequence[ParameterSpec], sizes: NetworkSizes):
+        super().__init__()
+        self.f_w = WeightEncoder(len(d.blendshapes), sizes)
+        self.f_ph = HyperNetwork(d.n_faces, specs, sizes, 9, 1e-4, base=True)
+        self.n_faces = d.n_faces
+        self.register_buffer(
+            "triangles", torch.as_tensor(d.skin_triangles, dtype=torch.long), persistent=False
+        )
+
+    def lr_scales(self) -> dict[str, float]:
+        return {"f_ph.": 0.1}
+
+    def init_from_data(self, batches: Sequence[Batch]) -> None:
+        """L0 = the leading modes of the deformation gradients that map S_t to T per face (the
+        classic deformation-transfer frames [e1, e2, n]), f_w's readout = their coefficients."""
+        g = torch.cat([frame_gradients(b.S, b.T, self.triangles) for b in batches])
+        eye = torch.eye(3).reshape(1, 1, 3, 3)
+        w = torch.cat([b.weights for b in batches])
+        # a few sliver faces reach |G - I| of 30 and would own the leading modes; clamped at
+        # 0.3 (the 90th percentile) DT still lands 0.17 mm from T where S_t is 0.69 mm off
+        # (measured on a softdeca-l3-v3 batch)
+        dg = (g - eye).clamp(-0.3, 0.3)
+        init_basis(self.f_ph, self.f_w.net, w, dg.reshape(len(g), -1), 1.0, readout=False)
+
+    def deformation_gradients(self, batch: Batch) -> torch.Tensor:
+        hyper = self.f_ph(expand(batch.p, self.n_faces), batch.h)  # (F, latent, 9)
+        z = self.f_w(batch.weights)  # (B, latent)
+        return torch.einsum("bk,fkn->bfn", z, hyper).reshape(len(z), self.n_faces, 3, 3)
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        return deformation_transfer(batch.dt, batch.S, self.deformation_gradients(batch))
+
+
+class SoftDecaVertex(Trainable):
+    """The vertex-position variant (Table 1): X = S_t + z(w) . L_v(p, h), no DT."""
+
+    def __init__(self, d: TemplateDefinition, specs: Sequence[ParameterSpec], sizes: NetworkSizes):
+        super().__init__()
+        self.f_w = WeightEncoder(len(d.blendshapes), sizes)
+        self.f_ph_v = HyperNetwork(d.skin_vertices, specs, sizes, 3, 1e-5, unit=CM, base=True)
+        self.n_vertices = d.skin_vertices
+
+    def init_from_data(self, batches: Sequence[Batch]) -> None:
+        w = torch.cat([b.weights for b in batches])
+        off = torch.cat([b.T - b.S for b in batches])
+        init_basis(self.f_ph_v, self.f_w.net, w, off.reshape(len(off), -1), CM)
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        hyper = self.f_ph_v(expand(batch.p, self.n_vertices), batch.h)  # (V, latent, 3)
+        return batch.S + torch.einsum("bk,vkn->bvn", self.f_w(batch.weights), hyper)
+
+
+class SparseSoftDeca(Trainable):
+    """f(L, p, h) = neutral + z(L - L_0) . L_v(p, h) (eq. 25); L_0: the identity's neutral
+    landmarks, evaluated on its neutral skin through the landmark definition."""
+
+    kind = "sparse"
+
+    def __init__(
+        self,
+        d: TemplateDefinition,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        noisy: bool = True,
+    ):
+        super().__init__()
+        self.noisy = noisy  # train on sigma(L) with noise (eq. 24) or on the clean landmarks
+        self.f_l = LandmarkEncoder(len(d.landmarks), sizes)
+        self.f_ph_v = HyperNetwork(d.skin_vertices, specs, sizes, 3, 1e-5, unit=CM, base=True)
+        self.n_vertices = d.skin_vertices
+        tri = torch.as_tensor(d.skin_triangles[d.landmarks.triangle], dtype=torch.long)
+        self.register_buffer("lm_corners", tri, persistent=False)  # (K, 3)
+        self.register_buffer(
+            "lm_bary", torch.as_tensor(d.landmarks.bary, dtype=torch.float32), persistent=False
+        )
+
+    def neutral_landmarks(self, neutral: torch.Tensor) -> torch.Tensor:
+        return (neutral[self.lm_corners] * self.lm_bary[..., None]).sum(1)  # (K, 3)
+
+    def landmarks_on(self, skin: torch.Tensor) -> torch.Tensor:
+        return (skin[:, self.lm_corners] * self.lm_bary[..., None]).sum(2)  # (B, K, 3)
+
+    def inputs(self, batch: Batch) -> torch.Tensor:
+        """The tracked landmarks: the batch's (noisy or clean) sigma(L), or for batches
+        without landmarks (dynamic sequences) the identity's own on S_t."""
+        lm = batch.landmarks if self.noisy else batch.landmarks_clean
+        return self.landmarks_on(batch.S) if lm is None else lm
+
+    def offsets(self, batch: Batch) -> torch.Tensor:
+        """The encoder's input: tracked landmarks minus the neutral ones, (B, 3K)."""
+        off = self.inputs(batch) - self.neutral_landmarks(batch.neutral)
+        return off.reshape(len(off), -1)
+
+    def init_from_data(self, batches: Sequence[Batch]) -> None:
+        x = torch.cat([self.offsets(b) * self.f_l.offset_scale for b in batches])
+        off = torch.cat([b.T - b.neutral for b in batches])
+        init_basis(self.f_ph_v, self.f_l.net, x, off.reshape(len(off), -1), CM)
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        offsets = self.offsets(batch)
+        z = self.f_l(offsets)
+        hyper = self.f_ph_v(expand(batch.p, self.n_vertices), batch.h)
+        return batch.neutral + torch.einsum("bk,vkn->bvn", z, hyper)
+
+
+class Dynamics(Trainable):
+    """Per-vertex alpha, beta, gamma (eq. 21) learned over a frozen static model: for a
+    sequence, Y_t = static(t), X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, started from
+    the simulated frames before the sequence (its initial velocity)."""
+
+    kind = "dynamic"
+
+    def __init__(
+        self,
+        static: Trainable,
+        n_vertices: int,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        gamma0: float = 0.7,
+        beta0: float = 0.3,
+    ):
+        super().__init__()
+        self.static = static
+        for q in self.static.parameters():
+            q.requires_grad_(False)
+        self.f_dyn = DynamicsNetwork(n_vertices, specs, sizes, gamma0, beta0)
+        self.n_vertices = n_vertices
+        self._y: dict[tuple[int, int], torch.Tensor] = {}  # static outputs per sequence
+
+    def static_frames(self, batch: Batch) -> torch.Tensor:
+        key = (batch.param_id, batch.identity_id)
+        if key not in self._y:
+            with torch.no_grad():
+                self._y[key] = self.static.predict(batch)
+            if len(self._y) > 256:
+                self._y.pop(next(iter(self._y)))
+        return self._y[key]
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        assert batch.prev_T is not None, "dynamics need sequence batches"
+        y = self.static_frames(batch)
+        alpha, beta, gamma = self.f_dyn(expand(batch.p, self.n_vertices), batch.h)
+        a, b, g = alpha[:, None], beta[:, None], gamma[:, None]
+        x2, x1 = batch.prev_T[0], batch.prev_T[1]
+        out = []
+        for t in range(len(y)):
+            x = g * y[t] + 2 * a * x1 - b * x2
+            out.append(x)
+            x2, x1 = x1, x
+        return torch.stack(out)
+
+
+# --- Table 1 baselines ---------------------------------------------------------------------
+
+
+class GlobalMlp(Trainable):
+    """SoftSMPL-style: one MLP from (w, p, h) to offsets of every skin vertex, X = S_t + MLP."""
+
+    def __init__(
+        self,
+        d: TemplateDefinition,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        hidden: Sequence[int],
+    ):
+        super().__init__()
+        self.normalise = Normalise(specs)
+        self.n_vertices = d.skin_vertices
+        n_in = len(d.blendshapes) + len(specs) + sizes.identity
+        self.net = mlp([n_in, *hidden, 3 * d.skin_vertices], 1e-3 / CM)
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        n = batch.frames
+        x = torch.cat(
+            [batch.weights, self.normalise(batch.p).expand(n, -1), batch.h.expand(n, -1)], 1
+        )
+        return batch.S + CM * self.net(x).reshape(n, self.n_vertices, 3)
+
+
+class FaceMlp(Trainable):
+    """Face-wise MLP: per face, an MLP of (w, p, h, pi(f)) gives G_f - I, then DT."""
+
+    def __init__(self, d: TemplateDefinition, specs: Sequence[ParameterSpec], sizes: NetworkSizes):
+        super().__init__()
+        self.n_faces = d.n_faces
+        self.body = ElementMLP(d.n_faces, specs, sizes, sizes.hyper_hidden, 9, 0.02)
+        self.from_weights = nn.Linear(len(d.blendshapes), sizes.hyper_hidden[0], bias=False)
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        p = expand(batch.p, self.n_faces)
+        base = (
+            self.body.from_parameters(self.body.normalise(p))
+            + self.body.from_positional(self.body.positional)
+            + self.body.from_identity(batch.h)
+        )  # (F, hidden): shared by the frames
+        x = base[None] + self.from_weights(batch.weights)[:, None]  # (B, F, hidden)
+        dg = self.body.rest(x).reshape(batch.frames, self.n_faces, 3, 3)
+        return deformation_transfer(batch.dt, batch.S, dg)
+
+
+class LatentDynamics(Trainable):
+    """SNP-style latent dynamics (Table 1): a recurrent state over a learned global latent of
+    the frame drives one set of offset modes; unlike eq. 21 nothing is per vertex, so the
+    dynamics cannot be localised. X_t = Y_t + U s_t, s_t = GRU(s_{t-1}, [e(Y_t), p, h])."""
+
+    kind = "dynamic"
+
+    def __init__(
+        self,
+        static: Trainable,
+        d: TemplateDefinition,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        modes: int = 32,
+        state: int = 64,
+    ):
+        super().__init__()
+        self.static = static
+        for q in self.static.parameters():
+            q.requires_grad_(False)
+        self.normalise = Normalise(specs)
+        self.n_vertices = d.skin_vertices
+        self.sub = torch.arange(0, d.skin_vertices, max(1, d.skin_vertices // 256))
+        n_in = 3 * len(self.sub) + len(specs) + sizes.identity
+        self.cell = nn.GRUCell(n_in, state)
+        self.modes = nn.Linear(state, 3 * d.skin_vertices)  # centimetres
+        with torch.no_grad():
+            self.modes.weight.mul_(0.1)
+            self.modes.bias.zero_()
+        self._y: dict[tuple[int, int], torch.Tensor] = {}
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        assert batch.prev_T is not None
+        key = (batch.param_id, batch.identity_id)
+        if key not in self._y:
+            with torch.no_grad():
+                self._y[key] = self.static.predict(batch)
+        y = self._y[key]
+        cond = torch.cat([self.normalise(batch.p), batch.h], 1)[0]
+        s = torch.zeros(1, self.cell.hidden_size)
+        # warm up on the two frames before the sequence, as the per-vertex model starts there
+        seq = torch.cat([batch.prev_T, y])
+        out = []
+        for t in range(len(seq)):
+            e = (seq[t, self.sub] - batch.neutral[self.sub]).reshape(-1) * 100.0
+            s = self.cell(torch.cat([e, cond])[None], s)
+            if t >= 2:
+                out.append(y[t - 2] + CM * self.modes(s).reshape(self.n_vertices, 3))
+        return torch.stack(out)

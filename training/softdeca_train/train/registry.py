@@ -1,0 +1,113 @@
+"""Every trainable model by name: what it is, which batches it trains on, which trained static
+model it builds on (dynamics stages and the latent-dynamics baseline), and how to make it.
+A training run (a folder) holds one checkpoint per name."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+
+from softdeca_train.data.ranges import sampling_parameters
+from softdeca_train.models.networks import NetworkSizes
+from softdeca_train.models.parameters import ParameterSpec, load_parameter_specs
+from softdeca_train.models.topology import TemplateDefinition
+from softdeca_train.parameters import load_parameters
+from softdeca_train.train import models as m
+
+Build = Callable[
+    [TemplateDefinition, Sequence[ParameterSpec], NetworkSizes, m.Trainable | None], m.Trainable
+]
+
+
+@dataclass(frozen=True)
+class Entry:
+    name: str
+    description: str
+    build: Build
+    base: str | None = None  # the static model a dynamics stage runs over
+
+    def make(
+        self,
+        d: TemplateDefinition,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+        base: m.Trainable | None = None,
+    ) -> m.Trainable:
+        if (self.base is None) != (base is None):
+            raise ValueError(
+                f"{self.name} needs the trained {self.base} model" if self.base else ""
+            )
+        return self.build(d, specs, sizes, base)
+
+
+# Widths of the SoftSMPL-style MLPs: "equal time" matches SoftDECA's per-frame cost at the
+# template's resolution (measured by `evaluate`, which prints both), "large" is 8x wider.
+MLP_EQUAL = (96,)
+MLP_LARGE = (768, 768)
+
+MODELS: dict[str, Entry] = {
+    e.name: e
+    for e in (
+        Entry(
+            "softdeca",
+            "SoftDECA: deformation gradients + DT",
+            lambda d, s, z, b: m.SoftDeca(d, s, z),
+        ),
+        Entry(
+            "softdeca-dynamics",
+            "SoftDECA's per-vertex dynamics (eq. 21)",
+            lambda d, s, z, b: m.Dynamics(b, d.skin_vertices, s, z),  # type: ignore[arg-type]
+            base="softdeca",
+        ),
+        Entry(
+            "sparse",
+            "SparseSoftDECA, trained with noise augmentation (eq. 24)",
+            lambda d, s, z, b: m.SparseSoftDeca(d, s, z, noisy=True),
+        ),
+        Entry(
+            "sparse-dynamics",
+            "SparseSoftDECA's per-vertex dynamics",
+            lambda d, s, z, b: m.Dynamics(b, d.skin_vertices, s, z, 0.6, 0.25),  # type: ignore[arg-type]
+            base="sparse",
+        ),
+        Entry(
+            "sparse-no-noise",
+            "SparseSoftDECA trained on clean personalised landmarks (Table 2 ablation)",
+            lambda d, s, z, b: m.SparseSoftDeca(d, s, z, noisy=False),
+        ),
+        Entry(
+            "softdeca-vertex",
+            "vertex-position variant of SoftDECA (Table 1)",
+            lambda d, s, z, b: m.SoftDecaVertex(d, s, z),
+        ),
+        Entry(
+            "mlp-equal-time",
+            f"SoftSMPL-style MLP {MLP_EQUAL} (Table 1, equal time)",
+            lambda d, s, z, b: m.GlobalMlp(d, s, z, MLP_EQUAL),
+        ),
+        Entry(
+            "mlp-large",
+            f"SoftSMPL-style MLP {MLP_LARGE} (Table 1, large)",
+            lambda d, s, z, b: m.GlobalMlp(d, s, z, MLP_LARGE),
+        ),
+        Entry("face-mlp", "face-wise MLP + DT (Table 1)", lambda d, s, z, b: m.FaceMlp(d, s, z)),
+        Entry(
+            "snp-dynamics",
+            "SNP-style latent dynamics over SoftDECA (Table 1, dynamic)",
+            lambda d, s, z, b: m.LatentDynamics(b, d, s, z),  # type: ignore[arg-type]
+            base="softdeca",
+        ),
+    )
+}
+
+BUNDLE_STAGES = ("softdeca", "softdeca-dynamics", "sparse", "sparse-dynamics")
+
+
+def dataset_specs(range_profile: str) -> tuple[ParameterSpec, ...]:
+    """The bundle's parameter specs: the physics' list with the ranges the data sampled (a
+    network is only valid there, so the runtime refuses values outside them)."""
+    sampled = {s.name: s for s in sampling_parameters(load_parameters(), range_profile).specs}
+    return tuple(
+        replace(s, min=sampled[s.name].lo, max=sampled[s.name].hi, default=sampled[s.name].default)
+        for s in load_parameter_specs()
+    )

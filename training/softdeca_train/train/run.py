@@ -1,0 +1,130 @@
+"""A training run: a folder with run.json (the dataset it trains on, network sizes, seed) and
+one checkpoint per trained model (registry.py names), plus the identity encoder. Every stage
+resumes from its checkpoint, so `train-bundle` can be killed and rerun at any point."""
+
+from __future__ import annotations
+
+import itertools
+import json
+from dataclasses import asdict, dataclass, field, replace
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from softdeca_train.data.config import GenerateConfig
+from softdeca_train.models.networks import FULL_SIZES, TEST_SIZES, NetworkSizes
+from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.topology import TemplateDefinition, from_template
+from softdeca_train.template import Template
+from softdeca_train.train.batches import Dataset
+from softdeca_train.train.identity import IdentityConfig, train_identity_encoder
+from softdeca_train.train.loop import LoopConfig, train
+from softdeca_train.train.models import Trainable
+from softdeca_train.train.registry import MODELS, dataset_specs
+
+# "test": the tiny networks of the tests, with the template's identity size (the data's h).
+SIZES = {"full": FULL_SIZES, "test": replace(TEST_SIZES, identity=FULL_SIZES.identity)}
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    dataset: str
+    sizes: str = "full"  # full: docs/bundle.md's networks; test: tiny ones for the tests
+    seed: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+class Run:
+    def __init__(self, folder: str | Path, config: RunConfig | None = None) -> None:
+        self.folder = Path(folder)
+        path = self.folder / "run.json"
+        if config is None:
+            if not path.is_file():
+                raise FileNotFoundError(f"{self.folder} is not a training run (no run.json)")
+            config = RunConfig(**json.loads(path.read_text()))
+        elif path.is_file():
+            old = RunConfig(**json.loads(path.read_text()))
+            if (old.dataset, old.sizes, old.seed) != (config.dataset, config.sizes, config.seed):
+                raise ValueError(
+                    f"{self.folder} trains on {old.dataset} ({old.sizes}, seed {old.seed}); "
+                    "use another folder for another dataset, sizes or seed"
+                )
+        else:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(asdict(config), indent=1) + "\n")
+        if config.sizes not in SIZES:
+            raise ValueError(f"sizes must be one of {sorted(SIZES)}")
+        self.config = config
+
+    @cached_property
+    def template(self) -> Template:
+        return Template.load()
+
+    @cached_property
+    def data(self) -> Dataset:
+        return Dataset(self.config.dataset, self.template)
+
+    @cached_property
+    def definition(self) -> TemplateDefinition:
+        return from_template(self.template)
+
+    @property
+    def sizes(self) -> NetworkSizes:
+        return SIZES[self.config.sizes]
+
+    @cached_property
+    def specs(self) -> tuple[ParameterSpec, ...]:
+        cfg = GenerateConfig.from_dict(self.data.manifest["header"]["config"])
+        return dataset_specs(cfg.ranges)
+
+    def checkpoint(self, name: str) -> Path:
+        return self.folder / f"{name}.pt"
+
+    def finished(self, name: str) -> bool:
+        path = self.checkpoint(name)
+        return path.is_file() and bool(torch.load(path, weights_only=False).get("done"))
+
+    def build(self, name: str) -> Trainable:
+        entry = MODELS[name]
+        base = self.load(entry.base) if entry.base else None
+        return entry.make(self.definition, self.specs, self.sizes, base)
+
+    def load(self, name: str) -> Trainable:
+        """A trained model (its checkpoint must be finished)."""
+        path = self.checkpoint(name)
+        if not path.is_file():
+            raise FileNotFoundError(f"{name} is not trained in {self.folder} (no {path.name})")
+        model = self.build(name)
+        model.load_state_dict(torch.load(path, weights_only=False)["model"])
+        return model.eval()
+
+    def train(self, name: str, cfg: LoopConfig, progress: bool = True) -> dict:
+        if name not in MODELS:
+            raise ValueError(f"unknown model {name!r}; known: {', '.join(MODELS)}")
+        model = self.build(name)
+        fresh = not self.checkpoint(name).is_file()
+        if fresh and type(model).init_from_data is not Trainable.init_from_data:
+            rng = np.random.default_rng(cfg.seed)
+            sample = list(itertools.islice(self.data.batches(model.kind, "train", rng), 48))
+            model.init_from_data(sample)
+        summary = train(model, self.data, cfg, self.folder, name, progress)
+        summary["config"] = asdict(cfg)
+        (self.folder / f"{name}.summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+        return summary
+
+    def identity_encoder(self, cfg: IdentityConfig, progress: bool = True) -> tuple:
+        """The trained identity encoder (trained now if the run has none) and its errors."""
+        path, info = self.folder / "identity.pt", self.folder / "identity.json"
+        from softdeca_train.models.networks import IdentityEncoder
+        from softdeca_train.template.model import N_SKIN
+
+        if path.is_file() and info.is_file():
+            enc = IdentityEncoder(N_SKIN, self.sizes, cfg.seed)
+            enc.load_state_dict(torch.load(path, weights_only=False))
+            return enc.eval(), json.loads(info.read_text())
+        enc, errors = train_identity_encoder(self.template, self.sizes, cfg, progress)
+        torch.save(enc.state_dict(), path)
+        info.write_text(json.dumps({"config": asdict(cfg), "errors": errors}, indent=1) + "\n")
+        return enc, json.loads(info.read_text())
