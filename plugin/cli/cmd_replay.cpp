@@ -145,7 +145,8 @@ int run_replay(const Args& args) {
       .option("--models", "LIST", "comma-separated: linear, softdeca, sparse", "linear,softdeca,sparse")
       .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated")
       .option("--localised", "SPEC", "an extra SoftDECA pass with this change 'name=value@x,y,z,r' on top of --set")
-      .option("--frames", "N", "at most N frames of the take (0: all)", "0")
+      .option("--start", "N", "skip the take's first N frames", "0")
+      .option("--frames", "N", "at most N frames of the take after --start (0: all)", "0")
       .option("--threads", "N", "threads per frame (1 or 2)", "1")
       .option("--precision", "P", "hyper-tensor storage: half, float or int8", "half")
       .option("--obj-every", "N", "also write every Nth frame as OBJ (0: none)", "0")
@@ -160,9 +161,14 @@ int run_replay(const Args& args) {
   const unsigned precision = precision_of(o.text("--precision"));
   const long obj_every = o.integer("--obj-every");
 
-  const Take take = read_take(o.arg(0), static_cast<std::size_t>(o.integer("--frames")));
-  std::fprintf(stderr, "take %s: %zu rows, %zu frames, %zu face-lost rows skipped, %zu unreadable\n", take.path.c_str(),
-               take.rows, take.weights.size(), take.face_lost, take.invalid);
+  const long start = o.integer("--start"), max_frames = o.integer("--frames");
+  if (start < 0 || max_frames < 0) throw UsageError("--start and --frames must not be negative");
+  Take take = read_take(o.arg(0), max_frames ? static_cast<std::size_t>(start + max_frames) : 0);
+  if (static_cast<std::size_t>(start) >= take.weights.size())
+    throw UsageError("--start " + std::to_string(start) + " is past the take's " + std::to_string(take.weights.size()) + " frames");
+  take.weights.erase(take.weights.begin(), take.weights.begin() + start);
+  std::fprintf(stderr, "take %s: %zu rows, %zu face-lost rows skipped, %zu unreadable; frames %ld to %zu\n", take.path.c_str(),
+               take.rows, take.face_lost, take.invalid, start, static_cast<std::size_t>(start) + take.weights.size() - 1);
   std::string avatar_dir = o.text("--avatar");
   if (o.given("--seed")) {
     avatar_dir = out + "/avatar";
@@ -256,6 +262,7 @@ int run_replay(const Args& args) {
   JsonObject summary;
   summary.text("take", take.path)
       .number("take_rows", static_cast<double>(take.rows))
+      .number("first_frame", static_cast<double>(start))
       .number("frames", static_cast<double>(take.weights.size()))
       .number("face_lost_rows_skipped", static_cast<double>(take.face_lost))
       .number("unreadable_rows_skipped", static_cast<double>(take.invalid))

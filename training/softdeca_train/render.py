@@ -60,6 +60,7 @@ class MeshLayer:
     smooth: bool = True
     show_edges: bool = False
     edge_color: Color = "dimgray"
+    vertex_colors: np.ndarray | None = None  # (V, 3) RGB in [0, 1]; replaces `color`
 
 
 @dataclass
@@ -131,6 +132,8 @@ def _check_layer(layer: Layer) -> None:
             )
         if t.size and (t.min() < 0 or t.max() >= len(v)):
             raise ValueError("mesh layer: triangle index outside the vertex array")
+        if layer.vertex_colors is not None and np.shape(layer.vertex_colors) != v.shape:
+            raise ValueError("mesh layer: vertex_colors must be (V, 3) like the vertices")
     elif isinstance(layer, LineLayer):
         s = np.asarray(layer.segments)
         if s.size and (
@@ -224,9 +227,15 @@ def render(
             if mesh is None:
                 continue
             if isinstance(layer, MeshLayer):
+                colors = {}
+                if layer.vertex_colors is not None:
+                    rgb = np.clip(np.asarray(layer.vertex_colors, np.float64), 0.0, 1.0)
+                    mesh.point_data["rgb"] = (rgb * 255).astype(np.uint8)
+                    colors = {"scalars": "rgb", "rgb": True}
                 plotter.add_mesh(
                     mesh,
-                    color=layer.color,
+                    **colors,
+                    color=None if colors else layer.color,
                     opacity=layer.opacity,
                     smooth_shading=layer.smooth,
                     show_edges=layer.show_edges,
