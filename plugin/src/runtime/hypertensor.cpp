@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "runtime/half.h"
 
@@ -14,14 +15,14 @@ namespace softdeca::runtime {
 
 HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision)
     : n_(n), latent_(latent), width_(width), precision_(precision) {
-  const std::size_t stride = block_stride(), total = blocks() * stride;
+  const std::size_t total = blocks() * block_stride();
   const auto source_at = [&](std::size_t e, int k, int c) {
     return source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
                   static_cast<std::size_t>(c)];
   };
   if (precision == Precision::Int8) {
     // One scale per block and latent: the largest magnitude of its width x 8 values maps to 127.
-    int8_.resize(total);
+    int8_.resize(total);  // zero: the padding latent and lanes past the last element
     scales_.resize(blocks() * static_cast<std::size_t>(latent));
     for (std::size_t b = 0; b < blocks(); ++b)
       for (int k = 0; k < latent; ++k) {
@@ -32,8 +33,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
         scales_[b * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)] = scale;
         for (std::size_t e = b * kLanes; e < std::min(n, (b + 1) * kLanes); ++e)
           for (int c = 0; c < width; ++c)
-            int8_[b * stride + (static_cast<std::size_t>(k) * width + c) * kLanes + e % kLanes] =
-                static_cast<std::int8_t>(std::lround(source_at(e, k, c) / scale));
+            int8_[index(b, k, c, e % kLanes)] = static_cast<std::int8_t>(std::lround(source_at(e, k, c) / scale));
       }
     return;
   }
@@ -45,7 +45,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
       for (int c = 0; c < width; ++c) {
         const float v = source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
                                static_cast<std::size_t>(c)];
-        const std::size_t at = b * stride + (static_cast<std::size_t>(k) * width + c) * kLanes + lane;
+        const std::size_t at = index(b, k, c, lane);
         if (precision == Precision::Half) half_[at] = float_to_half(v);
         else float_[at] = v;
       }
@@ -53,7 +53,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
 }
 
 float HyperTensor::at(std::size_t e, int k, int c) const {
-  const std::size_t i = (e / kLanes) * block_stride() + (static_cast<std::size_t>(k) * width_ + c) * kLanes + e % kLanes;
+  const std::size_t i = index(e / kLanes, k, c, e % kLanes);
   switch (precision_) {
     case Precision::Half: return half_to_float(half_[i]);
     case Precision::Float: return float_[i];
@@ -84,10 +84,9 @@ void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float*
   const int K = L.latent();
   for (std::size_t b = b0; b < b1; ++b) {
     float d[9][kLanes] = {};
-    const std::size_t base = b * L.block_stride();
     for (int k = 0; k < K; ++k)
       for (int c = 0; c < 9; ++c)
-        for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += z[k] * load(b, k, base + (static_cast<std::size_t>(k) * 9 + c) * kLanes + l);
+        for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += z[k] * load(b, k, L.index(b, k, c, l));
     const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
     const float* cf = faces.coeff.data() + b * 3 * kLanes;
     for (std::size_t l = 0; l < kLanes; ++l) {
@@ -117,10 +116,9 @@ void vertex_offsets_portable(const HyperTensor& L, const float* z, const float* 
   const int K = L.latent();
   for (std::size_t b = b0; b < b1; ++b) {
     float acc[3][kLanes] = {};
-    const std::size_t base = b * L.block_stride();
     for (int k = 0; k < K; ++k)
       for (int c = 0; c < 3; ++c)
-        for (std::size_t l = 0; l < kLanes; ++l) acc[c][l] += z[k] * load(b, k, base + (static_cast<std::size_t>(k) * 3 + c) * kLanes + l);
+        for (std::size_t l = 0; l < kLanes; ++l) acc[c][l] += z[k] * load(b, k, L.index(b, k, c, l));
     const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
     for (std::size_t l = 0; l < end; ++l)
       for (int c = 0; c < 3; ++c) {
@@ -137,43 +135,87 @@ template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) inline __m256 load8(const HyperTensor& L, std::size_t at) {
   if constexpr (P == Precision::Half)
     return _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(L.half_data() + at)));
-  else if constexpr (P == Precision::Int8)
-    return _mm256_cvtepi32_ps(_mm256_cvtepi8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(L.int8_data() + at))));
   else
     return _mm256_loadu_ps(L.float_data() + at);
 }
 
-// z_k, times the block's scale for int8 storage.
-template <Precision P>
-__attribute__((target("avx2,fma,f16c"))) inline __m256 coefficient(const HyperTensor& L, const float* z, std::size_t b, int k) {
-  if constexpr (P == Precision::Int8)
-    return _mm256_set1_ps(z[k] * L.scales()[b * static_cast<std::size_t>(L.latent()) + static_cast<std::size_t>(k)]);
-  else
-    return _mm256_set1_ps(z[k]);
+// out[c] (8 lanes) = sum_k z_k L[b, k, c] for c < W, half or float storage.
+template <Precision P, int W>
+__attribute__((target("avx2,fma,f16c"))) inline void contract(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  const int K = L.latent();
+  const std::size_t base = b * L.block_stride();
+  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
+  for (int k = 0; k < K; ++k) {
+    const __m256 zk = _mm256_set1_ps(z[k]);
+    const std::size_t at = base + static_cast<std::size_t>(k) * W * kLanes;
+#pragma GCC unroll 9
+    for (int c = 0; c < W; ++c) out[c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), out[c]);
+  }
+}
+
+// The same for int8 storage: the block's coefficients z_k s_{b,k} are quantised to int16 with
+// one step t = max_k |z_k s_{b,k}| / 32767 (a relative error of 1.5e-5 of the largest term,
+// negligible next to the int8 values' 1/254), multiplied with the int8 values two latents at a
+// time by pmaddwd and summed exactly in int32 (|sum| <= K * 32767 * 127 < 2^31 for up to
+// kMaxInt8Latent latents; more fall back to the portable kernel), then scaled by t.
+constexpr int kMaxInt8Latent = 256;
+
+template <int W>
+__attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  const int K = L.latent(), K16 = (K + 15) / 16 * 16;
+  const float* s = L.scales() + b * static_cast<std::size_t>(K);
+  alignas(32) float zs[kMaxInt8Latent];
+  alignas(32) std::int16_t zq[kMaxInt8Latent];
+  for (int k = 0; k < K; ++k) zs[k] = z[k] * s[k];
+  for (int k = K; k < K16; ++k) zs[k] = 0.0f;
+  const __m256 sign = _mm256_set1_ps(-0.0f);
+  __m256 peak8 = _mm256_setzero_ps();
+  for (int k = 0; k < K16; k += 8) peak8 = _mm256_max_ps(peak8, _mm256_andnot_ps(sign, _mm256_load_ps(zs + k)));
+  __m128 peak4 = _mm_max_ps(_mm256_castps256_ps128(peak8), _mm256_extractf128_ps(peak8, 1));
+  peak4 = _mm_max_ps(peak4, _mm_movehl_ps(peak4, peak4));
+  peak4 = _mm_max_ss(peak4, _mm_shuffle_ps(peak4, peak4, 1));
+  const float peak = _mm_cvtss_f32(peak4);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
+  if (!(peak > 0.0f)) return;
+  const __m256 inv = _mm256_set1_ps(32767.0f / peak);
+  for (int k = 0; k < K16; k += 16) {
+    const __m256i a = _mm256_cvtps_epi32(_mm256_mul_ps(_mm256_load_ps(zs + k), inv));
+    const __m256i c = _mm256_cvtps_epi32(_mm256_mul_ps(_mm256_load_ps(zs + k + 8), inv));
+    // packs works per 128-bit half: (a0-3, c0-3 | a4-7, c4-7); restore the order.
+    _mm256_store_si256(reinterpret_cast<__m256i*>(zq + k), _mm256_permute4x64_epi64(_mm256_packs_epi32(a, c), 0xD8));
+  }
+  __m256i acc[W];
+  for (int c = 0; c < W; ++c) acc[c] = _mm256_setzero_si256();
+  const std::int8_t* q = L.int8_data() + b * L.block_stride();
+  const int pairs = (K + 1) / 2;
+  for (int p = 0; p < pairs; ++p) {
+    std::int32_t pair;
+    std::memcpy(&pair, zq + 2 * p, sizeof pair);
+    const __m256i zp = _mm256_set1_epi32(pair);
+    const std::int8_t* qp = q + static_cast<std::size_t>(p) * W * 2 * kLanes;
+#pragma GCC unroll 9
+    for (int c = 0; c < W; ++c) {
+      const __m256i v = _mm256_cvtepi8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qp + c * 2 * kLanes)));
+      acc[c] = _mm256_add_epi32(acc[c], _mm256_madd_epi16(v, zp));
+    }
+  }
+  const __m256 t = _mm256_set1_ps(peak / 32767.0f);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), t);
+}
+
+template <Precision P, int W>
+__attribute__((target("avx2,fma,f16c"))) inline void contract_any(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  if constexpr (P == Precision::Int8) contract_int8<W>(L, z, b, out);
+  else contract<P, W>(L, z, b, out);
 }
 
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, const FaceBlocks& faces, const float* z,
                                                          const float* skin, std::size_t b0, std::size_t b1, float* rhs) {
-  const int K = L.latent();
-  const std::size_t stride = L.block_stride();
   alignas(32) float col[6][kLanes];
   for (std::size_t b = b0; b < b1; ++b) {
-    const std::size_t base = b * stride;
-    __m256 d0 = _mm256_setzero_ps(), d1 = d0, d2 = d0, d3 = d0, d4 = d0, d5 = d0, d6 = d0, d7 = d0, d8 = d0;
-    for (int k = 0; k < K; ++k) {
-      const __m256 zk = coefficient<P>(L, z, b, k);
-      const std::size_t at = base + static_cast<std::size_t>(k) * 9 * kLanes;
-      d0 = _mm256_fmadd_ps(zk, load8<P>(L, at), d0);
-      d1 = _mm256_fmadd_ps(zk, load8<P>(L, at + 8), d1);
-      d2 = _mm256_fmadd_ps(zk, load8<P>(L, at + 16), d2);
-      d3 = _mm256_fmadd_ps(zk, load8<P>(L, at + 24), d3);
-      d4 = _mm256_fmadd_ps(zk, load8<P>(L, at + 32), d4);
-      d5 = _mm256_fmadd_ps(zk, load8<P>(L, at + 40), d5);
-      d6 = _mm256_fmadd_ps(zk, load8<P>(L, at + 48), d6);
-      d7 = _mm256_fmadd_ps(zk, load8<P>(L, at + 56), d7);
-      d8 = _mm256_fmadd_ps(zk, load8<P>(L, at + 64), d8);
-    }
+    __m256 d[9];
+    contract_any<P, 9>(L, z, b, d);
     const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
     // Edge vectors of the 8 faces, transposed to one lane per face (scalar loads: AVX2 gathers
     // are slow on several CPUs and these vertices are in cache).
@@ -191,10 +233,10 @@ __attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, 
     const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
     const float* cf = faces.coeff.data() + b * 3 * kLanes;
     const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
-    const __m256 rows[3][3] = {{d0, d1, d2}, {d3, d4, d5}, {d6, d7, d8}};
     for (int r = 0; r < 3; ++r) {
-      const __m256 p0 = _mm256_fmadd_ps(rows[r][2], e1[2], _mm256_fmadd_ps(rows[r][1], e1[1], _mm256_mul_ps(rows[r][0], e1[0])));
-      const __m256 p1 = _mm256_fmadd_ps(rows[r][2], e2[2], _mm256_fmadd_ps(rows[r][1], e2[1], _mm256_mul_ps(rows[r][0], e2[0])));
+      const __m256* row = d + 3 * r;
+      const __m256 p0 = _mm256_fmadd_ps(row[2], e1[2], _mm256_fmadd_ps(row[1], e1[1], _mm256_mul_ps(row[0], e1[0])));
+      const __m256 p1 = _mm256_fmadd_ps(row[2], e2[2], _mm256_fmadd_ps(row[1], e2[1], _mm256_mul_ps(row[0], e2[0])));
       _mm256_store_ps(col[r], _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00)));
       _mm256_store_ps(col[3 + r], _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01)));
     }
@@ -214,22 +256,13 @@ __attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, 
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void vertex_offsets_avx2(const HyperTensor& L, const float* z, const float* base_pos,
                                                                  std::size_t b0, std::size_t b1, float* out) {
-  const int K = L.latent();
-  const std::size_t stride = L.block_stride();
   alignas(32) float acc[3][kLanes];
   for (std::size_t b = b0; b < b1; ++b) {
-    const std::size_t base = b * stride;
-    __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0;
-    for (int k = 0; k < K; ++k) {
-      const __m256 zk = coefficient<P>(L, z, b, k);
-      const std::size_t at = base + static_cast<std::size_t>(k) * 3 * kLanes;
-      a0 = _mm256_fmadd_ps(zk, load8<P>(L, at), a0);
-      a1 = _mm256_fmadd_ps(zk, load8<P>(L, at + 8), a1);
-      a2 = _mm256_fmadd_ps(zk, load8<P>(L, at + 16), a2);
-    }
-    _mm256_store_ps(acc[0], a0);
-    _mm256_store_ps(acc[1], a1);
-    _mm256_store_ps(acc[2], a2);
+    __m256 a[3];
+    contract_any<P, 3>(L, z, b, a);
+    _mm256_store_ps(acc[0], a[0]);
+    _mm256_store_ps(acc[1], a[1]);
+    _mm256_store_ps(acc[2], a[2]);
     const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
     for (std::size_t l = 0; l < end; ++l) {
       const std::size_t v = (b * kLanes + l) * 3;
@@ -259,7 +292,7 @@ bool simd_kernels() {
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0, std::size_t b1,
             float* rhs) {
 #ifdef SOFTDECA_X86
-  if (cpu_has_avx2()) {
+  if (cpu_has_avx2() && (L.precision() != Precision::Int8 || L.latent() <= kMaxInt8Latent)) {
     switch (L.precision()) {
       case Precision::Half: dg_rhs_avx2<Precision::Half>(L, faces, z, skin, b0, b1, rhs); break;
       case Precision::Float: dg_rhs_avx2<Precision::Float>(L, faces, z, skin, b0, b1, rhs); break;
@@ -273,7 +306,7 @@ void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const
 
 void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out) {
 #ifdef SOFTDECA_X86
-  if (cpu_has_avx2()) {
+  if (cpu_has_avx2() && (L.precision() != Precision::Int8 || L.latent() <= kMaxInt8Latent)) {
     switch (L.precision()) {
       case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, b0, b1, out); break;
       case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, b0, b1, out); break;

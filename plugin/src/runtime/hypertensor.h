@@ -3,6 +3,9 @@
 // [latent][width][8 lanes] so one SIMD lane is one element and z_k is a broadcast. The product
 // is bound by the bytes it reads, so the storage is compact: binary16, or int8 with one scale
 // per block and latent (a quarter of float); the error each adds is measured (docs/runtime.md).
+// Int8 blocks pair the latents, [latent / 2][width][8 lanes][2] (the latent count padded to
+// even with zeros), so that one pmaddwd multiplies two latents of 8 elements by (z_k, z_k+1)
+// quantised to int16 and sums them exactly in int32.
 #pragma once
 
 #include <cstddef>
@@ -25,9 +28,16 @@ class HyperTensor {
   std::size_t elements() const { return n_; }
   std::size_t blocks() const { return (n_ + kLanes - 1) / kLanes; }
   int latent() const { return latent_; }
+  int stored_latent() const { return precision_ == Precision::Int8 ? (latent_ + 1) / 2 * 2 : latent_; }
   int width() const { return width_; }
   Precision precision() const { return precision_; }
-  std::size_t block_stride() const { return static_cast<std::size_t>(latent_) * width_ * kLanes; }
+  std::size_t block_stride() const { return static_cast<std::size_t>(stored_latent()) * width_ * kLanes; }
+  // Flat index of block b, latent k, component c, lane (element b * 8 + lane).
+  std::size_t index(std::size_t b, int k, int c, std::size_t lane) const {
+    if (precision_ == Precision::Int8)
+      return b * block_stride() + (static_cast<std::size_t>(k / 2) * width_ + c) * 2 * kLanes + lane * 2 + k % 2;
+    return b * block_stride() + (static_cast<std::size_t>(k) * width_ + c) * kLanes + lane;
+  }
   const std::uint16_t* half_data() const { return half_.data(); }
   const float* float_data() const { return float_.data(); }
   const std::int8_t* int8_data() const { return int8_.data(); }

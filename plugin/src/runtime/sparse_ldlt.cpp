@@ -1,6 +1,10 @@
 #include "runtime/sparse_ldlt.h"
 
 #include <Eigen/SparseCholesky>
+#ifdef SOFTDECA_HAVE_METIS
+#include <iostream>  // Eigen's MetisSupport uses std::cerr without including it
+#include <Eigen/MetisSupport>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -15,8 +19,18 @@
 
 namespace softdeca::runtime {
 
+namespace {
+// Nested dissection (METIS) where the build has it: 11% fewer factor nonzeros than AMD for the
+// template's skin (396k against 447k), and a small top separator for the two-thread split.
+#ifdef SOFTDECA_HAVE_METIS
+using FillReducingOrdering = Eigen::MetisOrdering<int>;
+#else
+using FillReducingOrdering = Eigen::AMDOrdering<int>;
+#endif
+}  // namespace
+
 SparseLdlt::SparseLdlt(const Eigen::SparseMatrix<double>& K, std::size_t parts) : n_(static_cast<std::size_t>(K.rows())) {
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(K);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, FillReducingOrdering> ldlt(K);
   require(ldlt.info() == Eigen::Success, "the deformation-transfer matrix cannot be factorised");
   const Eigen::VectorXd d = ldlt.vectorD();
   inv_d_.resize(n_);
