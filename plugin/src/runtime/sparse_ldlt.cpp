@@ -55,8 +55,10 @@ SparseLdlt::SparseLdlt(const Eigen::SparseMatrix<double>& K, std::size_t parts) 
   const std::size_t nnz = static_cast<std::size_t>(L.nonZeros());
   col_ptr_.assign(L.outerIndexPtr(), L.outerIndexPtr() + L.outerSize() + 1);
   row_ptr_.assign(R.outerIndexPtr(), R.outerIndexPtr() + R.outerSize() + 1);
-  values_upper_.assign(L.valuePtr(), L.valuePtr() + nnz);
-  values_lower_.assign(R.valuePtr(), R.valuePtr() + nnz);
+  nnz_ = nnz;
+  values_.resize(2 * nnz);
+  std::copy(R.valuePtr(), R.valuePtr() + nnz, values_.data());
+  std::copy(L.valuePtr(), L.valuePtr() + nnz, values_.data() + nnz);
   if (n_ <= 65536) {
     col_rows16_.assign(L.innerIndexPtr(), L.innerIndexPtr() + nnz);
     row_cols16_.assign(R.innerIndexPtr(), R.innerIndexPtr() + nnz);
@@ -131,7 +133,7 @@ void SparseLdlt::schedule(std::size_t parts) {
 std::size_t SparseLdlt::bytes() const {
   return (gather_.size() + row_ptr_.size() + col_ptr_.size()) * 4 + inv_d_.size() * 8 +
          (row_cols16_.size() + col_rows16_.size()) * 2 + (row_cols32_.size() + col_rows32_.size()) * 4 +
-         (values_lower_.size() + values_upper_.size()) * 4;
+         values_.bytes();
 }
 
 namespace {
@@ -194,17 +196,17 @@ bool cpu_has_avx2_fma() {
 
 template <class Index>
 void substitute(const std::vector<std::int32_t>& rows, const std::vector<std::int32_t>& ptr, const Index* idx,
-                const std::vector<float>& values, double* y) {
+                const float* values, double* y) {
 #ifdef SOFTDECA_X86
   if (cpu_has_avx2_fma()) {
-    substitute_avx2(rows.data(), rows.size(), ptr.data(), idx, values.data(), y);
+    substitute_avx2(rows.data(), rows.size(), ptr.data(), idx, values, y);
     return;
   }
 #endif
   double a[3];
   for (const std::int32_t r : rows) {
     const std::size_t i = static_cast<std::size_t>(r);
-    dot_portable(idx, values.data(), ptr[i], ptr[i + 1], y, a);
+    dot_portable(idx, values, ptr[i], ptr[i + 1], y, a);
     for (int c = 0; c < 3; ++c) y[4 * i + c] -= a[c];
   }
 }
@@ -212,13 +214,13 @@ void substitute(const std::vector<std::int32_t>& rows, const std::vector<std::in
 }  // namespace
 
 void SparseLdlt::forward(const std::vector<std::int32_t>& rows, double* y) const {
-  if (n_ <= 65536) substitute(rows, row_ptr_, row_cols16_.data(), values_lower_, y);
-  else substitute(rows, row_ptr_, row_cols32_.data(), values_lower_, y);
+  if (n_ <= 65536) substitute(rows, row_ptr_, row_cols16_.data(), values_lower(), y);
+  else substitute(rows, row_ptr_, row_cols32_.data(), values_lower(), y);
 }
 
 void SparseLdlt::backward(const std::vector<std::int32_t>& rows, double* y) const {
-  if (n_ <= 65536) substitute(rows, col_ptr_, col_rows16_.data(), values_upper_, y);
-  else substitute(rows, col_ptr_, col_rows32_.data(), values_upper_, y);
+  if (n_ <= 65536) substitute(rows, col_ptr_, col_rows16_.data(), values_upper(), y);
+  else substitute(rows, col_ptr_, col_rows32_.data(), values_upper(), y);
 }
 
 void SparseLdlt::gather(const std::vector<std::int32_t>& rows, const float* const* b, std::size_t count, double* y) const {

@@ -26,7 +26,7 @@ class SparseLdlt {
   explicit SparseLdlt(const Eigen::SparseMatrix<double>& K, std::size_t parts = 1);
 
   std::size_t size() const { return n_; }
-  std::size_t factor_nonzeros() const { return values_lower_.size(); }
+  std::size_t factor_nonzeros() const { return nnz_; }
   std::size_t bytes() const;  // the factor and the schedule
 
   // x = K^-1 (b[0] + ... + b[count-1]), xyz interleaved (n x 3); the right-hand side comes in
@@ -56,7 +56,12 @@ class SparseLdlt {
   std::vector<std::int32_t> row_ptr_, col_ptr_;
   std::vector<std::uint16_t> row_cols16_, col_rows16_;  // when n <= 65536
   std::vector<std::uint32_t> row_cols32_, col_rows32_;  // otherwise
-  std::vector<float> values_lower_, values_upper_;     // strict lower L, row- and column-major
+  std::size_t nnz_ = 0;
+  // Strict lower L, row-major ([0, nnz)) for the forward and column-major ([nnz, 2 nnz)) for
+  // the backward pass; one array so that it is one huge-page stream (aligned.h).
+  AlignedArray<float> values_;
+  const float* values_lower() const { return values_.data(); }
+  const float* values_upper() const { return values_.data() + nnz_; }
   std::vector<std::vector<std::int32_t>> bins_, bins_down_;  // rows of independent subtrees, up and down
   std::vector<std::int32_t> top_, top_down_;                 // the top part, up and down
   double serial_fraction_ = 0;
