@@ -56,15 +56,19 @@ SparseLdlt::SparseLdlt(const Eigen::SparseMatrix<double>& K, std::size_t parts) 
   col_ptr_.assign(L.outerIndexPtr(), L.outerIndexPtr() + L.outerSize() + 1);
   row_ptr_.assign(R.outerIndexPtr(), R.outerIndexPtr() + R.outerSize() + 1);
   nnz_ = nnz;
-  values_.resize(2 * nnz);
-  std::copy(R.valuePtr(), R.valuePtr() + nnz, values_.data());
-  std::copy(L.valuePtr(), L.valuePtr() + nnz, values_.data() + nnz);
+  // One thread: the forward pass scatters by columns, so the column-major copy serves both
+  // passes. Several: the forward pass gathers by rows (a column of one subtree may update a
+  // row of the top part that another thread's column updates too), so it keeps a row-major copy.
+  rows_copy_ = parts > 1;
+  values_.resize((rows_copy_ ? 2 : 1) * nnz);
+  std::copy(L.valuePtr(), L.valuePtr() + nnz, values_.data());
+  if (rows_copy_) std::copy(R.valuePtr(), R.valuePtr() + nnz, values_.data() + nnz);
   if (n_ <= 65536) {
     col_rows16_.assign(L.innerIndexPtr(), L.innerIndexPtr() + nnz);
-    row_cols16_.assign(R.innerIndexPtr(), R.innerIndexPtr() + nnz);
+    if (rows_copy_) row_cols16_.assign(R.innerIndexPtr(), R.innerIndexPtr() + nnz);
   } else {
     col_rows32_.assign(L.innerIndexPtr(), L.innerIndexPtr() + nnz);
-    row_cols32_.assign(R.innerIndexPtr(), R.innerIndexPtr() + nnz);
+    if (rows_copy_) row_cols32_.assign(R.innerIndexPtr(), R.innerIndexPtr() + nnz);
   }
   schedule(parts < 1 ? 1 : parts);
 }
@@ -188,6 +192,21 @@ __attribute__((target("avx2,fma"))) void substitute_avx2(const std::int32_t* row
   }
 }
 
+// Column form of the forward pass: for each column j of `cols` (in elimination order), y[j] is
+// final; y[i] -= L[i, j] y[j] for the rows i of column j.
+template <class Index>
+__attribute__((target("avx2,fma"))) void scatter_avx2(const std::int32_t* cols, std::size_t count, const std::int32_t* ptr,
+                                                     const Index* idx, const float* values, double* y) {
+  for (std::size_t r = 0; r < count; ++r) {
+    const std::size_t j = static_cast<std::size_t>(cols[r]);
+    const __m256d yj = _mm256_loadu_pd(y + 4 * j);
+    for (std::int32_t p = ptr[j]; p < ptr[j + 1]; ++p) {
+      double* yi = y + 4 * static_cast<std::size_t>(idx[p]);
+      _mm256_storeu_pd(yi, _mm256_fnmadd_pd(_mm256_set1_pd(values[p]), yj, _mm256_loadu_pd(yi)));
+    }
+  }
+}
+
 bool cpu_has_avx2_fma() {
   static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   return has;
@@ -211,16 +230,43 @@ void substitute(const std::vector<std::int32_t>& rows, const std::vector<std::in
   }
 }
 
+template <class Index>
+void scatter(const std::vector<std::int32_t>& cols, const std::vector<std::int32_t>& ptr, const Index* idx, const float* values,
+             double* y) {
+#ifdef SOFTDECA_X86
+  if (cpu_has_avx2_fma()) {
+    scatter_avx2(cols.data(), cols.size(), ptr.data(), idx, values, y);
+    return;
+  }
+#endif
+  for (const std::int32_t c : cols) {
+    const std::size_t j = static_cast<std::size_t>(c);
+    const double yj[3] = {y[4 * j], y[4 * j + 1], y[4 * j + 2]};
+    for (std::int32_t p = ptr[j]; p < ptr[j + 1]; ++p) {
+      double* yi = y + 4 * static_cast<std::size_t>(idx[p]);
+      const double l = values[p];
+      yi[0] -= l * yj[0];
+      yi[1] -= l * yj[1];
+      yi[2] -= l * yj[2];
+    }
+  }
+}
+
 }  // namespace
 
 void SparseLdlt::forward(const std::vector<std::int32_t>& rows, double* y) const {
-  if (n_ <= 65536) substitute(rows, row_ptr_, row_cols16_.data(), values_lower(), y);
-  else substitute(rows, row_ptr_, row_cols32_.data(), values_lower(), y);
+  if (!rows_copy_) {
+    if (n_ <= 65536) scatter(rows, col_ptr_, col_rows16_.data(), values_.data(), y);
+    else scatter(rows, col_ptr_, col_rows32_.data(), values_.data(), y);
+    return;
+  }
+  if (n_ <= 65536) substitute(rows, row_ptr_, row_cols16_.data(), values_.data() + nnz_, y);
+  else substitute(rows, row_ptr_, row_cols32_.data(), values_.data() + nnz_, y);
 }
 
 void SparseLdlt::backward(const std::vector<std::int32_t>& rows, double* y) const {
-  if (n_ <= 65536) substitute(rows, col_ptr_, col_rows16_.data(), values_upper(), y);
-  else substitute(rows, col_ptr_, col_rows32_.data(), values_upper(), y);
+  if (n_ <= 65536) substitute(rows, col_ptr_, col_rows16_.data(), values_.data(), y);
+  else substitute(rows, col_ptr_, col_rows32_.data(), values_.data(), y);
 }
 
 void SparseLdlt::gather(const std::vector<std::int32_t>& rows, const float* const* b, std::size_t count, double* y) const {

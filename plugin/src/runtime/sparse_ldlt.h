@@ -1,7 +1,9 @@
 // A prefactored symmetric positive definite solve for three right-hand sides at once.
-// Eigen's SimplicialLDLT (AMD ordering) factorises P K P^T = L D L^T once; the factor is kept
-// twice, row-major for the forward and column-major for the backward substitution, so both
-// passes stream their part in order and gather from one xyz(w) vector that stays in L2.
+// Eigen's SimplicialLDLT (METIS nested-dissection ordering, else AMD) factorises
+// P K P^T = L D L^T once; the factor is kept column-major: the backward substitution gathers
+// (a dot product per column), the forward one scatters (an axpy per column), both streaming
+// the factor in order over one xyz(w) vector that stays in L2. With several threads the
+// forward pass gathers from a second, row-major copy instead (no two threads write one row).
 // Factor values are stored as float and indices as uint16 when the size allows (accumulation
 // is in double): the solve is bound by the bytes it reads, and this halves them at a relative
 // error of ~1e-7 (measured against double values, tests/native/test_runtime_math.cpp).
@@ -57,11 +59,10 @@ class SparseLdlt {
   std::vector<std::uint16_t> row_cols16_, col_rows16_;  // when n <= 65536
   std::vector<std::uint32_t> row_cols32_, col_rows32_;  // otherwise
   std::size_t nnz_ = 0;
-  // Strict lower L, row-major ([0, nnz)) for the forward and column-major ([nnz, 2 nnz)) for
-  // the backward pass; one array so that it is one huge-page stream (aligned.h).
+  // Strict lower L, column-major ([0, nnz)) and, with several parts, row-major ([nnz, 2 nnz));
+  // one array so that it is one huge-page stream (aligned.h).
+  bool rows_copy_ = false;
   AlignedArray<float> values_;
-  const float* values_lower() const { return values_.data(); }
-  const float* values_upper() const { return values_.data() + nnz_; }
   std::vector<std::vector<std::int32_t>> bins_, bins_down_;  // rows of independent subtrees, up and down
   std::vector<std::int32_t> top_, top_down_;                 // the top part, up and down
   double serial_fraction_ = 0;
