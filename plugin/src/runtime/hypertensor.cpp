@@ -64,29 +64,55 @@ float HyperTensor::at(std::size_t e, int k, int c) const {
 
 namespace {
 
-// Value of the stored tensor at flat index `at` of block b, latent k, in float.
-auto portable_load(const HyperTensor& L) {
-  return [&L](std::size_t b, int k, std::size_t at) -> float {
-    switch (L.precision()) {
-      case Precision::Half: return half_to_float(L.half_data()[at]);
-      case Precision::Float: return L.float_data()[at];
-      case Precision::Int8: return L.int8_data()[at] * L.scales()[b * static_cast<std::size_t>(L.latent()) + static_cast<std::size_t>(k)];
-    }
-    return 0.0f;
-  };
-}
+// The SIMD int8 kernels sum int16 x int8 products in int32: |sum| <= K * 32767 * 127 < 2^31 up
+// to this many latents (more run the portable kernel).
+constexpr int kMaxInt8Latent = 256;
 
 // ---- portable kernels -----------------------------------------------------------------------
 
-template <class Load>
-void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
-                     std::size_t b1, float* rhs, Load load) {
+// d[c][lane] = sum_k z_k L[b, k, c] (c < W), the storage's branch taken once per block and the
+// inner loops over the 8 lanes left to the compiler's vectoriser (NEON, SSE2).
+template <int W>
+void contract_portable(const HyperTensor& L, const float* z, std::size_t b, float (*d)[kLanes]) {
+  for (int c = 0; c < W; ++c)
+    for (std::size_t l = 0; l < kLanes; ++l) d[c][l] = 0.0f;
   const int K = L.latent();
+  const std::size_t base = b * L.block_stride();
+  switch (L.precision()) {
+    case Precision::Float:
+    case Precision::Half: {
+      const bool half = L.precision() == Precision::Half;
+      for (int k = 0; k < K; ++k) {
+        const float zk = z[k];
+        const std::size_t at = base + static_cast<std::size_t>(k) * W * kLanes;
+        for (int c = 0; c < W; ++c) {
+          const std::size_t row = at + static_cast<std::size_t>(c) * kLanes;
+          if (half)
+            for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += zk * half_to_float(L.half_data()[row + l]);
+          else
+            for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += zk * L.float_data()[row + l];
+        }
+      }
+      break;
+    }
+    case Precision::Int8: {
+      const float* s = L.scales() + b * static_cast<std::size_t>(K);
+      for (int k = 0; k < K; ++k) {
+        const float zk = z[k] * s[k];
+        const std::int8_t* q = L.int8_data() + base + static_cast<std::size_t>(k / 2) * W * 2 * kLanes + static_cast<std::size_t>(k % 2);
+        for (int c = 0; c < W; ++c)
+          for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += zk * static_cast<float>(q[(static_cast<std::size_t>(c) * kLanes + l) * 2]);
+      }
+      break;
+    }
+  }
+}
+
+void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
+                     std::size_t b1, float* rhs) {
   for (std::size_t b = b0; b < b1; ++b) {
-    float d[9][kLanes] = {};
-    for (int k = 0; k < K; ++k)
-      for (int c = 0; c < 9; ++c)
-        for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += z[k] * load(b, k, L.index(b, k, c, l));
+    float d[9][kLanes];
+    contract_portable<9>(L, z, b, d);
     const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
     const float* cf = faces.coeff.data() + b * 3 * kLanes;
     for (std::size_t l = 0; l < kLanes; ++l) {
@@ -110,15 +136,11 @@ void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float*
   }
 }
 
-template <class Load>
 void vertex_offsets_portable(const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0, std::size_t b1,
-                             float* out, Load load) {
-  const int K = L.latent();
+                             float* out) {
   for (std::size_t b = b0; b < b1; ++b) {
-    float acc[3][kLanes] = {};
-    for (int k = 0; k < K; ++k)
-      for (int c = 0; c < 3; ++c)
-        for (std::size_t l = 0; l < kLanes; ++l) acc[c][l] += z[k] * load(b, k, L.index(b, k, c, l));
+    float acc[3][kLanes];
+    contract_portable<3>(L, z, b, acc);
     const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
     for (std::size_t l = 0; l < end; ++l)
       for (int c = 0; c < 3; ++c) {
@@ -156,16 +178,15 @@ __attribute__((target("avx2,fma,f16c"))) inline void contract(const HyperTensor&
 // The same for int8 storage: the block's coefficients z_k s_{b,k} are quantised to int16 with
 // one step t = max_k |z_k s_{b,k}| / 32767 (a relative error of 1.5e-5 of the largest term,
 // negligible next to the int8 values' 1/254), multiplied with the int8 values two latents at a
-// time by pmaddwd and summed exactly in int32 (|sum| <= K * 32767 * 127 < 2^31 for up to
-// kMaxInt8Latent latents; more fall back to the portable kernel), then scaled by t.
-constexpr int kMaxInt8Latent = 256;
+// time by pmaddwd and summed exactly in int32 (kMaxInt8Latent), then scaled by t.
 
-template <int W>
-__attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+// z_k s_{b,k} of block b as int16 (zq, padded with zeros to an even count); returns the step
+// t (0 when every coefficient is zero).
+__attribute__((target("avx2,fma"))) inline float quantise_coefficients(const HyperTensor& L, const float* z, std::size_t b,
+                                                                     std::int16_t* zq) {
   const int K = L.latent(), K16 = (K + 15) / 16 * 16;
   const float* s = L.scales() + b * static_cast<std::size_t>(K);
   alignas(32) float zs[kMaxInt8Latent];
-  alignas(32) std::int16_t zq[kMaxInt8Latent];
   for (int k = 0; k < K; ++k) zs[k] = z[k] * s[k];
   for (int k = K; k < K16; ++k) zs[k] = 0.0f;
   const __m256 sign = _mm256_set1_ps(-0.0f);
@@ -175,8 +196,7 @@ __attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor&
   peak4 = _mm_max_ps(peak4, _mm_movehl_ps(peak4, peak4));
   peak4 = _mm_max_ss(peak4, _mm_shuffle_ps(peak4, peak4, 1));
   const float peak = _mm_cvtss_f32(peak4);
-  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
-  if (!(peak > 0.0f)) return;
+  if (!(peak > 0.0f)) return 0.0f;
   const __m256 inv = _mm256_set1_ps(32767.0f / peak);
   for (int k = 0; k < K16; k += 16) {
     const __m256i a = _mm256_cvtps_epi32(_mm256_mul_ps(_mm256_load_ps(zs + k), inv));
@@ -184,10 +204,19 @@ __attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor&
     // packs works per 128-bit half: (a0-3, c0-3 | a4-7, c4-7); restore the order.
     _mm256_store_si256(reinterpret_cast<__m256i*>(zq + k), _mm256_permute4x64_epi64(_mm256_packs_epi32(a, c), 0xD8));
   }
+  return peak / 32767.0f;
+}
+
+template <int W>
+__attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  alignas(32) std::int16_t zq[kMaxInt8Latent];
+  const float t = quantise_coefficients(L, z, b, zq);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
+  if (t == 0.0f) return;
   __m256i acc[W];
   for (int c = 0; c < W; ++c) acc[c] = _mm256_setzero_si256();
   const std::int8_t* q = L.int8_data() + b * L.block_stride();
-  const int pairs = (K + 1) / 2;
+  const int pairs = (L.latent() + 1) / 2;
   for (int p = 0; p < pairs; ++p) {
     std::int32_t pair;
     std::memcpy(&pair, zq + 2 * p, sizeof pair);
@@ -199,8 +228,33 @@ __attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor&
       acc[c] = _mm256_add_epi32(acc[c], _mm256_madd_epi16(v, zp));
     }
   }
-  const __m256 t = _mm256_set1_ps(peak / 32767.0f);
-  for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), t);
+  const __m256 step = _mm256_set1_ps(t);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), step);
+}
+
+// The same with AVX-512 VNNI's vpdpwssd (multiply, pair-sum and accumulate in one instruction).
+template <int W>
+__attribute__((target("avx2,fma,avx512f,avx512vl,avx512vnni"))) inline void contract_int8_vnni(const HyperTensor& L, const float* z,
+                                                                                             std::size_t b, __m256* out) {
+  alignas(32) std::int16_t zq[kMaxInt8Latent];
+  const float t = quantise_coefficients(L, z, b, zq);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
+  if (t == 0.0f) return;
+  __m256i acc[W];
+  for (int c = 0; c < W; ++c) acc[c] = _mm256_setzero_si256();
+  const std::int8_t* q = L.int8_data() + b * L.block_stride();
+  const int pairs = (L.latent() + 1) / 2;
+  for (int p = 0; p < pairs; ++p) {
+    std::int32_t pair;
+    std::memcpy(&pair, zq + 2 * p, sizeof pair);
+    const __m256i zp = _mm256_set1_epi32(pair);
+    const std::int8_t* qp = q + static_cast<std::size_t>(p) * W * 2 * kLanes;
+#pragma GCC unroll 9
+    for (int c = 0; c < W; ++c)
+      acc[c] = _mm256_dpwssd_epi32(acc[c], _mm256_cvtepi8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qp + c * 2 * kLanes))), zp);
+  }
+  const __m256 step = _mm256_set1_ps(t);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), step);
 }
 
 template <Precision P, int W>
@@ -209,67 +263,97 @@ __attribute__((target("avx2,fma,f16c"))) inline void contract_any(const HyperTen
   else contract<P, W>(L, z, b, out);
 }
 
+// rhs += the right-hand side of the 8 faces of block b, given their G_f - I (d, row-major 3x3).
+__attribute__((target("avx2,fma"))) inline void accumulate_rhs(const __m256* d, const FaceBlocks& faces, std::size_t b,
+                                                              const float* skin, float* rhs) {
+  const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
+  // Edge vectors of the 8 faces, transposed to one lane per face (scalar loads: AVX2 gathers
+  // are slow on several CPUs and these vertices are in cache).
+  alignas(32) float edge[6][kLanes];
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    const float* si = skin + 3 * static_cast<std::size_t>(idx[l]);
+    const float* sj = skin + 3 * static_cast<std::size_t>(idx[kLanes + l]);
+    const float* sk = skin + 3 * static_cast<std::size_t>(idx[2 * kLanes + l]);
+    for (int c = 0; c < 3; ++c) {
+      edge[c][l] = sj[c] - si[c];
+      edge[3 + c][l] = sk[c] - si[c];
+    }
+  }
+  const __m256 e1[3] = {_mm256_load_ps(edge[0]), _mm256_load_ps(edge[1]), _mm256_load_ps(edge[2])};
+  const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
+  const float* cf = faces.coeff.data() + b * 3 * kLanes;
+  const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
+  alignas(32) float col[6][kLanes];
+  for (int r = 0; r < 3; ++r) {
+    const __m256* row = d + 3 * r;
+    const __m256 p0 = _mm256_fmadd_ps(row[2], e1[2], _mm256_fmadd_ps(row[1], e1[1], _mm256_mul_ps(row[0], e1[0])));
+    const __m256 p1 = _mm256_fmadd_ps(row[2], e2[2], _mm256_fmadd_ps(row[1], e2[1], _mm256_mul_ps(row[0], e2[0])));
+    _mm256_store_ps(col[r], _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00)));
+    _mm256_store_ps(col[3 + r], _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01)));
+  }
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    float* ri = rhs + static_cast<std::size_t>(idx[l]) * 3;
+    float* rj = rhs + static_cast<std::size_t>(idx[kLanes + l]) * 3;
+    float* rk = rhs + static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
+    for (int r = 0; r < 3; ++r) {
+      rj[r] += col[r][l];
+      rk[r] += col[3 + r][l];
+      ri[r] -= col[r][l] + col[3 + r][l];
+    }
+  }
+}
+
+// out[v] = base[v] + the 8 lanes of a (3 components), for the elements of block b that exist.
+__attribute__((target("avx2"))) inline void write_offsets(const __m256* a, const HyperTensor& L, std::size_t b, const float* base_pos,
+                                                        float* out) {
+  alignas(32) float acc[3][kLanes];
+  for (int c = 0; c < 3; ++c) _mm256_store_ps(acc[c], a[c]);
+  const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
+  for (std::size_t l = 0; l < end; ++l) {
+    const std::size_t v = (b * kLanes + l) * 3;
+    out[v] = base_pos[v] + acc[0][l];
+    out[v + 1] = base_pos[v + 1] + acc[1][l];
+    out[v + 2] = base_pos[v + 2] + acc[2][l];
+  }
+}
+
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, const FaceBlocks& faces, const float* z,
                                                          const float* skin, std::size_t b0, std::size_t b1, float* rhs) {
-  alignas(32) float col[6][kLanes];
   for (std::size_t b = b0; b < b1; ++b) {
     __m256 d[9];
     contract_any<P, 9>(L, z, b, d);
-    const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
-    // Edge vectors of the 8 faces, transposed to one lane per face (scalar loads: AVX2 gathers
-    // are slow on several CPUs and these vertices are in cache).
-    alignas(32) float edge[6][kLanes];
-    for (std::size_t l = 0; l < kLanes; ++l) {
-      const float* si = skin + 3 * static_cast<std::size_t>(idx[l]);
-      const float* sj = skin + 3 * static_cast<std::size_t>(idx[kLanes + l]);
-      const float* sk = skin + 3 * static_cast<std::size_t>(idx[2 * kLanes + l]);
-      for (int c = 0; c < 3; ++c) {
-        edge[c][l] = sj[c] - si[c];
-        edge[3 + c][l] = sk[c] - si[c];
-      }
-    }
-    const __m256 e1[3] = {_mm256_load_ps(edge[0]), _mm256_load_ps(edge[1]), _mm256_load_ps(edge[2])};
-    const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
-    const float* cf = faces.coeff.data() + b * 3 * kLanes;
-    const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
-    for (int r = 0; r < 3; ++r) {
-      const __m256* row = d + 3 * r;
-      const __m256 p0 = _mm256_fmadd_ps(row[2], e1[2], _mm256_fmadd_ps(row[1], e1[1], _mm256_mul_ps(row[0], e1[0])));
-      const __m256 p1 = _mm256_fmadd_ps(row[2], e2[2], _mm256_fmadd_ps(row[1], e2[1], _mm256_mul_ps(row[0], e2[0])));
-      _mm256_store_ps(col[r], _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00)));
-      _mm256_store_ps(col[3 + r], _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01)));
-    }
-    for (std::size_t l = 0; l < kLanes; ++l) {
-      float* ri = rhs + static_cast<std::size_t>(idx[l]) * 3;
-      float* rj = rhs + static_cast<std::size_t>(idx[kLanes + l]) * 3;
-      float* rk = rhs + static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
-      for (int r = 0; r < 3; ++r) {
-        rj[r] += col[r][l];
-        rk[r] += col[3 + r][l];
-        ri[r] -= col[r][l] + col[3 + r][l];
-      }
-    }
+    accumulate_rhs(d, faces, b, skin, rhs);
+  }
+}
+
+__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"))) void dg_rhs_vnni(const HyperTensor& L, const FaceBlocks& faces,
+                                                                                    const float* z, const float* skin,
+                                                                                    std::size_t b0, std::size_t b1, float* rhs) {
+  for (std::size_t b = b0; b < b1; ++b) {
+    __m256 d[9];
+    contract_int8_vnni<9>(L, z, b, d);
+    accumulate_rhs(d, faces, b, skin, rhs);
   }
 }
 
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void vertex_offsets_avx2(const HyperTensor& L, const float* z, const float* base_pos,
                                                                  std::size_t b0, std::size_t b1, float* out) {
-  alignas(32) float acc[3][kLanes];
   for (std::size_t b = b0; b < b1; ++b) {
     __m256 a[3];
     contract_any<P, 3>(L, z, b, a);
-    _mm256_store_ps(acc[0], a[0]);
-    _mm256_store_ps(acc[1], a[1]);
-    _mm256_store_ps(acc[2], a[2]);
-    const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
-    for (std::size_t l = 0; l < end; ++l) {
-      const std::size_t v = (b * kLanes + l) * 3;
-      out[v] = base_pos[v] + acc[0][l];
-      out[v + 1] = base_pos[v + 1] + acc[1][l];
-      out[v + 2] = base_pos[v + 2] + acc[2][l];
-    }
+    write_offsets(a, L, b, base_pos, out);
+  }
+}
+
+__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"))) void vertex_offsets_vnni(const HyperTensor& L, const float* z,
+                                                                                            const float* base_pos, std::size_t b0,
+                                                                                            std::size_t b1, float* out) {
+  for (std::size_t b = b0; b < b1; ++b) {
+    __m256 a[3];
+    contract_int8_vnni<3>(L, z, b, a);
+    write_offsets(a, L, b, base_pos, out);
   }
 }
 
@@ -277,45 +361,74 @@ bool cpu_has_avx2() {
   static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
   return has;
 }
+bool cpu_has_vnni() {
+  static const bool has = cpu_has_avx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512vnni");
+  return has;
+}
 #endif
+
+// The kernel that runs: the one asked for, or (Best) the fastest this CPU has for L.
+Kernel resolve(Kernel k, const HyperTensor& L) {
+  const bool int8_ok = L.precision() != Precision::Int8 || L.latent() <= kMaxInt8Latent;
+  if (k == Kernel::Best) {
+    if (kernel_available(Kernel::Avx512Vnni) && L.precision() == Precision::Int8 && int8_ok) return Kernel::Avx512Vnni;
+    if (kernel_available(Kernel::Avx2) && int8_ok) return Kernel::Avx2;
+    return Kernel::Portable;
+  }
+  if (!kernel_available(k) || !int8_ok || (k == Kernel::Avx512Vnni && L.precision() != Precision::Int8)) return Kernel::Portable;
+  return k;
+}
 
 }  // namespace
 
-bool simd_kernels() {
+bool kernel_available(Kernel k) {
+  switch (k) {
+    case Kernel::Best:
+    case Kernel::Portable: return true;
 #ifdef SOFTDECA_X86
-  return cpu_has_avx2();
+    case Kernel::Avx2: return cpu_has_avx2();
+    case Kernel::Avx512Vnni: return cpu_has_vnni();
 #else
-  return false;
+    case Kernel::Avx2:
+    case Kernel::Avx512Vnni: return false;
 #endif
+  }
+  return false;
 }
 
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0, std::size_t b1,
-            float* rhs) {
+            float* rhs, Kernel kernel) {
+  switch (resolve(kernel, L)) {
 #ifdef SOFTDECA_X86
-  if (cpu_has_avx2() && (L.precision() != Precision::Int8 || L.latent() <= kMaxInt8Latent)) {
-    switch (L.precision()) {
-      case Precision::Half: dg_rhs_avx2<Precision::Half>(L, faces, z, skin, b0, b1, rhs); break;
-      case Precision::Float: dg_rhs_avx2<Precision::Float>(L, faces, z, skin, b0, b1, rhs); break;
-      case Precision::Int8: dg_rhs_avx2<Precision::Int8>(L, faces, z, skin, b0, b1, rhs); break;
-    }
-    return;
-  }
+    case Kernel::Avx512Vnni: dg_rhs_vnni(L, faces, z, skin, b0, b1, rhs); return;
+    case Kernel::Avx2:
+      switch (L.precision()) {
+        case Precision::Half: dg_rhs_avx2<Precision::Half>(L, faces, z, skin, b0, b1, rhs); return;
+        case Precision::Float: dg_rhs_avx2<Precision::Float>(L, faces, z, skin, b0, b1, rhs); return;
+        case Precision::Int8: dg_rhs_avx2<Precision::Int8>(L, faces, z, skin, b0, b1, rhs); return;
+      }
+      return;
 #endif
-  dg_rhs_portable(L, faces, z, skin, b0, b1, rhs, portable_load(L));
+    default: dg_rhs_portable(L, faces, z, skin, b0, b1, rhs); return;
+  }
 }
 
-void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out) {
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out,
+                    Kernel kernel) {
+  switch (resolve(kernel, L)) {
 #ifdef SOFTDECA_X86
-  if (cpu_has_avx2() && (L.precision() != Precision::Int8 || L.latent() <= kMaxInt8Latent)) {
-    switch (L.precision()) {
-      case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, b0, b1, out); break;
-      case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, b0, b1, out); break;
-      case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, b0, b1, out); break;
-    }
-    return;
-  }
+    case Kernel::Avx512Vnni: vertex_offsets_vnni(L, z, base, b0, b1, out); return;
+    case Kernel::Avx2:
+      switch (L.precision()) {
+        case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, b0, b1, out); return;
+        case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, b0, b1, out); return;
+        case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, b0, b1, out); return;
+      }
+      return;
 #endif
-  vertex_offsets_portable(L, z, base, b0, b1, out, portable_load(L));
+    default: vertex_offsets_portable(L, z, base, b0, b1, out); return;
+  }
 }
 
 }  // namespace softdeca::runtime

@@ -64,15 +64,19 @@ struct FaceBlocks {
   AlignedArray<float> coeff;           // [blocks][3][8]
 };
 
+// Which kernel computes the products: Best (frames) picks the fastest this CPU has for the
+// tensor's storage; the others exist so that tests can compare every kernel the CPU runs.
+// Avx512Vnni serves int8 storage only (vpdpwssd); a kernel the CPU lacks runs as Portable.
+enum class Kernel { Best, Portable, Avx2, Avx512Vnni };
+bool kernel_available(Kernel kernel);
+
 // rhs (V x 3, accumulated) += sum over the faces of blocks [b0, b1) of
 //   D_f a_f W_f ((G_f - I) E_f(S))^T   with   G_f - I = sum_k z_k L[f, k] (row-major 3x3).
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
-            std::size_t b1, float* rhs);
+            std::size_t b1, float* rhs, Kernel kernel = Kernel::Best);
 
 // out[v] = base[v] + sum_k z_k L[v, k] for the vertices of blocks [b0, b1) (width-3 tensor).
-void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out);
-
-// Whether the AVX2/F16C kernels run on this CPU (else the portable ones).
-bool simd_kernels();
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out,
+                    Kernel kernel = Kernel::Best);
 
 }  // namespace softdeca::runtime
