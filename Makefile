@@ -59,7 +59,7 @@ DEMO_TAKE      ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
 DEMO_SEED      ?= 1
 DEMO_START     ?= 360
 DEMO_FRAMES    ?= 240
-DEMO_LOCALISED ?= w_soft_strain=100@0.05,-0.015,0.085,0.03
+DEMO_LOCALISED ?= w_soft_strain=max@0.05,-0.015,0.085,0.03
 
 .PHONY: demo-bundle
 demo-bundle:

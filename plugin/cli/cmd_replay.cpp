@@ -26,11 +26,13 @@ using Clock = std::chrono::steady_clock;
 struct Change {
   std::string name;
   float value = 0;
+  std::string bound;  // "min", "max" or "default": the bundle's value, resolved when applied
   bool region = false;
   double centre[3] = {0, 0, 0}, radius = 0;
 };
 
-// "name=value" or "name=value@x,y,z,r" (faces whose neutral centroid lies within r metres).
+// "name=value" or "name=value@x,y,z,r" (faces whose neutral centroid lies within r metres);
+// value may be min, max or default (the bundle's, which depend on the data it was trained on).
 Change parse_change(const std::string& spec) {
   Change c;
   const std::size_t eq = spec.find('=');
@@ -39,8 +41,12 @@ Change parse_change(const std::string& spec) {
   const std::size_t at = spec.find('@', eq);
   const std::string value = spec.substr(eq + 1, at == std::string::npos ? std::string::npos : at - eq - 1);
   char* end = nullptr;
-  c.value = std::strtof(value.c_str(), &end);
-  if (end == value.c_str() || *end) throw UsageError("bad value in '" + spec + "'");
+  if (value == "min" || value == "max" || value == "default") {
+    c.bound = value;
+  } else {
+    c.value = std::strtof(value.c_str(), &end);
+    if (end == value.c_str() || *end) throw UsageError("bad value in '" + spec + "'");
+  }
   if (at != std::string::npos) {
     std::stringstream region(spec.substr(at + 1));
     std::string item;
@@ -71,8 +77,15 @@ std::size_t apply(const Model& model, Avatar& avatar, const ObjMesh& neutral, co
   std::size_t covered = 0;
   std::vector<std::int32_t> tri(3 * model.info.skin_triangle_count);
   check(softdeca_model_get_skin_triangles(model.handle, tri.data(), model.info.skin_triangle_count), "skin triangles");
-  for (const Change& c : changes) {
+  for (Change c : changes) {
     const int index = model.parameter(c.name);
+    if (!c.bound.empty()) {
+      softdeca_parameter_info info{};
+      info.struct_size = sizeof info;
+      check(softdeca_model_get_parameter(model.handle, static_cast<uint32_t>(index), &info), "parameter " + c.name);
+      c.value = static_cast<float>(c.bound == "min" ? info.lo : c.bound == "max" ? info.hi : info.default_value);
+      std::fprintf(stderr, "%s=%s: %g\n", c.name.c_str(), c.bound.c_str(), static_cast<double>(c.value));
+    }
     if (!c.region) {
       check(softdeca_avatar_set_parameter(avatar.handle, static_cast<uint32_t>(index), c.value), "setting " + c.name);
       continue;
@@ -143,7 +156,7 @@ int run_replay(const Args& args) {
       .option("--seed", "N", "instead of --avatar: the ICT identity of this seed, written to <out>/avatar by the Python helper")
       .option("--out", "DIR", "output folder", "out/replay")
       .option("--models", "LIST", "comma-separated: linear, softdeca, sparse", "linear,softdeca,sparse")
-      .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated")
+      .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated (value: a number, min, max or default)")
       .option("--localised", "SPEC", "an extra SoftDECA pass with this change 'name=value@x,y,z,r' on top of --set")
       .option("--start", "N", "skip the take's first N frames", "0")
       .option("--frames", "N", "at most N frames of the take after --start (0: all)", "0")

@@ -4,9 +4,9 @@ with render.py, framed on the face.
 
 A correction of a few millimetres is invisible in a shaded render, so the models' columns are
 coloured by how far each vertex lies from the linear blendshapes of the same frame, and the
-localised column by how far it lies from plain SoftDECA (what the localised change does): grey
-0 to red at the column's scale (its 99.5th percentile over the shown frames), written in the
-column's labels.
+localised column by how far it lies from plain SoftDECA (what the localised change does): white
+0 to dark red at the column's scale (its 99.5th percentile over the shown frames), written in
+the column's labels.
 """
 
 from __future__ import annotations
@@ -26,8 +26,7 @@ LABELS = {
     "softdeca_localised": "SoftDECA, localised change",
     "sparse": "SparseSoftDECA (landmarks)",
 }
-GREY = np.array([0.83, 0.83, 0.83])
-RED = np.array([0.85, 0.08, 0.05])
+COLORMAP = "Reds"  # 0: near white, the column's scale: dark red
 
 
 def pick_frames(caches: dict[str, np.ndarray], neutral: np.ndarray, count: int) -> list[int]:
@@ -47,11 +46,6 @@ def face_focus(neutral: np.ndarray) -> Focus:
     lo, hi = front.min(axis=0), front.max(axis=0)
     lo[2] = z.max() - 0.10
     return Focus(tuple(float(x) for x in lo), tuple(float(x) for x in hi))
-
-
-def heat(distance_mm: np.ndarray, scale_mm: float) -> np.ndarray:
-    t = np.clip(distance_mm / max(scale_mm, 1e-9), 0.0, 1.0)[:, None]
-    return GREY * (1 - t) + RED * t
 
 
 def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
@@ -78,13 +72,14 @@ def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
     images, labels = [], []
     for f in chosen:
         for name, cache in caches.items():
-            colors, note = None, ""
+            layer, note = MeshLayer(cache[f], triangles), ""
             if name in ref:
-                colors = heat(distance_mm(name, ref[name], f), scale[name])
+                layer.scalars = distance_mm(name, ref[name], f)
+                layer.cmap, layer.clim = COLORMAP, (0.0, max(scale[name], 1e-9))
                 note = f"\nred: {scale[name]:.3g} mm from {LABELS[ref[name]]}"
             images.append(
                 render(
-                    [MeshLayer(cache[f], triangles, vertex_colors=colors)],
+                    [layer],
                     "three_quarter",
                     settings=settings,
                     focus=focus,
@@ -100,8 +95,8 @@ def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
         f"{summary['face_lost_rows_skipped']} face-lost rows skipped; "
         f"landmarks from {summary['landmarks_from']}; dynamics "
         + ("on" if summary.get("dynamics") else "off"),
-        "colour: distance per vertex to the model named in the label, grey 0 to red at the "
-        "column's scale (99.5th percentile of the shown frames)"
+        "colour: distance per vertex to the model named in the label, white 0 to dark red at "
+        "the column's scale (99.5th percentile of the shown frames)"
         if ref
         else "",
         f"localised change: {localised} ({summary.get('localised_faces', 0)} skin faces)"
