@@ -25,12 +25,14 @@ class AlignedArray {
   explicit AlignedArray(std::size_t n) { resize(n); }
   AlignedArray(const AlignedArray&) = delete;
   AlignedArray& operator=(const AlignedArray&) = delete;
-  AlignedArray(AlignedArray&& o) noexcept : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)) {}
+  AlignedArray(AlignedArray&& o) noexcept
+      : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)), allocated_(std::exchange(o.allocated_, 0)) {}
   AlignedArray& operator=(AlignedArray&& o) noexcept {
     if (this != &o) {
       std::free(data_);
       data_ = std::exchange(o.data_, nullptr);
       size_ = std::exchange(o.size_, 0);
+      allocated_ = std::exchange(o.allocated_, 0);
     }
     return *this;
   }
@@ -41,6 +43,7 @@ class AlignedArray {
     std::free(data_);
     data_ = nullptr;
     size_ = 0;
+    allocated_ = 0;
     if (n == 0) return;
     const bool huge = n * sizeof(T) >= kHugePage;
     const std::size_t align = huge ? kHugePage : 64;
@@ -52,17 +55,19 @@ class AlignedArray {
 #endif
     std::memset(static_cast<void*>(data_), 0, bytes);
     size_ = n;
+    allocated_ = bytes;
   }
   T* data() { return data_; }
   const T* data() const { return data_; }
   std::size_t size() const { return size_; }
   std::size_t bytes() const { return size_ * sizeof(T); }
+  std::size_t allocated_bytes() const { return allocated_; }  // with the rounding to 64 B or 2 MB
   T& operator[](std::size_t i) { return data_[i]; }
   const T& operator[](std::size_t i) const { return data_[i]; }
 
  private:
   T* data_ = nullptr;
-  std::size_t size_ = 0;
+  std::size_t size_ = 0, allocated_ = 0;
 };
 
 }  // namespace softdeca::runtime

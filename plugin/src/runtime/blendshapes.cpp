@@ -42,7 +42,7 @@ Blendshapes::Blendshapes(const float* deltas, std::size_t n_shapes, std::size_t 
 }
 
 std::size_t Blendshapes::bytes() const {
-  std::size_t b = deltas_.bytes();
+  std::size_t b = deltas_.allocated_bytes();
   for (const Shape& s : shapes_) b += s.runs.size() * sizeof(Run) + s.part_begin.size() * sizeof(std::size_t);
   return b;
 }

@@ -42,7 +42,9 @@ class HyperTensor {
   const float* float_data() const { return float_.data(); }
   const std::int8_t* int8_data() const { return int8_.data(); }
   const float* scales() const { return scales_.data(); }  // Int8: [block][latent]
-  std::size_t bytes() const { return half_.bytes() + float_.bytes() + int8_.bytes() + scales_.bytes(); }
+  std::size_t bytes() const {
+    return half_.allocated_bytes() + float_.allocated_bytes() + int8_.allocated_bytes() + scales_.allocated_bytes();
+  }
   // Element e, latent k, component c (for tests and the error measurement).
   float at(std::size_t e, int k, int c) const;
 

@@ -137,7 +137,7 @@ void SparseLdlt::schedule(std::size_t parts) {
 std::size_t SparseLdlt::bytes() const {
   return (gather_.size() + row_ptr_.size() + col_ptr_.size()) * 4 + inv_d_.size() * 8 +
          (row_cols16_.size() + col_rows16_.size()) * 2 + (row_cols32_.size() + col_rows32_.size()) * 4 +
-         values_.bytes();
+         values_.allocated_bytes();
 }
 
 namespace {
