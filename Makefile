@@ -20,11 +20,13 @@ export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
 .PHONY: help setup build build-asan test test-native test-python demo bench lint clean
 
 help:
-	@echo "make demo    render the template, its layers, sampled identities, landmarks -> $(OUT)/demo"
+	@echo "make demo    render the template, its layers, sampled identities, landmarks -> $(OUT)/demo,"
+	@echo "             then replay a real take through SoftDECA and SparseSoftDECA -> $(OUT)/demo/replay"
 	@echo "make test    run every test (ctest release + ASan/UBSan, pytest, short fuzzing)"
 	@echo "make bench   run the benchmarks -> build/bench/<area>.json"
 	@echo "make setup   install what is missing (apt, .venv, ONNX Runtime root); idempotent"
-	@echo "variables:   ICT=<ICT-FaceKit checkout or archive folder> (default $(ICT)), OUT=$(OUT)"
+	@echo "variables:   ICT=<ICT-FaceKit checkout or archive folder> (default $(ICT)), OUT=$(OUT),"
+	@echo "             BUNDLE=<model bundle folder or .tar> (default $(BUNDLE))"
 
 setup:
 	@.ci/setup
@@ -49,8 +51,34 @@ test-python: build
 
 test: lint test-native test-fuzz test-python
 
-demo: build
+# The demo's replay: frames DEMO_START.. of a real Live Link Face take through linear
+# blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,
+# plus one localised change (stiffer soft tissue in a 3 cm ball on the subject's left cheek).
+BUNDLE         ?= models/softdeca-default
+DEMO_TAKE      ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
+DEMO_SEED      ?= 1
+DEMO_START     ?= 360
+DEMO_FRAMES    ?= 240
+DEMO_LOCALISED ?= w_soft_strain=max@0.05,-0.015,0.085,0.03
+
+.PHONY: demo-bundle
+demo-bundle:
+	@[ -f "$(BUNDLE)/manifest.json" ] || [ -f "$(BUNDLE)" ] || { \
+	  echo "make demo: no model bundle at '$(BUNDLE)' (a folder with manifest.json, or a .tar; docs/bundle.md)."; \
+	  echo "  The trained bundle is made by:  $(PY) -m softdeca_train train-bundle"; \
+	  echo "  For an UNTRAINED stand-in:      $(PY) -m softdeca_train runtime-bundle --out build/bundles/random-untrained"; \
+	  echo "                                  make demo BUNDLE=build/bundles/random-untrained"; exit 1; }
+
+demo: demo-bundle build
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo
+	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(DEMO_TAKE) --bundle $(BUNDLE) \
+	  --seed $(DEMO_SEED) --start $(DEMO_START) --frames $(DEMO_FRAMES) --dynamics --preview \
+	  --localised "$(DEMO_LOCALISED)" --out $(OUT)/demo/replay
+	@echo "demo replay ($(BUNDLE), identity seed $(DEMO_SEED), $(DEMO_FRAMES) frames of $(notdir $(DEMO_TAKE))):"
+	@echo "  mesh sequence: $(OUT)/demo/replay/{linear,softdeca,sparse,softdeca_localised}.pc2 over $(OUT)/demo/replay/neutral.obj"
+	@echo "                 (PC2 point caches: Blender Mesh Cache modifier; docs/runtime.md)"
+	@echo "  preview:       $(OUT)/demo/replay/preview.png"
+	@echo "  timings:       $(OUT)/demo/replay/replay.json"
 
 bench: build
 	@mkdir -p build/bench
@@ -98,8 +126,8 @@ fuzz-long: fuzz-build
 
 # ---- Runtime (issue 6) -----------------------------------------------------------------------
 # `make bench` also measures the native runtime (build/bench/runtime.json). `make replay-demo`
-# replays a real take through both models with an UNTRAINED random bundle (the replay path that
-# `make demo` will use once trained bundles exist) and prints where the results are.
+# replays a whole real take through both models with an UNTRAINED random bundle (exported on the
+# fly) and prints where the results are; `make demo` replays part of a take with $(BUNDLE).
 REPLAY_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
 REPLAY_BUNDLE ?= build/bundles/random-untrained
 .PHONY: bench-runtime replay-demo

@@ -218,7 +218,14 @@ int run_bench_runtime(const Args& args) {
     const char* name = precision == SOFTDECA_PRECISION_INT8 ? "int8" : "float";
     Avatar a(model, rig.neutral, rig.deltas, 1, precision);
     check(softdeca_avatar_prepare(a.handle), "prepare");
+    const Times lin = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_linear(a.handle, take.weights[f].data(), 52, &output), "linear");
+    });
     const Times st = median_ms(frames, warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
+    });
+    check(softdeca_avatar_set_dynamics(a.handle, 1), "dynamics");
+    const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
     });
     char load_text[64];
@@ -227,7 +234,15 @@ int run_bench_runtime(const Args& args) {
                 figure(st.wall, "ms", std::string("as softdeca_static_ms with ") + name + " hyper-tensors (1 thread); " + how + load_text));
     figures.raw(std::string("runtime.softdeca_static_cpu_ms_") + name,
                 figure(st.cpu, "ms", std::string("as softdeca_static_cpu_ms with ") + name + " hyper-tensors; " + how + load_text));
-    std::fprintf(stderr, "%s storage: softdeca wall %.3f cpu %.3f ms\n", name, st.wall, st.cpu);
+    figures.raw(std::string("runtime.softdeca_dynamic_ms_") + name,
+                figure(dy.wall, "ms", std::string("as softdeca_dynamic_ms with ") + name + " hyper-tensors (1 thread); " + how + load_text));
+    figures.raw(std::string("runtime.softdeca_over_linear_") + name,
+                figure(st.wall / lin.wall, "x", std::string("softdeca_static_ms_") + name + " / linear_blendshapes_ms measured just before on "
+                                                "the same avatar (1 thread); " + how + load_text, 3.0));
+    figures.raw(std::string("runtime.softdeca_over_linear_cpu_") + name,
+                figure(st.cpu / lin.cpu, "x", std::string("the same in thread CPU time; ") + how + load_text, 3.0));
+    std::fprintf(stderr, "%s storage: wall linear %.3f softdeca %.3f / dynamic %.3f ms (x%.2f); cpu linear %.3f softdeca %.3f ms (x%.2f)\n",
+                 name, lin.wall, st.wall, dy.wall, st.wall / lin.wall, lin.cpu, st.cpu, st.cpu / lin.cpu);
   }
 
   // Error of the compact storage: the same frames with float, half and int8 hyper-tensors.

@@ -26,11 +26,13 @@ using Clock = std::chrono::steady_clock;
 struct Change {
   std::string name;
   float value = 0;
+  std::string bound;  // "min", "max" or "default": the bundle's value, resolved when applied
   bool region = false;
   double centre[3] = {0, 0, 0}, radius = 0;
 };
 
-// "name=value" or "name=value@x,y,z,r" (faces whose neutral centroid lies within r metres).
+// "name=value" or "name=value@x,y,z,r" (faces whose neutral centroid lies within r metres);
+// value may be min, max or default (the bundle's, which depend on the data it was trained on).
 Change parse_change(const std::string& spec) {
   Change c;
   const std::size_t eq = spec.find('=');
@@ -39,8 +41,12 @@ Change parse_change(const std::string& spec) {
   const std::size_t at = spec.find('@', eq);
   const std::string value = spec.substr(eq + 1, at == std::string::npos ? std::string::npos : at - eq - 1);
   char* end = nullptr;
-  c.value = std::strtof(value.c_str(), &end);
-  if (end == value.c_str() || *end) throw UsageError("bad value in '" + spec + "'");
+  if (value == "min" || value == "max" || value == "default") {
+    c.bound = value;
+  } else {
+    c.value = std::strtof(value.c_str(), &end);
+    if (end == value.c_str() || *end) throw UsageError("bad value in '" + spec + "'");
+  }
   if (at != std::string::npos) {
     std::stringstream region(spec.substr(at + 1));
     std::string item;
@@ -71,8 +77,15 @@ std::size_t apply(const Model& model, Avatar& avatar, const ObjMesh& neutral, co
   std::size_t covered = 0;
   std::vector<std::int32_t> tri(3 * model.info.skin_triangle_count);
   check(softdeca_model_get_skin_triangles(model.handle, tri.data(), model.info.skin_triangle_count), "skin triangles");
-  for (const Change& c : changes) {
+  for (Change c : changes) {
     const int index = model.parameter(c.name);
+    if (!c.bound.empty()) {
+      softdeca_parameter_info info{};
+      info.struct_size = sizeof info;
+      check(softdeca_model_get_parameter(model.handle, static_cast<uint32_t>(index), &info), "parameter " + c.name);
+      c.value = static_cast<float>(c.bound == "min" ? info.lo : c.bound == "max" ? info.hi : info.default_value);
+      std::fprintf(stderr, "%s=%s: %g\n", c.name.c_str(), c.bound.c_str(), static_cast<double>(c.value));
+    }
     if (!c.region) {
       check(softdeca_avatar_set_parameter(avatar.handle, static_cast<uint32_t>(index), c.value), "setting " + c.name);
       continue;
@@ -143,9 +156,10 @@ int run_replay(const Args& args) {
       .option("--seed", "N", "instead of --avatar: the ICT identity of this seed, written to <out>/avatar by the Python helper")
       .option("--out", "DIR", "output folder", "out/replay")
       .option("--models", "LIST", "comma-separated: linear, softdeca, sparse", "linear,softdeca,sparse")
-      .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated")
+      .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated (value: a number, min, max or default)")
       .option("--localised", "SPEC", "an extra SoftDECA pass with this change 'name=value@x,y,z,r' on top of --set")
-      .option("--frames", "N", "at most N frames of the take (0: all)", "0")
+      .option("--start", "N", "skip the take's first N frames", "0")
+      .option("--frames", "N", "at most N frames of the take after --start (0: all)", "0")
       .option("--threads", "N", "threads per frame (1 or 2)", "1")
       .option("--precision", "P", "hyper-tensor storage: half, float or int8", "half")
       .option("--obj-every", "N", "also write every Nth frame as OBJ (0: none)", "0")
@@ -160,9 +174,14 @@ int run_replay(const Args& args) {
   const unsigned precision = precision_of(o.text("--precision"));
   const long obj_every = o.integer("--obj-every");
 
-  const Take take = read_take(o.arg(0), static_cast<std::size_t>(o.integer("--frames")));
-  std::fprintf(stderr, "take %s: %zu rows, %zu frames, %zu face-lost rows skipped, %zu unreadable\n", take.path.c_str(),
-               take.rows, take.weights.size(), take.face_lost, take.invalid);
+  const long start = o.integer("--start"), max_frames = o.integer("--frames");
+  if (start < 0 || max_frames < 0) throw UsageError("--start and --frames must not be negative");
+  Take take = read_take(o.arg(0), max_frames ? static_cast<std::size_t>(start + max_frames) : 0);
+  if (static_cast<std::size_t>(start) >= take.weights.size())
+    throw UsageError("--start " + std::to_string(start) + " is past the take's " + std::to_string(take.weights.size()) + " frames");
+  take.weights.erase(take.weights.begin(), take.weights.begin() + start);
+  std::fprintf(stderr, "take %s: %zu rows, %zu face-lost rows skipped, %zu unreadable; frames %ld to %zu\n", take.path.c_str(),
+               take.rows, take.face_lost, take.invalid, start, static_cast<std::size_t>(start) + take.weights.size() - 1);
   std::string avatar_dir = o.text("--avatar");
   if (o.given("--seed")) {
     avatar_dir = out + "/avatar";
@@ -256,6 +275,7 @@ int run_replay(const Args& args) {
   JsonObject summary;
   summary.text("take", take.path)
       .number("take_rows", static_cast<double>(take.rows))
+      .number("first_frame", static_cast<double>(start))
       .number("frames", static_cast<double>(take.weights.size()))
       .number("face_lost_rows_skipped", static_cast<double>(take.face_lost))
       .number("unreadable_rows_skipped", static_cast<double>(take.invalid))

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include "runtime/manifest.h"
+#include "stream/arkit_names.h"
 
 namespace softdeca::cli {
 
@@ -83,7 +83,7 @@ FaceRig read_rig(const std::string& dir, bool optional) {
   const std::size_t n = rig.neutral.vertices.size();
   rig.deltas.assign(52 * n, 0.0f);
   for (std::size_t s = 0; s < 52; ++s) {
-    const std::string path = dir + "/blendshapes/" + runtime::kArkitBlendshapes[s] + ".obj";
+    const std::string path = dir + "/blendshapes/" + stream::blendshape_name(s) + ".obj";
     if (!file_exists(path)) continue;
     const ObjMesh shape = read_obj(path);
     if (shape.vertices.size() != n) throw std::runtime_error(path + ": vertex count differs from the neutral");

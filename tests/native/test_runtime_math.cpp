@@ -139,12 +139,16 @@ TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
   for (double w : want) scale = std::max(scale, std::fabs(w));
   for (const Precision p : {Precision::Float, Precision::Half, Precision::Int8}) {
     const HyperTensor tensor(L.data(), nf, K, 9, p);
-    std::vector<float> got(3 * g.n, 0.0f);
-    const std::size_t half = tensor.blocks() / 2;  // two ranges, as two threads would do
-    dg_rhs(tensor, dt.faces(), z.data(), skin.data(), 0, half, got.data());
-    dg_rhs(tensor, dt.faces(), z.data(), skin.data(), half, tensor.blocks(), got.data());
-    const double tol = p == Precision::Float ? 1e-5 : p == Precision::Half ? 2e-3 : 2e-2;
-    for (std::size_t i = 0; i < got.size(); ++i) EXPECT_NEAR(got[i], want[i], tol * scale) << static_cast<int>(p);
+    for (const Kernel kernel : {Kernel::Best, Kernel::Portable, Kernel::Avx2, Kernel::Avx512Vnni}) {
+      if (!kernel_available(kernel)) continue;
+      std::vector<float> got(3 * g.n, 0.0f);
+      const std::size_t half = tensor.blocks() / 2;  // two ranges, as two threads would do
+      dg_rhs(tensor, dt.faces(), z.data(), skin.data(), 0, half, got.data(), kernel);
+      dg_rhs(tensor, dt.faces(), z.data(), skin.data(), half, tensor.blocks(), got.data(), kernel);
+      const double tol = p == Precision::Float ? 1e-5 : p == Precision::Half ? 2e-3 : 2e-2;
+      for (std::size_t i = 0; i < got.size(); ++i)
+        EXPECT_NEAR(got[i], want[i], tol * scale) << "precision " << static_cast<int>(p) << " kernel " << static_cast<int>(kernel);
+    }
     // Stored values read back within the precision's step.
     for (std::size_t f = 0; f < nf; f += 5)
       for (int k = 0; k < K; k += 3)
@@ -154,22 +158,37 @@ TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
 
 TEST(HyperTensor, VertexOffsetsMatchTheDirectProduct) {
   const std::size_t n = 29;  // not a multiple of the block size
-  const int K = 32;
-  std::mt19937 rng(5);
-  std::normal_distribution<float> nd;
-  std::vector<float> L(n * K * 3), z(K), base(3 * n), out(3 * n + 3, -7.0f);
-  for (auto& x : L) x = 0.001f * nd(rng);
-  for (auto& x : z) x = nd(rng);
-  for (auto& x : base) x = nd(rng);
-  const HyperTensor t(L.data(), n, K, 3, Precision::Float);
-  vertex_offsets(t, z.data(), base.data(), 0, t.blocks(), out.data());
-  for (std::size_t v = 0; v < n; ++v)
-    for (int c = 0; c < 3; ++c) {
-      double want = base[3 * v + c];
-      for (int k = 0; k < K; ++k) want += double(z[k]) * L[(v * K + k) * 3 + c];
-      EXPECT_NEAR(out[3 * v + c], want, 1e-5);
+  for (const int K : {32, 7}) {  // 7: int8 pads the latents to pairs
+    std::mt19937 rng(5);
+    std::normal_distribution<float> nd;
+    std::vector<float> L(n * K * 3), z(K), base(3 * n);
+    for (auto& x : L) x = 0.001f * nd(rng);
+    for (auto& x : z) x = nd(rng);
+    for (auto& x : base) x = nd(rng);
+    for (const auto& [p, kernel] : std::vector<std::pair<Precision, Kernel>>{
+             {Precision::Float, Kernel::Avx2}, {Precision::Float, Kernel::Portable}, {Precision::Half, Kernel::Avx2},
+             {Precision::Half, Kernel::Portable}, {Precision::Int8, Kernel::Avx2}, {Precision::Int8, Kernel::Avx512Vnni},
+             {Precision::Int8, Kernel::Portable}}) {
+      if (!kernel_available(kernel)) continue;
+      std::vector<float> out(3 * n + 3, -7.0f);
+      const HyperTensor t(L.data(), n, K, 3, p);
+      vertex_offsets(t, z.data(), base.data(), 0, t.blocks(), out.data(), kernel);
+      // Tolerance: float rounding; half's 2^-11 and int8's 1/254 of each term, summed.
+      const double step = p == Precision::Float ? 1e-6 : p == Precision::Half ? 1e-3 : 8e-3;
+      for (std::size_t v = 0; v < n; ++v)
+        for (int c = 0; c < 3; ++c) {
+          double want = base[3 * v + c], size = 0;
+          for (int k = 0; k < K; ++k) {
+            want += double(z[k]) * L[(v * K + k) * 3 + c];
+            size += std::fabs(double(z[k])) * 0.004;  // |L| < 4 sigma
+          }
+          EXPECT_NEAR(out[3 * v + c], want, 1e-6 + step * size)
+              << "K " << K << " precision " << static_cast<int>(p) << " kernel " << static_cast<int>(kernel);
+          EXPECT_NEAR(t.at(v, K - 1, c), L[(v * K + K - 1) * 3 + c], p == Precision::Float ? 0.0 : 0.004 / 100);
+        }
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(out[3 * n + c], -7.0f) << "wrote past the last vertex";
     }
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[3 * n + c], -7.0f) << "wrote past the last vertex";
+  }
 }
 
 TEST(SparseLdlt, RefusesAMatrixThatIsNotPositiveDefinite) {

@@ -238,7 +238,7 @@ void Avatar::read_weights(const float* weights, std::size_t count) {
   require_finite(weights, count, "weights");
   for (std::size_t i = 0; i < count; ++i) {
     expect(weights[i] >= -kWeightSlack && weights[i] <= 1 + kWeightSlack, [&] {
-      return "weights[" + std::to_string(i) + "] (" + kArkitBlendshapes[i] + ") = " + std::to_string(weights[i]) +
+      return "weights[" + std::to_string(i) + "] (" + stream::blendshape_name(i) + ") = " + std::to_string(weights[i]) +
              " is outside [0, 1]";
     });
     weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));

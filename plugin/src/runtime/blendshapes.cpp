@@ -1,5 +1,6 @@
 #include "runtime/blendshapes.h"
 
+#include <algorithm>
 #include <cstring>
 
 namespace softdeca::runtime {
@@ -8,6 +9,7 @@ Blendshapes::Blendshapes(const float* deltas, std::size_t n_shapes, std::size_t 
   part_vertex_.resize(parts + 1);
   for (std::size_t p = 0; p <= parts; ++p) part_vertex_[p] = n_vertices * p / parts;
   shapes_.resize(n_shapes);
+  std::vector<float> deltas_stored;
   for (std::size_t s = 0; s < n_shapes; ++s) {
     Shape& sh = shapes_[s];
     const float* d = deltas + s * n_vertices * 3;
@@ -28,25 +30,25 @@ Blendshapes::Blendshapes(const float* deltas, std::size_t n_shapes, std::size_t 
           ++probe;
         }
         sh.runs.push_back({static_cast<std::uint32_t>(v), static_cast<std::uint32_t>(last - v + 1),
-                           static_cast<std::uint32_t>(sh.delta.size())});
-        sh.delta.insert(sh.delta.end(), d + 3 * v, d + 3 * (last + 1));
+                           static_cast<std::uint32_t>(deltas_stored.size())});
+        deltas_stored.insert(deltas_stored.end(), d + 3 * v, d + 3 * (last + 1));
         v = last + 1;
       }
       sh.part_begin.push_back(sh.runs.size());
     }
   }
+  deltas_.resize(deltas_stored.size());
+  std::copy(deltas_stored.begin(), deltas_stored.end(), deltas_.data());
 }
 
 std::size_t Blendshapes::bytes() const {
-  std::size_t b = 0;
-  for (const Shape& s : shapes_) b += s.runs.size() * sizeof(Run) + s.delta.size() * 4 + s.part_begin.size() * sizeof(std::size_t);
+  std::size_t b = deltas_.allocated_bytes();
+  for (const Shape& s : shapes_) b += s.runs.size() * sizeof(Run) + s.part_begin.size() * sizeof(std::size_t);
   return b;
 }
 
 std::size_t Blendshapes::stored_vertices() const {
-  std::size_t n = 0;
-  for (const Shape& s : shapes_) n += s.delta.size() / 3;
-  return n;
+  return deltas_.size() / 3;
 }
 
 void Blendshapes::blend(const float* weights, const float* neutral, float* out, std::size_t part) const {
@@ -59,7 +61,7 @@ void Blendshapes::blend(const float* weights, const float* neutral, float* out, 
     for (std::size_t r = sh.part_begin[part]; r < sh.part_begin[part + 1]; ++r) {
       const Run& run = sh.runs[r];
       float* o = out + 3 * static_cast<std::size_t>(run.first_vertex);
-      const float* d = sh.delta.data() + run.offset;
+      const float* d = deltas_.data() + run.offset;
       const std::size_t n = 3 * static_cast<std::size_t>(run.count);
       for (std::size_t i = 0; i < n; ++i) o[i] += w * d[i];  // contiguous: the compiler vectorises
     }

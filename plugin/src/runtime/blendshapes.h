@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "runtime/aligned.h"
+
 namespace softdeca::runtime {
 
 class Blendshapes {
@@ -28,14 +30,14 @@ class Blendshapes {
 
  private:
   struct Run {
-    std::uint32_t first_vertex, count, offset;  // offset: first float in Shape::delta
+    std::uint32_t first_vertex, count, offset;  // offset: first float in deltas_
   };
   struct Shape {
     std::vector<Run> runs;
-    std::vector<float> delta;
     std::vector<std::size_t> part_begin;  // first run of each part, plus the end
   };
   std::vector<Shape> shapes_;
+  AlignedArray<float> deltas_;  // every shape's runs, one after the other (one huge-page stream)
   std::vector<std::size_t> part_vertex_;  // vertex range bounds, parts + 1
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "runtime/half.h"
 
@@ -14,14 +15,14 @@ namespace softdeca::runtime {
 
 HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision)
     : n_(n), latent_(latent), width_(width), precision_(precision) {
-  const std::size_t stride = block_stride(), total = blocks() * stride;
+  const std::size_t total = blocks() * block_stride();
   const auto source_at = [&](std::size_t e, int k, int c) {
     return source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
                   static_cast<std::size_t>(c)];
   };
   if (precision == Precision::Int8) {
     // One scale per block and latent: the largest magnitude of its width x 8 values maps to 127.
-    int8_.resize(total);
+    int8_.resize(total);  // zero: the padding latent and lanes past the last element
     scales_.resize(blocks() * static_cast<std::size_t>(latent));
     for (std::size_t b = 0; b < blocks(); ++b)
       for (int k = 0; k < latent; ++k) {
@@ -32,8 +33,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
         scales_[b * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)] = scale;
         for (std::size_t e = b * kLanes; e < std::min(n, (b + 1) * kLanes); ++e)
           for (int c = 0; c < width; ++c)
-            int8_[b * stride + (static_cast<std::size_t>(k) * width + c) * kLanes + e % kLanes] =
-                static_cast<std::int8_t>(std::lround(source_at(e, k, c) / scale));
+            int8_[index(b, k, c, e % kLanes)] = static_cast<std::int8_t>(std::lround(source_at(e, k, c) / scale));
       }
     return;
   }
@@ -45,7 +45,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
       for (int c = 0; c < width; ++c) {
         const float v = source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
                                static_cast<std::size_t>(c)];
-        const std::size_t at = b * stride + (static_cast<std::size_t>(k) * width + c) * kLanes + lane;
+        const std::size_t at = index(b, k, c, lane);
         if (precision == Precision::Half) half_[at] = float_to_half(v);
         else float_[at] = v;
       }
@@ -53,7 +53,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
 }
 
 float HyperTensor::at(std::size_t e, int k, int c) const {
-  const std::size_t i = (e / kLanes) * block_stride() + (static_cast<std::size_t>(k) * width_ + c) * kLanes + e % kLanes;
+  const std::size_t i = index(e / kLanes, k, c, e % kLanes);
   switch (precision_) {
     case Precision::Half: return half_to_float(half_[i]);
     case Precision::Float: return float_[i];
@@ -64,30 +64,55 @@ float HyperTensor::at(std::size_t e, int k, int c) const {
 
 namespace {
 
-// Value of the stored tensor at flat index `at` of block b, latent k, in float.
-auto portable_load(const HyperTensor& L) {
-  return [&L](std::size_t b, int k, std::size_t at) -> float {
-    switch (L.precision()) {
-      case Precision::Half: return half_to_float(L.half_data()[at]);
-      case Precision::Float: return L.float_data()[at];
-      case Precision::Int8: return L.int8_data()[at] * L.scales()[b * static_cast<std::size_t>(L.latent()) + static_cast<std::size_t>(k)];
-    }
-    return 0.0f;
-  };
-}
+// The SIMD int8 kernels sum int16 x int8 products in int32: |sum| <= K * 32767 * 127 < 2^31 up
+// to this many latents (more run the portable kernel).
+constexpr int kMaxInt8Latent = 256;
 
 // ---- portable kernels -----------------------------------------------------------------------
 
-template <class Load>
-void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
-                     std::size_t b1, float* rhs, Load load) {
+// d[c][lane] = sum_k z_k L[b, k, c] (c < W), the storage's branch taken once per block and the
+// inner loops over the 8 lanes left to the compiler's vectoriser (NEON, SSE2).
+template <int W>
+void contract_portable(const HyperTensor& L, const float* z, std::size_t b, float (*d)[kLanes]) {
+  for (int c = 0; c < W; ++c)
+    for (std::size_t l = 0; l < kLanes; ++l) d[c][l] = 0.0f;
   const int K = L.latent();
+  const std::size_t base = b * L.block_stride();
+  switch (L.precision()) {
+    case Precision::Float:
+    case Precision::Half: {
+      const bool half = L.precision() == Precision::Half;
+      for (int k = 0; k < K; ++k) {
+        const float zk = z[k];
+        const std::size_t at = base + static_cast<std::size_t>(k) * W * kLanes;
+        for (int c = 0; c < W; ++c) {
+          const std::size_t row = at + static_cast<std::size_t>(c) * kLanes;
+          if (half)
+            for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += zk * half_to_float(L.half_data()[row + l]);
+          else
+            for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += zk * L.float_data()[row + l];
+        }
+      }
+      break;
+    }
+    case Precision::Int8: {
+      const float* s = L.scales() + b * static_cast<std::size_t>(K);
+      for (int k = 0; k < K; ++k) {
+        const float zk = z[k] * s[k];
+        const std::int8_t* q = L.int8_data() + base + static_cast<std::size_t>(k / 2) * W * 2 * kLanes + static_cast<std::size_t>(k % 2);
+        for (int c = 0; c < W; ++c)
+          for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += zk * static_cast<float>(q[(static_cast<std::size_t>(c) * kLanes + l) * 2]);
+      }
+      break;
+    }
+  }
+}
+
+void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
+                     std::size_t b1, float* rhs) {
   for (std::size_t b = b0; b < b1; ++b) {
-    float d[9][kLanes] = {};
-    const std::size_t base = b * L.block_stride();
-    for (int k = 0; k < K; ++k)
-      for (int c = 0; c < 9; ++c)
-        for (std::size_t l = 0; l < kLanes; ++l) d[c][l] += z[k] * load(b, k, base + (static_cast<std::size_t>(k) * 9 + c) * kLanes + l);
+    float d[9][kLanes];
+    contract_portable<9>(L, z, b, d);
     const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
     const float* cf = faces.coeff.data() + b * 3 * kLanes;
     for (std::size_t l = 0; l < kLanes; ++l) {
@@ -111,16 +136,11 @@ void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float*
   }
 }
 
-template <class Load>
 void vertex_offsets_portable(const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0, std::size_t b1,
-                             float* out, Load load) {
-  const int K = L.latent();
+                             float* out) {
   for (std::size_t b = b0; b < b1; ++b) {
-    float acc[3][kLanes] = {};
-    const std::size_t base = b * L.block_stride();
-    for (int k = 0; k < K; ++k)
-      for (int c = 0; c < 3; ++c)
-        for (std::size_t l = 0; l < kLanes; ++l) acc[c][l] += z[k] * load(b, k, base + (static_cast<std::size_t>(k) * 3 + c) * kLanes + l);
+    float acc[3][kLanes];
+    contract_portable<3>(L, z, b, acc);
     const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
     for (std::size_t l = 0; l < end; ++l)
       for (int c = 0; c < 3; ++c) {
@@ -137,106 +157,203 @@ template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) inline __m256 load8(const HyperTensor& L, std::size_t at) {
   if constexpr (P == Precision::Half)
     return _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(L.half_data() + at)));
-  else if constexpr (P == Precision::Int8)
-    return _mm256_cvtepi32_ps(_mm256_cvtepi8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(L.int8_data() + at))));
   else
     return _mm256_loadu_ps(L.float_data() + at);
 }
 
-// z_k, times the block's scale for int8 storage.
-template <Precision P>
-__attribute__((target("avx2,fma,f16c"))) inline __m256 coefficient(const HyperTensor& L, const float* z, std::size_t b, int k) {
-  if constexpr (P == Precision::Int8)
-    return _mm256_set1_ps(z[k] * L.scales()[b * static_cast<std::size_t>(L.latent()) + static_cast<std::size_t>(k)]);
-  else
-    return _mm256_set1_ps(z[k]);
+// out[c] (8 lanes) = sum_k z_k L[b, k, c] for c < W, half or float storage.
+template <Precision P, int W>
+__attribute__((target("avx2,fma,f16c"))) inline void contract(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  const int K = L.latent();
+  const std::size_t base = b * L.block_stride();
+  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
+  for (int k = 0; k < K; ++k) {
+    const __m256 zk = _mm256_set1_ps(z[k]);
+    const std::size_t at = base + static_cast<std::size_t>(k) * W * kLanes;
+#pragma GCC unroll 9
+    for (int c = 0; c < W; ++c) out[c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), out[c]);
+  }
+}
+
+// The same for int8 storage: the block's coefficients z_k s_{b,k} are quantised to int16 with
+// one step t = max_k |z_k s_{b,k}| / 32767 (a relative error of 1.5e-5 of the largest term,
+// negligible next to the int8 values' 1/254), multiplied with the int8 values two latents at a
+// time by pmaddwd and summed exactly in int32 (kMaxInt8Latent), then scaled by t.
+
+// z_k s_{b,k} of block b as int16 (zq, padded with zeros to an even count); returns the step
+// t (0 when every coefficient is zero).
+__attribute__((target("avx2,fma"))) inline float quantise_coefficients(const HyperTensor& L, const float* z, std::size_t b,
+                                                                     std::int16_t* zq) {
+  const int K = L.latent(), K16 = (K + 15) / 16 * 16;
+  const float* s = L.scales() + b * static_cast<std::size_t>(K);
+  alignas(32) float zs[kMaxInt8Latent];
+  for (int k = 0; k < K; ++k) zs[k] = z[k] * s[k];
+  for (int k = K; k < K16; ++k) zs[k] = 0.0f;
+  const __m256 sign = _mm256_set1_ps(-0.0f);
+  __m256 peak8 = _mm256_setzero_ps();
+  for (int k = 0; k < K16; k += 8) peak8 = _mm256_max_ps(peak8, _mm256_andnot_ps(sign, _mm256_load_ps(zs + k)));
+  __m128 peak4 = _mm_max_ps(_mm256_castps256_ps128(peak8), _mm256_extractf128_ps(peak8, 1));
+  peak4 = _mm_max_ps(peak4, _mm_movehl_ps(peak4, peak4));
+  peak4 = _mm_max_ss(peak4, _mm_shuffle_ps(peak4, peak4, 1));
+  const float peak = _mm_cvtss_f32(peak4);
+  if (!(peak > 0.0f)) return 0.0f;
+  const __m256 inv = _mm256_set1_ps(32767.0f / peak);
+  for (int k = 0; k < K16; k += 16) {
+    const __m256i a = _mm256_cvtps_epi32(_mm256_mul_ps(_mm256_load_ps(zs + k), inv));
+    const __m256i c = _mm256_cvtps_epi32(_mm256_mul_ps(_mm256_load_ps(zs + k + 8), inv));
+    // packs works per 128-bit half: (a0-3, c0-3 | a4-7, c4-7); restore the order.
+    _mm256_store_si256(reinterpret_cast<__m256i*>(zq + k), _mm256_permute4x64_epi64(_mm256_packs_epi32(a, c), 0xD8));
+  }
+  return peak / 32767.0f;
+}
+
+template <int W>
+__attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  alignas(32) std::int16_t zq[kMaxInt8Latent];
+  const float t = quantise_coefficients(L, z, b, zq);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
+  if (t == 0.0f) return;
+  __m256i acc[W];
+  for (int c = 0; c < W; ++c) acc[c] = _mm256_setzero_si256();
+  const std::int8_t* q = L.int8_data() + b * L.block_stride();
+  const int pairs = (L.latent() + 1) / 2;
+  for (int p = 0; p < pairs; ++p) {
+    std::int32_t pair;
+    std::memcpy(&pair, zq + 2 * p, sizeof pair);
+    const __m256i zp = _mm256_set1_epi32(pair);
+    const std::int8_t* qp = q + static_cast<std::size_t>(p) * W * 2 * kLanes;
+#pragma GCC unroll 9
+    for (int c = 0; c < W; ++c) {
+      const __m256i v = _mm256_cvtepi8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qp + c * 2 * kLanes)));
+      acc[c] = _mm256_add_epi32(acc[c], _mm256_madd_epi16(v, zp));
+    }
+  }
+  const __m256 step = _mm256_set1_ps(t);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), step);
+}
+
+// The same with AVX-512 VNNI's vpdpwssd (multiply, pair-sum and accumulate in one instruction).
+template <int W>
+__attribute__((target("avx2,fma,avx512f,avx512vl,avx512vnni"))) inline void contract_int8_vnni(const HyperTensor& L, const float* z,
+                                                                                             std::size_t b, __m256* out) {
+  alignas(32) std::int16_t zq[kMaxInt8Latent];
+  const float t = quantise_coefficients(L, z, b, zq);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
+  if (t == 0.0f) return;
+  __m256i acc[W];
+  for (int c = 0; c < W; ++c) acc[c] = _mm256_setzero_si256();
+  const std::int8_t* q = L.int8_data() + b * L.block_stride();
+  const int pairs = (L.latent() + 1) / 2;
+  for (int p = 0; p < pairs; ++p) {
+    std::int32_t pair;
+    std::memcpy(&pair, zq + 2 * p, sizeof pair);
+    const __m256i zp = _mm256_set1_epi32(pair);
+    const std::int8_t* qp = q + static_cast<std::size_t>(p) * W * 2 * kLanes;
+#pragma GCC unroll 9
+    for (int c = 0; c < W; ++c)
+      acc[c] = _mm256_dpwssd_epi32(acc[c], _mm256_cvtepi8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qp + c * 2 * kLanes))), zp);
+  }
+  const __m256 step = _mm256_set1_ps(t);
+  for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), step);
+}
+
+template <Precision P, int W>
+__attribute__((target("avx2,fma,f16c"))) inline void contract_any(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  if constexpr (P == Precision::Int8) contract_int8<W>(L, z, b, out);
+  else contract<P, W>(L, z, b, out);
+}
+
+// rhs += the right-hand side of the 8 faces of block b, given their G_f - I (d, row-major 3x3).
+__attribute__((target("avx2,fma"))) inline void accumulate_rhs(const __m256* d, const FaceBlocks& faces, std::size_t b,
+                                                              const float* skin, float* rhs) {
+  const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
+  // Edge vectors of the 8 faces, transposed to one lane per face (scalar loads: AVX2 gathers
+  // are slow on several CPUs and these vertices are in cache).
+  alignas(32) float edge[6][kLanes];
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    const float* si = skin + 3 * static_cast<std::size_t>(idx[l]);
+    const float* sj = skin + 3 * static_cast<std::size_t>(idx[kLanes + l]);
+    const float* sk = skin + 3 * static_cast<std::size_t>(idx[2 * kLanes + l]);
+    for (int c = 0; c < 3; ++c) {
+      edge[c][l] = sj[c] - si[c];
+      edge[3 + c][l] = sk[c] - si[c];
+    }
+  }
+  const __m256 e1[3] = {_mm256_load_ps(edge[0]), _mm256_load_ps(edge[1]), _mm256_load_ps(edge[2])};
+  const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
+  const float* cf = faces.coeff.data() + b * 3 * kLanes;
+  const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
+  alignas(32) float col[6][kLanes];
+  for (int r = 0; r < 3; ++r) {
+    const __m256* row = d + 3 * r;
+    const __m256 p0 = _mm256_fmadd_ps(row[2], e1[2], _mm256_fmadd_ps(row[1], e1[1], _mm256_mul_ps(row[0], e1[0])));
+    const __m256 p1 = _mm256_fmadd_ps(row[2], e2[2], _mm256_fmadd_ps(row[1], e2[1], _mm256_mul_ps(row[0], e2[0])));
+    _mm256_store_ps(col[r], _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00)));
+    _mm256_store_ps(col[3 + r], _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01)));
+  }
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    float* ri = rhs + static_cast<std::size_t>(idx[l]) * 3;
+    float* rj = rhs + static_cast<std::size_t>(idx[kLanes + l]) * 3;
+    float* rk = rhs + static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
+    for (int r = 0; r < 3; ++r) {
+      rj[r] += col[r][l];
+      rk[r] += col[3 + r][l];
+      ri[r] -= col[r][l] + col[3 + r][l];
+    }
+  }
+}
+
+// out[v] = base[v] + the 8 lanes of a (3 components), for the elements of block b that exist.
+__attribute__((target("avx2"))) inline void write_offsets(const __m256* a, const HyperTensor& L, std::size_t b, const float* base_pos,
+                                                        float* out) {
+  alignas(32) float acc[3][kLanes];
+  for (int c = 0; c < 3; ++c) _mm256_store_ps(acc[c], a[c]);
+  const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
+  for (std::size_t l = 0; l < end; ++l) {
+    const std::size_t v = (b * kLanes + l) * 3;
+    out[v] = base_pos[v] + acc[0][l];
+    out[v + 1] = base_pos[v + 1] + acc[1][l];
+    out[v + 2] = base_pos[v + 2] + acc[2][l];
+  }
 }
 
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, const FaceBlocks& faces, const float* z,
                                                          const float* skin, std::size_t b0, std::size_t b1, float* rhs) {
-  const int K = L.latent();
-  const std::size_t stride = L.block_stride();
-  alignas(32) float col[6][kLanes];
   for (std::size_t b = b0; b < b1; ++b) {
-    const std::size_t base = b * stride;
-    __m256 d0 = _mm256_setzero_ps(), d1 = d0, d2 = d0, d3 = d0, d4 = d0, d5 = d0, d6 = d0, d7 = d0, d8 = d0;
-    for (int k = 0; k < K; ++k) {
-      const __m256 zk = coefficient<P>(L, z, b, k);
-      const std::size_t at = base + static_cast<std::size_t>(k) * 9 * kLanes;
-      d0 = _mm256_fmadd_ps(zk, load8<P>(L, at), d0);
-      d1 = _mm256_fmadd_ps(zk, load8<P>(L, at + 8), d1);
-      d2 = _mm256_fmadd_ps(zk, load8<P>(L, at + 16), d2);
-      d3 = _mm256_fmadd_ps(zk, load8<P>(L, at + 24), d3);
-      d4 = _mm256_fmadd_ps(zk, load8<P>(L, at + 32), d4);
-      d5 = _mm256_fmadd_ps(zk, load8<P>(L, at + 40), d5);
-      d6 = _mm256_fmadd_ps(zk, load8<P>(L, at + 48), d6);
-      d7 = _mm256_fmadd_ps(zk, load8<P>(L, at + 56), d7);
-      d8 = _mm256_fmadd_ps(zk, load8<P>(L, at + 64), d8);
-    }
-    const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
-    // Edge vectors of the 8 faces, transposed to one lane per face (scalar loads: AVX2 gathers
-    // are slow on several CPUs and these vertices are in cache).
-    alignas(32) float edge[6][kLanes];
-    for (std::size_t l = 0; l < kLanes; ++l) {
-      const float* si = skin + 3 * static_cast<std::size_t>(idx[l]);
-      const float* sj = skin + 3 * static_cast<std::size_t>(idx[kLanes + l]);
-      const float* sk = skin + 3 * static_cast<std::size_t>(idx[2 * kLanes + l]);
-      for (int c = 0; c < 3; ++c) {
-        edge[c][l] = sj[c] - si[c];
-        edge[3 + c][l] = sk[c] - si[c];
-      }
-    }
-    const __m256 e1[3] = {_mm256_load_ps(edge[0]), _mm256_load_ps(edge[1]), _mm256_load_ps(edge[2])};
-    const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
-    const float* cf = faces.coeff.data() + b * 3 * kLanes;
-    const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
-    const __m256 rows[3][3] = {{d0, d1, d2}, {d3, d4, d5}, {d6, d7, d8}};
-    for (int r = 0; r < 3; ++r) {
-      const __m256 p0 = _mm256_fmadd_ps(rows[r][2], e1[2], _mm256_fmadd_ps(rows[r][1], e1[1], _mm256_mul_ps(rows[r][0], e1[0])));
-      const __m256 p1 = _mm256_fmadd_ps(rows[r][2], e2[2], _mm256_fmadd_ps(rows[r][1], e2[1], _mm256_mul_ps(rows[r][0], e2[0])));
-      _mm256_store_ps(col[r], _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00)));
-      _mm256_store_ps(col[3 + r], _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01)));
-    }
-    for (std::size_t l = 0; l < kLanes; ++l) {
-      float* ri = rhs + static_cast<std::size_t>(idx[l]) * 3;
-      float* rj = rhs + static_cast<std::size_t>(idx[kLanes + l]) * 3;
-      float* rk = rhs + static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
-      for (int r = 0; r < 3; ++r) {
-        rj[r] += col[r][l];
-        rk[r] += col[3 + r][l];
-        ri[r] -= col[r][l] + col[3 + r][l];
-      }
-    }
+    __m256 d[9];
+    contract_any<P, 9>(L, z, b, d);
+    accumulate_rhs(d, faces, b, skin, rhs);
+  }
+}
+
+__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"))) void dg_rhs_vnni(const HyperTensor& L, const FaceBlocks& faces,
+                                                                                    const float* z, const float* skin,
+                                                                                    std::size_t b0, std::size_t b1, float* rhs) {
+  for (std::size_t b = b0; b < b1; ++b) {
+    __m256 d[9];
+    contract_int8_vnni<9>(L, z, b, d);
+    accumulate_rhs(d, faces, b, skin, rhs);
   }
 }
 
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void vertex_offsets_avx2(const HyperTensor& L, const float* z, const float* base_pos,
                                                                  std::size_t b0, std::size_t b1, float* out) {
-  const int K = L.latent();
-  const std::size_t stride = L.block_stride();
-  alignas(32) float acc[3][kLanes];
   for (std::size_t b = b0; b < b1; ++b) {
-    const std::size_t base = b * stride;
-    __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0;
-    for (int k = 0; k < K; ++k) {
-      const __m256 zk = coefficient<P>(L, z, b, k);
-      const std::size_t at = base + static_cast<std::size_t>(k) * 3 * kLanes;
-      a0 = _mm256_fmadd_ps(zk, load8<P>(L, at), a0);
-      a1 = _mm256_fmadd_ps(zk, load8<P>(L, at + 8), a1);
-      a2 = _mm256_fmadd_ps(zk, load8<P>(L, at + 16), a2);
-    }
-    _mm256_store_ps(acc[0], a0);
-    _mm256_store_ps(acc[1], a1);
-    _mm256_store_ps(acc[2], a2);
-    const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
-    for (std::size_t l = 0; l < end; ++l) {
-      const std::size_t v = (b * kLanes + l) * 3;
-      out[v] = base_pos[v] + acc[0][l];
-      out[v + 1] = base_pos[v + 1] + acc[1][l];
-      out[v + 2] = base_pos[v + 2] + acc[2][l];
-    }
+    __m256 a[3];
+    contract_any<P, 3>(L, z, b, a);
+    write_offsets(a, L, b, base_pos, out);
+  }
+}
+
+__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"))) void vertex_offsets_vnni(const HyperTensor& L, const float* z,
+                                                                                            const float* base_pos, std::size_t b0,
+                                                                                            std::size_t b1, float* out) {
+  for (std::size_t b = b0; b < b1; ++b) {
+    __m256 a[3];
+    contract_int8_vnni<3>(L, z, b, a);
+    write_offsets(a, L, b, base_pos, out);
   }
 }
 
@@ -244,45 +361,74 @@ bool cpu_has_avx2() {
   static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
   return has;
 }
+bool cpu_has_vnni() {
+  static const bool has = cpu_has_avx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512vnni");
+  return has;
+}
 #endif
+
+// The kernel that runs: the one asked for, or (Best) the fastest this CPU has for L.
+Kernel resolve(Kernel k, const HyperTensor& L) {
+  const bool int8_ok = L.precision() != Precision::Int8 || L.latent() <= kMaxInt8Latent;
+  if (k == Kernel::Best) {
+    if (kernel_available(Kernel::Avx512Vnni) && L.precision() == Precision::Int8 && int8_ok) return Kernel::Avx512Vnni;
+    if (kernel_available(Kernel::Avx2) && int8_ok) return Kernel::Avx2;
+    return Kernel::Portable;
+  }
+  if (!kernel_available(k) || !int8_ok || (k == Kernel::Avx512Vnni && L.precision() != Precision::Int8)) return Kernel::Portable;
+  return k;
+}
 
 }  // namespace
 
-bool simd_kernels() {
+bool kernel_available(Kernel k) {
+  switch (k) {
+    case Kernel::Best:
+    case Kernel::Portable: return true;
 #ifdef SOFTDECA_X86
-  return cpu_has_avx2();
+    case Kernel::Avx2: return cpu_has_avx2();
+    case Kernel::Avx512Vnni: return cpu_has_vnni();
 #else
-  return false;
+    case Kernel::Avx2:
+    case Kernel::Avx512Vnni: return false;
 #endif
+  }
+  return false;
 }
 
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0, std::size_t b1,
-            float* rhs) {
+            float* rhs, Kernel kernel) {
+  switch (resolve(kernel, L)) {
 #ifdef SOFTDECA_X86
-  if (cpu_has_avx2()) {
-    switch (L.precision()) {
-      case Precision::Half: dg_rhs_avx2<Precision::Half>(L, faces, z, skin, b0, b1, rhs); break;
-      case Precision::Float: dg_rhs_avx2<Precision::Float>(L, faces, z, skin, b0, b1, rhs); break;
-      case Precision::Int8: dg_rhs_avx2<Precision::Int8>(L, faces, z, skin, b0, b1, rhs); break;
-    }
-    return;
-  }
+    case Kernel::Avx512Vnni: dg_rhs_vnni(L, faces, z, skin, b0, b1, rhs); return;
+    case Kernel::Avx2:
+      switch (L.precision()) {
+        case Precision::Half: dg_rhs_avx2<Precision::Half>(L, faces, z, skin, b0, b1, rhs); return;
+        case Precision::Float: dg_rhs_avx2<Precision::Float>(L, faces, z, skin, b0, b1, rhs); return;
+        case Precision::Int8: dg_rhs_avx2<Precision::Int8>(L, faces, z, skin, b0, b1, rhs); return;
+      }
+      return;
 #endif
-  dg_rhs_portable(L, faces, z, skin, b0, b1, rhs, portable_load(L));
+    default: dg_rhs_portable(L, faces, z, skin, b0, b1, rhs); return;
+  }
 }
 
-void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out) {
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out,
+                    Kernel kernel) {
+  switch (resolve(kernel, L)) {
 #ifdef SOFTDECA_X86
-  if (cpu_has_avx2()) {
-    switch (L.precision()) {
-      case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, b0, b1, out); break;
-      case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, b0, b1, out); break;
-      case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, b0, b1, out); break;
-    }
-    return;
-  }
+    case Kernel::Avx512Vnni: vertex_offsets_vnni(L, z, base, b0, b1, out); return;
+    case Kernel::Avx2:
+      switch (L.precision()) {
+        case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, b0, b1, out); return;
+        case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, b0, b1, out); return;
+        case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, b0, b1, out); return;
+      }
+      return;
 #endif
-  vertex_offsets_portable(L, z, base, b0, b1, out, portable_load(L));
+    default: vertex_offsets_portable(L, z, base, b0, b1, out); return;
+  }
 }
 
 }  // namespace softdeca::runtime

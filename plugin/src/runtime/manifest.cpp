@@ -8,19 +8,6 @@
 
 namespace softdeca::runtime {
 
-const char* const kArkitBlendshapes[kBlendshapeCount] = {
-    "browDownLeft", "browDownRight", "browInnerUp", "browOuterUpLeft", "browOuterUpRight",
-    "cheekPuff", "cheekSquintLeft", "cheekSquintRight", "eyeBlinkLeft", "eyeBlinkRight",
-    "eyeLookDownLeft", "eyeLookDownRight", "eyeLookInLeft", "eyeLookInRight", "eyeLookOutLeft",
-    "eyeLookOutRight", "eyeLookUpLeft", "eyeLookUpRight", "eyeSquintLeft", "eyeSquintRight",
-    "eyeWideLeft", "eyeWideRight", "jawForward", "jawLeft", "jawOpen", "jawRight", "mouthClose",
-    "mouthDimpleLeft", "mouthDimpleRight", "mouthFrownLeft", "mouthFrownRight", "mouthFunnel",
-    "mouthLeft", "mouthLowerDownLeft", "mouthLowerDownRight", "mouthPressLeft",
-    "mouthPressRight", "mouthPucker", "mouthRight", "mouthRollLower", "mouthRollUpper",
-    "mouthShrugLower", "mouthShrugUpper", "mouthSmileLeft", "mouthSmileRight",
-    "mouthStretchLeft", "mouthStretchRight", "mouthUpperUpLeft", "mouthUpperUpRight",
-    "noseSneerLeft", "noseSneerRight", "tongueOut"};
-
 namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, "manifest: " + message); }
 void check(bool ok, const std::string& message) {
@@ -139,8 +126,9 @@ Manifest parse_manifest(const std::string& text) {
   const auto& names = doc.at("blendshapes", "manifest").array("blendshapes");
   check(names.size() == kBlendshapeCount, "blendshapes must list the 52 ARKit names");
   for (int i = 0; i < kBlendshapeCount; ++i)
-    check(names[static_cast<std::size_t>(i)].string("blendshapes") == kArkitBlendshapes[i],
-          "blendshapes[" + std::to_string(i) + "] must be " + kArkitBlendshapes[i] + " (canonical ARKit order)");
+    check(names[static_cast<std::size_t>(i)].string("blendshapes") == stream::blendshape_name(static_cast<std::size_t>(i)),
+          "blendshapes[" + std::to_string(i) + "] must be " + stream::blendshape_name(static_cast<std::size_t>(i)) +
+              " (canonical ARKit order)");
 
   std::set<std::string> seen;
   for (const Json& p : doc.at("parameters", "manifest").array("parameters")) {

@@ -7,15 +7,15 @@
 #include <string>
 #include <vector>
 
+#include "stream/arkit_names.h"
+
 namespace softdeca::runtime {
 
 constexpr int kBundleFormatVersion = 1;
 constexpr const char* kBundleFormat = "softdeca-bundle";
 constexpr const char* kDtFormulation = "cotangent-poisson-1";
-constexpr int kBlendshapeCount = 52;
-
-// Canonical ARKit order (alphabetical ARFaceAnchor.BlendShapeLocation names).
-extern const char* const kArkitBlendshapes[kBlendshapeCount];
+// The 52 ARKit shapes in canonical order: names from the one definition, stream/arkit_names.h.
+constexpr int kBlendshapeCount = static_cast<int>(stream::kBlendshapeCount);
 
 struct TensorSpec {
   std::string name;

@@ -1,7 +1,9 @@
 // A prefactored symmetric positive definite solve for three right-hand sides at once.
-// Eigen's SimplicialLDLT (AMD ordering) factorises P K P^T = L D L^T once; the factor is kept
-// twice, row-major for the forward and column-major for the backward substitution, so both
-// passes stream their part in order and gather from one xyz(w) vector that stays in L2.
+// Eigen's SimplicialLDLT (METIS nested-dissection ordering, else AMD) factorises
+// P K P^T = L D L^T once; the factor is kept column-major: the backward substitution gathers
+// (a dot product per column), the forward one scatters (an axpy per column), both streaming
+// the factor in order over one xyz(w) vector that stays in L2. With several threads the
+// forward pass gathers from a second, row-major copy instead (no two threads write one row).
 // Factor values are stored as float and indices as uint16 when the size allows (accumulation
 // is in double): the solve is bound by the bytes it reads, and this halves them at a relative
 // error of ~1e-7 (measured against double values, tests/native/test_runtime_math.cpp).
@@ -26,7 +28,7 @@ class SparseLdlt {
   explicit SparseLdlt(const Eigen::SparseMatrix<double>& K, std::size_t parts = 1);
 
   std::size_t size() const { return n_; }
-  std::size_t factor_nonzeros() const { return values_lower_.size(); }
+  std::size_t factor_nonzeros() const { return nnz_; }
   std::size_t bytes() const;  // the factor and the schedule
 
   // x = K^-1 (b[0] + ... + b[count-1]), xyz interleaved (n x 3); the right-hand side comes in
@@ -56,7 +58,11 @@ class SparseLdlt {
   std::vector<std::int32_t> row_ptr_, col_ptr_;
   std::vector<std::uint16_t> row_cols16_, col_rows16_;  // when n <= 65536
   std::vector<std::uint32_t> row_cols32_, col_rows32_;  // otherwise
-  std::vector<float> values_lower_, values_upper_;     // strict lower L, row- and column-major
+  std::size_t nnz_ = 0;
+  // Strict lower L, column-major ([0, nnz)) and, with several parts, row-major ([nnz, 2 nnz));
+  // one array so that it is one huge-page stream (aligned.h).
+  bool rows_copy_ = false;
+  AlignedArray<float> values_;
   std::vector<std::vector<std::int32_t>> bins_, bins_down_;  // rows of independent subtrees, up and down
   std::vector<std::int32_t> top_, top_down_;                 // the top part, up and down
   double serial_fraction_ = 0;

@@ -1,5 +1,13 @@
 """The contact sheet of a replay: chosen frames (rows) of every model the replay wrote (columns:
-linear blendshapes, SoftDECA, SparseSoftDECA, ...), rendered with render.py."""
+linear blendshapes, SoftDECA, SparseSoftDECA, SoftDECA with the localised change), rendered
+with render.py, framed on the face.
+
+A correction of a few millimetres is invisible in a shaded render, so the models' columns are
+coloured by how far each vertex lies from the linear blendshapes of the same frame, and the
+localised column by how far it lies from plain SoftDECA (what the localised change does): white
+0 to dark red at the column's scale (its 99.5th percentile over the shown frames), written in
+the column's labels.
+"""
 
 from __future__ import annotations
 
@@ -18,6 +26,7 @@ LABELS = {
     "softdeca_localised": "SoftDECA, localised change",
     "sparse": "SparseSoftDECA (landmarks)",
 }
+COLORMAP = "Reds"  # 0: near white, the column's scale: dark red
 
 
 def pick_frames(caches: dict[str, np.ndarray], neutral: np.ndarray, count: int) -> list[int]:
@@ -29,33 +38,70 @@ def pick_frames(caches: dict[str, np.ndarray], neutral: np.ndarray, count: int) 
     return [int(a + np.argmax(motion[a:b])) for a, b in pairwise(bounds) if b > a]
 
 
+def face_focus(neutral: np.ndarray) -> Focus:
+    """The box of the face: the extent (width, chin to forehead) of the vertices within 5 cm
+    of the most forward point (the nose tip), 10 cm deep so that the cheeks are in frame."""
+    z = neutral[:, 2]
+    front = neutral[z > z.max() - 0.05]
+    lo, hi = front.min(axis=0), front.max(axis=0)
+    lo[2] = z.max() - 0.10
+    return Focus(tuple(float(x) for x in lo), tuple(float(x) for x in hi))
+
+
 def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
     replay = Path(replay)
     summary = json.loads((replay / "replay.json").read_text())
     neutral, triangles = read_obj(replay / "neutral.obj")
     caches = {name: read_pc2(Path(path)) for name, path in summary["point_caches"].items()}
     chosen = pick_frames(caches, neutral, frames)
-    focus = Focus.of([MeshLayer(neutral, triangles)])
-    settings = RenderSettings(size=(size, size))
+    first = int(summary.get("first_frame", 0))
+    focus = face_focus(neutral)
+    settings = RenderSettings(size=(size, size), margin=1.15)
+
+    def distance_mm(a: str, b: str, f: int) -> np.ndarray:
+        return np.linalg.norm(caches[a][f] - caches[b][f], axis=1) * 1e3
+
+    # Colour scales per column: the 99.5th percentile over the shown frames.
+    ref = {"softdeca": "linear", "sparse": "linear", "softdeca_localised": "softdeca"}
+    ref = {k: v for k, v in ref.items() if k in caches and v in caches}
+    scale = {
+        k: float(np.percentile(np.concatenate([distance_mm(k, v, f) for f in chosen]), 99.5))
+        for k, v in ref.items()
+    }
+
     images, labels = [], []
     for f in chosen:
         for name, cache in caches.items():
+            layer, note = MeshLayer(cache[f], triangles), ""
+            if name in ref:
+                layer.scalars = distance_mm(name, ref[name], f)
+                layer.cmap, layer.clim = COLORMAP, (0.0, max(scale[name], 1e-9))
+                note = f"\nred: {scale[name]:.3g} mm from {LABELS[ref[name]]}"
             images.append(
                 render(
-                    [MeshLayer(cache[f], triangles)],
+                    [layer],
                     "three_quarter",
                     settings=settings,
                     focus=focus,
                 )
             )
-            labels.append(f"{LABELS.get(name, name)} - frame {f}")
+            labels.append(f"{LABELS.get(name, name)}, frame {first + f}{note}")
     untrained = summary.get("untrained", False)
     timing = summary["timings"]
+    localised = summary.get("localised") or ""
     notes = [
         "UNTRAINED: random-weight networks, not a model of physics" if untrained else "",
-        f"take {Path(summary['take']).name}: {summary['frames']} frames, "
+        f"take {Path(summary['take']).name}: frames {first} to {first + summary['frames'] - 1}, "
         f"{summary['face_lost_rows_skipped']} face-lost rows skipped; "
-        f"landmarks from {summary['landmarks_from']}",
+        f"landmarks from {summary['landmarks_from']}; dynamics "
+        + ("on" if summary.get("dynamics") else "off"),
+        "colour: distance per vertex to the model named in the label, white 0 to dark red at "
+        "the column's scale (99.5th percentile of the shown frames)"
+        if ref
+        else "",
+        f"localised change: {localised} ({summary.get('localised_faces', 0)} skin faces)"
+        if localised
+        else "",
         "median ms/frame: "
         + ", ".join(f"{LABELS.get(k, k)} {v['median_ms']:.2f}" for k, v in timing.items()),
     ]
@@ -64,6 +110,11 @@ def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
         images,
         labels,
         out,
-        TileSettings(columns=len(caches), font_size=14, extra_labels=[n for n in notes if n]),
+        TileSettings(
+            columns=len(caches),
+            font_size=14,
+            label_height=42,
+            extra_labels=[n for n in notes if n],
+        ),
     )
     return out
