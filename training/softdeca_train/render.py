@@ -60,6 +60,7 @@ class MeshLayer:
     smooth: bool = True
     show_edges: bool = False
     edge_color: Color = "dimgray"
+    vertex_colors: np.ndarray | None = None  # (V, 3) RGB in [0, 1]: replaces `color`
 
 
 @dataclass
@@ -131,6 +132,9 @@ def _check_layer(layer: Layer) -> None:
             )
         if t.size and (t.min() < 0 or t.max() >= len(v)):
             raise ValueError("mesh layer: triangle index outside the vertex array")
+        c = layer.vertex_colors
+        if c is not None and np.shape(c) != (len(v), 3):
+            raise ValueError(f"mesh layer: vertex_colors must be ({len(v)}, 3), got {np.shape(c)}")
     elif isinstance(layer, LineLayer):
         s = np.asarray(layer.segments)
         if s.size and (
@@ -148,6 +152,9 @@ def _polydata(layer: Layer):  # -> pv.PolyData | None
         t = np.asarray(layer.triangles, dtype=np.int64)
         faces = np.hstack([np.full((len(t), 1), 3, np.int64), t]).ravel()
         mesh = pv.PolyData(np.asarray(layer.vertices, dtype=np.float64), faces)
+        if layer.vertex_colors is not None:  # before clipping, which carries point data
+            rgb = np.clip(np.asarray(layer.vertex_colors, np.float64), 0, 1) * 255
+            mesh.point_data["rgb"] = rgb.astype(np.uint8)
     elif isinstance(layer, PointLayer):
         pts = np.asarray(layer.points, dtype=np.float64).reshape(-1, 3)
         if not len(pts):
@@ -223,7 +230,16 @@ def render(
             mesh = _polydata(layer)
             if mesh is None:
                 continue
-            if isinstance(layer, MeshLayer):
+            if isinstance(layer, MeshLayer) and layer.vertex_colors is not None:
+                plotter.add_mesh(
+                    mesh,
+                    scalars="rgb",
+                    rgb=True,
+                    opacity=layer.opacity,
+                    smooth_shading=layer.smooth,
+                    specular=0.2,
+                )
+            elif isinstance(layer, MeshLayer):
                 plotter.add_mesh(
                     mesh,
                     color=layer.color,

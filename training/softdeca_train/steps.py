@@ -510,3 +510,27 @@ STEPS["bench-datagen"] = (
     _bench_datagen_args,
     _bench_datagen_run,
 )
+
+
+# ---- Physics (issue 3): a take through φ† --------------------------------------------------
+
+
+def _simulate_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.sim.cli import add_simulate_args
+
+    add_simulate_args(p)
+
+
+def _simulate_run(args: argparse.Namespace) -> int:
+    from softdeca_train.sim.cli import run_simulate
+
+    return run_simulate(args)
+
+
+STEPS["simulate"] = (
+    "Simulate a Live Link Face take with the physics model for one identity: neutral.obj + "
+    "linear.pc2/physics.pc2 point caches, simulate.png (linear | physics | distance), "
+    "simulate.json (iterations, time, volume change, lip penetrations, distance).",
+    _simulate_args,
+    _simulate_run,
+)
