@@ -15,7 +15,6 @@ from softdeca_train.sim.lips import LipSets, lip_sets
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
-
 # How far behind the other lip a lip point may be and still count as penetrating. The lip
 # patches are open and curl round the lips: beyond about half a lip's thickness "behind the
 # other lip" is ambiguous, and with 1 cm the resolution kept finding false contacts on real
