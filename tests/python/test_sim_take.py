@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -50,7 +51,10 @@ def _take_with_face_lost_row(path: Path, rows: int) -> Path:
     return path
 
 
-def test_simulate_writes_caches_render_and_summary(tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """`softdeca simulate` on 2 frames of a take with a face-lost row: (output folder, stdout)."""
+    tmp_path = tmp_path_factory.mktemp("simulate")
     take = _take_with_face_lost_row(tmp_path / "take.csv", 40)
     params = tmp_path / "p.json"
     params.write_text(json.dumps({"w_soft_volume": 20.0}))
@@ -61,6 +65,11 @@ def test_simulate_writes_caches_render_and_summary(tmp_path: Path) -> None:
         "--seed", "3", "--quiet", cwd=tmp_path,
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
+    return out, r.stdout
+
+
+def test_simulate_writes_caches_render_and_summary(simulated: tuple[Path, str]) -> None:
+    out, stdout = simulated
     summary = json.loads((out / "simulate.json").read_text())
     assert summary["face_lost_rows_skipped"] == 1
     assert summary["tracked_frames"] == 40
@@ -73,14 +82,31 @@ def test_simulate_writes_caches_render_and_summary(tmp_path: Path) -> None:
         assert cache.shape == (2, len(neutral), 3)
         assert np.isfinite(cache).all()
         assert (out / "obj" / f"{name}_00001.obj").is_file()
-    # The physics differs from the linear blend on the face, not elsewhere.
+    # The physics differs from the linear blend.
     d = np.linalg.norm(
         read_pc2(out / "physics.pc2") - read_pc2(out / "linear.pc2"), axis=2
     )
     assert d.max() > 1e-4
     assert summary["summary"]["distance_mm_mean"] > 0
     assert (out / "simulate.png").stat().st_size > 10_000
-    assert "penetrating lip vertices" in r.stdout
+    assert "penetrating lip vertices" in stdout
+
+
+@pytest.mark.skipif(shutil.which("blender") is None, reason="Blender is not installed")
+def test_simulate_output_imports_into_blender(simulated: tuple[Path, str]) -> None:
+    """The documented Blender steps (training/blender/check_import.py) show the caches."""
+    script = (
+        Path(__file__).resolve().parents[2] / "training" / "blender" / "check_import.py"
+    )
+    for cache in ("physics.pc2", "linear.pc2"):
+        r = subprocess.run(
+            ["blender", "-b", "--factory-startup", "--python-exit-code", "1",
+             "--python", str(script), "--",
+             str(simulated[0]), cache],
+            capture_output=True, text=True, timeout=300, check=False,
+        )  # fmt: skip
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "largest difference" in r.stdout
 
 
 @pytest.mark.parametrize(

@@ -2,7 +2,8 @@
 replay` output folder the way docs/physics.md describes and check that what Blender shows is
 the point cache.
 
-    blender -b --factory-startup --python training/blender/check_import.py -- OUT_DIR [CACHE]
+    blender -b --factory-startup --python-exit-code 1 \
+        --python training/blender/check_import.py -- OUT_DIR [CACHE]
 
 Imports OUT_DIR/neutral.obj (Forward -Z, Up Y), adds a Mesh Cache modifier (PC2, default
 axes) reading OUT_DIR/CACHE (default physics.pc2), and for every cached frame compares the
