@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from softdeca_train.lhm import LhmConfig
 from softdeca_train.runtime.files import read_obj, read_pc2
-from softdeca_train.sim import build_head_simulation
+from softdeca_train.sim import HeadSimulation, build_head_simulation
 from softdeca_train.sim.measures import penetrating_points
 from softdeca_train.sim.take import read_take
 from softdeca_train.template import Template
@@ -147,11 +147,11 @@ def test_simulate_refuses_a_missing_take(tmp_path: Path) -> None:
 
 
 @pytest.fixture(scope="module")
-def lip_head(template: Template) -> object:
+def lip_head(template: Template) -> HeadSimulation:
     return build_head_simulation(template, None, LhmConfig(level=3))
 
 
-def _linear_penetrations(hs: object, weights: np.ndarray) -> int:
+def _linear_penetrations(hs: HeadSimulation, weights: np.ndarray) -> int:
     """Penetrating lip vertices of the linear blend, teeth placed rigidly (no solve)."""
     blended = hs.blend(weights[None])[0]
     jaw = hs.jaw_transforms(blended[None])[0]
@@ -161,7 +161,7 @@ def _linear_penetrations(hs: object, weights: np.ndarray) -> int:
     return penetrating_points(hs, blended[:N_SKIN], vertices)
 
 
-def _resolved(hs: object, weights: np.ndarray) -> tuple[int, dict]:
+def _resolved(hs: HeadSimulation, weights: np.ndarray) -> tuple[int, dict]:
     blended = hs.blend(weights[None])[0]
     jaw = hs.jaw_transforms(blended[None])[0]
     sim = hs.simulator(threads=1)
@@ -172,7 +172,7 @@ def _resolved(hs: object, weights: np.ndarray) -> tuple[int, dict]:
 
 
 def test_collisions_resolve_lips_that_linear_blendshapes_interpenetrate(
-    lip_head: object,
+    lip_head: HeadSimulation,
 ) -> None:
     """alex_rom_3, every 100th frame: the two frames whose linear blend has the most
     penetrating lip vertices (a cheap check, no solve) have none after φ† (LHM level 3)."""
@@ -195,7 +195,9 @@ def test_collisions_resolve_lips_that_linear_blendshapes_interpenetrate(
         )  # contacts close: no gap between the sides
 
 
-def test_collisions_need_the_contact_step_on_some_frames(lip_head: object) -> None:
+def test_collisions_need_the_contact_step_on_some_frames(
+    lip_head: HeadSimulation,
+) -> None:
     """Frame 1800 of alex_rom_3: penetrating after the volumetric solve, none after the
     contact rounds."""
     w = read_take(TAKE, start=1800, frames=1).weights[0]
@@ -212,7 +214,7 @@ def test_collisions_need_the_contact_step_on_some_frames(lip_head: object) -> No
     reason="known limit (docs/physics.md, Collisions): on 5 of 41 sampled frames of alex_rom_3 "
     "the contact rounds end with lip points still behind the other lip",
 )
-def test_collisions_resolve_every_sampled_frame(lip_head: object) -> None:
+def test_collisions_resolve_every_sampled_frame(lip_head: HeadSimulation) -> None:
     w = read_take(TAKE, start=2400, frames=1).weights[0]
     assert _linear_penetrations(lip_head, w) > 0
     assert _resolved(lip_head, w)[0] == 0

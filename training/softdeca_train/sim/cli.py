@@ -8,8 +8,14 @@ import argparse
 import json
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import softdeca_native as native
+
+    from softdeca_train.template import Template
 
 DEFAULT_LEVEL = 4
 
@@ -44,10 +50,10 @@ def add_simulate_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
-def _identity(args: argparse.Namespace, template: object) -> tuple[np.ndarray | None, str]:
-    n = template.identity_modes.shape[0]  # type: ignore[attr-defined]
+def _identity(args: argparse.Namespace, template: Template) -> tuple[np.ndarray | None, str]:
+    n = template.identity_modes.shape[0]
     if args.seed is not None:
-        return template.sample_identity(args.seed), f"seed {args.seed}"  # type: ignore[attr-defined]
+        return template.sample_identity(args.seed), f"seed {args.seed}"
     if args.coefficients is None:
         return None, "template"
     path = Path(args.coefficients)
@@ -74,7 +80,7 @@ def _parameters(path: str | None) -> dict[str, float]:
     return {str(k): float(v) for k, v in values.items()}
 
 
-def _set_parameters(sim: object, values: dict[str, float]) -> None:
+def _set_parameters(sim: native.Simulator, values: dict[str, float]) -> None:
     from softdeca_train.parameters import load_parameters
 
     specs = {s.name: s for s in load_parameters().specs}
@@ -84,7 +90,7 @@ def _set_parameters(sim: object, values: dict[str, float]) -> None:
         s = specs[name]
         if not (s.lo <= value <= s.hi):
             raise ValueError(f"parameter {name} = {value} outside its range [{s.lo}, {s.hi}]")
-        sim.set_parameter(name, value)  # type: ignore[attr-defined]
+        sim.set_parameter(name, value)
 
 
 def run_simulate(args: argparse.Namespace) -> int:
