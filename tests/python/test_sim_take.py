@@ -218,3 +218,26 @@ def test_collisions_resolve_every_sampled_frame(lip_head: HeadSimulation) -> Non
     w = read_take(TAKE, start=2400, frames=1).weights[0]
     assert _linear_penetrations(lip_head, w) > 0
     assert _resolved(lip_head, w)[0] == 0
+
+
+def test_simulate_dynamic_starts_static_then_lags(tmp_path: Path) -> None:
+    """--dynamic: the first frame is the static solution, later ones differ (eq. 9 with γ 0.5)."""
+    params = tmp_path / "p.json"
+    params.write_text(json.dumps({"dyn_gamma": 0.5, "dyn_beta": 0.5}))
+    caches = {}
+    for mode in ("static", "dynamic"):
+        out = tmp_path / mode
+        extra = ["--dynamic"] if mode == "dynamic" else []
+        r = _simulate(
+            str(TAKE), "--out", str(out), "--level", str(LEVEL), "--start", "1000",
+            "--frames", "4", "--parameters", str(params), "--render-frames", "0", "--quiet",
+            *extra, cwd=tmp_path,
+        )  # fmt: skip
+        assert r.returncode == 0, r.stderr
+        assert json.loads((out / "simulate.json").read_text())["dynamic"] == (
+            mode == "dynamic"
+        )
+        caches[mode] = read_pc2(out / "physics.pc2")
+    d = np.abs(caches["dynamic"] - caches["static"]).max(axis=(1, 2))
+    assert d[0] < 1e-6
+    assert d[1:].min() > 1e-5

@@ -70,7 +70,7 @@ def _parameters(path: str | None) -> dict[str, float]:
     if path is None:
         return {}
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():  # not is_file(): a shell's <(...) is a pipe
         raise FileNotFoundError(f"parameter file not found: {p}")
     values = json.loads(p.read_text())
     if not isinstance(values, dict) or not all(
