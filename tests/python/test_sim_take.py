@@ -174,16 +174,16 @@ def _resolved(hs: HeadSimulation, weights: np.ndarray) -> tuple[int, dict]:
 def test_collisions_resolve_lips_that_linear_blendshapes_interpenetrate(
     lip_head: HeadSimulation,
 ) -> None:
-    """alex_rom_3, every 100th frame: the two frames whose linear blend has the most
-    penetrating lip vertices (a cheap check, no solve) have none after φ† (LHM level 3)."""
-    take = read_take(TAKE, stride=100)
+    """alex_rom_3, every 200th frame: on each frame whose linear blend has penetrating lip
+    vertices (a cheap check, no solve) φ† leaves none (LHM level 3), its volumetric solve
+    converging with an energy that never increases."""
+    take = read_take(TAKE, stride=200)
     counts = np.array([_linear_penetrations(lip_head, w) for w in take.weights])
-    assert (counts > 0).sum() >= 10  # the take really makes linear lips interpenetrate
-    for k in np.argsort(-counts)[:2]:
+    assert (counts > 0).sum() >= 5  # the take really makes linear lips interpenetrate
+    assert counts.max() > 50
+    for k in np.flatnonzero(counts):
         after, stats = _resolved(lip_head, take.weights[k])
         print(f"frame {take.frames[k]}: linear {counts[k]}, after {after}")
-        assert counts[k] > 100
-        # The volumetric solve converges on real frames, its energy never increasing.
         assert stats["converged"]
         energy = np.array(stats["energy_history"])
         assert len(energy) > 5
@@ -207,17 +207,6 @@ def test_collisions_need_the_contact_step_on_some_frames(
     assert stats["penetrating_before"] > 0
     assert stats["collision_rounds"] > 0
     assert after == 0
-
-
-@pytest.mark.xfail(
-    strict=True,
-    reason="known limit (docs/physics.md, Collisions): on 5 of 41 sampled frames of alex_rom_3 "
-    "the contact rounds end with lip points still behind the other lip",
-)
-def test_collisions_resolve_every_sampled_frame(lip_head: HeadSimulation) -> None:
-    w = read_take(TAKE, start=2400, frames=1).weights[0]
-    assert _linear_penetrations(lip_head, w) > 0
-    assert _resolved(lip_head, w)[0] == 0
 
 
 def test_simulate_dynamic_starts_static_then_lags(tmp_path: Path) -> None:

@@ -15,12 +15,6 @@ from softdeca_train.sim.lips import LipSets, lip_sets
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
-# How far behind the other lip a lip point may be and still count as penetrating. The lip
-# patches are open and curl round the lips: beyond about half a lip's thickness "behind the
-# other lip" is ambiguous, and with 1 cm the resolution kept finding false contacts on real
-# takes and did not converge (docs/physics.md, Collisions). Teeth are closed: 1 cm there.
-LIP_MAX_DEPTH = 0.004
-
 
 def _homogeneous(r: np.ndarray, t: np.ndarray) -> np.ndarray:
     m = np.eye(4)
@@ -89,22 +83,12 @@ def build_head_simulation(
         lhm.soft_tets, lhm.skin_tet.tolist(), lhm.skin_bary
     )
     lips = lip_sets(template, head)
-    zone = np.union1d(lips.upper, lips.lower).astype(np.int32)
+    zone = lips.zone.astype(np.int32)
     upper_teeth_tris = template.component_triangles("teeth_upper") - up.start + teeth_upper[0]
     lower_teeth_tris = template.component_triangles("teeth_lower") - lo.start + teeth_lower[0]
     collisions = [
-        native.CollisionSet(
-            "upper_lip_over_lower_lip",
-            lips.upper.tolist(),
-            lips.lower_triangles,
-            max_distance=LIP_MAX_DEPTH,
-        ),
-        native.CollisionSet(
-            "lower_lip_over_upper_lip",
-            lips.lower.tolist(),
-            lips.upper_triangles,
-            max_distance=LIP_MAX_DEPTH,
-        ),
+        native.CollisionSet("upper_lip_over_lower_lip", lips.upper.tolist(), lips.lower_triangles),
+        native.CollisionSet("lower_lip_over_upper_lip", lips.lower.tolist(), lips.upper_triangles),
         native.CollisionSet(
             "lips_over_upper_teeth",
             zone.tolist(),
