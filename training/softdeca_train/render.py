@@ -60,7 +60,11 @@ class MeshLayer:
     smooth: bool = True
     show_edges: bool = False
     edge_color: Color = "dimgray"
-    vertex_colors: np.ndarray | None = None  # (V, 3) RGB in [0, 1]: replaces `color`
+    # Per-vertex values drawn through a colour map instead of `color` (e.g. errors in mm).
+    scalars: np.ndarray | None = None
+    cmap: str = "inferno"
+    clim: tuple[float, float] | None = None
+    scalar_bar: str | None = None  # title of a colour bar, None: no bar
 
 
 @dataclass
@@ -132,9 +136,8 @@ def _check_layer(layer: Layer) -> None:
             )
         if t.size and (t.min() < 0 or t.max() >= len(v)):
             raise ValueError("mesh layer: triangle index outside the vertex array")
-        c = layer.vertex_colors
-        if c is not None and np.shape(c) != (len(v), 3):
-            raise ValueError(f"mesh layer: vertex_colors must be ({len(v)}, 3), got {np.shape(c)}")
+        if layer.scalars is not None and np.shape(layer.scalars) != (len(v),):
+            raise ValueError(f"mesh layer: need one scalar per vertex ({len(v)})")
     elif isinstance(layer, LineLayer):
         s = np.asarray(layer.segments)
         if s.size and (
@@ -152,9 +155,8 @@ def _polydata(layer: Layer):  # -> pv.PolyData | None
         t = np.asarray(layer.triangles, dtype=np.int64)
         faces = np.hstack([np.full((len(t), 1), 3, np.int64), t]).ravel()
         mesh = pv.PolyData(np.asarray(layer.vertices, dtype=np.float64), faces)
-        if layer.vertex_colors is not None:  # before clipping, which carries point data
-            rgb = np.clip(np.asarray(layer.vertex_colors, np.float64), 0, 1) * 255
-            mesh.point_data["rgb"] = rgb.astype(np.uint8)
+        if layer.scalars is not None:  # point data survives the clip below
+            mesh.point_data["values"] = np.asarray(layer.scalars, dtype=np.float64)
     elif isinstance(layer, PointLayer):
         pts = np.asarray(layer.points, dtype=np.float64).reshape(-1, 3)
         if not len(pts):
@@ -230,14 +232,17 @@ def render(
             mesh = _polydata(layer)
             if mesh is None:
                 continue
-            if isinstance(layer, MeshLayer) and layer.vertex_colors is not None:
+            if isinstance(layer, MeshLayer) and layer.scalars is not None:
                 plotter.add_mesh(
                     mesh,
-                    scalars="rgb",
-                    rgb=True,
+                    scalars="values",
+                    cmap=layer.cmap,
+                    clim=layer.clim,
                     opacity=layer.opacity,
                     smooth_shading=layer.smooth,
                     specular=0.2,
+                    show_scalar_bar=layer.scalar_bar is not None,
+                    scalar_bar_args={"title": layer.scalar_bar or "", "color": "black"},
                 )
             elif isinstance(layer, MeshLayer):
                 plotter.add_mesh(

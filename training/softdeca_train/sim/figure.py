@@ -1,5 +1,6 @@
 """`simulate`'s side-by-side render: for a few frames, linear blendshapes | physics | the
-distance between them as a heat map on the physics result (one colour scale for all rows)."""
+distance between them as a heat map on the physics result (one colour scale for all rows,
+render.py's per-vertex scalars)."""
 
 from __future__ import annotations
 
@@ -10,16 +11,7 @@ import numpy as np
 
 from softdeca_train.render import Focus, MeshLayer, RenderSettings, TileSettings, render, tile
 
-# Heat ramp: light grey (no difference) -> yellow -> red (the scale's top).
-_RAMP = np.array([[0.85, 0.85, 0.85], [1.0, 0.85, 0.1], [0.8, 0.0, 0.0]])
-
-
-def heat_colors(distance: np.ndarray, top: float) -> np.ndarray:
-    """(V,) distances -> (V, 3) RGB on the ramp, `top` and above at its red end."""
-    t = np.clip(np.asarray(distance, np.float64) / max(top, 1e-12), 0.0, 1.0) * (len(_RAMP) - 1)
-    k = np.minimum(t.astype(int), len(_RAMP) - 2)
-    f = (t - k)[:, None]
-    return _RAMP[k] * (1 - f) + _RAMP[k + 1] * f
+HEAT_MAP = "YlOrRd"  # pale yellow (no difference) to dark red (the scale's top)
 
 
 def pick_frames(linear: list[np.ndarray], physics: list[np.ndarray], count: int) -> list[int]:
@@ -43,8 +35,8 @@ def render_comparison(
     notes: list[str] | None = None,
 ) -> Path:
     chosen = pick_frames(linear, physics, frames)
-    dist = {f: np.linalg.norm(physics[f] - linear[f], axis=1) for f in chosen}
-    top = max(float(np.percentile(d, 99.5)) for d in dist.values())
+    dist_mm = {f: 1e3 * np.linalg.norm(physics[f] - linear[f], axis=1) for f in chosen}
+    top = max(float(np.percentile(d, 99.5)) for d in dist_mm.values())
     focus = Focus.of([MeshLayer(neutral, triangles)])
     settings = RenderSettings(size=(size, size))
     images, names = [], []
@@ -54,13 +46,21 @@ def render_comparison(
             ("physics", MeshLayer(physics[f], triangles)),
             (
                 "|physics - linear|",
-                MeshLayer(physics[f], triangles, vertex_colors=heat_colors(dist[f], top)),
+                MeshLayer(
+                    physics[f],
+                    triangles,
+                    scalars=dist_mm[f],
+                    cmap=HEAT_MAP,
+                    clim=(0.0, top),
+                    scalar_bar="mm",
+                ),
             ),
         ):
             images.append(render([layer], "three_quarter", settings=settings, focus=focus))
             names.append(f"{title} - {labels[f]}")
     footer = [
-        f"heat map: grey 0 mm, yellow {top * 500:.2f} mm, red >= {top * 1e3:.2f} mm",
+        f"heat map: |physics - linear| per vertex, 0 to {top:.2f} mm (99.5th percentile of "
+        "the rows; above it at the top colour)",
         *(notes or []),
     ]
     tile(images, names, path, TileSettings(columns=3, font_size=14, extra_labels=footer))
