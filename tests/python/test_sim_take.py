@@ -230,3 +230,15 @@ def test_simulate_dynamic_starts_static_then_lags(tmp_path: Path) -> None:
     d = np.abs(caches["dynamic"] - caches["static"]).max(axis=(1, 2))
     assert d[0] < 1e-6
     assert d[1:].min() > 1e-5
+
+
+def test_steps_parse_without_the_native_module(tmp_path: Path) -> None:
+    """Every step's arguments load without softdeca_native (ctest runs steps that way)."""
+    training = Path(__file__).resolve().parents[2] / "training"
+    env = dict(os.environ, PYTHONPATH=str(training))
+    for step in ("simulate", "bench-physics", "runtime-test-data"):
+        r = subprocess.run(
+            [sys.executable, "-m", "softdeca_train", step, "--help"],
+            capture_output=True, text=True, env=env, cwd=tmp_path, check=False,
+        )  # fmt: skip
+        assert r.returncode == 0, r.stderr
