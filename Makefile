@@ -84,6 +84,7 @@ bench: build
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
+	@$(PY) -m softdeca_train bench-physics --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench-datagen --ict "$(SOFTDECA_ICT)" --out build/bench
 
@@ -142,3 +143,12 @@ replay-demo: build
 	  --bundle $(REPLAY_BUNDLE) --seed 1 --out $(OUT)/replay --dynamics --preview \
 	  --localised "w_skin_strain=100@0.05,-0.015,0.085,0.03"
 	@echo "replay (UNTRAINED bundle): $(OUT)/replay/preview.png, $(OUT)/replay/*.pc2 over $(OUT)/replay/neutral.obj, $(OUT)/replay/replay.json"
+
+# ---- Physics (issue 3) -----------------------------------------------------------------------
+# `make simulate-demo`: a few frames of a real take through the physics model (LHM level 3):
+# point caches, OBJ sequence, side-by-side render and summary in $(OUT)/simulate.
+SIMULATE_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/alex_rom_3.csv
+.PHONY: simulate-demo
+simulate-demo: build
+	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \
+	  --out $(OUT)/simulate --level 3 --start 1300 --frames 6 --stride 100 --obj-every 1

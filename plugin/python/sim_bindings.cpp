@@ -28,6 +28,7 @@ using W4 = Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor>;
 using W3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using Stack = nb::ndarray<const double, nb::shape<-1, -1, 3>, nb::c_contig, nb::device::cpu>;
 using StackOut = nb::ndarray<nb::numpy, double, nb::shape<-1, -1, 3>>;
+using Transforms = nb::ndarray<const double, nb::shape<-1, 4, 4>, nb::c_contig, nb::device::cpu>;
 
 nb::dict stats_dict(const SolveStats& s) {
   nb::dict d;
@@ -78,13 +79,16 @@ StackOut stack(const std::vector<FrameResult>& r, bool skin) {
   return StackOut(data, {frames, n, 3}, owner);
 }
 
-std::vector<FrameInput> frames_of(const Stack& skin, const std::optional<Stack>& landmarks) {
+std::vector<FrameInput> frames_of(const Stack& skin, const std::optional<Stack>& landmarks,
+                                  const std::optional<Transforms>& jaw) {
   std::vector<FrameInput> in(skin.shape(0));
   if (landmarks && landmarks->shape(0) != skin.shape(0))
     throw nb::value_error("landmark_targets must have as many frames as skin_targets");
+  if (jaw && jaw->shape(0) != skin.shape(0)) throw nb::value_error("jaw must have as many frames as skin_targets");
   for (std::size_t f = 0; f < in.size(); ++f) {
     in[f].skin_targets = frame_of(skin, f);
     if (landmarks) in[f].landmark_targets = frame_of(*landmarks, f);
+    if (jaw) in[f].bones.jaw = isometry(Mat4(Eigen::Map<const Mat4>(jaw->data() + 16 * f)));
   }
   return in;
 }
@@ -319,8 +323,8 @@ void bind_sim(nb::module_& m) {
       .def("reset_dynamics", &Simulator::reset_dynamics)
       .def(
           "solve_static_batch",
-          [](Simulator& s, const Stack& skin, std::optional<Stack> landmarks) {
-            const std::vector<FrameInput> in = frames_of(skin, landmarks);
+          [](Simulator& s, const Stack& skin, std::optional<Stack> landmarks, std::optional<Transforms> jaw) {
+            const std::vector<FrameInput> in = frames_of(skin, landmarks, jaw);
             std::vector<FrameResult> r;
             {
               nb::gil_scoped_release release;
@@ -328,13 +332,13 @@ void bind_sim(nb::module_& m) {
             }
             return results(r);
           },
-          nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(),
-          "Static frames (F, n, 3) over one factorisation on all threads -> (skin (F, n, 3), vertices (F, N, 3), "
-          "stats list).")
+          nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(), nb::arg("jaw") = nb::none(),
+          "Static frames (F, n, 3) (jaw: (F, 4, 4) rigid transforms) over one factorisation on all threads -> "
+          "(skin (F, n, 3), vertices (F, N, 3), stats list).")
       .def(
           "solve_sequence",
-          [](Simulator& s, const Stack& skin, std::optional<Stack> landmarks) {
-            const std::vector<FrameInput> in = frames_of(skin, landmarks);
+          [](Simulator& s, const Stack& skin, std::optional<Stack> landmarks, std::optional<Transforms> jaw) {
+            const std::vector<FrameInput> in = frames_of(skin, landmarks, jaw);
             std::vector<FrameResult> r;
             {
               nb::gil_scoped_release release;
@@ -342,7 +346,7 @@ void bind_sim(nb::module_& m) {
             }
             return results(r);
           },
-          nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(),
+          nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(), nb::arg("jaw") = nb::none(),
           "A dynamic sequence from rest of the dynamics -> (skin, vertices, stats list).")
       .def("rest_positions", &Simulator::rest_positions)
       .def_prop_ro("length_scale", &Simulator::length_scale)

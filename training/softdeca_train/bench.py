@@ -87,3 +87,13 @@ def machine() -> str:
     except OSError:
         pass
     return f"{cpu}, {os.cpu_count()} cores, {platform.system()}"
+
+
+def report_area(out_dir: Path, area: str, figures: dict) -> Path:
+    """Write <area>.json and print its figures with the machine."""
+    path = write_area(out_dir, area, figures)
+    print(f"machine: {machine()}")
+    for name, f in figures.items():
+        print(f"  {name:44s} {f['value']:>10.3f} {f['unit']:4s} (target {f['target']})")
+    print(f"wrote {path}")
+    return path

@@ -40,14 +40,9 @@ def _bench_args(p: argparse.ArgumentParser) -> None:
 def _bench_run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from softdeca_train.bench import bench_lhm, machine, write_area
+    from softdeca_train.bench import bench_lhm, report_area
 
-    figures = bench_lhm(args.ict, heads=args.heads)
-    path = write_area(Path(args.out), "lhm", figures)
-    print(f"machine: {machine()}")
-    for name, f in figures.items():
-        print(f"  {name:34s} {f['value']:>10.1f} {f['unit']:4s} (target {f['target']})")
-    print(f"wrote {path}")
+    report_area(Path(args.out), "lhm", bench_lhm(args.ict, heads=args.heads))
     return 0
 
 
@@ -537,3 +532,55 @@ STEPS |= {
         lambda a: _train_cli().run_evaluate(a),
     ),
 }
+
+
+# ---- Physics (issue 3): a take through φ† --------------------------------------------------
+
+
+def _simulate_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.sim.cli import add_simulate_args
+
+    add_simulate_args(p)
+
+
+def _simulate_run(args: argparse.Namespace) -> int:
+    from softdeca_train.sim.cli import run_simulate
+
+    return run_simulate(args)
+
+
+STEPS["simulate"] = (
+    "Simulate a Live Link Face take with the physics model for one identity: neutral.obj + "
+    "linear.pc2/physics.pc2 point caches, simulate.png (linear | physics | distance), "
+    "simulate.json (iterations, time, volume change, lip penetrations, distance).",
+    _simulate_args,
+    _simulate_run,
+)
+
+
+def _bench_physics_args(p: argparse.ArgumentParser) -> None:
+    _ict_arg(p)
+    p.add_argument("--out", default="build/bench", help="folder for physics_lhm.json")
+    p.add_argument("--take", default=None, help="Live Link Face CSV (default: alex_rom_3)")
+    p.add_argument("--levels", type=int, nargs="+", default=[3, 4], help="LHM levels (3 4)")
+    p.add_argument("--stride", type=int, default=400, help="every Nth frame (400)")
+
+
+def _bench_physics_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.bench import report_area
+    from softdeca_train.sim.bench import DEFAULT_TAKE, bench_physics_lhm
+
+    take = Path(args.take) if args.take else DEFAULT_TAKE
+    figures = bench_physics_lhm(args.ict, take, tuple(args.levels), args.stride)
+    report_area(Path(args.out), "physics_lhm", figures)
+    return 0
+
+
+STEPS["bench-physics"] = (
+    "Benchmark the physics model on the real layered head model and real frames "
+    "-> build/bench/physics_lhm.json.",
+    _bench_physics_args,
+    _bench_physics_run,
+)

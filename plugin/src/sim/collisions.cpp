@@ -167,45 +167,63 @@ std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Positio
   return find_penetrations(mesh, CollisionTopology(mesh), skin, vertices, tolerance);
 }
 
+namespace {
+// Triangle bounding boxes of a set's surface grown by its max_distance: a cheap reject.
+std::vector<Eigen::AlignedBox3d> surface_boxes(const CollisionSet& set, const Positions& sv) {
+  std::vector<Eigen::AlignedBox3d> boxes(static_cast<std::size_t>(set.surface.rows()));
+  for (Eigen::Index t = 0; t < set.surface.rows(); ++t) {
+    auto& box = boxes[static_cast<std::size_t>(t)];
+    for (int k = 0; k < 3; ++k) box.extend(Vec3(sv.row(set.surface(t, k)).transpose()));
+    box.min().array() -= set.max_distance;
+    box.max().array() += set.max_distance;
+  }
+  return boxes;
+}
+
+// The closest point of set `si`'s surface to skin point p and its signed depth (positive
+// behind the surface); false when none lies within max_distance or the closest feature is on
+// the boundary.
+bool locate(const SimulationMesh& mesh, const CollisionTopology& topology, std::size_t si, int32_t p,
+            const Positions& skin, const Positions& vertices, const std::vector<Eigen::AlignedBox3d>& boxes,
+            Contact& out) {
+  const CollisionSet& set = mesh.collisions[si];
+  const Positions& sv = surface_positions(set, skin, vertices);
+  const Vec3 q = skin.row(p).transpose();
+  Contact best{static_cast<int>(si), p, -1, Vec3::Zero(), 0};
+  double best_d2 = set.max_distance * set.max_distance;
+  for (Eigen::Index t = 0; t < set.surface.rows(); ++t) {
+    if (!boxes[static_cast<std::size_t>(t)].contains(q)) continue;
+    if (set.surface_on_skin && (set.surface(t, 0) == p || set.surface(t, 1) == p || set.surface(t, 2) == p))
+      continue;  // a point never collides with its own triangles
+    const Vec3 a = sv.row(set.surface(t, 0)), b = sv.row(set.surface(t, 1)), c = sv.row(set.surface(t, 2));
+    const Vec3 bc = closest_point_barycentric(q, a, b, c);
+    const double d2 = (q - (bc[0] * a + bc[1] * b + bc[2] * c)).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best.triangle = static_cast<int32_t>(t);
+      best.bary = bc;
+    }
+  }
+  if (best.triangle < 0) return false;
+  Vec3 n;
+  if (!feature_normal(topology.sets[si], set.surface, sv, best.triangle, best.bary, n) || !(n.norm() > 0)) return false;
+  Vec3 point = Vec3::Zero();
+  for (int k = 0; k < 3; ++k) point += best.bary[k] * sv.row(set.surface(best.triangle, k)).transpose();
+  best.depth = -(q - point).dot(n.normalized());
+  out = best;
+  return true;
+}
+}  // namespace
+
 std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const CollisionTopology& topology,
                                        const Positions& skin, const Positions& vertices, double tolerance) {
   std::vector<Contact> out;
   for (std::size_t si = 0; si < mesh.collisions.size(); ++si) {
     const CollisionSet& set = mesh.collisions[si];
-    const Positions& sv = surface_positions(set, skin, vertices);
-    // Triangle bounding boxes grown by max_distance: a cheap reject before the exact test.
-    std::vector<Eigen::AlignedBox3d> boxes(static_cast<std::size_t>(set.surface.rows()));
-    for (Eigen::Index t = 0; t < set.surface.rows(); ++t) {
-      auto& box = boxes[static_cast<std::size_t>(t)];
-      for (int k = 0; k < 3; ++k) box.extend(Vec3(sv.row(set.surface(t, k)).transpose()));
-      box.min().array() -= set.max_distance;
-      box.max().array() += set.max_distance;
-    }
-    for (int32_t p : set.points) {
-      const Vec3 q = skin.row(p).transpose();
-      Contact best{static_cast<int>(si), p, -1, Vec3::Zero(), 0};
-      double best_d2 = set.max_distance * set.max_distance;
-      for (Eigen::Index t = 0; t < set.surface.rows(); ++t) {
-        if (!boxes[static_cast<std::size_t>(t)].contains(q)) continue;
-        if (set.surface_on_skin && (set.surface(t, 0) == p || set.surface(t, 1) == p || set.surface(t, 2) == p))
-          continue;  // a point never collides with its own triangles
-        const Vec3 a = sv.row(set.surface(t, 0)), b = sv.row(set.surface(t, 1)), c = sv.row(set.surface(t, 2));
-        const Vec3 bc = closest_point_barycentric(q, a, b, c);
-        const double d2 = (q - (bc[0] * a + bc[1] * b + bc[2] * c)).squaredNorm();
-        if (d2 < best_d2) {
-          best_d2 = d2;
-          best.triangle = static_cast<int32_t>(t);
-          best.bary = bc;
-        }
-      }
-      if (best.triangle < 0) continue;
-      Vec3 n;
-      if (!feature_normal(topology.sets[si], set.surface, sv, best.triangle, best.bary, n) || !(n.norm() > 0)) continue;
-      Vec3 point = Vec3::Zero();
-      for (int k = 0; k < 3; ++k) point += best.bary[k] * sv.row(set.surface(best.triangle, k)).transpose();
-      best.depth = -(q - point).dot(n.normalized());
-      if (best.depth > tolerance) out.push_back(best);
-    }
+    const auto boxes = surface_boxes(set, surface_positions(set, skin, vertices));
+    Contact c{};
+    for (int32_t p : set.points)
+      if (locate(mesh, topology, si, p, skin, vertices, boxes, c) && c.depth > tolerance) out.push_back(c);
   }
   return out;
 }
@@ -254,7 +272,31 @@ CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTo
     }
 
   std::map<std::pair<int, int32_t>, Contact> contacts;  // one per (set, point)
+  // The round with the fewest penetrating points is the result: on real lips a later round
+  // can add contacts that fight each other (see docs/physics.md, Collisions).
+  Positions best_skin = r.skin;
+  std::size_t best_found = found.size();
+  int best_contacts = 0;
+  double best_gap = 0;
   while (!found.empty() && r.rounds < settings.collision_rounds) {
+    // Contacts slide: each persisting one moves to its point's newest closest surface point,
+    // and is released once the point is clearly outside (pulled there by other contacts);
+    // holding it at a stale place over-constrains lips that touch each other and the teeth.
+    if (!contacts.empty()) {
+      std::vector<std::vector<Eigen::AlignedBox3d>> boxes;
+      for (const CollisionSet& set : mesh.collisions) boxes.push_back(surface_boxes(set, surface_positions(set, r.skin, vertices)));
+      for (auto it = contacts.begin(); it != contacts.end();) {
+        Contact now{};
+        const auto si = static_cast<std::size_t>(it->second.set);
+        if (locate(mesh, topology, si, it->second.point, r.skin, vertices, boxes[si], now) &&
+            now.depth > -settings.penetration_tolerance) {
+          it->second = now;
+          ++it;
+        } else {
+          it = contacts.erase(it);
+        }
+      }
+    }
     for (const Contact& c : found) contacts[{c.set, c.point}] = c;
     Model m;
     m.pinned.resize(active.size());
@@ -284,10 +326,18 @@ CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTo
     r.iterations += stats.iterations;
     ++r.rounds;
     found = find_penetrations(mesh, topology, r.skin, vertices, settings.penetration_tolerance);
+    if (found.size() < best_found || r.rounds == 1) {
+      best_skin = r.skin;
+      best_found = found.size();
+      best_contacts = static_cast<int>(contacts.size());
+      best_gap = 0;
+      for (const auto& [key, c] : contacts) best_gap = std::max(best_gap, contact_gap(mesh, c, r.skin, vertices));
+    }
   }
-  r.penetrating_after = static_cast<int>(found.size());
-  r.contacts = static_cast<int>(contacts.size());
-  for (const auto& [key, c] : contacts) r.max_contact_gap = std::max(r.max_contact_gap, contact_gap(mesh, c, r.skin, vertices));
+  r.skin = best_skin;
+  r.penetrating_after = static_cast<int>(best_found);
+  r.contacts = best_contacts;
+  r.max_contact_gap = best_gap;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

@@ -83,7 +83,7 @@ def build_head_simulation(
         lhm.soft_tets, lhm.skin_tet.tolist(), lhm.skin_bary
     )
     lips = lip_sets(template, head)
-    zone = np.union1d(lips.upper, lips.lower).astype(np.int32)
+    zone = lips.zone.astype(np.int32)
     upper_teeth_tris = template.component_triangles("teeth_upper") - up.start + teeth_upper[0]
     lower_teeth_tris = template.component_triangles("teeth_lower") - lo.start + teeth_lower[0]
     collisions = [

@@ -1,0 +1,67 @@
+"""What `simulate` reports per frame, linear blendshapes against physics, on the same head:
+
+- soft-tissue volume change (%): the soft tets' volume against the rest. Physics: the
+  simulated vertices. Linear: the same tets with the layers above the muscle wrap refitted
+  (least squares) so that S's embedding lands on the linear blend S_t, over the muscle wrap
+  physics placed; both therefore differ only in where the skin is.
+- penetrating lip vertices: skin points of the lip collision sets behind the other lip or a
+  tooth (native find_penetrations, 10 µm tolerance), counted once per point.
+- distance: mean |S_physics - S_t| over S (mm)."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+import softdeca_native as native
+
+from softdeca_train.sim.head import HeadSimulation
+
+PENETRATION_TOLERANCE = 1e-5  # m, as the simulator's default
+
+
+class SoftVolume:
+    """Soft-tissue volume of a head simulation's tets, and the linear skin refit."""
+
+    def __init__(self, hs: HeadSimulation) -> None:
+        self.tets = hs.mesh.soft_tets
+        rest = hs.mesh.rest
+        self.rest_volume = float(native.tet_signed_volumes(rest, self.tets).sum())
+        n_free = hs.lhm.config.soft_layers * hs.lhm.n_wrap  # layers above the muscle wrap
+        rows = np.repeat(np.arange(len(hs.mesh.skin_vertices)), 4)
+        cols = hs.mesh.skin_vertices.ravel()
+        embed = sp.csr_matrix(
+            (hs.mesh.skin_weights.ravel(), (rows, cols)), shape=(len(rows) // 4, len(rest))
+        )
+        self.free = embed[:, :n_free].tocsc()
+        self.fixed = embed[:, n_free:].tocsr()
+        self.n_free = n_free
+        normal = (self.free.T @ self.free).tocsc()
+        self.ridge = 1e-6 * float(normal.diagonal().mean())
+        self.solve = spla.factorized((normal + self.ridge * sp.identity(n_free)).tocsc())
+
+    def change_percent(self, vertices: np.ndarray) -> float:
+        v = float(native.tet_signed_volumes(np.asarray(vertices, np.float64), self.tets).sum())
+        return 100.0 * (v / self.rest_volume - 1.0)
+
+    def linear_vertices(self, skin_target: np.ndarray, simulated: np.ndarray) -> np.ndarray:
+        """`simulated` with the layers above the muscle wrap refitted to the skin target."""
+        x = np.asarray(simulated, np.float64).copy()
+        rhs = np.asarray(skin_target, np.float64) - self.fixed @ x[self.n_free :]
+        b = self.free.T @ rhs + self.ridge * x[: self.n_free]
+        x[: self.n_free] = np.column_stack([self.solve(b[:, k]) for k in range(3)])
+        return x
+
+
+def penetrating_points(hs: HeadSimulation, skin: np.ndarray, vertices: np.ndarray) -> int:
+    found = native.find_penetrations(
+        hs.mesh,
+        np.asarray(skin, np.float64),
+        np.asarray(vertices, np.float64),
+        PENETRATION_TOLERANCE,
+    )
+    return len({point for _, point, _ in found})
+
+
+def mean_distance_mm(a: np.ndarray, b: np.ndarray) -> float:
+    return 1e3 * float(np.linalg.norm(np.asarray(a) - np.asarray(b), axis=-1).mean())

@@ -1,0 +1,127 @@
+"""φ† over a window of a take: per frame the linear blend S_t, the jaw from the lower teeth,
+then the static solve or one dynamic step; both whole heads kept, with the solver's figures
+and the measures of measures.py."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import softdeca_native as native
+from tqdm import tqdm
+
+from softdeca_train.sim.head import HeadSimulation
+from softdeca_train.sim.measures import SoftVolume, mean_distance_mm, penetrating_points
+from softdeca_train.template.model import N_SKIN
+
+STAT_KEYS = ("iterations", "converged", "estimated_error", "collision_rounds", "total_seconds")
+
+
+@dataclass
+class FrameRecord:
+    iterations: int
+    converged: bool
+    collision_rounds: int
+    seconds: float
+    volume_linear_percent: float
+    volume_physics_percent: float
+    penetrating_linear: int
+    penetrating_physics: int
+    distance_mm: float
+
+    def as_dict(self) -> dict[str, float | int | bool]:
+        return dict(self.__dict__)
+
+
+@dataclass
+class SimulatedTake:
+    linear: list[np.ndarray] = field(default_factory=list)  # whole heads (V, 3) float32
+    physics: list[np.ndarray] = field(default_factory=list)
+    records: list[FrameRecord] = field(default_factory=list)
+    seconds: float = 0.0
+
+
+def simulate_frames(
+    hs: HeadSimulation,
+    sim: native.Simulator,
+    weights: np.ndarray,
+    dynamic: bool = False,
+    progress: bool = True,
+) -> SimulatedTake:
+    """Static (each frame warm-started from rest) or dynamic (eq. 9 from the first frame)."""
+    volume = SoftVolume(hs)
+    out = SimulatedTake()
+    start = time.perf_counter()
+    if dynamic:
+        sim.reset_dynamics()
+    for w in tqdm(weights, desc="simulate", unit="frame", disable=not progress):
+        blended = hs.blend(w[None])[0]
+        jaw = hs.jaw_transforms(blended[None])[0]
+        target = blended[:N_SKIN].astype(np.float64)
+        solve = sim.step_dynamic if dynamic else sim.solve_static
+        vertices, skin, st = solve(target, jaw=jaw)
+        out.linear.append(blended.astype(np.float32))
+        out.physics.append(hs.whole_head(skin, blended, jaw).astype(np.float32))
+        linear_vertices = volume.linear_vertices(target, vertices)
+        out.records.append(
+            FrameRecord(
+                iterations=int(st["iterations"]),
+                converged=bool(st["converged"]),
+                collision_rounds=int(st["collision_rounds"]),
+                seconds=float(st["total_seconds"]),
+                volume_linear_percent=volume.change_percent(linear_vertices),
+                volume_physics_percent=volume.change_percent(vertices),
+                penetrating_linear=penetrating_points(hs, target, vertices),
+                penetrating_physics=penetrating_points(hs, skin, vertices),
+                distance_mm=mean_distance_mm(skin, target),
+            )
+        )
+    out.seconds = time.perf_counter() - start
+    return out
+
+
+def summarise(records: list[FrameRecord]) -> dict[str, float | int]:
+    """Means and worst values over the frames (volume: of the absolute change)."""
+    if not records:
+        return {}
+
+    def col(name: str) -> np.ndarray:
+        return np.array([getattr(r, name) for r in records], dtype=np.float64)
+
+    out: dict[str, float | int] = {
+        "frames": len(records),
+        "converged": int(col("converged").sum()),
+        "iterations_mean": float(col("iterations").mean()),
+        "iterations_max": int(col("iterations").max()),
+        "solve_seconds_mean": float(col("seconds").mean()),
+        "distance_mm_mean": float(col("distance_mm").mean()),
+    }
+    for kind in ("linear", "physics"):
+        v = np.abs(col(f"volume_{kind}_percent"))
+        p = col(f"penetrating_{kind}")
+        out |= {
+            f"volume_{kind}_abs_percent_mean": float(v.mean()),
+            f"volume_{kind}_abs_percent_worst": float(v.max()),
+            f"penetrating_{kind}_mean": float(p.mean()),
+            f"penetrating_{kind}_max": int(p.max()),
+            f"frames_penetrating_{kind}": int((p > 0).sum()),
+        }
+    return out
+
+
+def summary_lines(s: dict[str, float | int], seconds: float) -> list[str]:
+    """The terminal summary of `summarise`'s figures."""
+    return [
+        f"{s['frames']} frames ({s['converged']} converged), {s['iterations_mean']:.1f} "
+        f"iterations mean ({s['iterations_max']} max), {seconds / s['frames']:.2f} s/frame",
+        "soft-tissue volume change |%| mean / worst: "
+        f"linear {s['volume_linear_abs_percent_mean']:.3f} / "
+        f"{s['volume_linear_abs_percent_worst']:.3f}, "
+        f"physics {s['volume_physics_abs_percent_mean']:.3f} / "
+        f"{s['volume_physics_abs_percent_worst']:.3f}",
+        "penetrating lip vertices per frame mean / max: "
+        f"linear {s['penetrating_linear_mean']:.1f} / {s['penetrating_linear_max']}, "
+        f"physics {s['penetrating_physics_mean']:.1f} / {s['penetrating_physics_max']}",
+        f"mean distance physics - linear: {s['distance_mm_mean']:.3f} mm",
+    ]
