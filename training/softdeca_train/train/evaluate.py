@@ -57,15 +57,16 @@ class ErrorSum:
             self.by_source.setdefault(key, []).append(float(e[f].mean()))
 
     def summary(self) -> dict:
-        out = {"mean_mm": 1e3 * self.total / max(self.count, 1), "frames": self.frames}
+        if self.frames == 0:
+            return {"mean_mm": None, "frames": 0}
+        out = {"mean_mm": 1e3 * self.total / self.count, "frames": self.frames}
         for k, v in sorted(self.by_source.items()):
             out[f"{k}_mm"] = 1e3 * float(np.mean(v))
             out[f"{k}_frames"] = len(v)
         return out
 
-    def vertex_mm(self) -> np.ndarray:
-        assert self.per_vertex is not None
-        return 1e3 * self.per_vertex / self.frames
+    def vertex_mm(self) -> np.ndarray | None:
+        return None if self.per_vertex is None else 1e3 * self.per_vertex / self.frames
 
 
 def _with_landmarks(batch: Batch, which: str, model: SparseSoftDeca) -> Batch:
@@ -93,9 +94,7 @@ def measure(run: Run, name: str, model: Trainable, which: str | None = None) -> 
         if isinstance(model, SparseSoftDeca) and which:
             batch = _with_landmarks(batch, which, model)
         acc.add(vertex_error(model.predict(batch), batch.T), batch.source_take, take)
-    if acc.frames == 0:
-        raise ValueError(f"no {model.kind} test frames in {run.config.dataset} for {name}")
-    return acc
+    return acc  # may hold no frame: every test frame of the kind failed the solver filter
 
 
 def test_errors(

@@ -134,7 +134,7 @@ def _heatmaps(run: Run, maps: dict[str, np.ndarray], path: Path, vmax: float) ->
 
 
 def _row(r: dict | None, key: str = "mean_mm") -> str:
-    return "–" if r is None or key not in r else f"{r[key]:.3f}"
+    return "–" if r is None or r.get(key) is None else f"{r[key]:.3f}"
 
 
 def write_report(
@@ -154,7 +154,9 @@ def write_report(
         elif m.kind == "static":
             acc = measure(run, name, m)
             errors[name] = acc.summary()
-            maps[name] = acc.vertex_mm()
+            vertex_mm = acc.vertex_mm()
+            if vertex_mm is not None:
+                maps[name] = vertex_mm
             if name == "softdeca":
                 from softdeca_train.train.evaluate import _AsDynamic
 
@@ -286,7 +288,7 @@ def _write_bench(folder: Path, r: dict, run: Run) -> None:
                 "how": how,
             }
 
-    get = lambda k, f="mean_mm": e[k][f] if k in e else None  # noqa: E731
+    get = lambda k, f="mean_mm": e[k].get(f) if k in e else None  # noqa: E731
     fig("softdeca_static_mm", get("softdeca"), "mm", 0.5)
     fig("softdeca_dynamic_mm", get("softdeca-dynamics"), "mm", 1.0)
     fig("no_correction_static_mm", get("no-correction"), "mm", None)
