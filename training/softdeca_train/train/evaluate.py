@@ -144,7 +144,12 @@ class _AsDynamic(Trainable):
 def frame_function(model: Trainable, batch: Batch) -> Callable[[], object]:
     """The per-frame work of `model` for one frame of `batch`, with everything per avatar
     (hypernetwork outputs, the DT factorisation) prepared beforehand, as the runtime runs it."""
-    one = Batch(**{**batch.__dict__, "weights": batch.weights[:1], "S": batch.S[:1]})
+    first = {
+        k: v[:1]
+        for k, v in batch.__dict__.items()
+        if k in ("weights", "S", "T", "landmarks", "landmarks_clean") and v is not None
+    }
+    one = Batch(**{**batch.__dict__, **first})
     if isinstance(model, SoftDeca):
         hyper = model.f_ph(expand(batch.p, model.n_faces), batch.h)
 

@@ -27,7 +27,13 @@ from softdeca_train.train.evaluate import (
     measure,
     time_per_frame,
 )
-from softdeca_train.train.models import NoCorrection, SparseSoftDeca, Trainable, vertex_error
+from softdeca_train.train.models import (
+    NoCorrection,
+    SoftDeca,
+    SparseSoftDeca,
+    Trainable,
+    vertex_error,
+)
 from softdeca_train.train.registry import MODELS
 from softdeca_train.train.run import Run
 
@@ -179,7 +185,17 @@ def write_report(
     _heatmaps(
         run, {f"{k}: mean error": v for k, v in shown.items()}, out / "error_heatmaps.png", vmax
     )
-    result = {"errors": errors, "ms_per_frame": times, "bundle": bundle_rows}
+    from softdeca_train.train.localisation import localisation_figure
+
+    sd = models["softdeca"]
+    assert isinstance(sd, SoftDeca)
+    local = localisation_figure(run, sd, out / "localisation.png")
+    result = {
+        "errors": errors,
+        "ms_per_frame": times,
+        "bundle": bundle_rows,
+        "localisation": local,
+    }
     (out / "evaluation.json").write_text(json.dumps(result, indent=1) + "\n")
     (out / "README.md").write_text(_markdown(run, bundle, result))
     if bench is not None:
@@ -257,7 +273,20 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         lines.append(
             f"| the bundle end to end (ONNX, encoder's h) | – | – | {_row(r['bundle']['sparse'])} |"
         )
+    loc = r["localisation"]
     lines += [
+        "",
+        "## Localisation (eq. 20)",
+        "",
+        f"{loc['change']} ({loc['faces_changed']} faces) on a test identity and frame, the "
+        "rest of p as sampled for it; the displacement the change causes, physics (the same "
+        "value on the soft-tissue tets in the ball) next to SoftDECA (a per-face parameter "
+        f"map into f_ph). Mean displacement inside the ball: physics "
+        f"{loc['physics_mean_in_region_mm']:.3f} mm, SoftDECA "
+        f"{loc['softdeca_mean_in_region_mm']:.3f} mm; largest: physics "
+        f"{loc['physics_max_mm']:.2f} mm, SoftDECA {loc['softdeca_max_mm']:.2f} mm.",
+        "",
+        "![localisation](localisation.png)",
         "",
         "## Pictures",
         "",

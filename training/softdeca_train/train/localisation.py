@@ -1,0 +1,111 @@
+"""The localisation figure of the evaluation (paper eq. 20): one parameter changed inside a
+ball on the face, applied at inference to SoftDECA (a per-face parameter map into f_ph) and
+to the physics (the same value on the soft-tissue tets whose centroid lies in the ball), on a
+test identity and expression; both shown as the displacement the change causes."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from softdeca_train.models.dt import deformation_transfer
+from softdeca_train.render import MeshLayer, RenderSettings, render, tile
+from softdeca_train.template.model import N_SKIN
+from softdeca_train.train.batches import Batch
+from softdeca_train.train.models import SoftDeca
+from softdeca_train.train.run import Run
+
+
+@dataclass(frozen=True)
+class LocalChange:
+    """`name` set to `value` where the neutral lies within `radius` of `centre` (metres,
+    template frame). Default: puffier left cheek (soft-tissue target volume 1.5)."""
+
+    name: str = "target_volume"
+    value: float = 1.5
+    centre: tuple[float, float, float] = (0.05, -0.015, 0.085)
+    radius: float = 0.03
+
+    def label(self) -> str:
+        c = ", ".join(f"{x:.3f}" for x in self.centre)
+        return f"{self.name} = {self.value} within {self.radius * 100:.0f} cm of ({c})"
+
+
+def _inside(points: np.ndarray, change: LocalChange) -> np.ndarray:
+    return np.linalg.norm(points - np.asarray(change.centre), axis=1) < change.radius
+
+
+@torch.no_grad()
+def _softdeca(model: SoftDeca, batch: Batch, p_faces: torch.Tensor) -> torch.Tensor:
+    hyper = model.f_ph(p_faces, batch.h)
+    z = model.f_w(batch.weights[:1])
+    dg = torch.einsum("bk,fkn->bfn", z, hyper).reshape(1, model.n_faces, 3, 3)
+    return deformation_transfer(batch.dt, batch.S[:1], dg)[0]
+
+
+def _physics(run: Run, batch: Batch, change: LocalChange | None) -> np.ndarray:
+    import softdeca_native as native
+
+    from softdeca_train.data.config import GenerateConfig
+    from softdeca_train.data.simulate import without_collisions
+    from softdeca_train.lhm import LhmConfig
+    from softdeca_train.sim import build_head_simulation
+
+    cfg = GenerateConfig.from_dict(run.data.manifest["header"]["config"])
+    h = batch.h[0].double().numpy()
+    hs = build_head_simulation(run.template, h, LhmConfig(level=cfg.level))
+    # the same physics as the data: collisions and solver settings from the dataset
+    mesh = hs.mesh if cfg.collisions else without_collisions(hs.mesh)
+    sim = native.Simulator(mesh, tolerance=cfg.tolerance, max_iterations=cfg.max_iterations)
+    names = [s.name for s in run.specs]
+    for k, name in enumerate(names):
+        sim.set_parameter(name, float(batch.p[0, k]))
+    if change is not None:
+        tets = hs.lhm.soft_tets
+        centroids = hs.lhm.vertices[tets].mean(axis=1)
+        field = np.full(len(tets), float(batch.p[0, names.index(change.name)]))
+        field[_inside(centroids, change)] = change.value
+        sim.set_parameter_field(change.name, field)
+    blended = hs.blend(batch.weights[:1].double().numpy())[0]
+    jaw = hs.jaw_transforms(blended[None])[0]
+    _, skin, _ = sim.solve_static(blended[:N_SKIN].astype(np.float64), jaw=jaw)
+    return np.asarray(skin)
+
+
+def localisation_figure(
+    run: Run, model: SoftDeca, path: Path, change: LocalChange | None = None
+) -> dict:
+    """Render the figure; returns what it measured (mm)."""
+    change = change or LocalChange()
+    batch = next(run.data.batches("static", "test", None, 8))
+    names = [s.name for s in run.specs]
+    k = names.index(change.name)
+    neutral = batch.neutral.double().numpy()
+    tris = run.template.skin_triangles
+    inside = _inside(neutral[tris].mean(axis=1), change)
+    p_faces = batch.p.expand(model.n_faces, -1).clone()
+    x0 = _softdeca(model, batch, p_faces).numpy()
+    p_faces[torch.from_numpy(inside), k] = change.value
+    x1 = _softdeca(model, batch, p_faces).numpy()
+    t0, t1 = _physics(run, batch, None), _physics(run, batch, change)
+    d_model = 1e3 * np.linalg.norm(x1 - x0, axis=1)
+    d_phys = 1e3 * np.linalg.norm(t1 - t0, axis=1)
+    vmax = max(float(np.percentile(d_phys, 99.5)), 1e-3)
+    images, labels = [], []
+    for label, d, shape in (("physics", d_phys, t1), ("SoftDECA", d_model, x1)):
+        layer = MeshLayer(shape, tris, scalars=d, clim=(0.0, vmax), scalar_bar="mm")
+        images.append(render([layer], "three_quarter", settings=RenderSettings(size=(480, 480))))
+        labels.append(f"{label}: displacement by the change (max {d.max():.2f} mm)")
+    tile(images, labels, path)
+    ball = _inside(neutral, change)
+    return {
+        "change": change.label(),
+        "faces_changed": int(inside.sum()),
+        "physics_max_mm": float(d_phys.max()),
+        "physics_mean_in_region_mm": float(d_phys[ball].mean()),
+        "softdeca_max_mm": float(d_model.max()),
+        "softdeca_mean_in_region_mm": float(d_model[ball].mean()),
+    }
