@@ -8,14 +8,13 @@ from __future__ import annotations
 
 import json
 import platform
-import subprocess
 import sys
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
+from softdeca_train.data.generate import code_version
 from softdeca_train.models.bundle import BundleInfo, export_bundle
 from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, SparseNetworks
-from softdeca_train.paths import REPO_ROOT
 from softdeca_train.train.evaluate import test_errors
 from softdeca_train.train.identity import IdentityConfig
 from softdeca_train.train.loop import LoopConfig
@@ -63,19 +62,6 @@ def stage_config(stage: str, budget: BundleBudget, seed: int) -> LoopConfig:
     )
 
 
-def _code_version() -> str:
-    try:
-        out = subprocess.run(
-            ["git", "-C", str(REPO_ROOT), "describe", "--always", "--dirty"],
-            capture_output=True,
-            text=True,
-            check=True,
-        )
-        return out.stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def train_bundle(
     run: Run, bundle: Path, budget: BundleBudget, command: str, progress: bool = True
 ) -> Path:
@@ -109,7 +95,7 @@ def train_bundle(
         f"{Path(run.config.dataset).name} (reduced scale, see training.dataset)",
         training={
             "command": command,
-            "code_version": _code_version(),
+            "code_version": code_version(),
             "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
             "dataset": {
                 "name": Path(run.config.dataset).name,

@@ -240,12 +240,33 @@ class SparseSoftDeca(Trainable):
         return batch.neutral + torch.einsum("bk,vkn->bvn", z, hyper)
 
 
-class Dynamics(Trainable):
+class OverStatic(Trainable):
+    """A dynamics stage over a frozen static model whose outputs per sequence are computed
+    once (no gradient) and cached: training then costs only the stage's own networks."""
+
+    kind = "dynamic"
+
+    def __init__(self, static: Trainable) -> None:
+        super().__init__()
+        self.static = static
+        for q in self.static.parameters():
+            q.requires_grad_(False)
+        self._y: dict[tuple[int, int], torch.Tensor] = {}
+
+    def static_frames(self, batch: Batch) -> torch.Tensor:
+        key = (batch.param_id, batch.identity_id)
+        if key not in self._y:
+            with torch.no_grad():
+                self._y[key] = self.static.predict(batch)
+            if len(self._y) > 256:
+                self._y.pop(next(iter(self._y)))
+        return self._y[key]
+
+
+class Dynamics(OverStatic):
     """Per-vertex alpha, beta, gamma (eq. 21) learned over a frozen static model: for a
     sequence, Y_t = static(t), X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, started from
     the simulated frames before the sequence (its initial velocity)."""
-
-    kind = "dynamic"
 
     def __init__(
         self,
@@ -256,22 +277,9 @@ class Dynamics(Trainable):
         gamma0: float = 0.7,
         beta0: float = 0.3,
     ):
-        super().__init__()
-        self.static = static
-        for q in self.static.parameters():
-            q.requires_grad_(False)
+        super().__init__(static)
         self.f_dyn = DynamicsNetwork(n_vertices, specs, sizes, gamma0, beta0)
         self.n_vertices = n_vertices
-        self._y: dict[tuple[int, int], torch.Tensor] = {}  # static outputs per sequence
-
-    def static_frames(self, batch: Batch) -> torch.Tensor:
-        key = (batch.param_id, batch.identity_id)
-        if key not in self._y:
-            with torch.no_grad():
-                self._y[key] = self.static.predict(batch)
-            if len(self._y) > 256:
-                self._y.pop(next(iter(self._y)))
-        return self._y[key]
 
     def predict(self, batch: Batch) -> torch.Tensor:
         assert batch.prev_T is not None, "dynamics need sequence batches"
@@ -335,12 +343,10 @@ class FaceMlp(Trainable):
         return deformation_transfer(batch.dt, batch.S, dg)
 
 
-class LatentDynamics(Trainable):
+class LatentDynamics(OverStatic):
     """SNP-style latent dynamics (Table 1): a recurrent state over a learned global latent of
     the frame drives one set of offset modes; unlike eq. 21 nothing is per vertex, so the
     dynamics cannot be localised. X_t = Y_t + U s_t, s_t = GRU(s_{t-1}, [e(Y_t), p, h])."""
-
-    kind = "dynamic"
 
     def __init__(
         self,
@@ -351,10 +357,7 @@ class LatentDynamics(Trainable):
         modes: int = 32,
         state: int = 64,
     ):
-        super().__init__()
-        self.static = static
-        for q in self.static.parameters():
-            q.requires_grad_(False)
+        super().__init__(static)
         self.normalise = Normalise(specs)
         self.n_vertices = d.skin_vertices
         self.sub = torch.arange(0, d.skin_vertices, max(1, d.skin_vertices // 256))
@@ -364,15 +367,10 @@ class LatentDynamics(Trainable):
         with torch.no_grad():
             self.modes.weight.mul_(0.1)
             self.modes.bias.zero_()
-        self._y: dict[tuple[int, int], torch.Tensor] = {}
 
     def predict(self, batch: Batch) -> torch.Tensor:
         assert batch.prev_T is not None
-        key = (batch.param_id, batch.identity_id)
-        if key not in self._y:
-            with torch.no_grad():
-                self._y[key] = self.static.predict(batch)
-        y = self._y[key]
+        y = self.static_frames(batch)
         cond = torch.cat([self.normalise(batch.p), batch.h], 1)[0]
         s = torch.zeros(1, self.cell.hidden_size)
         # warm up on the two frames before the sequence, as the per-vertex model starts there
