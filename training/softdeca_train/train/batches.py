@@ -41,6 +41,7 @@ class Batch:
     landmarks_clean: torch.Tensor | None = None  # sparse: the same without the noise
     prev_S: torch.Tensor | None = None  # dynamic: (2, V, 3) frames t-2, t-1 before the sequence
     prev_T: torch.Tensor | None = None
+    prev_weights: torch.Tensor | None = None  # dynamic: (2, 52)
     source_take: np.ndarray | None = None  # (B,) take index or -1 (coverage)
 
     @property
@@ -151,5 +152,6 @@ class Dataset:
         if "prev_weights" in a:
             ps = self.blend.targets(neutral, a["prev_weights"][i0])
             batch.prev_S = f32(ps)
+            batch.prev_weights = f32(a["prev_weights"][i0])
             batch.prev_T = f32(ps + a["prev_offsets"][i0].astype(np.float64))
         return batch
