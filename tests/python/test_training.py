@@ -118,3 +118,12 @@ def test_committed_bundle_is_trained_loads_and_says_what_made_it() -> None:
     assert Path(
         REPO_ROOT / "docs" / "datasets" / readme["name"] / "manifest.json"
     ).is_file()
+
+
+def test_identity_encoder_recovers_identities_exactly(template) -> None:
+    from softdeca_train.models.networks import FULL_SIZES
+    from softdeca_train.train.identity import IdentityConfig, train_identity_encoder
+
+    _, errors = train_identity_encoder(template, FULL_SIZES, IdentityConfig(steps=0), False)
+    assert errors["coefficients_rms"] < 1e-3  # h has unit variance
+    assert errors["neutral_mm"] < 1e-3

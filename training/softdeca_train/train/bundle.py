@@ -31,7 +31,7 @@ class BundleBudget:
     softdeca_dynamics: float = 12.0
     sparse: float = 30.0
     sparse_dynamics: float = 8.0
-    identity_steps: int = 1500
+    identity_steps: int = 0  # the encoder starts exact (train/identity.py)
     steps: int | None = None  # a step budget per stage instead of the minutes (tests)
 
     def scaled(self, factor: float) -> BundleBudget:

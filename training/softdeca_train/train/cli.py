@@ -46,7 +46,12 @@ def add_bundle_args(p: argparse.ArgumentParser) -> None:
         default=1.0,
         help="multiply every stage's minutes (1.0: about 2 h on 2 cores; 0.25: a quick run)",
     )
-    p.add_argument("--identity-steps", type=int, default=1500, help="identity encoder steps")
+    p.add_argument(
+        "--identity-steps",
+        type=int,
+        default=0,
+        help="identity encoder fine-tuning steps after its exact least-squares start (0)",
+    )
 
 
 def run_bundle(args: argparse.Namespace) -> int:
