@@ -56,7 +56,7 @@ DYNAMIC = (
 def _trained(run: Run) -> dict[str, Trainable]:
     out: dict[str, Trainable] = {}
     for name in MODELS:
-        if run.checkpoint(name).is_file():
+        if run.finished(name):  # an interrupted training is not evaluated
             out[name] = run.load(name)
     return out
 
@@ -240,6 +240,12 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
             f"| SoftDECA, the bundle end to end (ONNX, encoder's h) | {_row(b)} | "
             f"{_row(b, 'real_take_mm')} | {_row(b, 'coverage_mm')} | – |"
         )
+    missing = [label for label, key in TABLE1 if key not in e]
+    if missing:
+        lines += [
+            "",
+            "Not trained in this run (no finished checkpoint): " + "; ".join(missing) + ".",
+        ]
     lines += [
         "",
         "## Dynamic sequences",
