@@ -46,8 +46,12 @@ test-native: build build-asan
 	@echo "== native tests (ASan+UBSan)"; ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
 
+# The training tests run in a process of their own: after the rest of the suite in one
+# process, the first of them died with SIGSEGV twice (not reproduced by any subset of the
+# modules; see docs/training.md, "Known problems").
 test-python: build
-	@echo "== Python tests"; $(PY) -m pytest -q tests/python
+	@echo "== Python tests"; $(PY) -m pytest -q tests/python --ignore=tests/python/test_training.py
+	@echo "== Python tests (training)"; $(PY) -m pytest -q tests/python/test_training.py
 
 test: lint test-native test-fuzz test-python
 
