@@ -124,6 +124,8 @@ def test_identity_encoder_recovers_identities_exactly(template) -> None:
     from softdeca_train.models.networks import FULL_SIZES
     from softdeca_train.train.identity import IdentityConfig, train_identity_encoder
 
-    _, errors = train_identity_encoder(template, FULL_SIZES, IdentityConfig(steps=0), False)
+    _, errors = train_identity_encoder(
+        template, FULL_SIZES, IdentityConfig(steps=0), False
+    )
     assert errors["coefficients_rms"] < 1e-3  # h has unit variance
     assert errors["neutral_mm"] < 1e-3
