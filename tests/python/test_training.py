@@ -22,6 +22,15 @@ from softdeca_train.train.run import Run, RunConfig
 COMMITTED = REPO_ROOT / "models" / "softdeca-default"
 
 
+def _check_export_deviation(manifest: dict) -> None:
+    """ONNX (onnxruntime) against torch at export: 1e-4 on the hypernetworks' outputs (DG
+    entries, metres), 1e-3 on the identity code (unit variance; the exact least-squares start
+    sums large terms, so float32 summation order shows)."""
+    dev = dict(manifest["export_check_max_abs"])
+    assert dev.pop("identity_encoder") < 1e-3
+    assert max(dev.values()) < 1e-4
+
+
 @pytest.fixture(scope="module")
 def run(small, tmp_path_factory) -> Run:
     folder, _ = small
@@ -89,7 +98,7 @@ def test_bundle_pipeline_exports_a_bundle_onnxruntime_agrees_with(
     )
     m = read_manifest(bundle)
     assert not m["untrained"]
-    assert max(m["export_check_max_abs"].values()) < 1e-4
+    _check_export_deviation(m)
     errors = m["errors"]
     for key in ("no_correction_static", "softdeca_static"):
         assert np.isfinite(errors[key]["mean_mm"]) and errors[key]["frames"] > 0
@@ -108,7 +117,7 @@ def test_committed_bundle_is_trained_loads_and_says_what_made_it() -> None:
     m = read_manifest(COMMITTED)
     assert not m["untrained"]
     assert m["training"]["command"].startswith("python -m softdeca_train train-bundle")
-    assert max(m["export_check_max_abs"].values()) < 1e-4
+    _check_export_deviation(m)
     nets = OnnxNetworks(COMMITTED)
     z = nets.f_w(np.zeros((1, 52), np.float32))
     assert z.shape == (1, m["latent_size"]) and np.isfinite(z).all()

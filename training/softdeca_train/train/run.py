@@ -24,8 +24,14 @@ from softdeca_train.train.loop import LoopConfig, train
 from softdeca_train.train.models import Trainable
 from softdeca_train.train.registry import MODELS, dataset_specs
 
-# "test": the tiny networks of the tests, with the template's identity size (the data's h).
-SIZES = {"full": FULL_SIZES, "test": replace(TEST_SIZES, identity=FULL_SIZES.identity)}
+# "test": the tiny networks of the tests, with the template's identity size (the data's h)
+# and an encoder wide enough for its exact least-squares start (train/identity.py).
+SIZES = {
+    "full": FULL_SIZES,
+    "test": replace(
+        TEST_SIZES, identity=FULL_SIZES.identity, encoder_hidden=(FULL_SIZES.identity,)
+    ),
+}
 
 
 @dataclass(frozen=True)
