@@ -40,10 +40,10 @@ class Entry:
         return self.build(d, specs, sizes, base)
 
 
-# Widths of the SoftSMPL-style MLPs. Measured (docs/evaluation): one hidden layer of 96 costs
-# 0.6 ms per frame in torch, a quarter of SoftDECA's 2.5 ms in the native runtime, so it is
-# cheaper than "equal time"; about 400 would match (to train next). "large" is 8x wider.
-MLP_EQUAL = (96,)
+# Widths of the SoftSMPL-style MLPs. Its cost is the output layer (hidden x 3 x skin vertices):
+# measured in torch, 96 hidden units took 0.6 ms per frame, so 400 match SoftDECA's 2.5 ms per
+# frame in the native runtime (docs/benchmarks.md): "equal time". "large" is two layers of 768.
+MLP_EQUAL = (400,)
 MLP_LARGE = (768, 768)
 
 MODELS: dict[str, Entry] = {
