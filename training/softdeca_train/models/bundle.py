@@ -164,7 +164,9 @@ def _store_half(data: bytes) -> tuple[bytes, list[str]]:
         if init.data_type != TensorProto.FLOAT or int(np.prod(init.dims)) < HALF_MIN_ELEMENTS:
             continue
         name = init.name
-        half = numpy_helper.from_array(numpy_helper.to_array(init).astype(np.float16), name + "_f16")
+        half = numpy_helper.from_array(
+            numpy_helper.to_array(init).astype(np.float16), name + "_f16"
+        )
         init.CopyFrom(half)
         casts.append(helper.make_node("Cast", [half.name], [name], to=TensorProto.FLOAT))
         names.append(name)
