@@ -24,10 +24,11 @@ COMMITTED = REPO_ROOT / "models" / "softdeca-default"
 
 def _check_export_deviation(manifest: dict) -> None:
     """ONNX (onnxruntime) against torch at export: 1e-4 on the hypernetworks' outputs (DG
-    entries, metres), 1e-3 on the identity code (unit variance; the exact least-squares start
-    sums large terms, so float32 summation order shows)."""
+    entries, metres), 1e-3 on the encoders' codes (identity h, the landmark code: unit
+    variance, and their first layers sum hundreds of inputs, so float32 summation order shows;
+    measured up to 1.3e-4)."""
     dev = dict(manifest["export_check_max_abs"])
-    assert dev.pop("identity_encoder") < 1e-3
+    assert max(dev.pop(k) for k in ("identity_encoder", "sparse.f_l")) < 1e-3
     assert max(dev.values()) < 1e-4
 
 

@@ -32,10 +32,17 @@ FORMAT = "softdeca-bundle"
 FORMAT_VERSION = 1
 OPSET = 17
 MANIFEST = "manifest.json"
-# Initialisers with at least this many elements are stored as float16 and cast back to float32
-# inside the graph: SoftDECA's per-face base table (28,068 x 32 x 9) is most of the bundle, and
-# the runtime keeps the per-avatar tensors in half precision anyway (docs/bundle.md).
-HALF_MIN_ELEMENTS = 1 << 20
+# The per-element tables (one row per face or vertex: HyperNetwork.base, the positional
+# encodings) are stored as float16 and cast back to float32 inside the graph. They are most of a
+# bundle (SoftDECA's base table alone is 28,068 x 32 x 9), and the runtime keeps the per-avatar
+# tensors in half precision anyway (docs/bundle.md). Encoders and MLP weights stay float32.
+HALF_TABLES = ("base", "positional")
+
+
+def _is_half_table(name: str) -> bool:
+    return name.rsplit(".", 1)[-1] in HALF_TABLES
+
+
 SKIN_TRIANGLES_FILE = "skin_triangles.i32"
 NON_SKIN_BONES_FILE = "non_skin_bones.u8"
 
@@ -152,8 +159,8 @@ def _export_onnx(
 
 
 def _store_half(data: bytes) -> tuple[bytes, list[str]]:
-    """Store the float32 initialisers of at least HALF_MIN_ELEMENTS as float16, each read
-    through a Cast node (torch's exporter folds such a Cast away, so it is done here)."""
+    """Store the per-element tables (HALF_TABLES) as float16, each read through a Cast node
+    (torch's exporter folds such a Cast away, so it is done here)."""
     import onnx
     from onnx import TensorProto, helper, numpy_helper
 
@@ -161,7 +168,7 @@ def _store_half(data: bytes) -> tuple[bytes, list[str]]:
     graph = model.graph
     casts, names = [], []
     for init in graph.initializer:
-        if init.data_type != TensorProto.FLOAT or int(np.prod(init.dims)) < HALF_MIN_ELEMENTS:
+        if init.data_type != TensorProto.FLOAT or not _is_half_table(init.name):
             continue
         name = init.name
         half = numpy_helper.from_array(
@@ -180,14 +187,14 @@ def _store_half(data: bytes) -> tuple[bytes, list[str]]:
 
 
 def _rounded_to_half(module: nn.Module) -> nn.Module:
-    """A copy of `module` whose tensors of at least HALF_MIN_ELEMENTS are rounded to float16,
-    as _store_half stores them."""
+    """A copy of `module` with its per-element tables rounded to float16, as _store_half
+    stores them."""
     import copy
 
     out = copy.deepcopy(module)
     with torch.no_grad():
-        for t in list(out.parameters()) + list(out.buffers()):
-            if t.dtype == torch.float32 and t.numel() >= HALF_MIN_ELEMENTS:
+        for name, t in [*out.named_parameters(), *out.named_buffers()]:
+            if t.dtype == torch.float32 and _is_half_table(name):
                 t.copy_(t.half().float())
     return out
 

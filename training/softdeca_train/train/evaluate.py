@@ -86,11 +86,25 @@ def _test_take(run: Run) -> int:
     return names.index(header["config"]["test_take"])
 
 
+class GroupOffsetOracle(NoCorrection):
+    """A reference, not a model: S_t plus the mean of T - S_t over the frames of its
+    (identity, p) group, i.e. the part of the physics' correction that does not depend on the
+    expression, known exactly. What it leaves is the expression-dependent part; what it removes
+    is what a model has to get from p and h alone."""
+
+    @torch.no_grad()
+    def predict(self, batch: Batch) -> torch.Tensor:
+        return batch.S + (batch.T - batch.S).mean(0, keepdim=True)
+
+
 @torch.no_grad()
-def measure(run: Run, name: str, model: Trainable, which: str | None = None) -> ErrorSum:
+def measure(
+    run: Run, name: str, model: Trainable, which: str | None = None, split: str = "test"
+) -> ErrorSum:
     acc = ErrorSum()
     take = _test_take(run)
-    for batch in run.data.batches(model.kind, "test", None, 8):
+    # batches of up to 8 frames of one (identity, p) group: the datasets' groups are 8 frames
+    for batch in run.data.batches(model.kind, split, None, 8):
         if isinstance(model, SparseSoftDeca) and which:
             batch = _with_landmarks(batch, which, model)
         acc.add(vertex_error(model.predict(batch), batch.T), batch.source_take, take)

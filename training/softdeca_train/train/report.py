@@ -23,6 +23,7 @@ from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.evaluate import (
     SPARSE_INPUTS,
     ErrorSum,
+    GroupOffsetOracle,
     _test_take,
     measure,
     time_per_frame,
@@ -172,6 +173,16 @@ def write_report(
     from softdeca_train.train.evaluate import _NoCorrectionDynamic
 
     errors["no-correction/dynamic"] = measure(run, "nc", _NoCorrectionDynamic()).summary()
+    oracle = measure(run, "oracle", GroupOffsetOracle())
+    errors["group-offset-oracle"] = oracle.summary()
+    if oracle.vertex_mm() is not None:
+        maps["group-offset-oracle"] = oracle.vertex_mm()
+    # the generalisation gap: the same models on the frames they trained on
+    for name in ("no-correction", "softdeca", "mlp-equal-time"):
+        if name in static_models:
+            errors[f"{name}/train"] = measure(
+                run, name, static_models[name], split="train"
+            ).summary()
     batch = next(run.data.batches("static", "test", None, 8))
     times = {}
     for name, m in static_models.items():
@@ -181,7 +192,11 @@ def write_report(
     bundle_rows = _bundle_errors(run, bundle, progress) if bundle.is_dir() else {}
     _curves(run, list(models), out / "training_curves.png")
     vmax = float(np.percentile(maps["no-correction"], 98))
-    shown = {k: maps[k] for k in ("no-correction", "softdeca", "mlp-equal-time") if k in maps}
+    shown = {
+        k: maps[k]
+        for k in ("no-correction", "softdeca", "mlp-equal-time", "group-offset-oracle")
+        if k in maps
+    }
     _heatmaps(
         run, {f"{k}: mean error": v for k, v in shown.items()}, out / "error_heatmaps.png", vmax
     )
@@ -246,6 +261,7 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
             "",
             "Not trained in this run (no finished checkpoint): " + "; ".join(missing) + ".",
         ]
+    lines += _where_the_error_is(e)
     lines += [
         "",
         "## Dynamic sequences",
@@ -304,6 +320,36 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+def _where_the_error_is(e: dict) -> list[str]:
+    """How much of the error depends on the expression at all, and the generalisation gap."""
+    nc, orc = e.get("no-correction"), e.get("group-offset-oracle")
+    if nc is None or orc is None or orc.get("mean_mm") is None:
+        return []
+    share = 1 - orc["mean_mm"] / nc["mean_mm"]
+    lines = [
+        "",
+        "### Where the error is",
+        "",
+        "Reference (uses the physics, not a model): S_t plus the mean of T - S_t over the "
+        "frames of the same (identity, p) group, the part of the correction that does not "
+        f"depend on the expression, known exactly: {_row(orc)} mm. So {100 * share:.0f} % of "
+        "the no-correction error is an offset that depends on p and h alone (skull scale, "
+        "gravity, target volume and the stiffness ratios that decide how far they move the "
+        "tissue); a model has to learn it from the training parameter sets.",
+        "",
+        "| model | training frames (mm) | test frames (mm) |",
+        "| --- | ---: | ---: |",
+    ]
+    for label, key in (
+        ("no correction (S_t)", "no-correction"),
+        ("SoftDECA", "softdeca"),
+        ("MLP, equal time", "mlp-equal-time"),
+    ):
+        if f"{key}/train" in e:
+            lines.append(f"| {label} | {_row(e[f'{key}/train'])} | {_row(e.get(key))} |")
+    return lines
 
 
 def _write_bench(folder: Path, r: dict, run: Run) -> None:
