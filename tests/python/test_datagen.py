@@ -291,3 +291,9 @@ def test_parameters_are_sampled_in_the_range_profile(small) -> None:
     assert GenerateConfig.from_dict(legacy).ranges == "appendix-a"
     with pytest.raises(ValueError, match="unknown range profile"):
         sampling_parameters(load_parameters(), "nonsense")
+    # every profile lies inside the physics' ranges and keeps the physics' defaults sampled
+    physics = {s.name: s for s in load_parameters().specs}
+    for profile in PROFILES:
+        for s in sampling_parameters(load_parameters(), profile).specs:
+            assert physics[s.name].lo <= s.lo <= s.default <= s.hi <= physics[s.name].hi
+            assert s.default == physics[s.name].default, (profile, s.name)

@@ -22,6 +22,7 @@ import numpy as np
 from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import KINDS, GenerateConfig
 from softdeca_train.data.expressions import expression_sources, load_takes
+from softdeca_train.data.offset_structure import RIDGE, offset_structure
 from softdeca_train.data.ranges import sampling_parameters
 from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.data.shards import iter_shards
@@ -224,6 +225,42 @@ def _landmark_distances(
     return np.stack([np.linalg.norm(x, axis=-1).ravel() for x in d])
 
 
+def _offset_structure_lines(
+    folder: Path, kinds: list[str], params: ParameterSet, max_error: float
+) -> list[str]:
+    rows = []
+    for kind in kinds:
+        if kind == "dynamic":
+            continue
+        o = offset_structure(folder, kind, params, max_error)
+        if o is None:
+            continue
+        linear = "–" if o.test_linear_in_p_mm is None else f"{o.test_linear_in_p_mm:.3f}"
+        rows.append(
+            f"| {kind} | {o.train_groups} / {o.test_groups} | {o.no_correction_mm:.3f} | "
+            f"{o.expression_part_mm:.3f} | {100 * o.shared_share:.0f} % | "
+            f"{o.test_no_correction_mm:.3f} | {linear} |"
+        )
+    if not rows:
+        return []
+    return [
+        "## How much of |T - S| depends on the expression",
+        "",
+        "The frames of one (identity, p) group share an offset that does not depend on the "
+        "expression (their mean T - S_t); a network has to predict it from p and h alone, on "
+        "parameter sets it never saw. Expression part: |T - S_t - the group's mean|. Linear in "
+        f"p: ridge (lambda {RIDGE} x groups) from the normalised p to the shared offset, fitted "
+        "on the train groups, applied to the test groups' frames (data/offset_structure.py). "
+        "Mean per-vertex distances in mm, frames within 3x the tolerance.",
+        "",
+        "| kind | groups train / test | \\|T - S\\| | expression part | shared share | "
+        "test: no correction | test: linear in p |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        *rows,
+        "",
+    ]
+
+
 def write_report(
     folder: Path, out: Path, ict: str | None = None, takes_dir: Path | None = None
 ) -> Path:
@@ -398,6 +435,7 @@ def write_report(
             cols.append(", ".join(f"{n} {v:+.2f}" for v, n in c[:3]))
         lines.append(f"| {k} | " + " | ".join(cols) + " |")
     lines.append("")
+    lines += _offset_structure_lines(folder, kinds, params, 3 * tol)
     if landmark_stats:
         ls = np.concatenate(landmark_stats, axis=1) * 1e3
         names = (  # pipes escaped: these sit in a markdown table
