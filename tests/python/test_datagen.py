@@ -297,3 +297,23 @@ def test_parameters_are_sampled_in_the_range_profile(small) -> None:
         for s in sampling_parameters(load_parameters(), profile).specs:
             assert physics[s.name].lo <= s.lo <= s.default <= s.hi <= physics[s.name].hi
             assert s.default == physics[s.name].default, (profile, s.name)
+
+
+def test_offset_structure_splits_shared_and_expression_parts(small) -> None:
+    from softdeca_train.data.offset_structure import offset_structure
+    from softdeca_train.data.report import dataset_parameters
+
+    out, _ = small
+    manifest = json.loads((out / "manifest.json").read_text())
+    params = dataset_parameters(manifest)
+    o = offset_structure(out, "static", params, max_error=np.inf)
+    assert o is not None
+    # every static frame kept: 16 frames in groups of frames_per_params
+    assert o.train_groups + o.test_groups == SMALL.static // SMALL.frames_per_params
+    assert o.frames_per_group == SMALL.frames_per_params
+    assert 0 < o.expression_part_mm < o.no_correction_mm
+    assert 0 < o.shared_share < 1
+    if o.test_groups and o.train_groups:
+        assert o.test_linear_in_p_mm is not None and np.isfinite(o.test_linear_in_p_mm)
+    # nothing passes a filter nothing meets
+    assert offset_structure(out, "static", params, max_error=-1.0) is None

@@ -25,6 +25,7 @@ class OffsetStructure:
 
     train_groups: int
     test_groups: int
+    frames_per_group: float  # with few frames, the group mean absorbs some of the expression
     no_correction_mm: float  # |T - S_t|, all groups
     expression_part_mm: float  # |T - S_t - group mean|, all groups
     test_no_correction_mm: float
@@ -48,6 +49,7 @@ def offset_structure(
     means: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {0: [], TEST: []}
     test_frames: list[np.ndarray] = []
     total = expr = count = 0.0
+    frames = 0
     for a in iter_shards(Path(folder), kind):
         ok = a["estimated_error"].reshape(len(a["p"]), -1).max(axis=1) <= max_error
         for g in np.unique(a["param_id"]):
@@ -59,6 +61,7 @@ def offset_structure(
             total += np.linalg.norm(off, axis=-1).sum()
             expr += np.linalg.norm(off - mean, axis=-1).sum()
             count += off.shape[0] * off.shape[1]
+            frames += off.shape[0]
             split = int(a["split"][idx[0]])
             p = np.asarray(params.normalise(a["p"][idx[0]][None]))[0]
             means[TEST if split == TEST else 0].append((p, mean.reshape(-1)))
@@ -72,6 +75,7 @@ def offset_structure(
     return OffsetStructure(
         train_groups=len(means[0]),
         test_groups=len(means[TEST]),
+        frames_per_group=frames / (len(means[0]) + len(means[TEST])),
         no_correction_mm=float(1e3 * total / count),
         expression_part_mm=float(1e3 * expr / count),
         test_no_correction_mm=float(np.mean([_mean_distance(f) for f in test_frames]))
