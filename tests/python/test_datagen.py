@@ -274,16 +274,20 @@ def test_resuming_with_another_configuration_is_refused(small) -> None:
 
 
 def test_parameters_are_sampled_in_the_range_profile(small) -> None:
-    from softdeca_train.data.ranges import PROFILES, sampling_parameters
+    from softdeca_train.data.ranges import (
+        DEFAULT_PROFILE,
+        PROFILES,
+        sampling_parameters,
+    )
 
     out, _ = small
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["dataset"]["range_profile"] == "plausible"
-    params = sampling_parameters(load_parameters(), "plausible")
+    assert manifest["dataset"]["range_profile"] == DEFAULT_PROFILE == "interactive"
+    params = sampling_parameters(load_parameters(), DEFAULT_PROFILE)
     for kind in KINDS:
         p = _all(out, kind)["p"]
         params.validate(p)  # inside the narrowed ranges, not only the physics' own
-    lo, hi = PROFILES["plausible"]["w_target"]
+    lo, hi = PROFILES[DEFAULT_PROFILE]["w_target"]
     k = params.names.index("w_target")
     assert params.specs[k].lo == lo and params.specs[k].hi == hi
     # datasets written before range profiles sampled the physics' ranges

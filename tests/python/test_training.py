@@ -106,9 +106,11 @@ def test_bundle_pipeline_exports_a_bundle_onnxruntime_agrees_with(
     # the small dataset's sparse test frames may all fail the solver filter: then it says so
     sparse = errors["sparse_other_head_noise"]
     assert sparse["frames"] == 0 or np.isfinite(sparse["mean_mm"])
-    # the networks accept only the ranges the data sampled (the "plausible" profile)
+    # the networks accept only the ranges the data sampled (the default "interactive" profile)
     w_target = next(p for p in m["parameters"] if p["name"] == "w_target")
     assert w_target["min"] == 1.0
+    skull = next(p for p in m["parameters"] if p["name"] == "cranium_scale_x")
+    assert (skull["min"], skull["max"]) == (0.9, 1.1)
     nets = OnnxNetworks(bundle)
     assert nets.has("softdeca") and nets.has("sparse")
 

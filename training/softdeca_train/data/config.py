@@ -8,7 +8,7 @@ import os
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
-from softdeca_train.data.ranges import LEGACY_PROFILE, PROFILES
+from softdeca_train.data.ranges import DEFAULT_PROFILE, LEGACY_PROFILE, PROFILES
 from softdeca_train.paths import REPO_ROOT
 
 KINDS = ("static", "dynamic", "sparse")
@@ -60,9 +60,10 @@ class GenerateConfig:
     # estimated error ~1.2e-4 after 300 iterations): past this the frame is kept with its
     # `converged` flag and `estimated_error` (the loader filters on them).
     max_iterations: int = 200
-    # Parameter sampling ranges (data/ranges.py): "plausible" narrows the weakest constraint
-    # weights of Appendix A, "appendix-a" samples the physics' own ranges.
-    ranges: str = "plausible"
+    # Parameter sampling ranges (data/ranges.py): "interactive" samples a decade around the
+    # defaults (what the shipped bundle covers), "plausible" narrows only the weakest
+    # constraint weights of Appendix A, "appendix-a" samples the physics' own ranges.
+    ranges: str = DEFAULT_PROFILE
 
     def __post_init__(self) -> None:
         problems = []

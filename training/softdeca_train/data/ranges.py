@@ -55,7 +55,7 @@ PROFILES: dict[str, dict[str, tuple[float, float]]] = {
         "jaw_scale_z": _TEN_PERCENT,
     },
 }
-DEFAULT_PROFILE = "plausible"
+DEFAULT_PROFILE = "interactive"
 # Datasets written before profiles existed sampled the physics' own ranges.
 LEGACY_PROFILE = "appendix-a"
 

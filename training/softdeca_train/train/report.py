@@ -140,6 +140,15 @@ def _heatmaps(run: Run, maps: dict[str, np.ndarray], path: Path, vmax: float) ->
     tile(images, labels, path)
 
 
+def _training(run: Run, name: str) -> str:
+    """Steps and minutes a model of the run trained for (its summary), or "–"."""
+    path = run.folder / f"{name}.summary.json"
+    if not path.is_file():
+        return "–"
+    s = json.loads(path.read_text())
+    return f"{s['steps']:,} steps, {s['minutes']:.0f} min"
+
+
 def _row(r: dict | None, key: str = "mean_mm") -> str:
     return "–" if r is None or r.get(key) is None else f"{r[key]:.3f}"
 
@@ -239,15 +248,15 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "",
         "## Table 1 analogue: static frames",
         "",
-        "| model | mean (mm) | held-out take (mm) | coverage (mm) | ms/frame |",
-        "| --- | ---: | ---: | ---: | ---: |",
+        "| model | mean (mm) | held-out take (mm) | coverage (mm) | ms/frame | training |",
+        "| --- | ---: | ---: | ---: | ---: | ---: |",
     ]
     for label, key in TABLE1:
         if key in e:
             t = f"{ms[key]:.2f}" if key in ms else "–"
             lines.append(
                 f"| {label} | {_row(e[key])} | {_row(e[key], 'real_take_mm')} | "
-                f"{_row(e[key], 'coverage_mm')} | {t} |"
+                f"{_row(e[key], 'coverage_mm')} | {t} | {_training(run, key)} |"
             )
     if r["bundle"]:
         b = r["bundle"]["softdeca"]
@@ -266,15 +275,15 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "",
         "## Dynamic sequences",
         "",
-        "| model | mean (mm) | held-out take (mm) | coverage (mm) |",
-        "| --- | ---: | ---: | ---: |",
+        "| model | mean (mm) | held-out take (mm) | coverage (mm) | training |",
+        "| --- | ---: | ---: | ---: | ---: |",
     ]
     for label, key in DYNAMIC:
         k = {"no-correction": "no-correction/dynamic", "softdeca": "softdeca/dynamic"}.get(key, key)
         if k in e:
             lines.append(
                 f"| {label} | {_row(e[k])} | {_row(e[k], 'real_take_mm')} | "
-                f"{_row(e[k], 'coverage_mm')} |"
+                f"{_row(e[k], 'coverage_mm')} | {_training(run, key)} |"
             )
     lines += [
         "",
@@ -284,16 +293,17 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "expression personalised to this head (other head); the same with the augmentation's "
         f"coordinate noise (sigma {cfg['landmark_noise_mm']} mm).",
         "",
-        "| trained | same head | other head | other head + noise |",
-        "| --- | ---: | ---: | ---: |",
+        "| trained | same head | other head | other head + noise | training |",
+        "| --- | ---: | ---: | ---: | ---: |",
     ]
     for name, label in (("sparse", "with noise augmentation"), ("sparse-no-noise", "without")):
         if f"{name}/same_head" in e:
             cells = " | ".join(_row(e[f"{name}/{w}"]) for w in SPARSE_INPUTS)
-            lines.append(f"| {label} | {cells} |")
+            lines.append(f"| {label} | {cells} | {_training(run, name)} |")
     if r["bundle"]:
         lines.append(
-            f"| the bundle end to end (ONNX, encoder's h) | – | – | {_row(r['bundle']['sparse'])} |"
+            "| the bundle end to end (ONNX, encoder's h) | – | – | "
+            f"{_row(r['bundle']['sparse'])} | – |"
         )
     loc = r["localisation"]
     lines += [
