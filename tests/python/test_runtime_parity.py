@@ -17,6 +17,7 @@ from softdeca_train.models import (
     BundleInfo,
     ReferenceAvatar,
     TorchNetworks,
+    as_stored,
     build_random,
     export_bundle,
     load_parameter_specs,
@@ -49,7 +50,7 @@ def frames(n: int, seed: int = 0) -> np.ndarray:
 def pair(setup, precision: str, localise: bool = False):
     head, nets, model = setup
     ref = ReferenceAvatar(
-        TorchNetworks(nets),
+        TorchNetworks(as_stored(nets)),
         head.definition,
         head.neutral,
         head.head_triangles,
@@ -183,7 +184,9 @@ def test_parity_on_the_template_topology(tmp_path, template):
     deltas = (
         template.arkit_to_ict.T @ template.expression_deltas.reshape(53, -1)
     ).reshape(52, -1, 3)
-    ref = ReferenceAvatar(TorchNetworks(nets), d, neutral, template.triangles, deltas)
+    ref = ReferenceAvatar(
+        TorchNetworks(as_stored(nets)), d, neutral, template.triangles, deltas
+    )
     nat = NativeAvatar(model, neutral, template.triangles, deltas)
     ref.prepare()
     nat.prepare()

@@ -186,16 +186,30 @@ def _store_half(data: bytes) -> tuple[bytes, list[str]]:
     return model.SerializeToString(), names
 
 
+def _round_tables(module: nn.Module) -> None:
+    """Round the per-element tables of `module` to float16 in place, as _store_half stores them."""
+    with torch.no_grad():
+        for name, t in [*module.named_parameters(), *module.named_buffers()]:
+            if t.dtype == torch.float32 and _is_half_table(name):
+                t.copy_(t.half().float())
+
+
 def _rounded_to_half(module: nn.Module) -> nn.Module:
-    """A copy of `module` with its per-element tables rounded to float16, as _store_half
-    stores them."""
     import copy
 
     out = copy.deepcopy(module)
-    with torch.no_grad():
-        for name, t in [*out.named_parameters(), *out.named_buffers()]:
-            if t.dtype == torch.float32 and _is_half_table(name):
-                t.copy_(t.half().float())
+    _round_tables(out)
+    return out
+
+
+def as_stored(nets: BundleNetworks) -> BundleNetworks:
+    """A copy of `nets` as an exported bundle holds them (per-element tables in float16): the
+    torch reference a runtime running the bundle should reproduce."""
+    import copy
+
+    out = copy.deepcopy(nets)
+    for m in out.modules():
+        _round_tables(m)
     return out
 
 
