@@ -5,7 +5,7 @@ test identity and expression; both shown as the displacement the change causes."
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -22,10 +22,11 @@ from softdeca_train.train.run import Run
 @dataclass(frozen=True)
 class LocalChange:
     """`name` set to `value` where the neutral lies within `radius` of `centre` (metres,
-    template frame). Default: puffier left cheek (soft-tissue target volume 1.5)."""
+    template frame). Default: puffier left cheek (soft-tissue target volume at the top of the
+    range the bundle was trained on; None: that top)."""
 
     name: str = "target_volume"
-    value: float = 1.5
+    value: float | None = None
     centre: tuple[float, float, float] = (0.05, -0.015, 0.085)
     radius: float = 0.03
 
@@ -83,6 +84,9 @@ def localisation_figure(
     batch = next(run.data.batches("static", "test", None, 8))
     names = [s.name for s in run.specs]
     k = names.index(change.name)
+    if change.value is None:  # the networks are only valid inside the trained range
+        change = replace(change, value=float(run.specs[k].max))
+    assert change.value is not None
     neutral = batch.neutral.double().numpy()
     tris = run.template.skin_triangles
     inside = _inside(neutral[tris].mean(axis=1), change)
