@@ -10,10 +10,11 @@ and its bundle only accepts, the sampled ranges (the manifest records them).
 `interactive` samples what a user moves live around the defaults: every constraint weight
 within a decade of its default, skull and jaw scale, target volume and the strain limit within
 10 %, gravity up to 1.2 g and 30 degrees off vertical. Measured on softdeca-l3-v3 (`plausible`):
-75 % of the test error of "no correction" is an offset that depends on p and h alone, not on
-the expression (docs/evaluation), and with weights spread over five decades and skulls scaled
-by up to 50 % no model learned it from 120 parameter sets (ridge and kernel regression on p,
-a linear model in the shape parameters, the hypernetwork: all within 5 % of no correction)."""
+69 % of |T - S| of its static frames is an offset shared by the frames of an (identity, p)
+group, independent of the expression (data/offset_structure.py), and with weights spread over
+five decades and skulls scaled by up to 50 % nothing learned it from 120 parameter sets (ridge
+linear in p made the test error worse; SoftDECA stayed within 1 % of no correction,
+docs/training.md)."""
 
 from __future__ import annotations
 

@@ -103,7 +103,8 @@ def measure(
 ) -> ErrorSum:
     acc = ErrorSum()
     take = _test_take(run)
-    # batches of up to 8 frames of one (identity, p) group: the datasets' groups are 8 frames
+    # batches of up to 8 frames of one (identity, p) group (GroupOffsetOracle needs whole
+    # groups: the datasets have 2 or 8 frames per group)
     for batch in run.data.batches(model.kind, split, None, 8):
         if isinstance(model, SparseSoftDeca) and which:
             batch = _with_landmarks(batch, which, model)

@@ -345,9 +345,9 @@ def _where_the_error_is(e: dict) -> list[str]:
         "Reference (uses the physics, not a model): S_t plus the mean of T - S_t over the "
         "frames of the same (identity, p) group, the part of the correction that does not "
         f"depend on the expression, known exactly: {_row(orc)} mm. So {100 * share:.0f} % of "
-        "the no-correction error is an offset that depends on p and h alone (skull scale, "
-        "gravity, target volume and the stiffness ratios that decide how far they move the "
-        "tissue); a model has to learn it from the training parameter sets.",
+        "the no-correction error is an offset shared by the frames of a group, which depends "
+        "on p and h alone; a model has to learn it from the training parameter sets "
+        "(data/offset_structure.py measures the same split on a whole dataset).",
         "",
         "| model | training frames (mm) | test frames (mm) |",
         "| --- | ---: | ---: |",
