@@ -15,7 +15,7 @@ from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.networks import BETA_MAX
 from softdeca_train.paths import REPO_ROOT
 from softdeca_train.train.bundle import BundleBudget, train_bundle
-from softdeca_train.train.loop import LoopConfig
+from softdeca_train.train.loop import LoopConfig, train
 from softdeca_train.train.models import vertex_error
 from softdeca_train.train.run import Run, RunConfig
 
@@ -72,6 +72,27 @@ def test_dynamics_learn_and_stay_stable(run: Run) -> None:
     alpha, beta, gamma = model.f_dyn(b.p.expand(b.neutral.shape[0], -1), b.h)
     assert torch.allclose(gamma + 2 * alpha - beta, torch.ones_like(gamma), atol=1e-6)
     assert float(beta.detach().min()) >= 0 and float(beta.detach().max()) <= BETA_MAX
+
+
+def test_hypernetwork_learning_rate_factor_reaches_the_optimiser(
+    run: Run, tmp_path
+) -> None:
+    """LoopConfig.hyper_lr overrides the model's factor for its hypernetworks only: at 0,
+    f_ph stays as initialised while f_w trains."""
+    model = run.build("softdeca")
+    before = {k: v.clone() for k, v in model.state_dict().items()}
+    train(
+        model,
+        run.data,
+        LoopConfig(steps=3, seed=1, hyper_lr=0.0),
+        tmp_path,
+        "sd",
+        False,
+    )
+    after = model.state_dict()
+    moved = {k for k in before if not torch.equal(before[k], after[k])}
+    assert moved and all(k.startswith("f_w.") for k in moved), sorted(moved)
+    assert model.lr_scales() == {"f_ph.": model.hyper_lr}
 
 
 def test_training_resumes_from_its_checkpoint(run: Run) -> None:

@@ -72,6 +72,17 @@ def add_model_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--lr", type=float, default=1e-3, help="initial learning rate (1e-3)")
     p.add_argument("--lr-end", type=float, default=5e-5, help="final learning rate (5e-5)")
     p.add_argument("--frames", type=int, default=8, help="frames per batch (8)")
+    p.add_argument(
+        "--hyper-lr",
+        type=float,
+        default=None,
+        help="learning-rate factor of the per-element hypernetworks (default: the model's)",
+    )
+    p.add_argument(
+        "--test-error",
+        action="store_true",
+        help="print the mean error on the dataset's test split after training (mm)",
+    )
 
 
 def run_model(args: argparse.Namespace) -> int:
@@ -87,9 +98,15 @@ def run_model(args: argparse.Namespace) -> int:
         lr_end=args.lr_end,
         frames=args.frames,
         seed=args.seed,
+        hyper_lr=args.hyper_lr,
     )
     summary = run.train(args.model, cfg, not args.no_progress)
     print(f"{args.model}: {summary}")
+    if args.test_error:
+        from softdeca_train.train.evaluate import measure
+
+        mm = measure(run, args.model, run.load(args.model)).summary()["mean_mm"]
+        print(f"{args.model}: test error {mm:.3f} mm")
     return 0
 
 

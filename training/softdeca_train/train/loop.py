@@ -31,6 +31,7 @@ class LoopConfig:
     seed: int = 0
     checkpoint_minutes: float = 2.0
     grad_clip: float = 1.0
+    hyper_lr: float | None = None  # the hypernetworks' learning-rate factor (None: the model's)
 
 
 def _lr(cfg: LoopConfig, progress: float) -> float:
@@ -67,7 +68,7 @@ def train(
     ckpt, log_path = folder / f"{name}.pt", folder / f"{name}.log.jsonl"
     torch.manual_seed(cfg.seed)
     params = [q for q in model.parameters() if q.requires_grad]
-    scales = model.lr_scales()
+    scales = model.lr_scales(cfg.hyper_lr)
     groups: dict[float, list[torch.nn.Parameter]] = {}
     for pname, q in model.named_parameters():
         if q.requires_grad:
