@@ -154,6 +154,7 @@ def train(
     return {
         "steps": step,
         "minutes": round(elapsed / 60, 2),
+        "lr_factors": scales,  # the effective per-prefix factors (cfg.hyper_lr may be None)
         "train_error_mm_last50": float(np.mean(recent)) if recent else None,
         "train_no_correction_mm_last50": float(np.mean(recent_nc)) if recent_nc else None,
     }

@@ -30,9 +30,9 @@ from softdeca_train.train.batches import Batch
 EPS = 1e-12
 CM = 0.01  # vertex offsets are learned in centimetres (HyperNetwork.unit)
 # f_ph's learning-rate factor: on softdeca-l3-i2, 400-step runs reached 0.570 / 0.524 / 0.479 /
-# 0.459 mm on the static test split at 0.3 / 0.1 / 0.03 / 0.01 (no correction 0.595 mm;
-# docs/training.md): with one (identity, p) group per step, larger hypernetwork steps fit the
-# group at hand and forget the others.
+# 0.459 mm on the static test split at 0.3 / 0.1 / 0.03 / 0.01 and 0.451 mm frozen (no
+# correction 0.595 mm; docs/training.md): with one (identity, p) group per step, larger
+# hypernetwork steps fit the group at hand and forget the others.
 HYPER_LR_SOFTDECA = 0.01
 
 
@@ -146,6 +146,9 @@ class SoftDeca(Trainable):
     """f(S_t, w, p, h) = DT(S_t, I + z(w) . L(p, h)) (eq. 17-19; the residual form of
     docs/bundle.md)."""
 
+    hypernetworks = ("f_ph",)
+    hyper_lr = HYPER_LR_SOFTDECA
+
     def __init__(self, d: TemplateDefinition, specs: Sequence[ParameterSpec], sizes: NetworkSizes):
         super().__init__()
         self.f_w = WeightEncoder(len(d.blendshapes), sizes)
@@ -154,9 +157,6 @@ class SoftDeca(Trainable):
         self.register_buffer(
             "triangles", torch.as_tensor(d.skin_triangles, dtype=torch.long), persistent=False
         )
-
-    hypernetworks = ("f_ph",)
-    hyper_lr = HYPER_LR_SOFTDECA
 
     def init_from_data(self, batches: Sequence[Batch]) -> None:
         """L0 = the leading modes of the deformation gradients that map S_t to T per face (the
