@@ -95,6 +95,18 @@ def test_hypernetwork_learning_rate_factor_reaches_the_optimiser(
     assert model.lr_scales() == {"f_ph.": model.hyper_lr}
 
 
+def test_a_step_can_average_several_groups(run: Run, tmp_path) -> None:
+    model = run.build("softdeca-vertex")
+    cfg = LoopConfig(steps=3, seed=1, groups=2)
+    summary = train(model, run.data, cfg, tmp_path, "v", False)
+    assert summary["steps"] == 3
+    assert len((tmp_path / "v.log.jsonl").read_text().splitlines()) == 3
+    with pytest.raises(ValueError, match="at least 1"):
+        train(
+            model, run.data, LoopConfig(steps=1, groups=0), tmp_path / "x", "v", False
+        )
+
+
 def test_training_resumes_from_its_checkpoint(run: Run) -> None:
     cfg = LoopConfig(steps=6, seed=2)
     run.train("softdeca-vertex", cfg, progress=False)

@@ -73,6 +73,9 @@ def add_model_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--lr-end", type=float, default=5e-5, help="final learning rate (5e-5)")
     p.add_argument("--frames", type=int, default=8, help="frames per batch (8)")
     p.add_argument(
+        "--groups", type=int, default=1, help="batches ((identity, p) groups) per step (1)"
+    )
+    p.add_argument(
         "--hyper-lr",
         type=float,
         default=None,
@@ -99,6 +102,7 @@ def run_model(args: argparse.Namespace) -> int:
         frames=args.frames,
         seed=args.seed,
         hyper_lr=args.hyper_lr,
+        groups=args.groups,
     )
     summary = run.train(args.model, cfg, not args.no_progress)
     print(f"{args.model}: {summary}")

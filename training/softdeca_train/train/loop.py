@@ -28,6 +28,7 @@ class LoopConfig:
     lr: float = 1e-3
     lr_end: float = 1e-4  # cosine decay from lr to lr_end over the budget (paper: 1e-4 -> 5e-5)
     frames: int = 8  # frames per batch (static/sparse: one (identity, p) group)
+    groups: int = 1  # batches per step: a step's gradient over several (identity, p) groups
     seed: int = 0
     checkpoint_minutes: float = 2.0
     grad_clip: float = 1.0
@@ -64,17 +65,19 @@ def train(
 ) -> dict:
     """Train `model` in place; checkpoint to folder/<name>.pt, log to folder/<name>.log.jsonl.
     Returns the run summary (steps, minutes, last losses)."""
+    if cfg.groups < 1:
+        raise ValueError(f"groups per step must be at least 1, not {cfg.groups}")
     folder.mkdir(parents=True, exist_ok=True)
     ckpt, log_path = folder / f"{name}.pt", folder / f"{name}.log.jsonl"
     torch.manual_seed(cfg.seed)
     params = [q for q in model.parameters() if q.requires_grad]
     scales = model.lr_scales(cfg.hyper_lr)
-    groups: dict[float, list[torch.nn.Parameter]] = {}
+    by_factor: dict[float, list[torch.nn.Parameter]] = {}
     for pname, q in model.named_parameters():
         if q.requires_grad:
             f = next((v for k, v in scales.items() if pname.startswith(k)), 1.0)
-            groups.setdefault(f, []).append(q)
-    opt = torch.optim.Adam([{"params": g, "scale": f} for f, g in groups.items()], lr=cfg.lr)
+            by_factor.setdefault(f, []).append(q)
+    opt = torch.optim.Adam([{"params": g, "scale": f} for f, g in by_factor.items()], lr=cfg.lr)
     step, elapsed, resumes = 0, 0.0, 0
     if ckpt.is_file():
         state = torch.load(ckpt, weights_only=False)
@@ -129,10 +132,13 @@ def train(
             frac = max(step / cfg.steps, elapsed / budget_s)
             for g in opt.param_groups:
                 g["lr"] = _lr(cfg, frac) * g["scale"]
-            batch = next(batches)
-            loss, metrics = model.loss(batch)
             opt.zero_grad(set_to_none=True)
-            loss.backward()
+            parts = []
+            for _ in range(cfg.groups):  # gradients accumulate over the groups of one step
+                loss, m = model.loss(next(batches))
+                (loss / cfg.groups).backward()
+                parts.append(m)
+            metrics = {k: float(np.mean([m[k] for m in parts])) for k in parts[0]}
             torch.nn.utils.clip_grad_norm_(params, cfg.grad_clip)
             opt.step()
             step += 1
