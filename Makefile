@@ -16,6 +16,10 @@ export PYTHONPATH := $(CURDIR)/$(BUILD)/python:$(CURDIR)/training
 export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
 export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
+# ccache, when installed, makes rebuilds and other checkouts of the same tree cheap; the build
+# never needs it. Paths under the checkout are hashed relative to it so checkouts share hits.
+LAUNCHER  := $(if $(shell command -v ccache),-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+export CCACHE_BASEDIR := $(CURDIR)
 
 .PHONY: help setup build build-asan test test-native test-python demo bench lint clean
 
@@ -32,12 +36,12 @@ setup:
 	@.ci/setup
 
 build: setup
-	@mkdir -p build; cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DONNXRUNTIME_ROOT=$(ORT_ROOT) \
+	@mkdir -p build; cmake -S . -B $(BUILD) -G Ninja $(LAUNCHER) -DCMAKE_BUILD_TYPE=Release -DONNXRUNTIME_ROOT=$(ORT_ROOT) \
 	  -DPython_EXECUTABLE=$(CURDIR)/$(PY) > $(BUILD).configure.log 2>&1 || { cat $(BUILD).configure.log; exit 1; }
 	@cmake --build $(BUILD) -j $(JOBS)
 
 build-asan: setup
-	@mkdir -p build; cmake -S . -B $(ASAN) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOFTDECA_SANITIZE=ON \
+	@mkdir -p build; cmake -S . -B $(ASAN) -G Ninja $(LAUNCHER) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOFTDECA_SANITIZE=ON \
 	  -DONNXRUNTIME_ROOT=$(ORT_ROOT) > $(ASAN).configure.log 2>&1 || { cat $(ASAN).configure.log; exit 1; }
 	@cmake --build $(ASAN) -j $(JOBS)
 
@@ -109,7 +113,7 @@ FUZZ_SECONDS ?= 620
 .PHONY: fuzz-build test-fuzz fuzz-long
 
 fuzz-build: setup
-	@mkdir -p build; CXX=clang++ cmake -S tests/fuzz -B $(FUZZ) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	@mkdir -p build; CXX=clang++ cmake -S tests/fuzz -B $(FUZZ) -G Ninja $(LAUNCHER) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  > $(FUZZ).configure.log 2>&1 || { cat $(FUZZ).configure.log; exit 1; }
 	@cmake --build $(FUZZ) -j $(JOBS)
 
