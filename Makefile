@@ -160,3 +160,19 @@ SIMULATE_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/alex_rom_3.csv
 simulate-demo: build
 	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \
 	  --out $(OUT)/simulate --level 3 --start 1300 --frames 6 --stride 100 --obj-every 1
+
+# ---- Physics stress suite -------------------------------------------------------------------
+# `make stress`: extreme expressions / identities / materials / gravity, levels 3 and 4, static
+# and dynamic, plus every take in $(RECORDINGS) (every STRESS_TAKE_STRIDE-th frame, 3
+# identities), judged by the sanity bounds (docs/physics.md) -> $(OUT)/stress/{stress.json,
+# stress.md,stress_worst.png}. `make bench` runs it too and writes build/bench/physics_stress.json.
+RECORDINGS         ?= ../shared/recordings
+STRESS_TAKE_STRIDE ?= 10
+.PHONY: stress bench-stress
+stress: build
+	@nice -n 5 $(PY) -m softdeca_train stress --ict "$(SOFTDECA_ICT)" --recordings "$(RECORDINGS)" \
+	  --take-stride $(STRESS_TAKE_STRIDE) --out $(OUT)/stress
+bench: bench-stress
+bench-stress: build
+	@nice -n 5 $(PY) -m softdeca_train stress --ict "$(SOFTDECA_ICT)" --recordings "$(RECORDINGS)" \
+	  --take-stride $(STRESS_TAKE_STRIDE) --out build/stress --bench-out build/bench --quiet
