@@ -80,7 +80,7 @@ struct LipTargets {
 // Detect, tie, solve on S, repeat (at most settings.collision_rounds times). Contacts persist
 // across rounds, one per (set, point), moved to the newest closest point. The result is the
 // round with the fewest penetrating points among those that reduce them and move no point
-// farther than the deepest initial penetration (+ 1 mm); otherwise the uncorrected skin. With
+// farther than twice the deepest initial penetration (+ 1 mm); otherwise the uncorrected skin. With
 // `lips`, the collision sets' points first follow their targets on S (strain relative to the
 // targets' shape, the solved skin pinned around the lip region), every frame, and the contacts
 // correct that.
