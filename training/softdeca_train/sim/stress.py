@@ -52,7 +52,7 @@ HOLD = 6
 @dataclass(frozen=True)
 class StressCase:
     group: str
-    identity: str  # "template", "seed N", "+2.5σ", "-2.5σ"
+    identity: str  # "template", "seed N", "h+2.5σ", "h-2.5σ"
     level: int
     frames: list[tuple[str, np.ndarray]]  # (label, (52,) ARKit weights)
     parameters: dict[str, float] = field(default_factory=dict)
@@ -62,7 +62,7 @@ class StressCase:
 
 @dataclass(frozen=True)
 class StressPlan:
-    identities: tuple[str, ...] = ("template", "seed 1", "seed 2", "+2.5σ", "-2.5σ")
+    identities: tuple[str, ...] = ("template", "seed 1", "seed 2", "h+2.5σ", "h-2.5σ")
     level: int = 3
     fine_level: int | None = 4  # every expression once more at this level (template); None: off
     materials: bool = True
@@ -78,11 +78,11 @@ def identity_coefficients(template: Template, label: str) -> np.ndarray | None:
         return None
     if label.startswith("seed "):
         return template.sample_identity(int(label.split()[1]))
-    if label in ("+2.5σ", "-2.5σ"):
+    if label in ("h+2.5σ", "h-2.5σ"):
         h = np.zeros(template.identity_modes.shape[0])
-        h[:EXTREME_MODES] = EXTREME_SIGMA * (1 if label[0] == "+" else -1)
+        h[:EXTREME_MODES] = EXTREME_SIGMA * (1 if label[1] == "+" else -1)
         return h
-    raise ValueError(f"unknown identity {label!r}: template, 'seed N', +2.5σ or -2.5σ")
+    raise ValueError(f"unknown identity {label!r}: template, 'seed N', h+2.5σ or h-2.5σ")
 
 
 def material_ends() -> dict[str, dict[str, float]]:

@@ -24,8 +24,8 @@ def add_stress_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--identities",
         nargs="+",
-        default=["template", "seed 1", "seed 2", "+2.5σ", "-2.5σ"],
-        help="identities: template, 'seed N', +2.5σ, -2.5σ (the leading modes at ±2.5 σ)",
+        default=["template", "seed 1", "seed 2", "h+2.5σ", "h-2.5σ"],
+        help="identities: template, 'seed N', h+2.5σ, h-2.5σ (the leading modes at ±2.5 σ)",
     )
     p.add_argument(
         "--recordings",
