@@ -3,7 +3,9 @@
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-ICT       ?= ../shared/ict-facekit
+DATA      ?= .cache/data
+ICT       ?= $(DATA)/ict-facekit
+TAKES     := $(DATA)/recordings/livelinkface-alexdjulin
 OUT       ?= out
 JOBS      ?= $(shell nproc)
 VENV      := .venv
@@ -13,6 +15,7 @@ ASAN      := build/asan
 ORT_ROOT  := $(CURDIR)/.deps/onnxruntime
 # training/ first: the shared .venv may hold an editable install of another checkout.
 export PYTHONPATH := $(CURDIR)/$(BUILD)/python:$(CURDIR)/training
+export SOFTDECA_DATA := $(abspath $(DATA))
 export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
 export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
@@ -63,7 +66,7 @@ test: lint test-native test-fuzz test-python
 # blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,
 # plus one localised change (stiffer soft tissue in a 3 cm ball on the subject's left cheek).
 BUNDLE         ?= models/softdeca-default
-DEMO_TAKE      ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
+DEMO_TAKE      ?= $(TAKES)/S07-001.csv
 DEMO_SEED      ?= 1
 DEMO_START     ?= 360
 DEMO_FRAMES    ?= 240
@@ -137,7 +140,7 @@ fuzz-long: fuzz-build
 # `make bench` also measures the native runtime (build/bench/runtime.json). `make replay-demo`
 # replays a whole real take through both models with an UNTRAINED random bundle (exported on the
 # fly) and prints where the results are; `make demo` replays part of a take with $(BUNDLE).
-REPLAY_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
+REPLAY_TAKE ?= $(TAKES)/S07-001.csv
 REPLAY_BUNDLE ?= build/bundles/random-untrained
 .PHONY: bench-runtime replay-demo
 bench: bench-runtime
@@ -155,7 +158,7 @@ replay-demo: build
 # ---- Physics (issue 3) -----------------------------------------------------------------------
 # `make simulate-demo`: a few frames of a real take through the physics model (LHM level 3):
 # point caches, OBJ sequence, side-by-side render and summary in $(OUT)/simulate.
-SIMULATE_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/alex_rom_3.csv
+SIMULATE_TAKE ?= $(TAKES)/alex_rom_3.csv
 .PHONY: simulate-demo
 simulate-demo: build
 	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \

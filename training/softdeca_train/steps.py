@@ -11,7 +11,7 @@ def _ict_arg(p: argparse.ArgumentParser) -> None:
         "--ict",
         default=None,
         help="ICT-FaceKit checkout, FaceXModel folder or .tar.xz archive "
-        "(default: $SOFTDECA_ICT or ../shared/ict-facekit)",
+        "(default: $SOFTDECA_ICT or ict-facekit in the data folder)",
     )
 
 
@@ -138,7 +138,7 @@ def _landmarks_args(p: argparse.ArgumentParser) -> None:
         "--arkit",
         default=None,
         help="folder with ARKit_reference_blendshapes.zip and ARKit_landmarks68.txt "
-        "(default: $SOFTDECA_ARKIT_REFERENCE or ../shared/arkit-reference)",
+        "(default: $SOFTDECA_ARKIT_REFERENCE or arkit-reference in the data folder)",
     )
     p.add_argument(
         "--out",
