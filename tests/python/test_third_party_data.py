@@ -120,6 +120,13 @@ def leftovers(data: Path) -> list[str]:
     return sorted(str(p.relative_to(data)) for p in data.rglob("*.part"))
 
 
+def leave_part(data: Path, path: str, content: bytes) -> None:
+    """A `.part` file as an earlier, interrupted run would have left it."""
+    part = data / f"{path}.part"
+    part.parent.mkdir(parents=True)
+    part.write_bytes(content)
+
+
 def assert_complete(data: Path) -> None:
     for p, b in CONTENT.items():
         assert (data / p).read_bytes() == b, p
@@ -177,9 +184,7 @@ def test_a_partial_file_restarts_when_the_server_ignores_ranges(
     tmp_path: Path, server: Server, behaviour: Behaviour
 ) -> None:
     behaviour.honour_ranges = False
-    part = tmp_path / "takes/one.csv.part"
-    part.parent.mkdir(parents=True)
-    part.write_bytes(CONTENT["takes/one.csv"][:5000])
+    leave_part(tmp_path, "takes/one.csv", CONTENT["takes/one.csv"][:5000])
     fetch(entries(), tmp_path, None, server.url, QUIET)
     assert_complete(tmp_path)
 
@@ -187,9 +192,9 @@ def test_a_partial_file_restarts_when_the_server_ignores_ranges(
 def test_a_partial_file_of_other_bytes_restarts_after_the_mismatch(
     tmp_path: Path, server: Server, behaviour: Behaviour
 ) -> None:
-    part = tmp_path / "head/Model/neutral.obj.part"
-    part.parent.mkdir(parents=True)
-    part.write_bytes(b"garbage from an older version\n" * 10)
+    leave_part(
+        tmp_path, "head/Model/neutral.obj", b"garbage from an older version\n" * 10
+    )
     fetch(entries(), tmp_path, None, server.url, QUIET)
     assert_complete(tmp_path)
     asked = [
@@ -201,9 +206,7 @@ def test_a_partial_file_of_other_bytes_restarts_after_the_mismatch(
 def test_a_partial_file_longer_than_the_original_restarts(
     tmp_path: Path, server: Server
 ) -> None:
-    part = tmp_path / "takes/LICENSE.part"
-    part.parent.mkdir(parents=True)
-    part.write_bytes(b"x" * 100)
+    leave_part(tmp_path, "takes/LICENSE", b"x" * 100)
     fetch(entries(), tmp_path, None, server.url, QUIET)
     assert_complete(tmp_path)
 
