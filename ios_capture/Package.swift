@@ -14,12 +14,7 @@ let package = Package(
         .executable(name: "softdeca-capture", targets: ["softdeca-capture"]),
     ],
     targets: [
-        .target(
-            name: "SoftDecaCapture",
-            // landmarks_definition.json links to training/softdeca_train/landmarks/definition.json,
-            // the landmark file the rest of the repository reads (one source of the indices).
-            resources: [.copy("Resources/landmarks_definition.json")]
-        ),
+        .target(name: "SoftDecaCapture"),
         .target(name: "SoftDecaCaptureUI", dependencies: ["SoftDecaCapture"]),
         .executableTarget(name: "softdeca-capture", dependencies: ["SoftDecaCapture"]),
         .testTarget(name: "SoftDecaCaptureTests", dependencies: ["SoftDecaCapture"]),

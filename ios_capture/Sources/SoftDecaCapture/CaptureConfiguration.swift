@@ -58,7 +58,7 @@ public struct CaptureConfiguration: Equatable, Sendable {
         if NumericAddress(host) == nil {
             problems.append("'\(host)' is no numeric IPv4 or IPv6 address (for example 192.168.1.20)")
         }
-        if port == 0 { problems.append("port 0 is no receiver port; use 1 to 65535 or leave it out for \(format.defaultPort)") }
+        if port == 0 { problems.append("port 0 is no receiver port (use 1 to 65535, or leave it out for \(format.defaultPort))") }
         if !(Self.rateRange.contains(rate)) {
             problems.append("rate \(rate) Hz is outside \(Int(Self.rateRange.lowerBound)) to \(Int(Self.rateRange.upperBound)) Hz")
         }

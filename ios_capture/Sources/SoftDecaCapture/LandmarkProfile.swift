@@ -35,11 +35,22 @@ public struct LandmarkProfile: Equatable, Sendable {
         self.id = CRC32.checksum(bytes.bytes)
     }
 
-    /// The landmark file every part of the product reads (`landmarks/definition.json` of the
-    /// training package, bundled as a resource): its `landmarks[].arkit_vertex`, in order.
+    /// Where the landmark file is found: the app's resources (`definition.json`, added to the
+    /// app target from the repository), else the repository this source file is in.
+    public static func definitionURL() -> URL? {
+        if let url = Bundle.main.url(forResource: "definition", withExtension: "json") { return url }
+        let repo = URL(fileURLWithPath: #filePath).deletingLastPathComponent().deletingLastPathComponent()
+            .deletingLastPathComponent().deletingLastPathComponent()
+        let url = repo.appendingPathComponent("training/softdeca_train/landmarks/definition.json")
+        return FileManager.default.fileExists(atPath: url.path) ? url : nil
+    }
+
+    /// The landmark file every part of the product reads (training/softdeca_train/landmarks/
+    /// definition.json, whose indices the model bundle carries too): its
+    /// `landmarks[].arkit_vertex`, in order.
     public static func softdeca149(definition: URL? = nil) throws -> LandmarkProfile {
-        guard let url = definition ?? Bundle.module.url(forResource: "landmarks_definition", withExtension: "json") else {
-            throw CaptureError.profile("the landmark definition is missing from the package's resources")
+        guard let url = definition ?? definitionURL() else {
+            throw CaptureError.profile("the landmark definition is missing: add training/softdeca_train/landmarks/definition.json to the app's resources")
         }
         let data: Data
         do { data = try Data(contentsOf: url) } catch {
@@ -76,7 +87,7 @@ public struct LandmarkProfile: Equatable, Sendable {
         return try LandmarkProfile(name: "arkit68", indices: indices)
     }
 
-    /// A profile by name: `softdeca149` from the bundled definition, `arkit68` from
+    /// A profile by name: `softdeca149` from the landmark definition, `arkit68` from
     /// `ARKit_landmarks68.txt` in `arkitReference` (a folder).
     public static func load(named name: String, arkitReference: URL? = nil) throws -> LandmarkProfile {
         switch name {
