@@ -105,7 +105,7 @@ func goldenBytes(_ name: String) throws -> [UInt8] {
 
 /// Runs a process to its end; returns stdout and stderr; throws on a nonzero exit.
 @discardableResult
-func run(_ tool: URL, _ arguments: [String], environment: [String: String] = [:], timeout: Double = 600) throws -> (out: String, err: String) {
+func runTool(_ tool: URL, _ arguments: [String], environment: [String: String] = [:], timeout: Double = 600) throws -> (out: String, err: String) {
     let p = Process()
     p.executableURL = tool
     p.arguments = arguments
