@@ -47,7 +47,11 @@ struct PlayedFrame {
         try output.split(separator: "\n").filter { $0.hasPrefix("{") }.map { line in
             let o = try JSONSerialization.jsonObject(with: Data(line.utf8)) as! [String: Any]
             func floats(_ k: String) -> [Float]? { (o[k] as? [NSNumber])?.map { $0.floatValue } }
-            return PlayedFrame(captureTime: (o["capture_time"] as! NSNumber).doubleValue,
+            // The time as printed (%.17g): Double(String) rounds correctly, JSONSerialization
+            // on Linux need not.
+            let time = line.range(of: #""capture_time":[-0-9.eE+]+"#, options: .regularExpression)
+                .map { Double(line[$0].dropFirst(15))! }
+            return PlayedFrame(captureTime: try XCTUnwrap(time),
                                tracking: (o["tracking"] as! NSNumber).intValue,
                                weights: floats("weights")!, headRotation: floats("head_rotation"),
                                profileID: (o["profile_id"] as? NSNumber).map { $0.uint32Value },
@@ -267,7 +271,7 @@ final class RecorderInteropTests: XCTestCase {
         p.executableURL = capture
         p.arguments = ["record", mirror.appendingPathComponent("recordings/livelinkface-alexdjulin/S07-001.csv").path,
                        "--out", folder.path, "--take", "killed", "--realtime", "--flush", "10", "--sdrec",
-                       "--reference-shapes", take.folder.path, "--frames", "1200"]
+                       "--reference-shapes", take.folder.path, "--frames", "400"]
         p.standardOutput = FileHandle.nullDevice
         try p.run()
         let csv = folder.appendingPathComponent("killed.csv")
@@ -284,7 +288,7 @@ final class RecorderInteropTests: XCTestCase {
 
         let rows = ((try? String(contentsOf: csv, encoding: .utf8)) ?? "").split(separator: "\n").count - 1
         XCTAssertGreaterThanOrEqual(rows, 90)
-        XCTAssertLessThan(rows, 1200)
+        XCTAssertLessThan(rows, 400)
         XCTAssertEqual(try convertedFrames(cli, csv, into: folder), rows)
         let i = try info(cli, folder.appendingPathComponent("killed.sdrec"))
         let recorded = Int(i["frames"] as! Double)
@@ -304,10 +308,11 @@ final class RecorderInteropTests: XCTestCase {
         let csv = try Data(contentsOf: r.csvURL), rec = try Data(contentsOf: r.recordingURL!)
         let rowLength = (csv.count - LiveLinkFace.csvHeader.utf8.count - 1) / 20
         let recordLength = try RecordingFormat.encodeRecord(try RecordingFormat.encodeFrame(.init(frame: take.frames[0]))).count
-        for cut in [1, rowLength / 2, rowLength - 1] {
+        // Without its line ending the last row is still whole; cut inside it, it is skipped.
+        for (cut, frames) in [(1, 20), (rowLength / 2, 19), (rowLength - 1, 19)] {
             let cutCSV = folder.appendingPathComponent("cut\(cut).csv")
             try csv.prefix(csv.count - cut).write(to: cutCSV)
-            XCTAssertEqual(try convertedFrames(cli, cutCSV, into: folder), 19, "CSV cut \(cut) bytes before its end")
+            XCTAssertEqual(try convertedFrames(cli, cutCSV, into: folder), frames, "CSV cut \(cut) bytes before its end")
         }
         for cut in [1, recordLength / 2, recordLength - 12] {
             let cutRec = folder.appendingPathComponent("cut\(cut).sdrec")
