@@ -69,23 +69,13 @@ public final class POSIXUDPTransport: DatagramTransport {
             a.sin_family = sa_family_t(AF_INET)
             a.sin_port = port.bigEndian
             withUnsafeMutableBytes(of: &a.sin_addr) { $0.copyBytes(from: address.bytes) }
-            #if canImport(Darwin)
-            a.sin_len = UInt8(MemoryLayout<sockaddr_in>.size)
-            #endif
-            rc = withUnsafePointer(to: &a) {
-                $0.withMemoryRebound(to: sockaddr.self, capacity: 1) { connect(fd, $0, socklen_t(MemoryLayout<sockaddr_in>.size)) }
-            }
+            rc = connectSocket(fd, &a)
         case .ipv6:
             var a = sockaddr_in6()
             a.sin6_family = sa_family_t(AF_INET6)
             a.sin6_port = port.bigEndian
             withUnsafeMutableBytes(of: &a.sin6_addr) { $0.copyBytes(from: address.bytes) }
-            #if canImport(Darwin)
-            a.sin6_len = UInt8(MemoryLayout<sockaddr_in6>.size)
-            #endif
-            rc = withUnsafePointer(to: &a) {
-                $0.withMemoryRebound(to: sockaddr.self, capacity: 1) { connect(fd, $0, socklen_t(MemoryLayout<sockaddr_in6>.size)) }
-            }
+            rc = connectSocket(fd, &a)
         }
         guard rc == 0 else {
             let text = Self.errorText()
@@ -119,6 +109,17 @@ public final class POSIXUDPTransport: DatagramTransport {
     }
 
     static func errorText() -> String { String(cString: strerror(errno)) }
+}
+
+/// `connect` for a `sockaddr_in` or `sockaddr_in6` (on Apple platforms with its length set).
+func connectSocket<Address>(_ fd: Int32, _ address: inout Address) -> Int32 {
+    let size = MemoryLayout<Address>.size
+    #if canImport(Darwin)
+    withUnsafeMutableBytes(of: &address) { $0[0] = UInt8(size) }  // sin_len / sin6_len
+    #endif
+    return withUnsafePointer(to: &address) {
+        $0.withMemoryRebound(to: sockaddr.self, capacity: 1) { connect(fd, $0, socklen_t(size)) }
+    }
 }
 
 /// `close` is shadowed by the transport's own method.

@@ -66,11 +66,11 @@ final class NativeReceiver {
     let output: URL
     let port: UInt16
 
-    init(cli: URL, format: String, recording: URL, folder: URL) throws {
+    init(cli: URL, format: String, recording: URL, folder: URL, bind: String = "127.0.0.1") throws {
         output = folder.appendingPathComponent("receive.log")
         _ = FileManager.default.createFile(atPath: output.path, contents: nil)
         process.executableURL = cli
-        process.arguments = ["receive", "--format", format, "--bind", "127.0.0.1", "--port", "0", "--delay", "0",
+        process.arguments = ["receive", "--format", format, "--bind", bind, "--port", "0", "--delay", "0",
                              "--out", recording.path, "--idle", "1", "--duration", "60", "--quiet"]
         let log = try FileHandle(forWritingTo: output)
         process.standardOutput = log
@@ -106,14 +106,14 @@ final class LoopbackTests: XCTestCase {
     /// Streams the synthetic take with `FrameStreamer` over a POSIX socket to `softdeca receive
     /// --out` and returns what `softdeca play` reads from the recording.
     private func roundTrip(_ format: StreamFormat, profile: LandmarkProfile?, frames: [CaptureFrame],
-                           neutral: [SIMD3<Float>]?) throws -> (played: [PlayedFrame], info: [String: Any], streamer: FrameStreamer) {
+                           neutral: [SIMD3<Float>]?, host: String = "127.0.0.1") throws -> (played: [PlayedFrame], info: [String: Any], streamer: FrameStreamer) {
         let cli = try TestEnvironment.cli()
         let folder = try TestEnvironment.temporaryFolder("loopback-\(format.rawValue)")
         defer { try? FileManager.default.removeItem(at: folder) }
         let recording = folder.appendingPathComponent("take.sdrec")
-        let receiver = try NativeReceiver(cli: cli, format: format.rawValue, recording: recording, folder: folder)
-        let config = CaptureConfiguration(host: "127.0.0.1", port: receiver.port, format: format, profileName: profile?.name)
-        let streamer = try FrameStreamer(configuration: config, transport: try POSIXUDPTransport(host: "127.0.0.1", port: receiver.port),
+        let receiver = try NativeReceiver(cli: cli, format: format.rawValue, recording: recording, folder: folder, bind: host)
+        let config = CaptureConfiguration(host: host, port: receiver.port, format: format, profileName: profile?.name)
+        let streamer = try FrameStreamer(configuration: config, transport: try POSIXUDPTransport(host: host, port: receiver.port),
                                          profile: profile)
         try streamer.start(neutral: neutral)
         try streamer.play(frames)
@@ -171,6 +171,19 @@ final class LoopbackTests: XCTestCase {
             let h = try XCTUnwrap(got.headRotation)
             for c in 0..<4 { XCTAssertEqual(h[c], sent.head!.rotation[c], accuracy: 1e-6) }
         }
+    }
+
+    /// The same sender over IPv6 (::1): weights, poses, times.
+    func testIPv6Loopback() throws {
+        let take = try SyntheticTake.load()
+        let frames = Array(take.frames.prefix(30)).map { f -> CaptureFrame in
+            var g = f
+            g.landmarks = nil
+            return g
+        }
+        let (played, _, _) = try roundTrip(.softdeca, profile: nil, frames: frames, neutral: nil, host: "::1")
+        XCTAssertEqual(played.map(\.captureTime), frames.map(\.timestamp))
+        XCTAssertNil(played.first?.landmarks)
     }
 
     func testIFacialMocapEndToEnd() throws {
