@@ -3,6 +3,7 @@ import ARKit
 import Foundation
 import SoftDecaCapture
 import SwiftUI
+import UIKit
 
 /// The app's state: the AR session (its delegate turns face anchors into frames), the stream to
 /// the receiver, the take being recorded and the live status the screens show. ARKit calls the
@@ -80,12 +81,13 @@ public final class CaptureModel: NSObject, ObservableObject, ARSessionDelegate, 
     /// Starts or stops streaming with the current settings.
     public func setStreaming(_ on: Bool) {
         do {
-            var next: FrameStreamer?
+            var made: FrameStreamer?
             if on {
                 let c = try configuration()
                 let profile = try c.profileName.map { try LandmarkProfile.load(named: $0, arkitReference: Bundle.main.resourceURL) }
-                next = try FrameStreamer(configuration: c, transport: try NetworkTransport(host: c.host, port: c.effectivePort), profile: profile)
+                made = try FrameStreamer(configuration: c, transport: try NetworkTransport(host: c.host, port: c.effectivePort), profile: profile)
             }
+            let next = made
             frameQueue.async {
                 self.streamer = next
                 self.neutralSent = false
@@ -154,7 +156,7 @@ public final class CaptureModel: NSObject, ObservableObject, ARSessionDelegate, 
         do {
             let profile = streamer?.profile ?? recorder?.metadata.profile
             let f = try FaceFrameConverter.frame(from: frame, anchor: anchor, profile: profile,
-                                                 timecodeRate: Timecode.liveLinkFaceRate, withMesh: !neutralSent)
+                                                 timecodeRate: Timecode.liveLinkFaceRate, withMesh: streamer != nil && !neutralSent)
             if let s = streamer {
                 if !neutralSent {
                     // The first mesh stands in for the user's neutral face (calibration).

@@ -46,7 +46,7 @@ struct LiveScreen: View {
             VStack(spacing: 12) {
                 Grid(alignment: .leading) {
                     GridRow { Text("Tracking"); Text(model.trackingText).bold() }
-                    GridRow { Text("Sent"); Text(String(format: "%.1f fps, %d packets", model.fps, model.packetsSent)) }
+                    GridRow { Text("Sent"); Text("\(String(format: "%.1f", model.fps)) fps, \(model.packetsSent) packets") }
                     if model.sendErrors > 0 { GridRow { Text("Errors"); Text("\(model.sendErrors) sends failed") } }
                     if let take = model.recordingTake { GridRow { Text("Recording"); Text("\(take): \(model.framesRecorded) frames") } }
                 }
@@ -56,7 +56,11 @@ struct LiveScreen: View {
                     Toggle("Stream", isOn: Binding(get: { model.streaming }, set: { model.setStreaming($0) }))
                         .toggleStyle(.button)
                     Button(model.recordingTake == nil ? "Record" : "Stop") {
-                        model.recordingTake == nil ? model.startRecording() : model.stopRecording()
+                        if model.recordingTake == nil {
+                            model.startRecording()
+                        } else {
+                            model.stopRecording()
+                        }
                     }
                     .buttonStyle(.borderedProminent)
                     .tint(model.recordingTake == nil ? .red : .gray)
