@@ -253,6 +253,7 @@ final class RecorderInteropTests: XCTestCase {
         let env = ProcessInfo.processInfo.environment
         let python = env["SOFTDECA_PYTHON"] ?? TestEnvironment.repoRoot.appendingPathComponent(".venv/bin/python").path
         var replayEnv = ["SOFTDECA_PYTHON": python]
+        if env["SOFTDECA_ICT"] == nil { replayEnv["SOFTDECA_ICT"] = try TestEnvironment.dataMirror().appendingPathComponent("ict-facekit").path }
         if env["PYTHONPATH"] == nil { replayEnv["PYTHONPATH"] = TestEnvironment.repoRoot.appendingPathComponent("build/release/python").path + ":" + TestEnvironment.repoRoot.appendingPathComponent("training").path }
         try runTool(cli, ["replay", r.csvURL.path, "--bundle", TestEnvironment.repoRoot.appendingPathComponent("models/softdeca-default").path,
                       "--seed", "1", "--frames", "30", "--models", "linear,softdeca", "--out", out.path], environment: replayEnv)
