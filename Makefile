@@ -26,7 +26,7 @@ export CCACHE_BASEDIR := $(CURDIR)
 help:
 	@echo "make demo    render the template, its layers, sampled identities, landmarks -> $(OUT)/demo,"
 	@echo "             then replay a real take through SoftDECA and SparseSoftDECA -> $(OUT)/demo/replay"
-	@echo "make test    run every test (ctest release + ASan/UBSan, pytest, short fuzzing, Swift core)"
+	@echo "make test    run every test (ctest release + ASan/UBSan, pytest, short fuzzing)"
 	@echo "make bench   run the benchmarks -> build/bench/<area>.json"
 	@echo "make setup   install what is missing (apt, .venv, ONNX Runtime root); idempotent"
 	@echo "variables:   ICT=<ICT-FaceKit checkout or archive folder> (default $(ICT)), OUT=$(OUT),"
