@@ -36,7 +36,7 @@ public struct ReferenceFace: Sendable {
         var out = [SIMD3<Float>]()
         out.reserveCapacity(LandmarkProfile.arkitVertexCount)
         for line in text.split(separator: "\n") where line.hasPrefix("v ") {
-            let f = line.split(separator: " ").dropFirst().prefix(3).compactMap { Double($0.trimmingCharacters(in: .whitespaces)) }
+            let f = line.split(separator: " ").dropFirst().prefix(3).compactMap { Double($0.trimmingCharacters(in: .whitespacesAndNewlines)) }
             guard f.count == 3 else { throw CaptureError.format("\(url.lastPathComponent): bad vertex line '\(line)'") }
             out.append(SIMD3(Float(f[0]), Float(f[1]), Float(f[2])))
         }
