@@ -167,3 +167,20 @@ SIMULATE_TAKE ?= $(TAKES)/alex_rom_3.csv
 simulate-demo: build ## a few frames of a real take through the physics model -> out/simulate
 	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \
 	  --out $(OUT)/simulate --level 3 --start 1300 --frames 6 --stride 100 --obj-every 1
+
+# ---- iOS capture core (Swift package ios_capture/) --------------------------------------------
+# `swift test` of the platform-independent core: golden encodings, loopback streams into
+# `softdeca receive`, recorder takes through `softdeca replay`/`convert`/`info`. The toolchain
+# is /opt/swift or `swift` on PATH; without one the tests are skipped, visibly.
+SWIFT ?= $(firstword $(wildcard /opt/swift/usr/bin/swift) $(shell command -v swift 2>/dev/null))
+.PHONY: test-swift
+test: test-swift
+test-swift: build ## the iOS capture core: swift test (skipped without a Swift toolchain)
+	@if [ -z "$(SWIFT)" ]; then \
+	  echo "== Swift tests (ios_capture): SKIPPED, no Swift toolchain (/opt/swift/usr/bin/swift or swift on PATH)"; \
+	else \
+	  echo "== Swift tests (ios_capture, $$($(SWIFT) --version 2>/dev/null | head -n1))"; \
+	  cd ios_capture && nice -n 5 $(SWIFT) build --build-tests -j $(JOBS) && \
+	  SOFTDECA_CLI=$(CURDIR)/$(BUILD)/plugin/cli/softdeca SOFTDECA_PYTHON=$(CURDIR)/$(PY) \
+	    $(SWIFT) test --skip-build; \
+	fi
