@@ -160,3 +160,15 @@ SIMULATE_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/alex_rom_3.csv
 simulate-demo: build
 	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \
 	  --out $(OUT)/simulate --level 3 --start 1300 --frames 6 --stride 100 --obj-every 1
+
+# ---- Unity package -------------------------------------------------------------------------
+# test-unity: the C# core (unity_package/Runtime/Core) compiled by mono and tested with NUnit
+# against this build's library (tests/unity/run). bench-unity: its managed overhead per frame
+# (build/bench/unity.json).
+.PHONY: test-unity bench-unity
+test: test-unity
+bench: bench-unity
+test-unity: build
+	@echo "== Unity core (C# on mono, NUnit)"; PY=$(PY) tests/unity/run $(BUILD)
+bench-unity: build
+	@PY=$(PY) tests/unity/bench $(BUILD)
