@@ -12,7 +12,7 @@
  *      rejects a smaller struct_size with SOFTDECA_ERROR_INVALID_ARGUMENT and a message naming
  *      the struct and both sizes; it reads and writes only the fields it knows, so fields are
  *      only ever appended. Structs are plain data: fixed-width integers, float, double,
- *      pointers, fixed arrays; no bool, no bit fields, no uint32_t, no enum-typed fields (enums
+ *      pointers, fixed arrays; no bool, no bit fields, no size_t, no enum-typed fields (enums
  *      travel as int32_t).
  *   3. Every function returns a softdeca_status, except: the *_destroy functions, which return
  *      void and accept NULL (a no-op); and the static queries softdeca_abi_version,
