@@ -97,7 +97,7 @@ bench: build
 	@$(PY) -m softdeca_train bench-datagen --ict "$(SOFTDECA_ICT)" --out build/bench
 
 lint: setup
-	@$(VENV)/bin/ruff check training tests/python && $(VENV)/bin/ruff format --check training tests/python
+	@$(VENV)/bin/ruff check training tests/python tests/unity && $(VENV)/bin/ruff format --check training tests/python tests/unity
 
 clean:
 	rm -rf build $(OUT)
@@ -163,12 +163,14 @@ simulate-demo: build
 
 # ---- Unity package -------------------------------------------------------------------------
 # test-unity: the C# core (unity_package/Runtime/Core) compiled by mono and tested with NUnit
-# against this build's library (tests/unity/run). bench-unity: its managed overhead per frame
-# (build/bench/unity.json).
+# against this build's library (tests/unity/run); the Unity layer compiled against the
+# declaration-only reference (tests/unity/compile-check); the package check (metas, GUIDs,
+# asmdefs, package.json). bench-unity: the core's managed overhead per frame (build/bench/unity.json).
 .PHONY: test-unity bench-unity
 test: test-unity
 bench: bench-unity
 test-unity: build
 	@echo "== Unity core (C# on mono, NUnit)"; PY=$(PY) tests/unity/run $(BUILD)
+	@echo "== Unity layer and package"; tests/unity/compile-check && $(PY) tests/unity/package.py check
 bench-unity: build
 	@PY=$(PY) tests/unity/bench $(BUILD)
