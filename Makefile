@@ -65,7 +65,7 @@ test-python: build ## pytest
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python --ignore=tests/python/test_training.py
 	@echo "== Python tests (training)"; $(PY) -m pytest -q tests/python/test_training.py
 
-test: lint test-native test-fuzz test-python ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest
+test: lint test-native test-fuzz test-python test-swift ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, Swift
 
 # The demo's replay: frames DEMO_START.. of a real Live Link Face take through linear
 # blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,
@@ -174,7 +174,6 @@ simulate-demo: build ## a few frames of a real take through the physics model ->
 # is /opt/swift or `swift` on PATH; without one the tests are skipped, visibly.
 SWIFT ?= $(firstword $(wildcard /opt/swift/usr/bin/swift) $(shell command -v swift 2>/dev/null))
 .PHONY: test-swift
-test: test-swift
 test-swift: build ## the iOS capture core: swift test (skipped without a Swift toolchain)
 	@if [ -z "$(SWIFT)" ]; then \
 	  echo "== Swift tests (ios_capture): SKIPPED, no Swift toolchain (/opt/swift/usr/bin/swift or swift on PATH)"; \
