@@ -128,7 +128,7 @@ def _failures(frames: list, reason: str) -> list[str]:
 
 # Known failures, measured and kept visible (strict: the test fails once they are fixed, so
 # the mark must go): the volumetric solve inverts muscle tets where the skull wrap runs across
-# cranium and jaw (docs/physics.md, Known problems), which also moves the soft-tissue volume.
+# cranium and jaw (docs/physics.md, Known limits), which also moves the soft-tissue volume.
 _KNOWN = (
     "the LHM's wraps close over the mouth and span cranium and jaw (docs/physics.md)"
 )

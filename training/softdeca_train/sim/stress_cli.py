@@ -9,9 +9,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from softdeca_train.paths import REPO_ROOT
-
-DEFAULT_RECORDINGS = REPO_ROOT.parent / "shared" / "recordings"
+from softdeca_train.paths import data_dir
 
 
 def add_stress_args(p: argparse.ArgumentParser) -> None:
@@ -29,8 +27,9 @@ def add_stress_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--recordings",
-        default=str(DEFAULT_RECORDINGS),
-        help="folder searched for Live Link Face takes (*.csv); '' for none",
+        default=str(data_dir() / "recordings"),
+        help="folder searched for Live Link Face takes (*.csv; default: the data folder's "
+        "recordings); '' for none",
     )
     p.add_argument("--take-stride", type=int, default=10, help="every Nth take frame (10)")
     p.add_argument("--take-identities", type=int, default=3, help="identities on takes (3)")
