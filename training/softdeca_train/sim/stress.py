@@ -71,6 +71,7 @@ class StressPlan:
     takes: tuple[Path, ...] = ()
     take_stride: int = 10
     take_identities: int = 3
+    combinations_only: bool = False  # the combinations without the single shapes
 
 
 def identity_coefficients(template: Template, label: str) -> np.ndarray | None:
@@ -94,8 +95,8 @@ def material_ends() -> dict[str, dict[str, float]]:
 
 
 def build_cases(plan: StressPlan) -> list[StressCase]:
-    exprs = list(all_expressions().items())
     combos = list(combinations().items())
+    exprs = combos if plan.combinations_only else list(all_expressions().items())
     cases = [StressCase("expressions", who, plan.level, exprs) for who in plan.identities]
     first = plan.identities[0]
     if plan.fine_level is not None:

@@ -33,6 +33,9 @@ def add_stress_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--take-stride", type=int, default=10, help="every Nth take frame (10)")
     p.add_argument("--take-identities", type=int, default=3, help="identities on takes (3)")
+    p.add_argument(
+        "--combinations-only", action="store_true", help="leave out the 52 single shapes"
+    )
     p.add_argument("--no-materials", action="store_true", help="skip the material cases")
     p.add_argument("--no-gravity", action="store_true", help="skip the 2 g cases")
     p.add_argument("--no-dynamic", action="store_true", help="skip the dynamic run")
@@ -70,6 +73,7 @@ def run_stress_cli(args: argparse.Namespace) -> int:
         takes=takes,
         take_stride=args.take_stride,
         take_identities=args.take_identities,
+        combinations_only=args.combinations_only,
     )
     template = Template.load(args.ict)
     cases = build_cases(plan)
