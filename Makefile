@@ -65,7 +65,7 @@ test-python: build ## pytest
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python --ignore=tests/python/test_training.py
 	@echo "== Python tests (training)"; $(PY) -m pytest -q tests/python/test_training.py
 
-test: lint test-native test-fuzz test-python test-swift ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, Swift
+test: lint test-native test-fuzz test-python test-swift test-unity ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, Swift, Unity
 
 # The demo's replay: frames DEMO_START.. of a real Live Link Face take through linear
 # blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,
@@ -97,7 +97,7 @@ demo: demo-bundle build ## template, layers, identities, landmarks, then a real 
 	@echo "  preview:       $(OUT)/demo/replay/preview.png"
 	@echo "  timings:       $(OUT)/demo/replay/replay.json"
 
-bench: build bench-runtime ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
+bench: build bench-runtime bench-unity ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
@@ -106,7 +106,7 @@ bench: build bench-runtime ## every benchmark -> build/bench/<area>.json (docs/b
 	@$(PY) -m softdeca_train bench-datagen --ict "$(SOFTDECA_ICT)" --out build/bench
 
 lint: setup ## ruff check and format check of the Python code
-	@$(VENV)/bin/ruff check training tests/python && $(VENV)/bin/ruff format --check training tests/python
+	@$(VENV)/bin/ruff check training tests/python tests/unity && $(VENV)/bin/ruff format --check training tests/python tests/unity
 
 clean: ## remove build/ and out/ (OUT)
 	rm -rf build $(OUT)
@@ -185,3 +185,14 @@ test-swift: build ## the iOS capture core: swift test (skipped without a Swift t
 	  SOFTDECA_CLI=$(CURDIR)/$(BUILD)/plugin/cli/softdeca SOFTDECA_PYTHON=$(CURDIR)/$(PY) \
 	    $(SWIFT) test --skip-build; \
 	fi
+# ---- Unity package -------------------------------------------------------------------------
+# test-unity: the C# core (unity_package/Runtime/Core) compiled by mono and tested with NUnit
+# against this build's library (tests/unity/run); the Unity layer compiled against the
+# declaration-only reference (tests/unity/compile-check); the package check (metas, GUIDs,
+# asmdefs, package.json). bench-unity: the core's managed overhead per frame (build/bench/unity.json).
+.PHONY: test-unity bench-unity
+test-unity: build ## the Unity package: C# core on mono with NUnit, layer compile check, package check
+	@echo "== Unity core (C# on mono, NUnit)"; PY=$(PY) tests/unity/run $(BUILD)
+	@echo "== Unity layer and package"; tests/unity/compile-check && $(PY) tests/unity/package.py check
+bench-unity: build ## managed call overhead of the C# core per frame -> build/bench/unity.json
+	@PY=$(PY) tests/unity/bench $(BUILD)
