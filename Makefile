@@ -87,9 +87,10 @@ demo-bundle: ## check that BUNDLE exists, else say how to make one
 
 demo: demo-bundle build ## template, layers, identities, landmarks, then a real take replayed -> out/demo (OUT)
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo
-	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(DEMO_TAKE) --bundle $(BUNDLE) \
-	  --seed $(DEMO_SEED) --start $(DEMO_START) --frames $(DEMO_FRAMES) --dynamics --preview \
-	  --localised "$(DEMO_LOCALISED)" --out $(OUT)/demo/replay
+	@$(PY) -m softdeca_train avatar --ict "$(SOFTDECA_ICT)" --seed $(DEMO_SEED) --out $(OUT)/demo/replay/avatar
+	@$(BUILD)/plugin/cli/softdeca replay $(DEMO_TAKE) --bundle $(BUNDLE) --avatar $(OUT)/demo/replay/avatar \
+	  --start $(DEMO_START) --frames $(DEMO_FRAMES) --dynamics --localised "$(DEMO_LOCALISED)" --out $(OUT)/demo/replay
+	@$(PY) -m softdeca_train replay-preview --replay $(OUT)/demo/replay
 	@echo "demo replay ($(BUNDLE), identity seed $(DEMO_SEED), $(DEMO_FRAMES) frames of $(notdir $(DEMO_TAKE))):"
 	@echo "  mesh sequence: $(OUT)/demo/replay/{linear,softdeca,sparse,softdeca_localised}.pc2 over $(OUT)/demo/replay/neutral.obj"
 	@echo "                 (PC2 point caches: Blender Mesh Cache modifier; docs/runtime.md)"
@@ -154,9 +155,10 @@ bench-runtime: build ## the native runtime per frame -> build/bench/runtime.json
 
 replay-demo: build ## a whole take through both models with an UNTRAINED bundle -> out/replay
 	@$(PY) -m softdeca_train runtime-bundle --ict "$(SOFTDECA_ICT)" --out $(REPLAY_BUNDLE)
-	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(REPLAY_TAKE) \
-	  --bundle $(REPLAY_BUNDLE) --seed 1 --out $(OUT)/replay --dynamics --preview \
-	  --localised "w_skin_strain=100@0.05,-0.015,0.085,0.03"
+	@$(PY) -m softdeca_train avatar --ict "$(SOFTDECA_ICT)" --seed 1 --out $(OUT)/replay/avatar
+	@$(BUILD)/plugin/cli/softdeca replay $(REPLAY_TAKE) --bundle $(REPLAY_BUNDLE) --avatar $(OUT)/replay/avatar \
+	  --out $(OUT)/replay --dynamics --localised "w_skin_strain=100@0.05,-0.015,0.085,0.03"
+	@$(PY) -m softdeca_train replay-preview --replay $(OUT)/replay
 	@echo "replay (UNTRAINED bundle): $(OUT)/replay/preview.png, $(OUT)/replay/*.pc2 over $(OUT)/replay/neutral.obj, $(OUT)/replay/replay.json"
 
 # ---- Physics ---------------------------------------------------------------------------------
@@ -165,7 +167,7 @@ replay-demo: build ## a whole take through both models with an UNTRAINED bundle 
 SIMULATE_TAKE ?= $(TAKES)/alex_rom_3.csv
 .PHONY: simulate-demo
 simulate-demo: build ## a few frames of a real take through the physics model -> out/simulate
-	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \
+	@$(PY) -m softdeca_train simulate $(SIMULATE_TAKE) \
 	  --out $(OUT)/simulate --level 3 --start 1300 --frames 6 --stride 100 --obj-every 1
 
 # ---- iOS capture core (Swift package ios_capture/) --------------------------------------------
