@@ -53,6 +53,12 @@ def test_bounds_name_each_failure() -> None:
     assert math.isnan(closed.open_ratio) and closed.failures() == []
     assert _check(inverted_elements=1).failures() == ["inverted_elements"]
     assert _check(volume_physics_percent=-1.2).failures() == ["volume"]
+    # A soft tissue asked to grow 7.6 % (target_volume 1.076; a generated shard: physics
+    # +4.3 %, linear -1.0 %) is measured from that request, not from the rest volume.
+    grown = {"volume_physics_percent": 4.3, "volume_linear_percent": -1.0}
+    assert _check(**grown).failures() == ["volume"]
+    assert _check(**grown, volume_requested_percent=7.6).failures() == []
+    assert _check(**grown, volume_requested_percent=-2.0).failures() == ["volume"]
     assert _check(converged=False).failures() == ["not_converged"]
     both = [_check(), _check(penetrating_physics=9, inverted_elements=2)]
     counts = failure_counts(both)
@@ -196,6 +202,8 @@ def test_jaw_and_skin_motion_do_not_invert_the_muscle_layer(
     """With the jaw's skull vertices behind the oral cavity pinned to the jaw, jawOpen 1 left
     278 inverted tets on the template at level 3; with a 2 mm muscle layer behind the sockets,
     eyeBlinkLeft 1 left 5 and mouthSmileLeft 1 36 (docs/physics.md, Inverted elements)."""
-    case = StressCase("single", "template", LEVEL, [(shape, single_shapes()[f"{shape}=1"])])
+    case = StressCase(
+        "single", "template", LEVEL, [(shape, single_shapes()[f"{shape}=1"])]
+    )
     (frame,) = run_stress(template, [case], keep_worst=0, progress=False).frames
     assert frame.check.inverted_elements <= most, frame.check.as_dict()

@@ -28,6 +28,10 @@ def _decade(default: float) -> tuple[float, float]:
 
 
 _TEN_PERCENT = (0.9, 1.1)
+# The pinned bones scale about their pivots: 5 % moves skull vertices 4-5 mm, farther than
+# the muscle layer is thick over most of the head, so the bone crosses the muscle wrap at rest
+# (docs/physics.md, Known limits).
+_BONE_SCALE = (0.98, 1.02)
 PROFILES: dict[str, dict[str, tuple[float, float]]] = {
     "appendix-a": {},
     "plausible": {"w_target": (1.0, 100.0), "w_regularisation": (0.1, 10.0)},
@@ -48,12 +52,12 @@ PROFILES: dict[str, dict[str, tuple[float, float]]] = {
         "max_strain": _TEN_PERCENT,
         "gravity_strength": (1.0, 1.2),
         "gravity_tilt": (0.0, 30.0),
-        "cranium_scale_x": _TEN_PERCENT,
-        "cranium_scale_y": _TEN_PERCENT,
-        "cranium_scale_z": _TEN_PERCENT,
-        "jaw_scale_x": _TEN_PERCENT,
-        "jaw_scale_y": _TEN_PERCENT,
-        "jaw_scale_z": _TEN_PERCENT,
+        "cranium_scale_x": _BONE_SCALE,
+        "cranium_scale_y": _BONE_SCALE,
+        "cranium_scale_z": _BONE_SCALE,
+        "jaw_scale_x": _BONE_SCALE,
+        "jaw_scale_y": _BONE_SCALE,
+        "jaw_scale_z": _BONE_SCALE,
     },
 }
 DEFAULT_PROFILE = "interactive"
