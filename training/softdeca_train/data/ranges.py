@@ -8,8 +8,8 @@ off S (p99 56 mm, max 0.8 m), a sagging mask rather than a face. A network is on
 and its bundle only accepts, the sampled ranges (the manifest records them).
 
 `interactive` samples what a user moves live around the defaults: every constraint weight
-within a decade of its default, skull and jaw scale, target volume and the strain limit within
-10 %, gravity up to 1.2 g and 30 degrees off vertical. Measured on softdeca-l3-v3 (`plausible`):
+within a decade of its default, target volume and the strain limit within 10 %, skull and jaw
+scale within 2 %, gravity up to 1.2 g and 30 degrees off vertical. Measured on softdeca-l3-v3 (`plausible`):
 69 % of |T - S| of its static frames is an offset shared by the frames of an (identity, p)
 group, independent of the expression (data/offset_structure.py), and with weights spread over
 five decades and skulls scaled by up to 50 % nothing learned it from 120 parameter sets (ridge
