@@ -174,19 +174,3 @@ test-unity: build
 	@echo "== Unity layer and package"; tests/unity/compile-check && $(PY) tests/unity/package.py check
 bench-unity: build
 	@PY=$(PY) tests/unity/bench $(BUILD)
-
-# unity-package: a UPM tarball (Package Manager > Add package from tarball) with the native
-# binaries built here: Linux x86_64 (this build) and Windows x64 (plugin/platforms/windows-x64.sh,
-# MinGW cross build, checked under wine) -> build/unity-package/com.softdeca.facial-animation-<version>.tgz.
-# windows-x64 alone: the cross build and its wine checks.
-UNITY_PKG := build/unity-package
-.PHONY: unity-package windows-x64
-windows-x64: build
-	@PY=$(PY) plugin/platforms/windows-x64.sh build/windows-x64
-unity-package: build windows-x64
-	@rm -rf $(UNITY_PKG)/binaries; mkdir -p $(UNITY_PKG)/binaries/Plugins/Linux/x86_64 $(UNITY_PKG)/binaries/Plugins/Windows/x86_64
-	@cp $(BUILD)/plugin/libsoftdeca.so $(UNITY_PKG)/binaries/Plugins/Linux/x86_64/libsoftdeca.so
-	@cp -L $(ORT_ROOT)/lib/libonnxruntime.so.1 $(UNITY_PKG)/binaries/Plugins/Linux/x86_64/libonnxruntime.so.1
-	@cp build/windows-x64/bin/softdeca.dll build/windows-x64/bin/onnxruntime.dll $(UNITY_PKG)/binaries/Plugins/Windows/x86_64/
-	@$(PY) tests/unity/package.py pack --binaries $(UNITY_PKG)/binaries \
-	  --out $(UNITY_PKG)/com.softdeca.facial-animation-$$($(PY) -c "import json; print(json.load(open('unity_package/package.json'))['version'])").tgz

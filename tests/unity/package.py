@@ -54,7 +54,6 @@ PLUGINS = [
     Plugin("Plugins/macOS/softdeca.bundle", "OSXUniversal", "AnyCPU", "OSX"),
     Plugin("Plugins/iOS/libsoftdeca.a", "iOS", "AnyCPU", None),
     Plugin("Plugins/Android/arm64-v8a/libsoftdeca.so", "Android", "ARM64", None),
-    Plugin("Plugins/Android/arm64-v8a/libonnxruntime.so", "Android", "ARM64", None),
 ]
 
 

@@ -13,30 +13,10 @@
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
-#ifdef _WIN32
-#include <malloc.h>
-#endif
 
 namespace softdeca::runtime {
 
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
-
-// std::aligned_alloc is missing from the Windows C runtime (MinGW and MSVC): _aligned_malloc there.
-inline void* allocate_aligned(std::size_t align, std::size_t bytes) {
-#ifdef _WIN32
-  return _aligned_malloc(bytes, align);
-#else
-  return std::aligned_alloc(align, bytes);
-#endif
-}
-
-inline void free_aligned(void* p) {
-#ifdef _WIN32
-  _aligned_free(p);
-#else
-  std::free(p);
-#endif
-}
 
 template <class T>
 class AlignedArray {
@@ -49,18 +29,18 @@ class AlignedArray {
       : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)), allocated_(std::exchange(o.allocated_, 0)) {}
   AlignedArray& operator=(AlignedArray&& o) noexcept {
     if (this != &o) {
-      free_aligned(data_);
+      std::free(data_);
       data_ = std::exchange(o.data_, nullptr);
       size_ = std::exchange(o.size_, 0);
       allocated_ = std::exchange(o.allocated_, 0);
     }
     return *this;
   }
-  ~AlignedArray() { free_aligned(data_); }
+  ~AlignedArray() { std::free(data_); }
 
   // Zero-filled; throws std::bad_alloc.
   void resize(std::size_t n) {
-    free_aligned(data_);
+    std::free(data_);
     data_ = nullptr;
     size_ = 0;
     allocated_ = 0;
@@ -68,7 +48,7 @@ class AlignedArray {
     const bool huge = n * sizeof(T) >= kHugePage;
     const std::size_t align = huge ? kHugePage : 64;
     const std::size_t bytes = (n * sizeof(T) + align - 1) / align * align;
-    data_ = static_cast<T*>(allocate_aligned(align, bytes));
+    data_ = static_cast<T*>(std::aligned_alloc(align, bytes));
     if (!data_) throw std::bad_alloc();
 #ifdef __linux__
     if (huge) madvise(data_, bytes, MADV_HUGEPAGE);  // advice only: failure is harmless
