@@ -3,7 +3,7 @@
 #include <cstring>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 
 #ifdef _WIN32
 #pragma comment(lib, "ws2_32.lib")
