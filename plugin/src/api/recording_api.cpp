@@ -52,6 +52,15 @@ void report_out(const recording::ConversionReport& r, softdeca_convert_report* o
   out->face_lost_rows = static_cast<uint32_t>(r.face_lost_rows);
   out->malformed_rows = static_cast<uint32_t>(r.malformed_rows);
 }
+
+// The arguments both file conversions take: two paths, a timecode rate and an optional report.
+void check_conversion(const char* from, const char* from_name, const char* to, const char* to_name, double timecode_rate,
+                      softdeca_convert_report* out_report) {
+  require_not_null(from, from_name);
+  require_not_null(to, to_name);
+  require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000, "timecode_rate must be in [0, 1000]");
+  if (out_report) require_struct(out_report, "out_report");
+}
 }  // namespace
 
 extern "C" {
@@ -217,11 +226,7 @@ SOFTDECA_API softdeca_status softdeca_convert_livelinkface_csv(const char* csv_p
                                                                double timecode_rate,
                                                                softdeca_convert_report* out_report) {
   return guarded(__func__, [&] {
-    require_not_null(csv_path, "csv_path");
-    require_not_null(recording_path, "recording_path");
-    require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000,
-            "timecode_rate must be in [0, 1000]");
-    if (out_report) require_struct(out_report, "out_report");
+    check_conversion(csv_path, "csv_path", recording_path, "recording_path", timecode_rate, out_report);
     report_out(recording::csv_to_recording(csv_path, recording_path, timecode_rate), out_report);
   });
 }
@@ -230,11 +235,7 @@ SOFTDECA_API softdeca_status softdeca_export_livelinkface_csv(const char* record
                                                               double timecode_rate,
                                                               softdeca_convert_report* out_report) {
   return guarded(__func__, [&] {
-    require_not_null(recording_path, "recording_path");
-    require_not_null(csv_path, "csv_path");
-    require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000,
-            "timecode_rate must be in [0, 1000]");
-    if (out_report) require_struct(out_report, "out_report");
+    check_conversion(recording_path, "recording_path", csv_path, "csv_path", timecode_rate, out_report);
     report_out(recording::recording_to_csv(recording_path, csv_path, timecode_rate), out_report);
   });
 }

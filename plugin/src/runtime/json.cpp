@@ -46,6 +46,19 @@ class JsonParser {
     while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\n' || s_[pos_] == '\r' || s_[pos_] == '\t'))
       ++pos_;
   }
+  // After an object member or array element: true at ',' (another follows), false at `close`.
+  bool another_item(char close) {
+    skip_space();
+    if (pos_ < s_.size() && s_[pos_] == ',') {
+      ++pos_;
+      return true;
+    }
+    if (pos_ < s_.size() && s_[pos_] == close) {
+      ++pos_;
+      return false;
+    }
+    error(std::string("expected ',' or '") + close + "'");
+  }
   bool consume(const char* word) {
     std::size_t n = 0;
     while (word[n]) ++n;
@@ -73,10 +86,7 @@ class JsonParser {
         if (pos_ >= s_.size() || s_[pos_] != ':') error("expected ':'");
         ++pos_;
         v.object_.emplace_back(std::move(key), value(depth + 1));
-        skip_space();
-        if (pos_ < s_.size() && s_[pos_] == ',') { ++pos_; continue; }
-        if (pos_ < s_.size() && s_[pos_] == '}') { ++pos_; return v; }
-        error("expected ',' or '}'");
+        if (!another_item('}')) return v;
       }
     }
     if (c == '[') {
@@ -86,10 +96,7 @@ class JsonParser {
       if (pos_ < s_.size() && s_[pos_] == ']') { ++pos_; return v; }
       for (;;) {
         v.array_.push_back(value(depth + 1));
-        skip_space();
-        if (pos_ < s_.size() && s_[pos_] == ',') { ++pos_; continue; }
-        if (pos_ < s_.size() && s_[pos_] == ']') { ++pos_; return v; }
-        error("expected ',' or ']'");
+        if (!another_item(']')) return v;
       }
     }
     if (c == '"') {
