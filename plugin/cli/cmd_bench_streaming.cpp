@@ -13,6 +13,7 @@
 
 #include <sys/resource.h>
 
+#include "bench_figures.h"
 #include "command.h"
 #include "json.h"
 #include "options.h"
@@ -29,14 +30,6 @@ using stream::percentile;
 using stream::steady_seconds;
 
 constexpr std::size_t kLandmarks = 149;  // SparseSoftDECA's landmark profile (softdeca149)
-
-// The 1-minute load average (Linux), to tell the reader how busy the machine was.
-double load_average() {
-  std::ifstream in("/proc/loadavg");
-  double load = -1;
-  in >> load;
-  return load;
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -181,12 +174,6 @@ RecordingRates recording_run(const std::string& path, std::size_t frames) {
   std::fclose(f);
   std::remove(path.c_str());
   return {double(frames) / write_s, double(frames) / read_s, bytes / double(frames)};
-}
-
-std::string figure(double value, const char* unit, const std::string& target, const char* better,
-                   const std::string& how) {
-  return JsonObject().number("value", value).text("unit", unit).raw("target", target).text("better", better)
-      .text("how", how).str();
 }
 
 }  // namespace

@@ -35,7 +35,11 @@ class NativeError(RuntimeError):
 
 
 class ModelOptions(C.Structure):
-    _fields_ = [("size", C.c_uint32), ("prepare_threads", C.c_uint32)]
+    _fields_ = [
+        ("size", C.c_uint32),
+        ("prepare_threads", C.c_uint32),
+        ("memory_budget_bytes", C.c_uint64),
+    ]
 
 
 class ModelInfo(C.Structure):
