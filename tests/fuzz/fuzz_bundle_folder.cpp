@@ -5,14 +5,14 @@
 //
 // Input: entries of [kind % 5][name length][name][content length][content]; kind 0 file,
 // 1 link to content, 2 FIFO, 3 folder, 4 link to the secret file.
-#include <unistd.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -30,10 +30,17 @@ fs::path workspace() {
   static const fs::path dir = [] {
     fs::path d = fs::temp_directory_path() / ("softdeca-fuzz-folder-" + std::to_string(::getpid()));
     fs::create_directories(d);
-    std::ofstream(d / "secret") << kSecret;
     return d;
   }();
   return dir;
+}
+
+// The harness itself must not block: no following links, no waiting for a FIFO's reader.
+void write_file(const fs::path& path, const std::string& content) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0600);
+  if (fd < 0) return;
+  if (::write(fd, content.data(), content.size()) < 0) { /* a short file is fine */ }
+  ::close(fd);
 }
 
 // Names stay inside the bundle folder: [a-z0-9._/], no leading slash, no "..".
@@ -54,6 +61,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::error_code ec;
   fs::remove_all(bundle, ec);
   fs::create_directories(bundle);
+  fs::remove(workspace() / "secret", ec);  // links in the last input may have replaced it
+  write_file(workspace() / "secret", kSecret);
   std::vector<std::string> names = {"manifest.json"};
   std::size_t pos = 0;
   const auto take = [&](std::size_t n) {
@@ -68,8 +77,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string content = pos < size ? take(data[pos++]) : std::string();
     const fs::path path = bundle / name;
     fs::create_directories(path.parent_path(), ec);
+    fs::remove_all(path, ec);
     switch (kind) {
-      case 0: std::ofstream(path, std::ios::binary) << content; break;
+      case 0: write_file(path, content); break;
       case 1: fs::create_symlink(content.empty() ? "x" : content, path, ec); break;
       case 2: ::mkfifo(path.c_str(), 0600); break;
       case 3: fs::create_directories(path, ec); break;
