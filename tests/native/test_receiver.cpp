@@ -170,7 +170,9 @@ TEST(Receiver, HostileDatagramsAreDroppedAndCountedAndTheStreamGoesOn) {
 }
 
 TEST(Receiver, AutomaticFormatTakesLiveLinkFaceAndIFacialMocapToo) {
-  Receiver r(loopback(Format::automatic, 0.0));
+  ReceiverConfig c = loopback(Format::automatic, 0.0);
+  c.follow_newest = true;  // two senders, one after the other (docs/security.md)
+  Receiver r(c);
   const Endpoint to = make_endpoint("127.0.0.1", r.port());
   FrameSender llf(to, Format::livelinkface, 0);
   Frame f = make_frame(4);

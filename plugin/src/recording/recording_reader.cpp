@@ -41,11 +41,11 @@ class PrefixCrc {
  public:
   explicit PrefixCrc(const uint8_t* data) : data_(data), ring_(kWindow) {}
 
-  // crc32 of [a, b); a must not lie before the first a of this stretch nor more than kWindow
-  // before the furthest b so far (records are shorter).
+  // crc32 of [a, b); a must not lie before the first call's a nor kWindow or more before the
+  // furthest b so far (records are shorter).
   uint32_t range(std::size_t a, std::size_t b, std::size_t& checksum_bytes) {
-    if (!started_ || a > filled_) {
-      filled_ = a;  // a new stretch: prefixes count from a
+    if (!started_) {  // prefixes count from the first byte asked for; later calls never ask before it
+      filled_ = a;
       ring_[a & kMask] = 0;
       started_ = true;
     }
@@ -56,7 +56,7 @@ class PrefixCrc {
  private:
   static constexpr std::size_t kWindow = std::size_t{1} << 17;  // > a record's header and payload
   static constexpr std::size_t kMask = kWindow - 1;
-  // crc32 from the stretch's start to i.
+  // crc32 from the first call's a to i.
   uint32_t prefix(std::size_t i, std::size_t& checksum_bytes) {
     if (i <= filled_) return ring_[i & kMask];
     checksum_bytes += i - filled_;
@@ -77,8 +77,9 @@ std::size_t good_record(const uint8_t* data, std::size_t size, std::size_t at, P
   const std::size_t length = framed_length(data, size, at);
   if (length == 0) return 0;
   const std::size_t payload = at + kRecordHeaderBytes;
-  const uint32_t crc = stream::crc32_combine(window.range(at + 4, at + 8, checksum_bytes),
-                                             window.range(payload, payload + length, checksum_bytes), length);
+  const uint32_t length_crc = window.range(at + 4, at + 8, checksum_bytes);  // first: the window moves forward
+  const uint32_t payload_crc = window.range(payload, payload + length, checksum_bytes);
+  const uint32_t crc = stream::crc32_combine(length_crc, payload_crc, length);
   return crc == load_u32(data + at + 8) ? kRecordHeaderBytes + length : 0;
 }
 
