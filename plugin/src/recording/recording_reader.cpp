@@ -50,7 +50,15 @@ class PrefixCrc {
       started_ = true;
     }
     const uint32_t before = prefix(a, checksum_bytes);
-    return stream::crc32_combine(before, 0, b - a) ^ prefix(b, checksum_bytes);
+    return stream::crc32_apply(shift(b - a), before) ^ prefix(b, checksum_bytes);
+  }
+
+  // crc32_shift(n) from a table filled on demand (n is at most a record's length): a crafted
+  // file may give every candidate another length.
+  uint32_t shift(std::size_t n) {
+    if (shifts_.empty()) shifts_.push_back(stream::crc32_shift(0));
+    while (shifts_.size() <= n) shifts_.push_back(stream::crc32_apply(shifts_.back(), stream::crc32_shift(1)));
+    return shifts_[n];
   }
 
  private:
@@ -65,6 +73,7 @@ class PrefixCrc {
   }
   const uint8_t* data_;
   std::vector<uint32_t> ring_;
+  std::vector<uint32_t> shifts_;
   std::size_t filled_ = 0;  // prefixes are known up to here
   bool started_ = false;
 };
@@ -79,7 +88,7 @@ std::size_t good_record(const uint8_t* data, std::size_t size, std::size_t at, P
   const std::size_t payload = at + kRecordHeaderBytes;
   const uint32_t length_crc = window.range(at + 4, at + 8, checksum_bytes);  // first: the window moves forward
   const uint32_t payload_crc = window.range(payload, payload + length, checksum_bytes);
-  const uint32_t crc = stream::crc32_combine(length_crc, payload_crc, length);
+  const uint32_t crc = stream::crc32_apply(window.shift(length), length_crc) ^ payload_crc;
   return crc == load_u32(data + at + 8) ? kRecordHeaderBytes + length : 0;
 }
 

@@ -45,13 +45,18 @@ uint32_t crc32(const void* data, std::size_t size, uint32_t crc) {
   return ~crc;
 }
 
-uint32_t crc32_combine(uint32_t crc_a, uint32_t crc_b, std::size_t size_b) {
-  // x^(8 size_b): the shift of A's checksum past B's bytes.
+uint32_t crc32_shift(std::size_t size_b) {
   uint32_t shift = 1u << 31;  // x^0
-  unsigned k = 3;
+  unsigned k = 3;             // x^(8 size_b) = product of x^(2^k) over the bits of size_b, shifted by 3
   for (std::size_t n = size_b; n != 0; n >>= 1, ++k)
     if (n & 1) shift = multiply(kPowers[k & 31], shift);
-  return multiply(shift, crc_a) ^ crc_b;
+  return shift;
+}
+
+uint32_t crc32_apply(uint32_t shift, uint32_t crc) { return multiply(shift, crc); }
+
+uint32_t crc32_combine(uint32_t crc_a, uint32_t crc_b, std::size_t size_b) {
+  return multiply(crc32_shift(size_b), crc_a) ^ crc_b;
 }
 
 }  // namespace softdeca::stream
