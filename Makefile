@@ -3,7 +3,9 @@
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-ICT       ?= ../shared/ict-facekit
+DATA      ?= .cache/data
+ICT       ?= $(DATA)/ict-facekit
+TAKES     := $(DATA)/recordings/livelinkface-alexdjulin
 OUT       ?= out
 JOBS      ?= $(shell nproc)
 VENV      := .venv
@@ -13,6 +15,7 @@ ASAN      := build/asan
 ORT_ROOT  := $(CURDIR)/.deps/onnxruntime
 # training/ first: the shared .venv may hold an editable install of another checkout.
 export PYTHONPATH := $(CURDIR)/$(BUILD)/python:$(CURDIR)/training
+export SOFTDECA_DATA := $(abspath $(DATA))
 export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
 export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
@@ -23,29 +26,34 @@ export CCACHE_BASEDIR := $(CURDIR)
 
 .PHONY: help setup build build-asan test test-native test-python demo bench lint clean
 
-help:
-	@echo "make demo    render the template, its layers, sampled identities, landmarks -> $(OUT)/demo,"
-	@echo "             then replay a real take through SoftDECA and SparseSoftDECA -> $(OUT)/demo/replay"
-	@echo "make test    run every test (ctest release + ASan/UBSan, pytest, short fuzzing)"
-	@echo "make bench   run the benchmarks -> build/bench/<area>.json"
-	@echo "make setup   install what is missing (apt, .venv, ONNX Runtime root); idempotent"
-	@echo "variables:   ICT=<ICT-FaceKit checkout or archive folder> (default $(ICT)), OUT=$(OUT),"
-	@echo "             BUNDLE=<model bundle folder or .tar> (default $(BUNDLE))"
+# Every target is listed by `make help`: those with a `## description` on their rule line with
+# it, any other under "more targets".
+help: ## this list
+	@echo "usage: make <target> [VARIABLE=value ...]"
+	@awk -F':' '/^[a-zA-Z][a-zA-Z0-9_-]*:([^=]|$$)/ { t = $$1; d = ""; \
+	    if (match($$0, /## .*/)) d = substr($$0, RSTART + 3); \
+	    if (!(t in seen)) { seen[t] = 1; n++; name[n] = t }; if (d != "") desc[t] = d } \
+	  END { for (i = 1; i <= n; i++) if (name[i] in desc) printf "  %-14s %s\n", name[i], desc[name[i]]; \
+	        more = ""; for (i = 1; i <= n; i++) if (!(name[i] in desc)) more = more " " name[i]; \
+	        if (more != "") print "  more targets:" more }' $(MAKEFILE_LIST)
+	@echo "variables: DATA=<third-party data folder> (default $(DATA)), ICT=<ICT-FaceKit checkout,"
+	@echo "  FaceXModel folder or archive> (default $(ICT)), OUT=$(OUT), BUNDLE=<model bundle folder or"
+	@echo "  .tar> (default $(BUNDLE)), JOBS=$(JOBS); SOFTDECA_DATA_MIRROR=<mirror folder> (THIRD_PARTY.md)"
 
-setup:
+setup: ## install what is missing (apt, .venv, ONNX Runtime root, third-party data); idempotent
 	@.ci/setup
 
-build: setup
+build: setup ## release build in build/release
 	@mkdir -p build; cmake -S . -B $(BUILD) -G Ninja $(LAUNCHER) -DCMAKE_BUILD_TYPE=Release -DONNXRUNTIME_ROOT=$(ORT_ROOT) \
 	  -DPython_EXECUTABLE=$(CURDIR)/$(PY) > $(BUILD).configure.log 2>&1 || { cat $(BUILD).configure.log; exit 1; }
 	@cmake --build $(BUILD) -j $(JOBS)
 
-build-asan: setup
+build-asan: setup ## ASan+UBSan build in build/asan
 	@mkdir -p build; cmake -S . -B $(ASAN) -G Ninja $(LAUNCHER) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOFTDECA_SANITIZE=ON \
 	  -DONNXRUNTIME_ROOT=$(ORT_ROOT) > $(ASAN).configure.log 2>&1 || { cat $(ASAN).configure.log; exit 1; }
 	@cmake --build $(ASAN) -j $(JOBS)
 
-test-native: build build-asan
+test-native: build build-asan ## ctest on both builds
 	@echo "== native tests (release)";  ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 	@echo "== native tests (ASan+UBSan)"; ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
@@ -53,31 +61,31 @@ test-native: build build-asan
 # The training tests run in a process of their own: after the rest of the suite in one
 # process, the first of them died with SIGSEGV twice (not reproduced by any subset of the
 # modules; see docs/training.md, "Known problems").
-test-python: build
+test-python: build ## pytest
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python --ignore=tests/python/test_training.py
 	@echo "== Python tests (training)"; $(PY) -m pytest -q tests/python/test_training.py
 
-test: lint test-native test-fuzz test-python
+test: lint test-native test-fuzz test-python ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest
 
 # The demo's replay: frames DEMO_START.. of a real Live Link Face take through linear
 # blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,
 # plus one localised change (stiffer soft tissue in a 3 cm ball on the subject's left cheek).
 BUNDLE         ?= models/softdeca-default
-DEMO_TAKE      ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
+DEMO_TAKE      ?= $(TAKES)/S07-001.csv
 DEMO_SEED      ?= 1
 DEMO_START     ?= 360
 DEMO_FRAMES    ?= 240
 DEMO_LOCALISED ?= w_soft_strain=max@0.05,-0.015,0.085,0.03
 
 .PHONY: demo-bundle
-demo-bundle:
+demo-bundle: ## check that BUNDLE exists, else say how to make one
 	@[ -f "$(BUNDLE)/manifest.json" ] || [ -f "$(BUNDLE)" ] || { \
 	  echo "make demo: no model bundle at '$(BUNDLE)' (a folder with manifest.json, or a .tar; docs/bundle.md)."; \
 	  echo "  The trained bundle is made by:  $(PY) -m softdeca_train train-bundle"; \
 	  echo "  For an UNTRAINED stand-in:      $(PY) -m softdeca_train runtime-bundle --out build/bundles/random-untrained"; \
 	  echo "                                  make demo BUNDLE=build/bundles/random-untrained"; exit 1; }
 
-demo: demo-bundle build
+demo: demo-bundle build ## template, layers, identities, landmarks, then a real take replayed -> out/demo (OUT)
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo
 	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(DEMO_TAKE) --bundle $(BUNDLE) \
 	  --seed $(DEMO_SEED) --start $(DEMO_START) --frames $(DEMO_FRAMES) --dynamics --preview \
@@ -88,7 +96,7 @@ demo: demo-bundle build
 	@echo "  preview:       $(OUT)/demo/replay/preview.png"
 	@echo "  timings:       $(OUT)/demo/replay/replay.json"
 
-bench: build
+bench: build bench-runtime ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json
@@ -97,13 +105,13 @@ bench: build
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench-datagen --ict "$(SOFTDECA_ICT)" --out build/bench
 
-lint: setup
+lint: setup ## ruff check and format check of the Python code
 	@$(VENV)/bin/ruff check training tests/python && $(VENV)/bin/ruff format --check training tests/python
 
-clean:
+clean: ## remove build/ and out/ (OUT)
 	rm -rf build $(OUT)
 
-# ---- Streaming and recorded takes (issue 7): fuzzing -------------------------------------------
+# ---- Fuzzing the streaming and recording parsers -------------------------------------------------
 # libFuzzer targets of the streaming parsers (tests/fuzz), built by clang in build/fuzz.
 # test-fuzz: a few seconds each on the committed corpus; fuzz-long: the long runs of
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
@@ -114,12 +122,12 @@ FUZZ_SECONDS ?= 620
 
 .PHONY: fuzz-build test-fuzz fuzz-long
 
-fuzz-build: setup
+fuzz-build: setup ## build the libFuzzer targets (clang) in build/fuzz
 	@mkdir -p build; CXX=clang++ cmake -S tests/fuzz -B $(FUZZ) -G Ninja $(LAUNCHER) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  > $(FUZZ).configure.log 2>&1 || { cat $(FUZZ).configure.log; exit 1; }
 	@cmake --build $(FUZZ) -j $(JOBS)
 
-test-fuzz: fuzz-build
+test-fuzz: fuzz-build ## 3 s of fuzzing per target on the committed corpus
 	@echo "== fuzzing (3 s per target on tests/fuzz/corpus)"
 	@for t in $(FUZZ_TARGETS); do \
 	  tmp=$$(mktemp -d); \
@@ -128,37 +136,53 @@ test-fuzz: fuzz-build
 	  echo "fuzz_$$t: $$(grep -o 'Done [0-9]* runs' $$tmp/log), no crash"; rm -rf $$tmp; \
 	done
 
-fuzz-long: fuzz-build
+fuzz-long: fuzz-build ## the long fuzzing runs of docs/fuzzing.md (FUZZ_SECONDS each)
 	@mkdir -p build/fuzz-long
 	@echo "$(FUZZ_TARGETS)" | tr ' ' '\n' | xargs -P 2 -I{} sh -c 'mkdir -p build/fuzz-long/{}/corpus && \
 	  nice -n 10 $(FUZZ)/fuzz_{} -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 -rss_limit_mb=2048 \
 	  -artifact_prefix=build/fuzz-long/{}/ build/fuzz-long/{}/corpus tests/fuzz/corpus/{} \
 	  > build/fuzz-long/{}.log 2>&1; echo "fuzz_{}: exit $$?, $$(grep -o "Done [0-9]* runs in [0-9]* second(s)" build/fuzz-long/{}.log)"'
 
-# ---- Runtime (issue 6) -----------------------------------------------------------------------
+# ---- Runtime: benchmark and replay with an untrained bundle ----------------------------------
 # `make bench` also measures the native runtime (build/bench/runtime.json). `make replay-demo`
 # replays a whole real take through both models with an UNTRAINED random bundle (exported on the
 # fly) and prints where the results are; `make demo` replays part of a take with $(BUNDLE).
-REPLAY_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/S07-001.csv
+REPLAY_TAKE ?= $(TAKES)/S07-001.csv
 REPLAY_BUNDLE ?= build/bundles/random-untrained
 .PHONY: bench-runtime replay-demo
-bench: bench-runtime
-bench-runtime: build
+bench-runtime: build ## the native runtime per frame -> build/bench/runtime.json
 	@mkdir -p build/bench
 	@$(PY) -m softdeca_train runtime-bench --ict "$(SOFTDECA_ICT)" --out build/bench
 
-replay-demo: build
+replay-demo: build ## a whole take through both models with an UNTRAINED bundle -> out/replay
 	@$(PY) -m softdeca_train runtime-bundle --ict "$(SOFTDECA_ICT)" --out $(REPLAY_BUNDLE)
 	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(REPLAY_TAKE) \
 	  --bundle $(REPLAY_BUNDLE) --seed 1 --out $(OUT)/replay --dynamics --preview \
 	  --localised "w_skin_strain=100@0.05,-0.015,0.085,0.03"
 	@echo "replay (UNTRAINED bundle): $(OUT)/replay/preview.png, $(OUT)/replay/*.pc2 over $(OUT)/replay/neutral.obj, $(OUT)/replay/replay.json"
 
-# ---- Physics (issue 3) -----------------------------------------------------------------------
+# ---- Physics ---------------------------------------------------------------------------------
 # `make simulate-demo`: a few frames of a real take through the physics model (LHM level 3):
 # point caches, OBJ sequence, side-by-side render and summary in $(OUT)/simulate.
-SIMULATE_TAKE ?= ../shared/recordings/livelinkface-alexdjulin/alex_rom_3.csv
+SIMULATE_TAKE ?= $(TAKES)/alex_rom_3.csv
 .PHONY: simulate-demo
-simulate-demo: build
+simulate-demo: build ## a few frames of a real take through the physics model -> out/simulate
 	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \
 	  --out $(OUT)/simulate --level 3 --start 1300 --frames 6 --stride 100 --obj-every 1
+
+# ---- iOS capture core (Swift package ios_capture/) --------------------------------------------
+# `swift test` of the platform-independent core: golden encodings, loopback streams into
+# `softdeca receive`, recorder takes through `softdeca replay`/`convert`/`info`. The toolchain
+# is /opt/swift or `swift` on PATH; without one the tests are skipped, visibly.
+SWIFT ?= $(firstword $(wildcard /opt/swift/usr/bin/swift) $(shell command -v swift 2>/dev/null))
+.PHONY: test-swift
+test: test-swift
+test-swift: build ## the iOS capture core: swift test (skipped without a Swift toolchain)
+	@if [ -z "$(SWIFT)" ]; then \
+	  echo "== Swift tests (ios_capture): SKIPPED, no Swift toolchain (/opt/swift/usr/bin/swift or swift on PATH)"; \
+	else \
+	  echo "== Swift tests (ios_capture, $$($(SWIFT) --version 2>/dev/null | head -n1))"; \
+	  cd ios_capture && nice -n 5 $(SWIFT) build --build-tests -j $(JOBS) && \
+	  SOFTDECA_CLI=$(CURDIR)/$(BUILD)/plugin/cli/softdeca SOFTDECA_PYTHON=$(CURDIR)/$(PY) \
+	    $(SWIFT) test --skip-build; \
+	fi

@@ -105,7 +105,7 @@ int run_bench_runtime(const Args& args) {
   const FaceRig rig = read_rig(o.text("--avatar"));
   const FaceRig user = read_rig(o.text("--avatar") + "/user_face", true);
   Model model(o.text("--bundle"));
-  const std::size_t vh = model.info.head_vertex_count;
+  const uint32_t vh = model.info.head_vertex_count;
   const std::string how = o.text("--how") + " on " + cpu_name() + " (" + std::to_string(std::thread::hardware_concurrency()) +
                           " cores); " + std::to_string(frames) + " frames of " + take.path + ", median; " +
                           std::to_string(model.info.skin_triangle_count) + " skin triangles, " + std::to_string(vh) +
@@ -154,18 +154,18 @@ int run_bench_runtime(const Args& args) {
     const Times lin = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_linear(a.handle, w(f), 52, &output), "linear");
     });
-    check(softdeca_avatar_set_dynamics(a.handle, 0), "dynamics");
+    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_FALSE), "dynamics");
     const Times st = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
     });
-    check(softdeca_avatar_set_dynamics(a.handle, 1), "dynamics");
+    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_TRUE), "dynamics");
     const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
     });
     const Times sp = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
     });
-    check(softdeca_avatar_set_dynamics(a.handle, 0), "dynamics");
+    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_FALSE), "dynamics");
     const Times sp_static = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
     });
@@ -224,7 +224,7 @@ int run_bench_runtime(const Args& args) {
     const Times st = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
     });
-    check(softdeca_avatar_set_dynamics(a.handle, 1), "dynamics");
+    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_TRUE), "dynamics");
     const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
       check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
     });

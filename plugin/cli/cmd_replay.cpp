@@ -90,9 +90,9 @@ std::size_t apply(const Model& model, Avatar& avatar, const ObjMesh& neutral, co
       check(softdeca_avatar_set_parameter(avatar.handle, static_cast<uint32_t>(index), c.value), "setting " + c.name);
       continue;
     }
-    float current = 0;
+    double current = 0;
     check(softdeca_avatar_get_parameter(avatar.handle, static_cast<uint32_t>(index), &current, nullptr), "parameter");
-    std::vector<float> map(model.info.skin_triangle_count, current);
+    std::vector<float> map(model.info.skin_triangle_count, static_cast<float>(current));
     for (std::size_t f = 0; f < map.size(); ++f) {
       double d2 = 0;
       for (int k = 0; k < 3; ++k) {
@@ -105,7 +105,7 @@ std::size_t apply(const Model& model, Avatar& avatar, const ObjMesh& neutral, co
         ++covered;
       }
     }
-    check(softdeca_avatar_set_parameter_faces(avatar.handle, static_cast<uint32_t>(index), map.data(), map.size()),
+    check(softdeca_avatar_set_parameter_faces(avatar.handle, static_cast<uint32_t>(index), map.data(), static_cast<uint32_t>(map.size())),
           "setting " + c.name + " over a region");
   }
   return covered;
@@ -191,13 +191,13 @@ int run_replay(const Args& args) {
   const FaceRig user = read_rig(avatar_dir + "/user_face", true);
 
   Model model(o.text("--bundle"));
-  const std::size_t vh = model.info.head_vertex_count;
+  const uint32_t vh = model.info.head_vertex_count;
   if (rig.neutral.vertex_count() != vh)
     throw std::runtime_error(avatar_dir + "/neutral.obj has " + std::to_string(rig.neutral.vertex_count()) +
                              " vertices; the bundle's template has " + std::to_string(vh));
   Avatar avatar(model, rig.neutral, rig.deltas, threads, precision);
   apply(model, avatar, rig.neutral, parse_changes(o.text("--set")));
-  check(softdeca_avatar_set_dynamics(avatar.handle, o.on("--dynamics") ? 1 : 0), "dynamics");
+  check(softdeca_avatar_set_dynamics(avatar.handle, o.on("--dynamics") ? SOFTDECA_TRUE : SOFTDECA_FALSE), "dynamics");
   check(softdeca_avatar_prepare(avatar.handle), "prepare");
   const double prepare_ms = avatar.stats().prepare_ms;
 

@@ -18,7 +18,7 @@ void check(softdeca_status status, const std::string& what) {
 Model::Model(const std::string& bundle, unsigned prepare_threads) {
   softdeca_model_options opts{sizeof(softdeca_model_options), prepare_threads, 0};
   check(softdeca_model_load(bundle.c_str(), &opts, &handle), "loading " + bundle);
-  info.size = sizeof info;
+  info.struct_size = sizeof info;
   check(softdeca_model_get_info(handle, &info), "model info");
 }
 
@@ -31,21 +31,21 @@ int Model::parameter(const std::string& name) const {
 Avatar::Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads,
                unsigned precision) {
   softdeca_avatar_desc d{};
-  d.size = sizeof d;
+  d.struct_size = sizeof d;
   d.neutral = neutral.vertices.data();
-  d.vertex_count = neutral.vertex_count();
+  d.vertex_count = static_cast<uint32_t>(neutral.vertex_count());
   d.triangles = neutral.triangles.data();
-  d.triangle_count = neutral.triangles.size() / 3;
+  d.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
   d.blendshapes = deltas.empty() ? nullptr : deltas.data();
   d.blendshape_count = deltas.empty() ? 0 : 52;
   d.threads = threads;
-  d.precision = precision;
+  d.precision = static_cast<int32_t>(precision);
   check(softdeca_avatar_create(model.handle, &d, &handle), "creating the avatar");
 }
 
 softdeca_stats Avatar::stats() const {
   softdeca_stats s{};
-  s.size = sizeof s;
+  s.struct_size = sizeof s;
   check(softdeca_avatar_get_stats(handle, &s), "stats");
   return s;
 }

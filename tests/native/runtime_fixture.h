@@ -72,7 +72,7 @@ struct AvatarPtr {
 
 inline softdeca_avatar_desc describe(const Head& h, uint32_t threads = 1, uint32_t precision = SOFTDECA_PRECISION_HALF) {
   softdeca_avatar_desc d{};
-  d.size = sizeof d;
+  d.struct_size = sizeof d;
   d.neutral = h.neutral.data();
   d.vertex_count = h.vertices();
   d.triangles = h.triangles.data();
@@ -88,7 +88,7 @@ struct Buffers {
   std::vector<float> vertices, normals;
   softdeca_output out{};
   explicit Buffers(std::size_t n, float fill = 0.0f) : vertices(3 * n, fill), normals(3 * n, fill) {
-    out = {sizeof(softdeca_output), vertices.data(), n, normals.data(), n};
+    out = {sizeof(softdeca_output), vertices.data(), static_cast<uint32_t>(n), normals.data(), static_cast<uint32_t>(n)};
   }
 };
 

@@ -1,4 +1,4 @@
-// Shared by the streaming tests: paths to the golden files and ../shared, the golden files'
+// Shared by the streaming tests: paths to the golden files and the third-party data, the golden files'
 // expected-values format (tests/golden/streaming/README.md), and frames to play with.
 #pragma once
 
@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -20,8 +21,12 @@
 namespace softdeca::test {
 
 inline std::string golden_dir() { return std::string(SOFTDECA_REPO_ROOT) + "/tests/golden/streaming/"; }
-inline std::string shared_dir() { return std::string(SOFTDECA_REPO_ROOT) + "/../shared/"; }
-inline std::string takes_dir() { return shared_dir() + "recordings/livelinkface-alexdjulin/"; }
+// The data folder `make setup` fills; $SOFTDECA_DATA overrides the configured one.
+inline std::string data_dir() {
+  const char* env = std::getenv("SOFTDECA_DATA");
+  return std::string(env && *env ? env : SOFTDECA_DATA_DIR) + "/";
+}
+inline std::string takes_dir() { return data_dir() + "recordings/livelinkface-alexdjulin/"; }
 
 // A file name in the test's temporary folder, unique to this process.
 inline std::string temp_path(const std::string& name) {

@@ -262,12 +262,12 @@ TEST_F(HostileBundle, MemoryBudgetIsConfigurable) {
   EXPECT_EQ(load_error(), "");
   // Through the C ABI.
   softdeca_model_options o{};
-  o.size = sizeof o;
-  o.memory_budget_bytes = 1024;
+  o.struct_size = sizeof o;
+  o.memory_budget_mib = 1;  // the ABI counts MiB: the small test bundle needs more than that
   softdeca_model* m = nullptr;
   EXPECT_EQ(softdeca_model_load(bundle_.c_str(), &o, &m), SOFTDECA_ERROR_FORMAT);
   EXPECT_NE(std::string(softdeca_last_error()).find("memory budget"), std::string::npos);
-  o.memory_budget_bytes = 0;  // the default
+  o.memory_budget_mib = 0;  // the default
   ASSERT_EQ(softdeca_model_load(bundle_.c_str(), &o, &m), SOFTDECA_OK) << softdeca_last_error();
   softdeca_model_destroy(m);
 }

@@ -84,7 +84,7 @@ TEST(RuntimeAllocations, FramesAllocateNothingBeyondOnnxRuntime) {
     const auto d = describe(head, threads);
     ASSERT_EQ(softdeca_avatar_create(model.p, &d, &a.p), SOFTDECA_OK);
     ASSERT_EQ(softdeca_avatar_prepare(a.p), SOFTDECA_OK);
-    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, 1), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_TRUE), SOFTDECA_OK);
     ASSERT_EQ(softdeca_avatar_calibrate_landmarks(a.p, head.user_neutral.data(), head.user_vertices()), SOFTDECA_OK);
     Buffers b(head.vertices());
     std::vector<std::vector<float>> weights(8, std::vector<float>(52, 0.0f)), faces;
@@ -94,7 +94,7 @@ TEST(RuntimeAllocations, FramesAllocateNothingBeyondOnnxRuntime) {
       faces.push_back(head.user_face(weights[f].data()));
     }
     softdeca_stats s{};
-    s.size = sizeof s;
+    s.struct_size = sizeof s;
     const auto frame = [&](int i) { return weights[static_cast<std::size_t>(i) % weights.size()].data(); };
     const double linear = allocations_per_call([&](int i) {
       ASSERT_EQ(softdeca_avatar_evaluate_linear(a.p, frame(i), 52, &b.out), SOFTDECA_OK);

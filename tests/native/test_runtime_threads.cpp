@@ -153,13 +153,13 @@ TEST_F(Threads, HelperThreadsGiveTheSameOutput) {
     const auto d = describe(head, threads);
     ASSERT_EQ(softdeca_avatar_create(model.p, &d, &a.p), SOFTDECA_OK);
     ASSERT_EQ(softdeca_avatar_prepare(a.p), SOFTDECA_OK);
-    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, 1), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_TRUE), SOFTDECA_OK);
     Buffers b(head.vertices()), l(head.vertices());
     for (int f = 0; f < 5; ++f) ASSERT_EQ(softdeca_avatar_evaluate_weights(a.p, weights.data(), 52, &b.out), SOFTDECA_OK);
     const auto pts = head.user_face(weights.data());
     ASSERT_EQ(softdeca_avatar_evaluate_landmarks(a.p, pts.data(), head.user_vertices(), &l.out), SOFTDECA_OK);
     softdeca_stats s{};
-    s.size = sizeof s;
+    s.struct_size = sizeof s;
     ASSERT_EQ(softdeca_avatar_get_stats(a.p, &s), SOFTDECA_OK);
     EXPECT_EQ(s.threads, threads);
     if (threads == 1) {

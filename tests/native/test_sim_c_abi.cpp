@@ -66,6 +66,13 @@ SimulationMesh head() {
 }
 
 std::string last_error() { return softdeca_last_error(); }
+
+// A simulator parameter's index by name (the ABI addresses parameters by index).
+uint32_t param(const char* name) {
+  uint32_t index = 0;
+  EXPECT_EQ(softdeca_parameter_find(name, &index), SOFTDECA_OK) << name;
+  return index;
+}
 }  // namespace
 
 class SimCAbi : public ::testing::Test {
@@ -85,30 +92,35 @@ class SimCAbi : public ::testing::Test {
 
   CMesh mesh{head()};
   softdeca_sim* sim = nullptr;
-  size_t skin_count = 0, vertex_count = 0;
+  uint32_t skin_count = 0, vertex_count = 0;
   std::vector<float> rest_skin;
   softdeca_sim_frame frame{};
   softdeca_sim_stats stats{};
 };
 
 TEST_F(SimCAbi, EnumeratesTheParameters) {
-  size_t n = 0;
+  uint32_t n = 0;
   ASSERT_EQ(softdeca_parameter_count(&n), SOFTDECA_OK);
   ASSERT_GT(n, 20u);
   softdeca_parameter_info info{};
   info.struct_size = sizeof(info);
   bool found = false;
-  for (size_t i = 0; i < n; ++i) {
+  for (uint32_t i = 0; i < n; ++i) {
     ASSERT_EQ(softdeca_parameter_get_info(i, &info), SOFTDECA_OK);
     if (std::string(info.name) == "w_soft_volume") {
       found = true;
-      EXPECT_EQ(info.log_scale, 1);
+      EXPECT_EQ(param("w_soft_volume"), i);
+      EXPECT_EQ(info.log_scale, SOFTDECA_TRUE);
       EXPECT_STREQ(info.domain, "soft_tet");
       EXPECT_STREQ(info.unit, "kPa");
     }
   }
   EXPECT_TRUE(found);
   EXPECT_EQ(softdeca_parameter_get_info(n, &info), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  uint32_t index = 7;
+  EXPECT_EQ(softdeca_parameter_find("nope", &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(index, 7u);
+  EXPECT_EQ(softdeca_parameter_find(nullptr, &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
   const char* json = nullptr;
   ASSERT_EQ(softdeca_parameters_json(&json), SOFTDECA_OK);
   EXPECT_NE(std::string(json).find("\"w_soft_volume\""), std::string::npos);
@@ -120,13 +132,13 @@ TEST_F(SimCAbi, SolvesAndReadsBack) {
   for (size_t i = 0; i < skin_count; ++i)
     if (target[3 * i + 2] > 0.05f) target[3 * i + 2] += 0.004f;
   frame.skin_targets = target.data();
-  ASSERT_EQ(softdeca_sim_set_parameter(sim, "w_soft_strain", 2.0), SOFTDECA_OK) << last_error();
+  ASSERT_EQ(softdeca_sim_set_parameter(sim, param("w_soft_strain"), 2.0), SOFTDECA_OK) << last_error();
   double v = 0;
-  ASSERT_EQ(softdeca_sim_get_parameter(sim, "w_soft_strain", &v), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_get_parameter(sim, param("w_soft_strain"), &v), SOFTDECA_OK);
   EXPECT_EQ(v, 2.0);
   ASSERT_EQ(softdeca_sim_solve_static(sim, &frame, &stats), SOFTDECA_OK) << last_error();
-  EXPECT_EQ(stats.converged, 1);
-  EXPECT_GT(stats.iterations, 0);
+  EXPECT_EQ(stats.converged, SOFTDECA_TRUE);
+  EXPECT_GT(stats.iterations, 0u);
   std::vector<float> skin(skin_count * 3), verts(vertex_count * 3);
   ASSERT_EQ(softdeca_sim_get_skin(sim, skin.data(), skin_count), SOFTDECA_OK);
   ASSERT_EQ(softdeca_sim_get_vertices(sim, verts.data(), vertex_count), SOFTDECA_OK);
@@ -136,7 +148,7 @@ TEST_F(SimCAbi, SolvesAndReadsBack) {
   EXPECT_GT(moved, 0.002);
 
   // Dynamic steps and a batch through the same handle.
-  ASSERT_EQ(softdeca_sim_set_parameter(sim, "dyn_gamma", 0.5), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_set_parameter(sim, param("dyn_gamma"), 0.5), SOFTDECA_OK);
   ASSERT_EQ(softdeca_sim_reset_dynamics(sim), SOFTDECA_OK);
   ASSERT_EQ(softdeca_sim_step_dynamic(sim, &frame, nullptr), SOFTDECA_OK) << last_error();
   ASSERT_EQ(softdeca_sim_step_dynamic(sim, &frame, &stats), SOFTDECA_OK) << last_error();
@@ -165,12 +177,14 @@ TEST_F(SimCAbi, RefusesBadInputAndKeepsTheLastGoodOutput) {
   EXPECT_NE(last_error().find("skin_count"), std::string::npos) << last_error();
   frame.skin_count = skin_count;
 
-  EXPECT_EQ(softdeca_sim_set_parameter(sim, "max_strain", 2.0), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_sim_set_parameter(sim, param("max_strain"), 2.0), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(last_error().find("outside its range [0.7, 1.3]"), std::string::npos) << last_error();
-  EXPECT_EQ(softdeca_sim_set_parameter(sim, "nope", 1.0), SOFTDECA_ERROR_INVALID_ARGUMENT);
-  EXPECT_EQ(softdeca_sim_set_parameter(sim, nullptr, 1.0), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  uint32_t count = 0;
+  ASSERT_EQ(softdeca_parameter_count(&count), SOFTDECA_OK);
+  EXPECT_EQ(softdeca_sim_set_parameter(sim, count, 1.0), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(last_error().find("not below"), std::string::npos) << last_error();
   const float few[2] = {1, 1};
-  EXPECT_EQ(softdeca_sim_set_parameter_field(sim, "w_target", few, 2), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_sim_set_parameter_field(sim, param("w_target"), few, 2), SOFTDECA_ERROR_INVALID_ARGUMENT);
 
   const float shear[12] = {1, 0.5f, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
   frame.jaw_transform = shear;

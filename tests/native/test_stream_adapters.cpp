@@ -1,5 +1,5 @@
 // Third-party formats into the canonical frame: Live Link Face's packet and CSV takes (with
-// the real takes in ../shared), its timecode, iFacialMocap's text, and the angle conventions.
+// the real takes of the data folder), its timecode, iFacialMocap's text, and the angle conventions.
 #include <gtest/gtest.h>
 
 #include <cmath>

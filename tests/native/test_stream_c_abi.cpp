@@ -21,7 +21,7 @@ using softdeca::test::temp_path;
 softdeca_frame blank_frame() {
   softdeca_frame f;
   std::memset(&f, 0, sizeof f);
-  f.size = sizeof f;
+  f.struct_size = sizeof f;
   f.tracking = SOFTDECA_TRACKING_TRACKED;
   f.head.rotation[3] = f.left_eye.rotation[3] = f.right_eye.rotation[3] = 1;
   return f;
@@ -29,7 +29,7 @@ softdeca_frame blank_frame() {
 
 softdeca_recording_header header() {
   softdeca_recording_header h{};
-  h.size = sizeof h;
+  h.struct_size = sizeof h;
   h.device = "abi test";
   return h;
 }
@@ -45,7 +45,7 @@ TEST(StreamCAbi, BlendshapeNames) {
 TEST(StreamCAbi, RejectsNullsSmallStructsAndBadConfigs) {
   softdeca_receiver_config c{};
   EXPECT_EQ(softdeca_receiver_config_init(&c), SOFTDECA_ERROR_INVALID_ARGUMENT);  // size 0
-  c.size = sizeof c;
+  c.struct_size = sizeof c;
   ASSERT_EQ(softdeca_receiver_config_init(&c), SOFTDECA_OK);
   EXPECT_EQ(c.port, 50110u);
   softdeca_receiver* r = nullptr;
@@ -64,7 +64,7 @@ TEST(StreamCAbi, RejectsNullsSmallStructsAndBadConfigs) {
   EXPECT_NE(std::string(softdeca_last_error()).find("256.1.1.1"), std::string::npos);
   EXPECT_EQ(r, nullptr);
   softdeca_frame f = blank_frame();
-  int32_t got = 7;
+  softdeca_bool got = 7;
   EXPECT_EQ(softdeca_receiver_next(nullptr, 0, &f, &got), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(got, 7);
   softdeca_receiver_destroy(nullptr);
@@ -80,10 +80,10 @@ TEST(StreamCAbi, RecorderRejectsBadFramesAndPlayerPlaysWhatWasWritten) {
   softdeca_recording_header h = header();
   softdeca_recorder* rec = nullptr;
   ASSERT_EQ(softdeca_recorder_create(path.c_str(), &h, &rec), SOFTDECA_OK);
-  const uint16_t indices[3] = {7, 8, 9};
+  const int32_t indices[3] = {7, 8, 9};
   uint32_t id = 0;
   ASSERT_EQ(softdeca_recorder_write_profile(rec, "three", indices, 3, &id), SOFTDECA_OK);
-  const uint16_t repeated[2] = {7, 7};
+  const int32_t repeated[2] = {7, 7};
   EXPECT_EQ(softdeca_recorder_write_profile(rec, "bad", repeated, 2, &id), SOFTDECA_ERROR_INVALID_ARGUMENT);
   const float neutral[6] = {0, 0.1f, 0.2f, 0.3f, 0.4f, 0.5f};
   ASSERT_EQ(softdeca_recorder_write_neutral(rec, neutral, 2), SOFTDECA_OK);
@@ -110,27 +110,27 @@ TEST(StreamCAbi, RecorderRejectsBadFramesAndPlayerPlaysWhatWasWritten) {
   bad.head.rotation[3] = 0;
   EXPECT_EQ(softdeca_recorder_write(rec, &bad), SOFTDECA_ERROR_INVALID_ARGUMENT);
   bad = blank_frame();
-  bad.size = 16;
+  bad.struct_size = 16;
   EXPECT_EQ(softdeca_recorder_write(rec, &bad), SOFTDECA_ERROR_INVALID_ARGUMENT);
   softdeca_recorder_destroy(rec);
 
   softdeca_player* p = nullptr;
   ASSERT_EQ(softdeca_player_open(path.c_str(), &p), SOFTDECA_OK);
   softdeca_recording_info info{};
-  info.size = sizeof info;
+  info.struct_size = sizeof info;
   ASSERT_EQ(softdeca_player_info(p, &info), SOFTDECA_OK);
   EXPECT_EQ(info.frame_count, 5u);
   EXPECT_NEAR(info.duration, 0.4, 1e-12);
   EXPECT_STREQ(info.device, "abi test");
-  uint16_t out_idx[2];
-  size_t count = 0;
+  int32_t out_idx[2];
+  uint32_t count = 0;
   EXPECT_EQ(softdeca_player_profile(p, &id, out_idx, 2, &count), SOFTDECA_ERROR_BUFFER_TOO_SMALL);
   EXPECT_EQ(count, 3u);
-  uint16_t all_idx[3];
+  int32_t all_idx[3];
   ASSERT_EQ(softdeca_player_profile(p, &id, all_idx, 3, &count), SOFTDECA_OK);
   EXPECT_EQ(all_idx[2], 9);
   float n[6];
-  size_t vertices = 0;
+  uint32_t vertices = 0;
   ASSERT_EQ(softdeca_player_neutral(p, n, 2, &vertices), SOFTDECA_OK);
   EXPECT_EQ(vertices, 2u);
   EXPECT_EQ(n[5], 0.5f);
@@ -141,11 +141,11 @@ TEST(StreamCAbi, RecorderRejectsBadFramesAndPlayerPlaysWhatWasWritten) {
   EXPECT_NEAR(f.capture_time, 10.25, 1e-9);
   EXPECT_EQ(f.landmark_count, 3u);
   EXPECT_EQ(softdeca_player_frame(p, 5, &f), SOFTDECA_ERROR_INVALID_ARGUMENT);
-  ASSERT_EQ(softdeca_player_set_loop(p, 1), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_set_loop(p, SOFTDECA_TRUE), SOFTDECA_OK);
   ASSERT_EQ(softdeca_player_set_speed(p, 2), SOFTDECA_OK);
   EXPECT_EQ(softdeca_player_set_speed(p, -1), SOFTDECA_ERROR_INVALID_ARGUMENT);
   ASSERT_EQ(softdeca_player_seek(p, 0.3), SOFTDECA_OK);
-  int32_t ended = 9;
+  softdeca_bool ended = 9;
   ASSERT_EQ(softdeca_player_advance(p, 0.1, &f, &ended), SOFTDECA_OK);  // 0.3 + 0.2 wraps to 0.1
   EXPECT_EQ(ended, 0);
   double pos = 0;
@@ -159,7 +159,7 @@ TEST(StreamCAbi, RecorderRejectsBadFramesAndPlayerPlaysWhatWasWritten) {
 
 TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
   softdeca_receiver_config c{};
-  c.size = sizeof c;
+  c.struct_size = sizeof c;
   softdeca_receiver_config_init(&c);
   c.bind_address = "127.0.0.1";
   c.port = 0;
@@ -176,7 +176,7 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
                                   softdeca::stream::Format::softdeca, 3);
   for (uint32_t i = 0; i < 10; ++i) ASSERT_TRUE(s.send(softdeca::test::make_frame(i)));
   softdeca_frame f = blank_frame();
-  int32_t got = 0;
+  softdeca_bool got = 0;
   for (int i = 0; i < 10; ++i) {
     ASSERT_EQ(softdeca_receiver_next(r, 10.0, &f, &got), SOFTDECA_OK);
     ASSERT_EQ(got, 1);
@@ -188,19 +188,19 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
   ASSERT_EQ(softdeca_receiver_next(r, 0, &f, &got), SOFTDECA_OK);
   EXPECT_EQ(got, 0);
   softdeca_receiver_stats st{};
-  st.size = sizeof st;
+  st.struct_size = sizeof st;
   ASSERT_EQ(softdeca_receiver_get_stats(r, &st), SOFTDECA_OK);
   EXPECT_EQ(st.delivered, 10u);
   EXPECT_EQ(st.lost, 0u);
-  uint64_t recorded = 0;
+  uint32_t recorded = 0;
   ASSERT_EQ(softdeca_receiver_stop_recording(r, &recorded), SOFTDECA_OK);
   EXPECT_EQ(recorded, 10u);
   uint32_t id = 1;
-  size_t count = 9;
+  uint32_t count = 9;
   ASSERT_EQ(softdeca_receiver_profile(r, &id, nullptr, 0, &count), SOFTDECA_OK);
   EXPECT_EQ(count, 0u);
   EXPECT_EQ(id, 0u);
-  int32_t sent = 0;
+  softdeca_bool sent = 0;
   ASSERT_EQ(softdeca_receiver_request_neutral(r, &sent), SOFTDECA_OK);
   EXPECT_EQ(sent, 1);
   softdeca_receiver_destroy(r);
@@ -208,7 +208,7 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
   softdeca_player* p = nullptr;
   ASSERT_EQ(softdeca_player_open(path.c_str(), &p), SOFTDECA_OK);
   softdeca_recording_info info{};
-  info.size = sizeof info;
+  info.struct_size = sizeof info;
   softdeca_player_info(p, &info);
   EXPECT_EQ(info.frame_count, 10u);
   softdeca_player_destroy(p);
@@ -218,7 +218,7 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
 TEST(StreamCAbi, ConvertsLiveLinkFaceCsv) {
   const std::string rec = temp_path("apfel.sdrec"), csv = temp_path("apfel.csv");
   softdeca_convert_report report{};
-  report.size = sizeof report;
+  report.struct_size = sizeof report;
   ASSERT_EQ(softdeca_convert_livelinkface_csv((softdeca::test::takes_dir() + "apfel.csv").c_str(), rec.c_str(), 0,
                                               &report),
             SOFTDECA_OK)

@@ -1,4 +1,4 @@
-"""Training data generation (issue 4): a small dataset of every kind end to end, its format,
+"""Training data generation: a small dataset of every kind end to end, its format,
 splits, loader and report; planning, personalisation and configuration errors.
 
 Scale: the small dataset is LHM level 2 (162 vertices per wrap), 16 static + 16 sparse

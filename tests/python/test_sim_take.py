@@ -1,5 +1,5 @@
 """`softdeca simulate` on a real take (the native CLI runs `python -m softdeca_train
-simulate`), its bad-input errors, and lip collisions on real frames (issue 3)."""
+simulate`), its bad-input errors, and lip collisions on real frames."""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
-"""The Python side of the streaming formats: Live Link Face CSV takes (the real ones in
-../shared), timecodes, recordings and their recovery, hostile datagrams, ARKit's reference face,
-and the impairment draws. Cross-checked against the native CLI where both read the same file."""
+"""The Python side of the streaming formats: Live Link Face CSV takes (the real ones in the
+data folder), timecodes, recordings and their recovery, hostile datagrams, ARKit's reference
+face, and the impairment draws. Cross-checked against the native CLI where both read the same
+file."""
 
 from __future__ import annotations
 

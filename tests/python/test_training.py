@@ -1,4 +1,4 @@
-"""Training (issue 5) at the smallest scale: the small dataset of conftest (LHM level 2, 16
+"""Training at the smallest scale: the small dataset of conftest (LHM level 2, 16
 static, 2 dynamic, 16 sparse frames) and the tiny "test" network sizes. Each model trains a
 few dozen steps and must lower its error on the frames it trained on; the bundle pipeline runs
 end to end and its ONNX files agree with torch; the committed bundle loads in onnxruntime."""

@@ -11,7 +11,7 @@ def _ict_arg(p: argparse.ArgumentParser) -> None:
         "--ict",
         default=None,
         help="ICT-FaceKit checkout, FaceXModel folder or .tar.xz archive "
-        "(default: $SOFTDECA_ICT or ../shared/ict-facekit)",
+        "(default: $SOFTDECA_ICT or ict-facekit in the data folder)",
     )
 
 
@@ -138,7 +138,7 @@ def _landmarks_args(p: argparse.ArgumentParser) -> None:
         "--arkit",
         default=None,
         help="folder with ARKit_reference_blendshapes.zip and ARKit_landmarks68.txt "
-        "(default: $SOFTDECA_ARKIT_REFERENCE or ../shared/arkit-reference)",
+        "(default: $SOFTDECA_ARKIT_REFERENCE or arkit-reference in the data folder)",
     )
     p.add_argument(
         "--out",
@@ -189,7 +189,7 @@ STEPS = {
 }
 
 
-# ---- Streaming (issue 7): the virtual device and the golden files -----------------------------
+# ---- Streaming: the virtual device and the golden files -------------------------------------
 
 
 def _virtual_device_args(p: argparse.ArgumentParser) -> None:
@@ -304,7 +304,7 @@ STEPS["stream-golden"] = (
 )
 
 
-# ---- runtime (issue 6) -------------------------------------------------------------------
+# ---- runtime -----------------------------------------------------------------------------
 
 
 def _runtime_bundle_args(p: argparse.ArgumentParser) -> None:
@@ -349,7 +349,7 @@ def _runtime_bundle_run(args: argparse.Namespace) -> int:
     info = BundleInfo(
         untrained=True,
         description="UNTRAINED: random-weight networks of the contract's shapes, for tests, "
-        "benchmarks and the replay path until trained models exist (issue 5)",
+        "benchmarks and replays that must not depend on a trained bundle",
     )
     out = export_bundle(Path(args.out), definition, nets, info)
     if args.tar:
@@ -449,7 +449,7 @@ STEPS["runtime-bench"] = (
 )
 
 
-# ---- Training data (issue 4): generation, report, benchmark --------------------------------
+# ---- Training data: generation, report, benchmark -------------------------------------------
 
 
 def _generate_args(p: argparse.ArgumentParser) -> None:
@@ -534,7 +534,7 @@ STEPS |= {
 }
 
 
-# ---- Physics (issue 3): a take through φ† --------------------------------------------------
+# ---- Physics: a take through φ† ------------------------------------------------------------
 
 
 def _simulate_args(p: argparse.ArgumentParser) -> None:

@@ -2,14 +2,41 @@
  * SoftDECA native library: the public C ABI.
  *
  * This header is the only way into the library, from Unity (P/Invoke), Python or the CLI.
- * Conventions that hold for every function:
- *   - Units are metres; the frame is right-handed, +Y up, +Z out of the face (ARKit's
- *     face-anchor frame). Arrays of 3D points are packed xyz floats.
- *   - Every function returns a softdeca_status. On failure the reason is available from
- *     softdeca_last_error() on the same thread, and output buffers are left untouched.
- *   - Every array argument comes with its element count; null pointers, wrong sizes and
- *     non-finite values are rejected with a status, never with a crash or an exception.
- *   - The library keeps no global mutable state (the last-error text is thread-local).
+ *
+ * ABI CONVENTION (holds for every declaration below; a binding can rely on it mechanically):
+ *   1. Versions. SOFTDECA_ABI_VERSION is the version of this convention and of every signature
+ *      and struct layout below; softdeca_abi_version() returns the loaded library's. A binding
+ *      compares the two at load and refuses a mismatch. It changes with any incompatible edit.
+ *   2. Structs passed by pointer start with `uint32_t struct_size`, which the caller sets to
+ *      sizeof(the struct) (output structs too, and *_init functions expect it set). The library
+ *      rejects a smaller struct_size with SOFTDECA_ERROR_INVALID_ARGUMENT and a message naming
+ *      the struct and both sizes; it reads and writes only the fields it knows, so fields are
+ *      only ever appended. Structs are plain data: fixed-width integers, float, double,
+ *      pointers, fixed arrays; no bool, no bit fields, no size_t, no enum-typed fields (enums
+ *      travel as int32_t).
+ *   3. Every function returns a softdeca_status, except: the *_destroy functions, which return
+ *      void and accept NULL (a no-op); and the static queries softdeca_abi_version,
+ *      softdeca_version, softdeca_last_error, softdeca_status_name and softdeca_blendshape_name.
+ *      On failure the reason is available from softdeca_last_error() on the same thread, and
+ *      output buffers are left untouched.
+ *   4. Booleans are softdeca_bool (int32_t): 0 is false, 1 is true; inputs take any non-zero
+ *      value as true.
+ *   5. Counts, capacities, sizes in bytes and element indices are uint32_t. Arrays of indices
+ *      into meshes (triangles, tetrahedra, vertex lists, landmark profiles) are int32_t.
+ *      Only running totals in *_stats structs (frames, datagrams, bytes) are uint64_t.
+ *   6. Parameters: every parameter list has a count, a softdeca_parameter_info by index and a
+ *      lookup by name (softdeca_parameter_find for the simulator's, softdeca_model_find_parameter
+ *      for a bundle's). Every function that reads or writes a parameter takes its uint32_t
+ *      index, so any parameter is addressable by index directly and by name through the lookup.
+ *      Scalar parameter values are double; per-element maps are float arrays.
+ *   7. Every array argument comes with its element count; null pointers, wrong sizes and
+ *      non-finite values are rejected with a status, never with a crash or an exception.
+ *   8. No callbacks into the caller; strings are NUL-terminated UTF-8, owned by the library when
+ *      returned (their lifetime is stated) and copied when passed in.
+ *
+ * Units are metres; the frame is right-handed, +Y up, +Z out of the face (ARKit's face-anchor
+ * frame). Arrays of 3D points are packed xyz floats. The library keeps no global mutable state
+ * (the last-error text is thread-local).
  */
 #ifndef SOFTDECA_SOFTDECA_H
 #define SOFTDECA_SOFTDECA_H
@@ -45,6 +72,17 @@ typedef enum softdeca_status {
   SOFTDECA_ERROR_NOT_READY = 8         /* a required earlier step has not run (prepare)  */
 } softdeca_status;
 
+/* The version of the ABI convention and signatures in this header; see softdeca_abi_version. */
+#define SOFTDECA_ABI_VERSION 1u
+
+/* softdeca_bool: 0 false, 1 true (inputs: non-zero is true). */
+typedef int32_t softdeca_bool;
+#define SOFTDECA_FALSE 0
+#define SOFTDECA_TRUE 1
+
+/* SOFTDECA_ABI_VERSION of the library as built: a binding checks it at load. */
+SOFTDECA_API uint32_t softdeca_abi_version(void);
+
 /* Library version as "MAJOR.MINOR.PATCH". The pointer is static and never freed. */
 SOFTDECA_API const char* softdeca_version(void);
 
@@ -55,7 +93,7 @@ SOFTDECA_API const char* softdeca_last_error(void);
 /* Human-readable name of a status code (static string). */
 SOFTDECA_API const char* softdeca_status_name(softdeca_status status);
 
-/* ==== Runtime: SoftDECA and SparseSoftDECA per frame (issue 6) ============================
+/* ==== Runtime: SoftDECA and SparseSoftDECA per frame ===================================
  * A model bundle (docs/bundle.md) is loaded once into a softdeca_model; each head is a
  * softdeca_avatar made from a model and the host's own mesh. Per avatar:
  *   create -> set parameters (optional) -> prepare -> evaluate every frame.
@@ -71,9 +109,6 @@ SOFTDECA_API const char* softdeca_status_name(softdeca_status status);
  * avatars are independent and run in parallel. Destroy a handle only when no call on it runs.
  * A model may be destroyed before its avatars: they keep what they need.
  *
- * Structs with a `size` field: set it to sizeof(the struct); the library rejects a smaller size
- * and reads or writes only the fields it knows.
- *
  * Arrays of points are xyz floats in metres in the face-anchor frame; counts are in elements
  * (vertices, triangles, weights) unless stated. Vertex order is the template's (the bundle's
  * head_vertex_count vertices; the first skin_vertex_count are the skin surface S).
@@ -86,10 +121,10 @@ typedef struct softdeca_avatar softdeca_avatar;
 #define SOFTDECA_BUNDLE_FORMAT_VERSION 1
 
 typedef struct softdeca_model_options {
-  uint32_t size;            /* sizeof(softdeca_model_options) */
+  uint32_t struct_size;            /* sizeof(softdeca_model_options) */
   uint32_t prepare_threads; /* ONNX Runtime threads for the per-avatar networks; 0: 1 */
-  uint64_t memory_budget_bytes; /* most a bundle's networks may ask for, checked before loading
-                                 * them (docs/security.md); 0: 2 GiB */
+  uint32_t memory_budget_mib; /* most a bundle's networks may ask for, in MiB, checked before
+                               * loading them (docs/security.md); 0: 2048 */
 } softdeca_model_options;
 
 /* Loads a bundle from a folder or from a .tar of its files. `options` may be NULL.
@@ -100,15 +135,15 @@ SOFTDECA_API softdeca_status softdeca_model_load(const char* path, const softdec
 
 /* The same from memory: an uncompressed tar (ustar) of the bundle's files, e.g. a Unity
  * TextAsset's bytes. The bytes are copied; the caller may free them on return. */
-SOFTDECA_API softdeca_status softdeca_model_load_memory(const void* data, size_t size,
+SOFTDECA_API softdeca_status softdeca_model_load_memory(const void* data, uint32_t byte_count,
                                                         const softdeca_model_options* options,
                                                         softdeca_model** out_model);
 
 /* Releases the caller's reference. NULL is a no-op. */
-SOFTDECA_API softdeca_status softdeca_model_destroy(softdeca_model* model);
+SOFTDECA_API void softdeca_model_destroy(softdeca_model* model);
 
 typedef struct softdeca_model_info {
-  uint32_t size; /* sizeof(softdeca_model_info) */
+  uint32_t struct_size; /* sizeof(softdeca_model_info) */
   uint32_t format_version;
   uint32_t head_vertex_count;   /* vertices of the whole head (template topology)  */
   uint32_t skin_vertex_count;   /* the first skin_vertex_count of them are S       */
@@ -119,9 +154,9 @@ typedef struct softdeca_model_info {
   uint32_t parameter_count;
   uint32_t landmark_count;     /* landmarks SparseSoftDECA reads                  */
   uint32_t arkit_vertex_count; /* vertices of ARKit's face mesh (1220)            */
-  uint32_t has_softdeca;       /* 1: evaluate_weights/evaluate_surface available  */
-  uint32_t has_sparse;         /* 1: evaluate_landmarks available                 */
-  uint32_t untrained;          /* 1: random weights (tests, demos): not a model   */
+  softdeca_bool has_softdeca;  /* evaluate_weights/evaluate_surface available      */
+  softdeca_bool has_sparse;    /* evaluate_landmarks available                     */
+  softdeca_bool untrained;     /* random weights (tests, demos): not a model       */
   float dynamics_frame_rate_hz; /* the frame rate the dynamics were trained at; 0: unknown */
 } softdeca_model_info;
 
@@ -141,19 +176,19 @@ SOFTDECA_API softdeca_status softdeca_model_find_parameter(const softdeca_model*
 /* The ARKit face-mesh vertex index of every landmark (landmark_count int32), so a host can send
  * just those vertices to evaluate_landmarks. */
 SOFTDECA_API softdeca_status softdeca_model_get_landmark_vertices(const softdeca_model* model,
-                                                                  int32_t* out_vertices, size_t capacity);
+                                                                  int32_t* out_vertices, uint32_t capacity);
 
 /* The bundle's triangulation of the skin S (skin_triangle_count * 3 int32 indices): the face
  * order of per-face parameter maps. */
 SOFTDECA_API softdeca_status softdeca_model_get_skin_triangles(const softdeca_model* model, int32_t* out_triangles,
-                                                               size_t capacity);
+                                                               uint32_t capacity);
 
 /* The landmarks on a mesh in template topology (skin_vertex_count or head_vertex_count
  * vertices): landmark_count points from the bundle's barycentric definition on S. For hosts
  * that drive SparseSoftDECA from their own rig, and to show where the landmarks sit. */
 SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_model* model, const float* vertices,
-                                                               size_t vertex_count, float* out_points,
-                                                               size_t point_capacity);
+                                                               uint32_t vertex_count, float* out_points,
+                                                               uint32_t point_capacity);
 
 typedef enum softdeca_precision {
   SOFTDECA_PRECISION_HALF = 0, /* hyper-tensors in binary16 (default: half the memory traffic) */
@@ -162,97 +197,98 @@ typedef enum softdeca_precision {
 } softdeca_precision;
 
 typedef struct softdeca_avatar_desc {
-  uint32_t size;            /* sizeof(softdeca_avatar_desc) */
+  uint32_t struct_size;            /* sizeof(softdeca_avatar_desc) */
   const float* neutral;     /* vertex_count * 3 floats: the avatar's neutral head       */
-  size_t vertex_count;      /* must equal head_vertex_count                              */
+  uint32_t vertex_count;      /* must equal head_vertex_count                              */
   const int32_t* triangles; /* triangle_count * 3 indices over the whole head: normals   */
-  size_t triangle_count;
+  uint32_t triangle_count;
   const float* blendshapes; /* NULL, or blendshape_count * vertex_count * 3 floats: the
                                avatar's own 52 ARKit shapes (or the template's) as deltas
                                from the neutral, canonical order                         */
-  size_t blendshape_count;  /* 0 or 52 */
+  uint32_t blendshape_count;  /* 0 or 52 */
   uint32_t threads;         /* threads per frame: 0 or 1 the caller only; 2 or more: the
                                caller plus helper threads owned by the avatar (max 8)    */
-  uint32_t precision;       /* softdeca_precision */
+  int32_t precision;        /* softdeca_precision */
 } softdeca_avatar_desc;
 
 /* Checks the mesh (sizes, finite values, indices, no degenerate skin triangle) and runs the
  * bundle's identity encoder on the neutral skin (softdeca_avatar_get_identity). */
 SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model, const softdeca_avatar_desc* desc,
                                                     softdeca_avatar** out_avatar);
-SOFTDECA_API softdeca_status softdeca_avatar_destroy(softdeca_avatar* avatar);
+/* NULL is a no-op. */
+SOFTDECA_API void softdeca_avatar_destroy(softdeca_avatar* avatar);
 
 /* Material parameters (see softdeca_model_get_parameter), effective at the next prepare.
  * A global value replaces any map. Maps give one value per skin triangle (skin_triangle_count,
  * in the bundle's triangulation) or per skin vertex (skin_vertex_count); the other element
  * kind is derived (face -> vertex: area-weighted mean of the incident faces; vertex -> face:
  * mean of the corners). Values outside [min, max] are rejected. */
-SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avatar, uint32_t index, float value);
+SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avatar, uint32_t index, double value);
 SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_faces(softdeca_avatar* avatar, uint32_t index,
-                                                                 const float* values, size_t face_count);
+                                                                 const float* values, uint32_t face_count);
 SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_vertices(softdeca_avatar* avatar, uint32_t index,
-                                                                    const float* values, size_t vertex_count);
+                                                                    const float* values, uint32_t vertex_count);
 SOFTDECA_API softdeca_status softdeca_avatar_reset_parameters(softdeca_avatar* avatar);
 /* The global value (a map's parameters report their last global value) and whether a map is set;
  * either output may be NULL. */
 SOFTDECA_API softdeca_status softdeca_avatar_get_parameter(const softdeca_avatar* avatar, uint32_t index,
-                                                           float* out_value, uint32_t* out_localised);
+                                                           double* out_value, softdeca_bool* out_localised);
 
 /* The identity code h (identity_size floats): from the encoder, or as set; set takes effect at
  * the next prepare. */
 SOFTDECA_API softdeca_status softdeca_avatar_get_identity(const softdeca_avatar* avatar, float* out_identity,
-                                                          size_t capacity);
+                                                          uint32_t capacity);
 SOFTDECA_API softdeca_status softdeca_avatar_set_identity(softdeca_avatar* avatar, const float* identity,
-                                                          size_t count);
+                                                          uint32_t count);
 
 /* Builds a new preparation from the current parameters and identity and publishes it. */
 SOFTDECA_API softdeca_status softdeca_avatar_prepare(softdeca_avatar* avatar);
 
 /* Where a frame's result goes: vertices of the whole head, and optionally unit normals. */
 typedef struct softdeca_output {
-  uint32_t size;          /* sizeof(softdeca_output) */
+  uint32_t struct_size;          /* sizeof(softdeca_output) */
   float* vertices;        /* vertex_capacity * 3 floats */
-  size_t vertex_capacity; /* at least head_vertex_count */
+  uint32_t vertex_capacity; /* at least head_vertex_count */
   float* normals;         /* NULL, or normal_capacity * 3 floats */
-  size_t normal_capacity;
+  uint32_t normal_capacity;
 } softdeca_output;
 
 /* SoftDECA from 52 weights in [0, 1] (canonical ARKit order): the avatar's blendshapes give
  * S_t, the model corrects the skin; non-skin vertices (teeth, eyes, ...) follow the blendshapes.
  * Needs blendshapes at creation and a preparation (SOFTDECA_ERROR_NOT_READY). */
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* avatar, const float* weights,
-                                                              size_t weight_count, const softdeca_output* output);
+                                                              uint32_t weight_count, const softdeca_output* output);
 
 /* SoftDECA on a caller-blended S_t: `surface` holds the skin (skin_vertex_count) or the whole
  * head (head_vertex_count); `weights` still drive f_w. Non-skin vertices come from a whole-head
  * surface, else they follow the skin rigidly (cranium fixed, jaw with the jaw anchors). */
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_surface(softdeca_avatar* avatar, const float* weights,
-                                                              size_t weight_count, const float* surface,
-                                                              size_t vertex_count, const softdeca_output* output);
+                                                              uint32_t weight_count, const float* surface,
+                                                              uint32_t vertex_count, const softdeca_output* output);
 
 /* Landmark calibration: the user's neutral face, as the landmark_count landmarks or the whole
  * ARKit face mesh (arkit_vertex_count vertices). Later frames are retargeted: offsets from this
  * neutral, mapped by the similarity between the user's and the avatar's neutral landmarks.
  * Without calibration, evaluate_landmarks takes its points as the avatar's own landmarks. */
 SOFTDECA_API softdeca_status softdeca_avatar_calibrate_landmarks(softdeca_avatar* avatar, const float* points,
-                                                                 size_t point_count);
+                                                                 uint32_t point_count);
 
 /* SparseSoftDECA from tracked landmarks (landmark_count points, or the arkit_vertex_count
  * vertices of ARKit's face mesh); non-skin vertices follow the skin rigidly. */
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_landmarks(softdeca_avatar* avatar, const float* points,
-                                                                size_t point_count, const softdeca_output* output);
+                                                                uint32_t point_count, const softdeca_output* output);
 
 /* Plain linear blendshapes and normals (the baseline, and a fallback); needs no preparation. */
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_linear(softdeca_avatar* avatar, const float* weights,
-                                                             size_t weight_count, const softdeca_output* output);
+                                                             uint32_t weight_count, const softdeca_output* output);
 
-/* Second-order dynamics on (1) or off (0, the default); reset forgets the past frames (the next
+/* Second-order dynamics on (true) or off (false, the default); reset forgets the past frames (the next
  * frame starts at rest). Changing model between frames also starts at rest. */
-SOFTDECA_API softdeca_status softdeca_avatar_set_dynamics(softdeca_avatar* avatar, int enabled);
+SOFTDECA_API softdeca_status softdeca_avatar_set_dynamics(softdeca_avatar* avatar, softdeca_bool enabled);
 SOFTDECA_API softdeca_status softdeca_avatar_reset_dynamics(softdeca_avatar* avatar);
 
 typedef struct softdeca_stats {
-  uint32_t size;              /* sizeof(softdeca_stats) */
+  uint32_t struct_size;              /* sizeof(softdeca_stats) */
   uint32_t threads;           /* threads a frame uses */
   uint64_t frames;            /* successful evaluations */
   uint64_t preparations;      /* completed prepares */
@@ -289,14 +325,14 @@ SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* av
  *   out_outside     point_count floats (metres), may be NULL
  */
 SOFTDECA_API softdeca_status softdeca_embed_points(
-    const float* vertices, size_t vertex_count, const int32_t* tets, size_t tet_count,
-    const float* points, size_t point_count, int32_t* out_tet, float* out_barycentric,
+    const float* vertices, uint32_t vertex_count, const int32_t* tets, uint32_t tet_count,
+    const float* points, uint32_t point_count, int32_t* out_tet, float* out_barycentric,
     float* out_outside);
 
 /* Signed volumes of tetrahedra (positive for the orientation of the layered head model;
  * (b-a) . ((c-a) x (d-a)) / 6). out_volumes holds tet_count floats. */
 SOFTDECA_API softdeca_status softdeca_tet_volumes(
-    const float* vertices, size_t vertex_count, const int32_t* tets, size_t tet_count,
+    const float* vertices, uint32_t vertex_count, const int32_t* tets, uint32_t tet_count,
     float* out_volumes);
 
 
@@ -308,16 +344,13 @@ SOFTDECA_API softdeca_status softdeca_tet_volumes(
  * barycentric embedding. Soft Dirichlet targets on S (and landmarks, SparseSoftDECA) drive it.
  * The material parameters p are the list of plugin/data/parameters.json, compiled in:
  * enumerate it with softdeca_parameter_count / softdeca_parameter_get_info.
- *
- * Structs carry their own size (struct_size = sizeof(struct)) for forward compatibility: the
- * library refuses a struct_size smaller than the version it knows and ignores trailing fields
- * it does not know. Arrays are packed row by row; index arrays are int32.
+ * Arrays are packed row by row.
  */
 
 typedef struct softdeca_sim softdeca_sim; /* opaque */
 
 typedef struct softdeca_parameter_info {
-  size_t struct_size;
+  uint32_t struct_size;
   const char* name;        /* e.g. "w_soft_volume" (static string) */
   const char* unit;        /* "kPa", "g", "deg" or "" */
   const char* domain;      /* "global" or the element kind of per-element values: "soft_tet",
@@ -325,65 +358,67 @@ typedef struct softdeca_parameter_info {
                               "vertex", "skin_point", "landmark" */
   const char* description;
   double default_value, lo, hi; /* closed range */
-  int32_t log_scale;            /* 1: sample uniformly in log space */
+  softdeca_bool log_scale;      /* sample uniformly in log space */
 } softdeca_parameter_info;
 
-SOFTDECA_API softdeca_status softdeca_parameter_count(size_t* out_count);
-SOFTDECA_API softdeca_status softdeca_parameter_get_info(size_t index, softdeca_parameter_info* out_info);
+SOFTDECA_API softdeca_status softdeca_parameter_count(uint32_t* out_count);
+SOFTDECA_API softdeca_status softdeca_parameter_get_info(uint32_t index, softdeca_parameter_info* out_info);
+/* Index of a simulator parameter by name; SOFTDECA_ERROR_INVALID_ARGUMENT if there is none. */
+SOFTDECA_API softdeca_status softdeca_parameter_find(const char* name, uint32_t* out_index);
 /* plugin/data/parameters.json as compiled in (static string, never freed). */
 SOFTDECA_API softdeca_status softdeca_parameters_json(const char** out_json);
 
 /* One side of a lip or teeth collision: skin points that must stay on the outer side of an
  * oriented surface (normals by the right-hand rule point to where the points belong). */
 typedef struct softdeca_sim_collision_set {
-  size_t struct_size;
+  uint32_t struct_size;
   const int32_t* points;      /* point_count skin point indices */
-  size_t point_count;
+  uint32_t point_count;
   const int32_t* surface;     /* surface_triangle_count * 3 indices */
-  size_t surface_triangle_count;
-  int32_t surface_on_skin;    /* 1: indices of skin points; 0: of simulated vertices (teeth) */
+  uint32_t surface_triangle_count;
+  softdeca_bool surface_on_skin; /* true: indices of skin points; false: of simulated vertices (teeth) */
   float max_distance;         /* metres: farther closest points are not this contact */
 } softdeca_sim_collision_set;
 
 typedef struct softdeca_sim_mesh {
-  size_t struct_size;
+  uint32_t struct_size;
   const float* vertices;            /* vertex_count * 3: simulated vertices at rest (metres) */
-  size_t vertex_count;
+  uint32_t vertex_count;
   const int32_t* soft_tets;         /* soft tissue, positively oriented, 4 each */
-  size_t soft_tet_count;
+  uint32_t soft_tet_count;
   const int32_t* muscle_tets;       /* muscle tissue, positively oriented */
-  size_t muscle_tet_count;
+  uint32_t muscle_tet_count;
   const int32_t* connecting_tets;   /* skull to muscle, eyes to skull (any orientation) */
-  size_t connecting_tet_count;
+  uint32_t connecting_tet_count;
   const int32_t* skull_triangles;   /* skull surface: strain and bending, 3 each */
-  size_t skull_triangle_count;
+  uint32_t skull_triangle_count;
   const int32_t* cranium_vertices;  /* rigid bones; disjoint */
-  size_t cranium_vertex_count;
+  uint32_t cranium_vertex_count;
   const int32_t* jaw_vertices;
-  size_t jaw_vertex_count;
-  int32_t cranium_pinned, jaw_pinned; /* 1: follow the frame's transform exactly */
+  uint32_t jaw_vertex_count;
+  softdeca_bool cranium_pinned, jaw_pinned; /* follow the frame's transform exactly */
   const float* cranium_pivot;       /* 3 floats, centre of the cranium scale; NULL: centroid */
   const float* jaw_pivot;
   const int32_t* skin_vertices;     /* skin_count * 4 simulated vertices per skin point */
   const float* skin_weights;        /* skin_count * 4 weights summing to 1 (0 for unused) */
-  size_t skin_count;
+  uint32_t skin_count;
   const int32_t* skin_triangles;    /* S's triangles over skin points, 3 each */
-  size_t skin_triangle_count;
+  uint32_t skin_triangle_count;
   const int32_t* landmark_points;   /* landmark_count * 3 skin points (SparseSoftDECA) */
   const float* landmark_weights;    /* landmark_count * 3 barycentric weights */
-  size_t landmark_count;
+  uint32_t landmark_count;
   const softdeca_sim_collision_set* collisions;
-  size_t collision_count;
+  uint32_t collision_count;
 } softdeca_sim_mesh;
 
 typedef struct softdeca_sim_settings {
-  size_t struct_size;
-  int32_t max_iterations;      /* iteration cap per solve (default 300) */
+  uint32_t struct_size;
+  uint32_t max_iterations;     /* iteration cap per solve (default 300) */
   float tolerance;             /* converged when the RMS move of one step < tolerance * size */
-  int32_t anderson_window;     /* 0: plain projective dynamics (default 5) */
-  int32_t threads;             /* 0: all hardware threads */
-  int32_t paper_strain_rule;   /* 1: rotation projection above eps (paper); 0: nearest point */
-  int32_t collision_rounds;    /* 0: no collision resolution */
+  uint32_t anderson_window;    /* 0: plain projective dynamics (default 5) */
+  uint32_t threads;            /* 0: all hardware threads (at most 1024) */
+  softdeca_bool paper_strain_rule; /* true: rotation projection above eps (paper); false: nearest point */
+  uint32_t collision_rounds;   /* 0: no collision resolution */
   float collision_weight;      /* kPa */
   float penetration_tolerance; /* metres */
 } softdeca_sim_settings;
@@ -396,42 +431,45 @@ SOFTDECA_API softdeca_status softdeca_sim_default_settings(softdeca_sim_settings
 SOFTDECA_API softdeca_status softdeca_sim_create(const softdeca_sim_mesh* mesh,
                                                  const softdeca_sim_settings* settings,
                                                  softdeca_sim** out_sim);
+/* NULL is a no-op. */
 SOFTDECA_API void softdeca_sim_destroy(softdeca_sim* sim);
 
-SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, size_t* out_count);
-SOFTDECA_API softdeca_status softdeca_sim_skin_count(const softdeca_sim* sim, size_t* out_count);
+SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, uint32_t* out_count);
+SOFTDECA_API softdeca_status softdeca_sim_skin_count(const softdeca_sim* sim, uint32_t* out_count);
 
-/* Sets a parameter to one value everywhere (out of range: INVALID_ARGUMENT, nothing changes). */
-SOFTDECA_API softdeca_status softdeca_sim_set_parameter(softdeca_sim* sim, const char* name, double value);
-SOFTDECA_API softdeca_status softdeca_sim_get_parameter(const softdeca_sim* sim, const char* name,
+/* Parameter `index` of the simulator's list (softdeca_parameter_get_info; by name through
+ * softdeca_parameter_find) set to one value everywhere (out of range: INVALID_ARGUMENT, nothing
+ * changes). */
+SOFTDECA_API softdeca_status softdeca_sim_set_parameter(softdeca_sim* sim, uint32_t index, double value);
+SOFTDECA_API softdeca_status softdeca_sim_get_parameter(const softdeca_sim* sim, uint32_t index,
                                                         double* out_value);
 /* Per-element values: count must equal the element count of the parameter's domain. */
-SOFTDECA_API softdeca_status softdeca_sim_set_parameter_field(softdeca_sim* sim, const char* name,
-                                                              const float* values, size_t count);
+SOFTDECA_API softdeca_status softdeca_sim_set_parameter_field(softdeca_sim* sim, uint32_t index,
+                                                              const float* values, uint32_t count);
 
 typedef struct softdeca_sim_frame {
-  size_t struct_size;
+  uint32_t struct_size;
   const float* skin_targets;        /* skin_count * 3: the target expression S_t */
-  size_t skin_count;
+  uint32_t skin_count;
   const float* landmark_targets;    /* landmark_count * 3 (SparseSoftDECA) or NULL */
-  size_t landmark_count;
+  uint32_t landmark_count;
   const float* cranium_transform;   /* 12 floats, 3x4 row-major rigid transform; NULL: identity */
   const float* jaw_transform;
   const float* warm_start;          /* vertex_count * 3 or NULL */
-  size_t warm_start_count;
+  uint32_t warm_start_count;
 } softdeca_sim_frame;
 
 typedef struct softdeca_sim_stats {
-  size_t struct_size;
-  int32_t iterations;
-  int32_t converged;
+  uint32_t struct_size;
+  uint32_t iterations;
+  softdeca_bool converged;
   double relative_step;     /* last plain step's RMS move / rest bounding-box diagonal */
   double estimated_error;   /* relative_step / (1 - contraction): distance to the solution */
   double contraction;       /* measured contraction of a plain step on the slowest mode */
   double energy;            /* projective dynamics energy (J) */
   double target_rms;        /* RMS distance of S to its (blended) targets (m) */
   double local_seconds, global_seconds, factor_seconds, total_seconds;
-  int32_t penetrating_before, penetrating_after, contacts;
+  uint32_t penetrating_before, penetrating_after, contacts;
 } softdeca_sim_stats;
 
 /* One static frame T = phi†(S_t, p). stats may be NULL. On success the result replaces the
@@ -447,20 +485,18 @@ SOFTDECA_API softdeca_status softdeca_sim_reset_dynamics(softdeca_sim* sim);
  * out_skin_count = frame_count * skin_count points (3 floats each); stats (frame_count
  * entries) may be NULL. The simulator's output becomes the last frame's. */
 SOFTDECA_API softdeca_status softdeca_sim_solve_static_batch(softdeca_sim* sim, const softdeca_sim_frame* frames,
-                                                             size_t frame_count, float* out_skin,
-                                                             size_t out_skin_count, softdeca_sim_stats* stats);
+                                                             uint32_t frame_count, float* out_skin,
+                                                             uint32_t out_skin_count, softdeca_sim_stats* stats);
 /* The last result (rest before the first solve): vertex_count * 3 / skin_count * 3 floats. */
 SOFTDECA_API softdeca_status softdeca_sim_get_vertices(const softdeca_sim* sim, float* out_vertices,
-                                                       size_t vertex_count);
-SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, float* out_skin, size_t skin_count);
+                                                       uint32_t vertex_count);
+SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, float* out_skin, uint32_t skin_count);
 
-/* ==== Streaming and recorded takes (issue 7) ============================================
+/* ==== Streaming and recorded takes =====================================================
  * Face frames arrive live over UDP (our protocol, docs/protocol.md; Epic's Live Link Face app;
  * iFacialMocap) or from recording files (docs/recording.md), and all come out as one canonical
  * frame: 52 weights in canonical ARKit order (softdeca_blendshape_name), poses and landmarks in
  * metres in ARKit's face-anchor frame.
- * Structs with a `size` field: set it to sizeof(the struct) before the call; the library reads
- * and writes only the fields of the size it knows and rejects a smaller size.
  * The receiver's functions may be called from any thread, concurrently, except
  * softdeca_receiver_destroy, which must follow every other call on that receiver; a recorder or
  * player handle must be used by one thread at a time. */
@@ -491,7 +527,7 @@ typedef struct softdeca_pose {
 } softdeca_pose;
 
 typedef struct softdeca_frame {
-  uint32_t size;          /* sizeof(softdeca_frame) */
+  uint32_t struct_size;          /* sizeof(softdeca_frame) */
   uint32_t flags;         /* SOFTDECA_FRAME_HAS_* */
   uint32_t session_id;    /* the sender's stream */
   uint32_t sequence;      /* the sender's datagram number, with SOFTDECA_FRAME_HAS_SEQUENCE */
@@ -519,7 +555,7 @@ typedef enum softdeca_stream_format {
 } softdeca_stream_format;
 
 typedef struct softdeca_receiver_config {
-  uint32_t size;
+  uint32_t struct_size;
   int32_t format;           /* softdeca_stream_format */
   const char* bind_address; /* numeric IPv4 or IPv6 address; NULL: "127.0.0.1" (loopback), or
                              * "0.0.0.0" (all IPv4) with listen_network */
@@ -527,9 +563,9 @@ typedef struct softdeca_receiver_config {
   uint32_t queue_capacity;  /* delivered frames kept for softdeca_receiver_next, 1 to 65536 */
   double jitter_delay;      /* seconds in [0, 5] that frames wait to be put in order; 0: none */
   /* Security (docs/security.md). */
-  int32_t listen_network;   /* 1: may bind a network address; 0: loopback addresses only */
-  int32_t follow_newest;    /* 1: a new sender takes the session at once; 0: the first sender
-                             * holds it until quiet for session_hold seconds */
+  softdeca_bool listen_network; /* 1: may bind a network address; 0: loopback addresses only */
+  softdeca_bool follow_newest;  /* 1: a new sender takes the session at once; 0: the first
+                                 * sender holds it until quiet for session_hold seconds */
   double session_hold;      /* seconds in (0, 3600]; 0: 2 */
   double source_rate_limit; /* datagrams per second per sender; 0: 1000; negative: no limit */
 } softdeca_receiver_config;
@@ -548,17 +584,17 @@ SOFTDECA_API void softdeca_receiver_destroy(softdeca_receiver* receiver);
 SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* receiver,
                                                     uint32_t* out_port);
 /* The oldest delivered frame not yet taken, waiting up to `timeout` seconds (0: do not wait).
- * *out_received is 1 when a frame was written, else 0. */
+ * *out_received is true when a frame was written, else false. */
 SOFTDECA_API softdeca_status softdeca_receiver_next(softdeca_receiver* receiver, double timeout,
                                                     softdeca_frame* out_frame,
-                                                    int32_t* out_received);
+                                                    softdeca_bool* out_received);
 /* The newest delivered frame, taken or not (what an avatar shows now). */
 SOFTDECA_API softdeca_status softdeca_receiver_latest(const softdeca_receiver* receiver,
                                                       softdeca_frame* out_frame,
-                                                      int32_t* out_received);
+                                                      softdeca_bool* out_received);
 
 typedef struct softdeca_receiver_stats {
-  uint32_t size;
+  uint32_t struct_size;
   uint32_t reserved;
   uint64_t datagrams;        /* read from the socket */
   uint64_t frames;           /* well-formed frames */
@@ -596,20 +632,20 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
  * its id and ARKit vertex indices. *out_count is always set to the profile's size (0 and id 0
  * when there is none yet); SOFTDECA_ERROR_BUFFER_TOO_SMALL when capacity is smaller. */
 SOFTDECA_API softdeca_status softdeca_receiver_profile(const softdeca_receiver* receiver,
-                                                       uint32_t* out_id, uint16_t* out_indices,
-                                                       size_t capacity, size_t* out_count);
+                                                       uint32_t* out_id, int32_t* out_indices,
+                                                       uint32_t capacity, uint32_t* out_count);
 /* The sender's neutral face mesh (calibration), xyz per vertex; *out_vertex_count as above. */
 SOFTDECA_API softdeca_status softdeca_receiver_neutral(const softdeca_receiver* receiver,
-                                                       float* out_xyz, size_t vertex_capacity,
-                                                       size_t* out_vertex_count);
-/* Asks the current sender (our protocol) for its neutral mesh; *out_sent 0 without a sender. */
+                                                       float* out_xyz, uint32_t vertex_capacity,
+                                                       uint32_t* out_vertex_count);
+/* Asks the current sender (our protocol) for its neutral mesh; *out_sent false without a sender. */
 SOFTDECA_API softdeca_status softdeca_receiver_request_neutral(softdeca_receiver* receiver,
-                                                               int32_t* out_sent);
+                                                               softdeca_bool* out_sent);
 
 /* ---- Recordings ----------------------------------------------------------------------------- */
 
 typedef struct softdeca_recording_header {
-  uint32_t size;
+  uint32_t struct_size;
   uint32_t reserved;
   const char* device;     /* capturing device or app; NULL: "" */
   const char* subject;    /* performer or take; NULL: "" */
@@ -625,7 +661,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_start_recording(
 /* Ends the recording; *out_frames (may be NULL) gets the frames written. SOFTDECA_ERROR_IO when
  * a write failed on the way (the file then holds every frame before the failure). */
 SOFTDECA_API softdeca_status softdeca_receiver_stop_recording(softdeca_receiver* receiver,
-                                                              uint64_t* out_frames);
+                                                              uint32_t* out_frames);
 
 typedef struct softdeca_recorder softdeca_recorder;
 
@@ -639,16 +675,16 @@ SOFTDECA_API softdeca_status softdeca_recorder_write(softdeca_recorder* recorder
 /* Appends a landmark profile (name may be NULL) and returns its id for frames to name. */
 SOFTDECA_API softdeca_status softdeca_recorder_write_profile(softdeca_recorder* recorder,
                                                              const char* name,
-                                                             const uint16_t* indices, size_t count,
+                                                             const int32_t* indices, uint32_t count,
                                                              uint32_t* out_id);
 SOFTDECA_API softdeca_status softdeca_recorder_write_neutral(softdeca_recorder* recorder,
                                                              const float* xyz,
-                                                             size_t vertex_count);
+                                                             uint32_t vertex_count);
 /* Closes the file. NULL is ignored. */
 SOFTDECA_API void softdeca_recorder_destroy(softdeca_recorder* recorder);
 
 typedef struct softdeca_recording_info {
-  uint32_t size;
+  uint32_t struct_size;
   uint32_t frame_count;
   double duration;         /* seconds from the first to the last frame */
   double start_unix_time;
@@ -665,6 +701,7 @@ typedef struct softdeca_player softdeca_player;
 /* Reads a recording, recovering what a damaged file still holds (info tells what was lost);
  * SOFTDECA_ERROR_FORMAT when its header is unreadable or it has no frame. */
 SOFTDECA_API softdeca_status softdeca_player_open(const char* path, softdeca_player** out_player);
+/* NULL is ignored. */
 SOFTDECA_API void softdeca_player_destroy(softdeca_player* player);
 SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player,
                                                   softdeca_recording_info* out_info);
@@ -677,26 +714,26 @@ SOFTDECA_API softdeca_status softdeca_player_frame_at(const softdeca_player* pla
 SOFTDECA_API softdeca_status softdeca_player_seek(softdeca_player* player, double time);
 /* Playback speed in [0, 1000]; 1 is real time, 0 pauses. */
 SOFTDECA_API softdeca_status softdeca_player_set_speed(softdeca_player* player, double speed);
-SOFTDECA_API softdeca_status softdeca_player_set_loop(softdeca_player* player, int32_t loop);
+SOFTDECA_API softdeca_status softdeca_player_set_loop(softdeca_player* player, softdeca_bool loop);
 /* Moves the playhead by dt * speed seconds (wrapping when looping) and returns the frame there;
- * *out_ended (may be NULL) is 1 when playback reached the end without looping. */
+ * *out_ended (may be NULL) is true when playback reached the end without looping. */
 SOFTDECA_API softdeca_status softdeca_player_advance(softdeca_player* player, double dt,
                                                      softdeca_frame* out_frame,
-                                                     int32_t* out_ended);
+                                                     softdeca_bool* out_ended);
 SOFTDECA_API softdeca_status softdeca_player_position(const softdeca_player* player,
                                                       double* out_time);
 /* The recording's newest landmark profile and neutral mesh, as for the receiver. */
 SOFTDECA_API softdeca_status softdeca_player_profile(const softdeca_player* player,
-                                                     uint32_t* out_id, uint16_t* out_indices,
-                                                     size_t capacity, size_t* out_count);
+                                                     uint32_t* out_id, int32_t* out_indices,
+                                                     uint32_t capacity, uint32_t* out_count);
 SOFTDECA_API softdeca_status softdeca_player_neutral(const softdeca_player* player,
-                                                     float* out_xyz, size_t vertex_capacity,
-                                                     size_t* out_vertex_count);
+                                                     float* out_xyz, uint32_t vertex_capacity,
+                                                     uint32_t* out_vertex_count);
 
 /* ---- Live Link Face CSV takes --------------------------------------------------------------- */
 
 typedef struct softdeca_convert_report {
-  uint32_t size;
+  uint32_t struct_size;
   uint32_t frames;         /* frames written */
   uint32_t rows;           /* CSV data rows read (CSV -> recording) */
   uint32_t face_lost_rows; /* rows where the app had lost the face: skipped */

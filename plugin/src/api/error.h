@@ -63,6 +63,17 @@ inline void require_not_null(const void* p, const char* name) {
   if (p == nullptr) throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, std::string(name) + " is null");
 }
 
+// The ABI's struct rule: non-null, struct_size at least this library's sizeof (trailing fields
+// of a newer caller are ignored). The message names the struct and both sizes.
+template <class T>
+void require_struct(const T* s, const char* name) {
+  require_not_null(s, name);
+  if (s->struct_size < sizeof(T))
+    throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, std::string(name) + "->struct_size is " + std::to_string(s->struct_size) +
+                                                     ", expected sizeof = " + std::to_string(sizeof(T)) +
+                                                     ": set struct_size to sizeof the struct before the call");
+}
+
 // For per-frame paths: the message (a callable returning it) is built only on failure, so a
 // passing check allocates nothing.
 template <class Message>

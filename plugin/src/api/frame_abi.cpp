@@ -29,9 +29,9 @@ stream::Pose pose_in(const softdeca_pose& in, const char* name) {
 }  // namespace
 
 void frame_to_abi(const stream::Frame& f, softdeca_frame* out) {
-  const uint32_t size = out->size;
+  const uint32_t struct_size = out->struct_size;
   std::memset(out, 0, sizeof(softdeca_frame));
-  out->size = size;
+  out->struct_size = struct_size;
   out->flags = (f.has_head ? SOFTDECA_FRAME_HAS_HEAD : 0u) | (f.has_eyes ? SOFTDECA_FRAME_HAS_EYES : 0u) |
                (f.has_sequence ? SOFTDECA_FRAME_HAS_SEQUENCE : 0u);
   out->session_id = f.session_id;
@@ -84,11 +84,11 @@ stream::Frame frame_from_abi(const softdeca_frame* in) {
   return f;
 }
 
-void profile_to_abi(const stream::wire::Profile* p, uint32_t* out_id, uint16_t* out_indices,
-                    std::size_t capacity, std::size_t* out_count) {
+void profile_to_abi(const stream::wire::Profile* p, uint32_t* out_id, int32_t* out_indices,
+                    uint32_t capacity, uint32_t* out_count) {
   require_not_null(out_id, "out_id");
   require_not_null(out_count, "out_count");
-  const std::size_t n = p ? p->indices.size() : 0;
+  const uint32_t n = p ? static_cast<uint32_t>(p->indices.size()) : 0;
   *out_count = n;
   require(capacity >= n, "the profile has " + std::to_string(n) + " indices, capacity is " + std::to_string(capacity),
           SOFTDECA_ERROR_BUFFER_TOO_SMALL);
@@ -97,10 +97,10 @@ void profile_to_abi(const stream::wire::Profile* p, uint32_t* out_id, uint16_t* 
   if (n > 0) std::copy(p->indices.begin(), p->indices.end(), out_indices);
 }
 
-void neutral_to_abi(const std::vector<float>& xyz, float* out_xyz, std::size_t vertex_capacity,
-                    std::size_t* out_vertex_count) {
+void neutral_to_abi(const std::vector<float>& xyz, float* out_xyz, uint32_t vertex_capacity,
+                    uint32_t* out_vertex_count) {
   require_not_null(out_vertex_count, "out_vertex_count");
-  const std::size_t n = xyz.size() / 3;
+  const uint32_t n = static_cast<uint32_t>(xyz.size() / 3);
   *out_vertex_count = n;
   require(vertex_capacity >= n, "the neutral mesh has " + std::to_string(n) + " vertices, capacity is " +
                                     std::to_string(vertex_capacity),

@@ -40,9 +40,9 @@ void check_mesh(const float* vertices, std::size_t vertex_count, const int32_t* 
 
 extern "C" {
 
-SOFTDECA_API softdeca_status softdeca_embed_points(const float* vertices, size_t vertex_count,
-                                                   const int32_t* tets, size_t tet_count,
-                                                   const float* points, size_t point_count,
+SOFTDECA_API softdeca_status softdeca_embed_points(const float* vertices, uint32_t vertex_count,
+                                                   const int32_t* tets, uint32_t tet_count,
+                                                   const float* points, uint32_t point_count,
                                                    int32_t* out_tet, float* out_barycentric,
                                                    float* out_outside) {
   return guarded(__func__, [&] {
@@ -64,8 +64,8 @@ SOFTDECA_API softdeca_status softdeca_embed_points(const float* vertices, size_t
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_tet_volumes(const float* vertices, size_t vertex_count,
-                                                  const int32_t* tets, size_t tet_count,
+SOFTDECA_API softdeca_status softdeca_tet_volumes(const float* vertices, uint32_t vertex_count,
+                                                  const int32_t* tets, uint32_t tet_count,
                                                   float* out_volumes) {
   return guarded(__func__, [&] {
     check_mesh(vertices, vertex_count, tets, tet_count);

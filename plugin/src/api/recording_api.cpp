@@ -43,10 +43,10 @@ void copy_text(const std::string& s, char (&out)[64]) {
 
 void report_out(const recording::ConversionReport& r, softdeca_convert_report* out) {
   if (!out) return;
-  abi::require_struct(out, "out_report");
-  const uint32_t size = out->size;
+  require_struct(out, "out_report");
+  const uint32_t struct_size = out->struct_size;
   *out = softdeca_convert_report{};
-  out->size = size;
+  out->struct_size = struct_size;
   out->frames = static_cast<uint32_t>(r.frames);
   out->rows = static_cast<uint32_t>(r.rows);
   out->face_lost_rows = static_cast<uint32_t>(r.face_lost_rows);
@@ -75,7 +75,7 @@ SOFTDECA_API softdeca_status softdeca_recorder_write(softdeca_recorder* recorder
 }
 
 SOFTDECA_API softdeca_status softdeca_recorder_write_profile(softdeca_recorder* recorder, const char* name,
-                                                             const uint16_t* indices, size_t count,
+                                                             const int32_t* indices, uint32_t count,
                                                              uint32_t* out_id) {
   return guarded(__func__, [&] {
     auto& r = recorder_of(recorder);
@@ -84,7 +84,12 @@ SOFTDECA_API softdeca_status softdeca_recorder_write_profile(softdeca_recorder* 
     require_not_null(out_id, "out_id");
     stream::wire::Profile p;
     p.name = name ? name : "";
-    p.indices.assign(indices, indices + count);
+    for (uint32_t i = 0; i < count; ++i) {
+      expect(indices[i] >= 0 && indices[i] < SOFTDECA_ARKIT_VERTEX_COUNT, [&] {
+        return "indices[" + std::to_string(i) + "] = " + std::to_string(indices[i]) + " is not an ARKit face-mesh vertex";
+      });
+      p.indices.push_back(static_cast<uint16_t>(indices[i]));
+    }
     p.id = stream::wire::profile_id_of(p.indices);
     r.write_profile(p);
     *out_id = p.id;
@@ -92,7 +97,7 @@ SOFTDECA_API softdeca_status softdeca_recorder_write_profile(softdeca_recorder* 
 }
 
 SOFTDECA_API softdeca_status softdeca_recorder_write_neutral(softdeca_recorder* recorder, const float* xyz,
-                                                             size_t vertex_count) {
+                                                             uint32_t vertex_count) {
   return guarded(__func__, [&] {
     auto& r = recorder_of(recorder);
     require_not_null(xyz, "xyz");
@@ -123,11 +128,11 @@ SOFTDECA_API void softdeca_player_destroy(softdeca_player* player) {
 SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player, softdeca_recording_info* out) {
   return guarded(__func__, [&] {
     const auto& p = player_of(player);
-    abi::require_struct(out, "out_info");
+    require_struct(out, "out_info");
     const auto& rec = p.recording();
-    const uint32_t size = out->size;
+    const uint32_t struct_size = out->struct_size;
     *out = softdeca_recording_info{};
-    out->size = size;
+    out->struct_size = struct_size;
     out->frame_count = static_cast<uint32_t>(p.frame_count());
     out->duration = p.duration();
     out->start_unix_time = rec.header.start_unix_time;
@@ -144,7 +149,7 @@ SOFTDECA_API softdeca_status softdeca_player_frame(const softdeca_player* player
                                                    softdeca_frame* out_frame) {
   return guarded(__func__, [&] {
     const auto& p = player_of(player);
-    abi::require_struct(out_frame, "out_frame");
+    require_struct(out_frame, "out_frame");
     require(index < p.frame_count(), "index " + std::to_string(index) + " is not below the frame count " +
                                          std::to_string(p.frame_count()));
     abi::frame_to_abi(p.recording().frames[index], out_frame);
@@ -155,7 +160,7 @@ SOFTDECA_API softdeca_status softdeca_player_frame_at(const softdeca_player* pla
                                                       softdeca_frame* out_frame) {
   return guarded(__func__, [&] {
     const auto& p = player_of(player);
-    abi::require_struct(out_frame, "out_frame");
+    require_struct(out_frame, "out_frame");
     require(std::isfinite(time), "time is not finite", SOFTDECA_ERROR_NON_FINITE);
     abi::frame_to_abi(p.frame_at(time), out_frame);
   });
@@ -169,15 +174,15 @@ SOFTDECA_API softdeca_status softdeca_player_set_speed(softdeca_player* player, 
   return guarded(__func__, [&] { player_of(player).set_speed(speed); });
 }
 
-SOFTDECA_API softdeca_status softdeca_player_set_loop(softdeca_player* player, int32_t loop) {
+SOFTDECA_API softdeca_status softdeca_player_set_loop(softdeca_player* player, softdeca_bool loop) {
   return guarded(__func__, [&] { player_of(player).set_loop(loop != 0); });
 }
 
 SOFTDECA_API softdeca_status softdeca_player_advance(softdeca_player* player, double dt,
-                                                     softdeca_frame* out_frame, int32_t* out_ended) {
+                                                     softdeca_frame* out_frame, softdeca_bool* out_ended) {
   return guarded(__func__, [&] {
     auto& p = player_of(player);
-    abi::require_struct(out_frame, "out_frame");
+    require_struct(out_frame, "out_frame");
     require(std::isfinite(dt) && dt >= 0, "dt must be finite and >= 0");
     const bool ended = p.advance(dt);
     abi::frame_to_abi(p.frame_at(p.position()), out_frame);
@@ -194,7 +199,7 @@ SOFTDECA_API softdeca_status softdeca_player_position(const softdeca_player* pla
 }
 
 SOFTDECA_API softdeca_status softdeca_player_profile(const softdeca_player* player, uint32_t* out_id,
-                                                     uint16_t* out_indices, size_t capacity, size_t* out_count) {
+                                                     int32_t* out_indices, uint32_t capacity, uint32_t* out_count) {
   return guarded(__func__, [&] {
     const auto& profiles = player_of(player).recording().profiles;
     abi::profile_to_abi(profiles.empty() ? nullptr : &profiles.back(), out_id, out_indices, capacity, out_count);
@@ -202,7 +207,7 @@ SOFTDECA_API softdeca_status softdeca_player_profile(const softdeca_player* play
 }
 
 SOFTDECA_API softdeca_status softdeca_player_neutral(const softdeca_player* player, float* out_xyz,
-                                                     size_t vertex_capacity, size_t* out_vertex_count) {
+                                                     uint32_t vertex_capacity, uint32_t* out_vertex_count) {
   return guarded(__func__, [&] {
     abi::neutral_to_abi(player_of(player).recording().neutral, out_xyz, vertex_capacity, out_vertex_count);
   });
@@ -216,7 +221,7 @@ SOFTDECA_API softdeca_status softdeca_convert_livelinkface_csv(const char* csv_p
     require_not_null(recording_path, "recording_path");
     require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000,
             "timecode_rate must be in [0, 1000]");
-    if (out_report) abi::require_struct(out_report, "out_report");
+    if (out_report) require_struct(out_report, "out_report");
     report_out(recording::csv_to_recording(csv_path, recording_path, timecode_rate), out_report);
   });
 }
@@ -229,7 +234,7 @@ SOFTDECA_API softdeca_status softdeca_export_livelinkface_csv(const char* record
     require_not_null(csv_path, "csv_path");
     require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000,
             "timecode_rate must be in [0, 1000]");
-    if (out_report) abi::require_struct(out_report, "out_report");
+    if (out_report) require_struct(out_report, "out_report");
     report_out(recording::recording_to_csv(recording_path, csv_path, timecode_rate), out_report);
   });
 }

@@ -24,15 +24,6 @@ using runtime::Model;
 
 constexpr std::size_t kMaxThreads = 8;
 
-template <class T>
-void require_struct(const T* s, const char* name) {
-  require_not_null(s, name);
-  expect(s->size >= sizeof(T), [&] {
-    return std::string(name) + "->size is " + std::to_string(s->size) + ", expected sizeof = " + std::to_string(sizeof(T)) +
-           " (set it before the call)";
-  });
-}
-
 const Model& model_of(const softdeca_model* m) {
   require_not_null(m, "model");
   return *m->model;
@@ -59,7 +50,7 @@ runtime::ModelOptions model_options(const softdeca_model_options* o) {
   require_struct(o, "options");
   require(o->prepare_threads <= 64, "options->prepare_threads must be at most 64");
   opts.prepare_threads = o->prepare_threads == 0 ? 1 : static_cast<int>(o->prepare_threads);
-  if (o->memory_budget_bytes) opts.memory_budget_bytes = o->memory_budget_bytes;
+  if (o->memory_budget_mib) opts.memory_budget_bytes = std::uint64_t{o->memory_budget_mib} << 20;
   return opts;
 }
 
@@ -84,21 +75,21 @@ SOFTDECA_API softdeca_status softdeca_model_load(const char* path, const softdec
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_model_load_memory(const void* data, size_t size, const softdeca_model_options* options,
-                                                        softdeca_model** out_model) {
+SOFTDECA_API softdeca_status softdeca_model_load_memory(const void* data, uint32_t byte_count,
+                                                        const softdeca_model_options* options, softdeca_model** out_model) {
   return guarded(__func__, [&] {
     require_not_null(data, "data");
     require_not_null(out_model, "out_model");
-    require(size > 0, "size is 0");
+    require(byte_count > 0, "byte_count is 0");
     const auto opts = model_options(options);
     auto handle = std::make_unique<softdeca_model>();
-    handle->model = Model::load(runtime::BundleFiles::from_tar(static_cast<const std::uint8_t*>(data), size), opts);
+    handle->model = Model::load(runtime::BundleFiles::from_tar(static_cast<const std::uint8_t*>(data), byte_count), opts);
     *out_model = handle.release();
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_model_destroy(softdeca_model* model) {
-  return guarded(__func__, [&] { delete model; });
+SOFTDECA_API void softdeca_model_destroy(softdeca_model* model) {
+  guarded(__func__, [&] { delete model; });
 }
 
 SOFTDECA_API softdeca_status softdeca_model_get_info(const softdeca_model* model, softdeca_model_info* out_info) {
@@ -115,9 +106,9 @@ SOFTDECA_API softdeca_status softdeca_model_get_info(const softdeca_model* model
     out_info->parameter_count = static_cast<uint32_t>(m.parameters.size());
     out_info->landmark_count = static_cast<uint32_t>(m.landmarks.size());
     out_info->arkit_vertex_count = static_cast<uint32_t>(m.arkit_vertex_count);
-    out_info->has_softdeca = m.has_softdeca ? 1u : 0u;
-    out_info->has_sparse = m.has_sparse ? 1u : 0u;
-    out_info->untrained = m.untrained ? 1u : 0u;
+    out_info->has_softdeca = m.has_softdeca ? SOFTDECA_TRUE : SOFTDECA_FALSE;
+    out_info->has_sparse = m.has_sparse ? SOFTDECA_TRUE : SOFTDECA_FALSE;
+    out_info->untrained = m.untrained ? SOFTDECA_TRUE : SOFTDECA_FALSE;
     out_info->dynamics_frame_rate_hz = static_cast<float>(m.frame_rate_hz);
   });
 }
@@ -126,11 +117,7 @@ SOFTDECA_API softdeca_status softdeca_model_get_parameter(const softdeca_model* 
                                                           softdeca_parameter_info* out_info) {
   return guarded(__func__, [&] {
     const Model& m = model_of(model);
-    require_not_null(out_info, "out_info");
-    expect(out_info->struct_size >= sizeof(softdeca_parameter_info), [&] {
-      return "out_info->struct_size is " + std::to_string(out_info->struct_size) + ", expected sizeof = " +
-             std::to_string(sizeof(softdeca_parameter_info));
-    });
+    require_struct(out_info, "out_info");
     const auto& p = m.manifest().parameters[static_cast<std::size_t>(parameter_index(m, index))];
     out_info->name = p.name.c_str();
     out_info->unit = p.unit.c_str();
@@ -156,7 +143,7 @@ SOFTDECA_API softdeca_status softdeca_model_find_parameter(const softdeca_model*
 }
 
 SOFTDECA_API softdeca_status softdeca_model_get_landmark_vertices(const softdeca_model* model, int32_t* out_vertices,
-                                                                  size_t capacity) {
+                                                                  uint32_t capacity) {
   return guarded(__func__, [&] {
     const auto& lm = model_of(model).manifest().landmarks;
     require_not_null(out_vertices, "out_vertices");
@@ -168,7 +155,7 @@ SOFTDECA_API softdeca_status softdeca_model_get_landmark_vertices(const softdeca
 }
 
 SOFTDECA_API softdeca_status softdeca_model_get_skin_triangles(const softdeca_model* model, int32_t* out_triangles,
-                                                               size_t capacity) {
+                                                               uint32_t capacity) {
   return guarded(__func__, [&] {
     const auto& t = model_of(model).skin_triangles();
     require_not_null(out_triangles, "out_triangles");
@@ -180,7 +167,7 @@ SOFTDECA_API softdeca_status softdeca_model_get_skin_triangles(const softdeca_mo
 }
 
 SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_model* model, const float* vertices,
-                                                               size_t vertex_count, float* out_points, size_t point_capacity) {
+                                                               uint32_t vertex_count, float* out_points, uint32_t point_capacity) {
   return guarded(__func__, [&] {
     const Model& mo = model_of(model);
     const auto& m = mo.manifest();
@@ -229,7 +216,8 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
       require_finite(desc->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->blendshapes");
     }
     require(desc->threads <= kMaxThreads, "desc->threads must be at most " + std::to_string(kMaxThreads));
-    require(desc->precision <= SOFTDECA_PRECISION_INT8, "desc->precision is not a softdeca_precision");
+    require(desc->precision >= SOFTDECA_PRECISION_HALF && desc->precision <= SOFTDECA_PRECISION_INT8,
+            "desc->precision is not a softdeca_precision");
     runtime::AvatarDesc d;
     d.neutral = desc->neutral;
     d.vertex_count = vh;
@@ -247,11 +235,11 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_destroy(softdeca_avatar* avatar) {
-  return guarded(__func__, [&] { delete avatar; });
+SOFTDECA_API void softdeca_avatar_destroy(softdeca_avatar* avatar) {
+  guarded(__func__, [&] { delete avatar; });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avatar, uint32_t index, float value) {
+SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avatar, uint32_t index, double value) {
   return guarded(__func__, [&] {
     Avatar& a = avatar_of(avatar);
     a.set_parameter(parameter_index(a.model(), index), value);
@@ -259,7 +247,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avat
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_faces(softdeca_avatar* avatar, uint32_t index, const float* values,
-                                                                 size_t face_count) {
+                                                                 uint32_t face_count) {
   return guarded(__func__, [&] {
     Avatar& a = avatar_of(avatar);
     a.set_parameter_faces(parameter_index(a.model(), index), values, face_count);
@@ -267,7 +255,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_faces(softdeca_avatar
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_vertices(softdeca_avatar* avatar, uint32_t index,
-                                                                    const float* values, size_t vertex_count) {
+                                                                    const float* values, uint32_t vertex_count) {
   return guarded(__func__, [&] {
     Avatar& a = avatar_of(avatar);
     a.set_parameter_vertices(parameter_index(a.model(), index), values, vertex_count);
@@ -278,20 +266,22 @@ SOFTDECA_API softdeca_status softdeca_avatar_reset_parameters(softdeca_avatar* a
   return guarded(__func__, [&] { avatar_of(avatar).reset_parameters(); });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_get_parameter(const softdeca_avatar* avatar, uint32_t index, float* out_value,
-                                                           uint32_t* out_localised) {
+SOFTDECA_API softdeca_status softdeca_avatar_get_parameter(const softdeca_avatar* avatar, uint32_t index, double* out_value,
+                                                           softdeca_bool* out_localised) {
   return guarded(__func__, [&] {
     const Avatar& a = avatar_of(avatar);
-    a.get_parameter(parameter_index(a.model(), index), out_value, out_localised);
+    bool localised = false;
+    a.get_parameter(parameter_index(a.model(), index), out_value, &localised);
+    if (out_localised) *out_localised = localised ? SOFTDECA_TRUE : SOFTDECA_FALSE;
   });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_get_identity(const softdeca_avatar* avatar, float* out_identity,
-                                                          size_t capacity) {
+                                                          uint32_t capacity) {
   return guarded(__func__, [&] { avatar_of(avatar).get_identity(out_identity, capacity); });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_set_identity(softdeca_avatar* avatar, const float* identity, size_t count) {
+SOFTDECA_API softdeca_status softdeca_avatar_set_identity(softdeca_avatar* avatar, const float* identity, uint32_t count) {
   return guarded(__func__, [&] { avatar_of(avatar).set_identity(identity, count); });
 }
 
@@ -300,12 +290,12 @@ SOFTDECA_API softdeca_status softdeca_avatar_prepare(softdeca_avatar* avatar) {
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* avatar, const float* weights,
-                                                              size_t weight_count, const softdeca_output* output) {
+                                                              uint32_t weight_count, const softdeca_output* output) {
   return guarded(__func__, [&] { avatar_of(avatar).evaluate_weights(weights, weight_count, output_of(output)); });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_surface(softdeca_avatar* avatar, const float* weights,
-                                                              size_t weight_count, const float* surface, size_t vertex_count,
+                                                              uint32_t weight_count, const float* surface, uint32_t vertex_count,
                                                               const softdeca_output* output) {
   return guarded(__func__, [&] {
     avatar_of(avatar).evaluate_surface(weights, weight_count, surface, vertex_count, output_of(output));
@@ -313,21 +303,21 @@ SOFTDECA_API softdeca_status softdeca_avatar_evaluate_surface(softdeca_avatar* a
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_calibrate_landmarks(softdeca_avatar* avatar, const float* points,
-                                                                 size_t point_count) {
+                                                                 uint32_t point_count) {
   return guarded(__func__, [&] { avatar_of(avatar).calibrate_landmarks(points, point_count); });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_landmarks(softdeca_avatar* avatar, const float* points,
-                                                                size_t point_count, const softdeca_output* output) {
+                                                                uint32_t point_count, const softdeca_output* output) {
   return guarded(__func__, [&] { avatar_of(avatar).evaluate_landmarks(points, point_count, output_of(output)); });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_evaluate_linear(softdeca_avatar* avatar, const float* weights, size_t weight_count,
+SOFTDECA_API softdeca_status softdeca_avatar_evaluate_linear(softdeca_avatar* avatar, const float* weights, uint32_t weight_count,
                                                              const softdeca_output* output) {
   return guarded(__func__, [&] { avatar_of(avatar).evaluate_linear(weights, weight_count, output_of(output)); });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_set_dynamics(softdeca_avatar* avatar, int enabled) {
+SOFTDECA_API softdeca_status softdeca_avatar_set_dynamics(softdeca_avatar* avatar, softdeca_bool enabled) {
   return guarded(__func__, [&] { avatar_of(avatar).set_dynamics(enabled != 0); });
 }
 

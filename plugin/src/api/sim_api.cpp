@@ -19,13 +19,6 @@ using namespace softdeca::sim;
 
 constexpr std::size_t kMaxCount = std::size_t{1} << 30;
 
-template <class S>
-void check_struct(const S* s, const char* name) {
-  require_not_null(s, name);
-  require(s->struct_size >= sizeof(S), std::string(name) + "->struct_size is " + std::to_string(s->struct_size) +
-                                           ", expected at least " + std::to_string(sizeof(S)));
-}
-
 void check_count(std::size_t n, const char* name) {
   require(n < kMaxCount, std::string(name) + " is implausibly large");
 }
@@ -96,7 +89,7 @@ SimulationMesh to_mesh(const softdeca_sim_mesh& c) {
   if (c.collision_count) require_not_null(c.collisions, "collisions");
   for (std::size_t i = 0; i < c.collision_count; ++i) {
     const softdeca_sim_collision_set& s = c.collisions[i];
-    check_struct(&s, "collisions[i]");
+    require_struct(&s, "collisions[i]");
     CollisionSet set;
     set.name = "collision set " + std::to_string(i);
     set.points = index_list(s.points, s.point_count, "collision points");
@@ -112,18 +105,20 @@ SimulationMesh to_mesh(const softdeca_sim_mesh& c) {
 SolverSettings to_settings(const softdeca_sim_settings* c) {
   SolverSettings s;
   if (!c) return s;
-  check_struct(c, "settings");
+  require_struct(c, "settings");
   require(std::isfinite(c->tolerance) && std::isfinite(c->collision_weight) && std::isfinite(c->penetration_tolerance),
           "settings contain a non-finite value", SOFTDECA_ERROR_NON_FINITE);
-  s.max_iterations = c->max_iterations;
+  require(c->max_iterations <= 1000000 && c->anderson_window <= 1024 && c->collision_rounds <= 1024,
+          "settings.max_iterations, anderson_window or collision_rounds is implausibly large");
+  require(c->threads <= 1024, "settings.threads must be in [0, 1024]");
+  s.max_iterations = static_cast<int>(c->max_iterations);
   s.tolerance = c->tolerance;
-  s.anderson_window = c->anderson_window;
-  s.threads = c->threads;
+  s.anderson_window = static_cast<int>(c->anderson_window);
+  s.threads = static_cast<int>(c->threads);
   s.strain_limit = c->paper_strain_rule ? StrainLimit::kPaperRotation : StrainLimit::kNearestInSet;
-  s.collision_rounds = c->collision_rounds;
+  s.collision_rounds = static_cast<int>(c->collision_rounds);
   s.collision_weight = c->collision_weight;
   s.penetration_tolerance = c->penetration_tolerance;
-  require(s.threads >= 0 && s.threads <= 1024, "settings.threads must be in [0, 1024]");
   validate(s);
   return s;
 }
@@ -138,7 +133,7 @@ Eigen::Isometry3d transform(const float* t, const char* name) {
 }
 
 FrameInput to_frame(const softdeca_sim& h, const softdeca_sim_frame* f) {
-  check_struct(f, "frame");
+  require_struct(f, "frame");
   const SimulationMesh& m = h.sim->mesh();
   require(f->skin_count == static_cast<std::size_t>(m.skin_count()),
           "frame->skin_count is " + std::to_string(f->skin_count) + ", the mesh has " + std::to_string(m.skin_count()) +
@@ -159,9 +154,9 @@ FrameInput to_frame(const softdeca_sim& h, const softdeca_sim_frame* f) {
 
 void to_stats(const SolveStats& s, softdeca_sim_stats* out) {
   if (!out) return;
-  check_struct(out, "stats");
-  out->iterations = s.iterations;
-  out->converged = s.converged ? 1 : 0;
+  require_struct(out, "stats");
+  out->iterations = static_cast<uint32_t>(s.iterations);
+  out->converged = s.converged ? SOFTDECA_TRUE : SOFTDECA_FALSE;
   out->relative_step = s.relative_step;
   out->estimated_error = s.estimated_error;
   out->contraction = s.contraction;
@@ -171,9 +166,9 @@ void to_stats(const SolveStats& s, softdeca_sim_stats* out) {
   out->global_seconds = s.global_seconds;
   out->factor_seconds = s.factor_seconds;
   out->total_seconds = s.total_seconds;
-  out->penetrating_before = s.penetrating_before;
-  out->penetrating_after = s.penetrating_after;
-  out->contacts = s.contacts;
+  out->penetrating_before = static_cast<uint32_t>(s.penetrating_before);
+  out->penetrating_after = static_cast<uint32_t>(s.penetrating_after);
+  out->contacts = static_cast<uint32_t>(s.contacts);
 }
 
 void copy_out(const Positions& p, float* out, std::size_t count, const char* name) {
@@ -189,26 +184,28 @@ void store(softdeca_sim& h, FrameResult&& r) {
   h.skin = std::move(r.skin);
 }
 
-Param parameter(const char* name) {
-  require_not_null(name, "name");
-  return find_parameter(name);
+Param parameter(uint32_t index) {
+  expect(index < parameter_table().size(), [&] {
+    return "parameter index " + std::to_string(index) + " is not below the " + std::to_string(parameter_table().size()) +
+           " simulator parameters";
+  });
+  return static_cast<Param>(index);
 }
 }  // namespace
 
 extern "C" {
 
-SOFTDECA_API softdeca_status softdeca_parameter_count(size_t* out_count) {
+SOFTDECA_API softdeca_status softdeca_parameter_count(uint32_t* out_count) {
   return guarded(__func__, [&] {
     require_not_null(out_count, "out_count");
-    *out_count = parameter_table().size();
+    *out_count = static_cast<uint32_t>(parameter_table().size());
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_parameter_get_info(size_t index, softdeca_parameter_info* out) {
+SOFTDECA_API softdeca_status softdeca_parameter_get_info(uint32_t index, softdeca_parameter_info* out) {
   return guarded(__func__, [&] {
-    check_struct(out, "out_info");
-    require(index < parameter_table().size(), "parameter index " + std::to_string(index) + " is out of range");
-    const ParameterInfo& p = parameter_table()[index];
+    require_struct(out, "out_info");
+    const ParameterInfo& p = parameter_info(parameter(index));
     out->name = p.name;
     out->unit = p.unit;
     out->domain = domain_name(p.domain);
@@ -216,7 +213,15 @@ SOFTDECA_API softdeca_status softdeca_parameter_get_info(size_t index, softdeca_
     out->default_value = p.default_value;
     out->lo = p.lo;
     out->hi = p.hi;
-    out->log_scale = p.scale == Scale::kLog ? 1 : 0;
+    out->log_scale = p.scale == Scale::kLog ? SOFTDECA_TRUE : SOFTDECA_FALSE;
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_parameter_find(const char* name, uint32_t* out_index) {
+  return guarded(__func__, [&] {
+    require_not_null(name, "name");
+    require_not_null(out_index, "out_index");
+    *out_index = static_cast<uint32_t>(find_parameter(name));
   });
 }
 
@@ -229,14 +234,14 @@ SOFTDECA_API softdeca_status softdeca_parameters_json(const char** out_json) {
 
 SOFTDECA_API softdeca_status softdeca_sim_default_settings(softdeca_sim_settings* s) {
   return guarded(__func__, [&] {
-    check_struct(s, "settings");
+    require_struct(s, "settings");
     const SolverSettings d;
-    s->max_iterations = d.max_iterations;
+    s->max_iterations = static_cast<uint32_t>(d.max_iterations);
     s->tolerance = static_cast<float>(d.tolerance);
-    s->anderson_window = d.anderson_window;
-    s->threads = d.threads;
-    s->paper_strain_rule = d.strain_limit == StrainLimit::kPaperRotation ? 1 : 0;
-    s->collision_rounds = d.collision_rounds;
+    s->anderson_window = static_cast<uint32_t>(d.anderson_window);
+    s->threads = static_cast<uint32_t>(d.threads);
+    s->paper_strain_rule = d.strain_limit == StrainLimit::kPaperRotation ? SOFTDECA_TRUE : SOFTDECA_FALSE;
+    s->collision_rounds = static_cast<uint32_t>(d.collision_rounds);
     s->collision_weight = static_cast<float>(d.collision_weight);
     s->penetration_tolerance = static_cast<float>(d.penetration_tolerance);
   });
@@ -246,7 +251,7 @@ SOFTDECA_API softdeca_status softdeca_sim_create(const softdeca_sim_mesh* mesh, 
                                                  softdeca_sim** out_sim) {
   return guarded(__func__, [&] {
     require_not_null(out_sim, "out_sim");
-    check_struct(mesh, "mesh");
+    require_struct(mesh, "mesh");
     auto h = std::make_unique<softdeca_sim>();
     h->sim = std::make_unique<Simulator>(to_mesh(*mesh), to_settings(settings));
     h->vertices = h->sim->rest_positions();
@@ -255,44 +260,46 @@ SOFTDECA_API softdeca_status softdeca_sim_create(const softdeca_sim_mesh* mesh, 
   });
 }
 
-SOFTDECA_API void softdeca_sim_destroy(softdeca_sim* sim) { delete sim; }
+SOFTDECA_API void softdeca_sim_destroy(softdeca_sim* sim) {
+  guarded(__func__, [&] { delete sim; });
+}
 
-SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, size_t* out_count) {
+SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, uint32_t* out_count) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     require_not_null(out_count, "out_count");
-    *out_count = static_cast<size_t>(sim->vertices.rows());
+    *out_count = static_cast<uint32_t>(sim->vertices.rows());
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_skin_count(const softdeca_sim* sim, size_t* out_count) {
+SOFTDECA_API softdeca_status softdeca_sim_skin_count(const softdeca_sim* sim, uint32_t* out_count) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     require_not_null(out_count, "out_count");
-    *out_count = static_cast<size_t>(sim->skin.rows());
+    *out_count = static_cast<uint32_t>(sim->skin.rows());
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_set_parameter(softdeca_sim* sim, const char* name, double value) {
+SOFTDECA_API softdeca_status softdeca_sim_set_parameter(softdeca_sim* sim, uint32_t index, double value) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
-    sim->sim->parameters().set(parameter(name), value);
+    sim->sim->parameters().set(parameter(index), value);
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_get_parameter(const softdeca_sim* sim, const char* name, double* out_value) {
+SOFTDECA_API softdeca_status softdeca_sim_get_parameter(const softdeca_sim* sim, uint32_t index, double* out_value) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     require_not_null(out_value, "out_value");
-    *out_value = sim->sim->parameters().global(parameter(name));
+    *out_value = sim->sim->parameters().global(parameter(index));
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_set_parameter_field(softdeca_sim* sim, const char* name, const float* values,
-                                                              size_t count) {
+SOFTDECA_API softdeca_status softdeca_sim_set_parameter_field(softdeca_sim* sim, uint32_t index, const float* values,
+                                                              uint32_t count) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
-    const Param p = parameter(name);
+    const Param p = parameter(index);
     check_count(count, "count");
     require(count == 0 || values != nullptr, "values is null");
     Eigen::VectorXd v(static_cast<Eigen::Index>(count));
@@ -305,7 +312,7 @@ SOFTDECA_API softdeca_status softdeca_sim_solve_static(softdeca_sim* sim, const 
                                                        softdeca_sim_stats* stats) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
-    if (stats) check_struct(stats, "stats");
+    if (stats) require_struct(stats, "stats");
     FrameResult r = sim->sim->solve_static(to_frame(*sim, frame));
     to_stats(r.stats, stats);
     store(*sim, std::move(r));
@@ -316,7 +323,7 @@ SOFTDECA_API softdeca_status softdeca_sim_step_dynamic(softdeca_sim* sim, const 
                                                        softdeca_sim_stats* stats) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
-    if (stats) check_struct(stats, "stats");
+    if (stats) require_struct(stats, "stats");
     FrameResult r = sim->sim->step_dynamic(to_frame(*sim, frame));
     to_stats(r.stats, stats);
     store(*sim, std::move(r));
@@ -331,8 +338,8 @@ SOFTDECA_API softdeca_status softdeca_sim_reset_dynamics(softdeca_sim* sim) {
 }
 
 SOFTDECA_API softdeca_status softdeca_sim_solve_static_batch(softdeca_sim* sim, const softdeca_sim_frame* frames,
-                                                             size_t frame_count, float* out_skin,
-                                                             size_t out_skin_count, softdeca_sim_stats* stats) {
+                                                             uint32_t frame_count, float* out_skin,
+                                                             uint32_t out_skin_count, softdeca_sim_stats* stats) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     check_count(frame_count, "frame_count");
@@ -345,7 +352,7 @@ SOFTDECA_API softdeca_status softdeca_sim_solve_static_batch(softdeca_sim* sim, 
                 std::to_string(frame_count * ns),
             SOFTDECA_ERROR_BUFFER_TOO_SMALL);
     if (stats)
-      for (std::size_t f = 0; f < frame_count; ++f) check_struct(&stats[f], "stats[f]");
+      for (std::size_t f = 0; f < frame_count; ++f) require_struct(&stats[f], "stats[f]");
     std::vector<FrameInput> in;
     in.reserve(frame_count);
     for (std::size_t f = 0; f < frame_count; ++f) in.push_back(to_frame(*sim, &frames[f]));
@@ -359,14 +366,14 @@ SOFTDECA_API softdeca_status softdeca_sim_solve_static_batch(softdeca_sim* sim, 
 }
 
 SOFTDECA_API softdeca_status softdeca_sim_get_vertices(const softdeca_sim* sim, float* out_vertices,
-                                                       size_t vertex_count) {
+                                                       uint32_t vertex_count) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     copy_out(sim->vertices, out_vertices, vertex_count, "out_vertices");
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, float* out_skin, size_t skin_count) {
+SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, float* out_skin, uint32_t skin_count) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     copy_out(sim->skin, out_skin, skin_count, "out_skin");

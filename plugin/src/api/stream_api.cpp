@@ -23,7 +23,7 @@ stream::Receiver& receiver_of(softdeca_receiver* r) {
   return *r->impl;
 }
 
-void frame_out(softdeca_frame* out, int32_t* out_received, bool got, const stream::Frame& f) {
+void frame_out(softdeca_frame* out, softdeca_bool* out_received, bool got, const stream::Frame& f) {
   *out_received = got ? 1 : 0;
   if (got) abi::frame_to_abi(f, out);
 }
@@ -35,10 +35,10 @@ SOFTDECA_API const char* softdeca_blendshape_name(uint32_t index) { return strea
 
 SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_config* config) {
   return guarded(__func__, [&] {
-    abi::require_struct(config, "config");
-    const uint32_t size = config->size;
+    require_struct(config, "config");
+    const uint32_t struct_size = config->struct_size;
     *config = softdeca_receiver_config{};
-    config->size = size;
+    config->struct_size = struct_size;
     config->format = SOFTDECA_FORMAT_AUTO;
     config->bind_address = nullptr;
     config->port = stream::default_port(stream::Format::softdeca);
@@ -53,7 +53,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_con
 SOFTDECA_API softdeca_status softdeca_receiver_create(const softdeca_receiver_config* config,
                                                       softdeca_receiver** out_receiver) {
   return guarded(__func__, [&] {
-    abi::require_struct(config, "config");
+    require_struct(config, "config");
     require_not_null(out_receiver, "out_receiver");
     require(config->format >= SOFTDECA_FORMAT_AUTO && config->format <= SOFTDECA_FORMAT_IFACIALMOCAP,
             "config->format is not a softdeca_stream_format");
@@ -90,10 +90,10 @@ SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* rec
 }
 
 SOFTDECA_API softdeca_status softdeca_receiver_next(softdeca_receiver* receiver, double timeout,
-                                                    softdeca_frame* out_frame, int32_t* out_received) {
+                                                    softdeca_frame* out_frame, softdeca_bool* out_received) {
   return guarded(__func__, [&] {
     auto& r = receiver_of(receiver);
-    abi::require_struct(out_frame, "out_frame");
+    require_struct(out_frame, "out_frame");
     require_not_null(out_received, "out_received");
     require(std::isfinite(timeout) && timeout >= 0, "timeout must be finite and >= 0");
     stream::Frame f;
@@ -102,10 +102,10 @@ SOFTDECA_API softdeca_status softdeca_receiver_next(softdeca_receiver* receiver,
 }
 
 SOFTDECA_API softdeca_status softdeca_receiver_latest(const softdeca_receiver* receiver,
-                                                      softdeca_frame* out_frame, int32_t* out_received) {
+                                                      softdeca_frame* out_frame, softdeca_bool* out_received) {
   return guarded(__func__, [&] {
     const auto& r = receiver_of(receiver);
-    abi::require_struct(out_frame, "out_frame");
+    require_struct(out_frame, "out_frame");
     require_not_null(out_received, "out_received");
     stream::Frame f;
     frame_out(out_frame, out_received, r.latest(f), f);
@@ -116,11 +116,11 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
                                                          softdeca_receiver_stats* out) {
   return guarded(__func__, [&] {
     const auto& r = receiver_of(receiver);
-    abi::require_struct(out, "out_stats");
+    require_struct(out, "out_stats");
     const stream::ReceiverStats s = r.stats();
-    const uint32_t size = out->size;
+    const uint32_t struct_size = out->struct_size;
     *out = softdeca_receiver_stats{};
-    out->size = size;
+    out->struct_size = struct_size;
     out->datagrams = s.datagrams;
     out->frames = s.frames;
     out->control_messages = s.control_messages;
@@ -153,8 +153,8 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
 }
 
 SOFTDECA_API softdeca_status softdeca_receiver_profile(const softdeca_receiver* receiver, uint32_t* out_id,
-                                                       uint16_t* out_indices, size_t capacity,
-                                                       size_t* out_count) {
+                                                       int32_t* out_indices, uint32_t capacity,
+                                                       uint32_t* out_count) {
   return guarded(__func__, [&] {
     stream::wire::Profile p;
     const bool have = receiver_of(receiver).profile(p);
@@ -163,7 +163,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_profile(const softdeca_receiver* 
 }
 
 SOFTDECA_API softdeca_status softdeca_receiver_neutral(const softdeca_receiver* receiver, float* out_xyz,
-                                                       size_t vertex_capacity, size_t* out_vertex_count) {
+                                                       uint32_t vertex_capacity, uint32_t* out_vertex_count) {
   return guarded(__func__, [&] {
     std::vector<float> xyz;
     receiver_of(receiver).neutral(xyz);
@@ -171,7 +171,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_neutral(const softdeca_receiver* 
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_receiver_request_neutral(softdeca_receiver* receiver, int32_t* out_sent) {
+SOFTDECA_API softdeca_status softdeca_receiver_request_neutral(softdeca_receiver* receiver, softdeca_bool* out_sent) {
   return guarded(__func__, [&] {
     auto& r = receiver_of(receiver);
     require_not_null(out_sent, "out_sent");
@@ -188,12 +188,12 @@ SOFTDECA_API softdeca_status softdeca_receiver_start_recording(softdeca_receiver
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_receiver_stop_recording(softdeca_receiver* receiver, uint64_t* out_frames) {
+SOFTDECA_API softdeca_status softdeca_receiver_stop_recording(softdeca_receiver* receiver, uint32_t* out_frames) {
   return guarded(__func__, [&] {
     auto& r = receiver_of(receiver);
     const std::size_t frames = r.frames_recorded();
     const std::string error = r.stop_recording();
-    if (out_frames) *out_frames = frames;
+    if (out_frames) *out_frames = static_cast<uint32_t>(frames);
     require(error.empty(), "the recording stopped early: " + error, SOFTDECA_ERROR_IO);
   });
 }

@@ -35,7 +35,7 @@ bool parse_float(std::string_view s, float& out) {
 }
 
 // The app's CSV column order: its packet order with JawLeft/JawRight and MouthLeft/MouthRight
-// swapped (as in every take of ../shared/recordings).
+// swapped (as in every take of the sample Live Link Face recordings).
 std::array<std::size_t, llf::kValueCount> csv_order() {
   std::array<std::size_t, llf::kValueCount> order{};
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;

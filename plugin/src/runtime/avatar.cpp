@@ -121,11 +121,11 @@ void Avatar::reset_parameters() {
   params_.reset();
 }
 
-void Avatar::get_parameter(int index, float* value, std::uint32_t* localised) const {
+void Avatar::get_parameter(int index, double* value, bool* localised) const {
   std::lock_guard<std::mutex> lock(params_mutex_);
   require(index >= 0 && static_cast<std::size_t>(index) < m_.parameters.size(), "parameter index out of range");
-  if (value) *value = static_cast<float>(params_.global(index));
-  if (localised) *localised = params_.kind(index) == ParameterState::Kind::Global ? 0u : 1u;
+  if (value) *value = params_.global(index);
+  if (localised) *localised = params_.kind(index) != ParameterState::Kind::Global;
 }
 
 void Avatar::set_identity(const float* values, std::size_t count) {

@@ -77,7 +77,7 @@ class Avatar {
   void set_parameter_faces(int index, const float* values, std::size_t count);
   void set_parameter_vertices(int index, const float* values, std::size_t count);
   void reset_parameters();
-  void get_parameter(int index, float* value, std::uint32_t* localised) const;
+  void get_parameter(int index, double* value, bool* localised) const;
   void set_identity(const float* values, std::size_t count);
   void get_identity(float* out, std::size_t capacity) const;
 

@@ -115,7 +115,7 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
   if (estimate.bytes > budget)
     fail("the bundle's networks need an estimated " + mib(estimate.bytes) + " (largest: " + estimate.largest + ", " +
          mib(estimate.largest_bytes) + "), over the memory budget of " + mib(budget) +
-         " (model options: memory_budget_bytes)");
+         " (softdeca_model_options.memory_budget_mib; C++ ModelOptions::memory_budget_bytes)");
 
   try {
     m->env_ = std::make_unique<Ort::Env>(ORT_LOGGING_LEVEL_ERROR, "softdeca");

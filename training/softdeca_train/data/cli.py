@@ -19,7 +19,7 @@ def _ict(p: argparse.ArgumentParser) -> None:
         "--ict",
         default=None,
         help="ICT-FaceKit checkout, FaceXModel folder or .tar.xz archive "
-        "(default: $SOFTDECA_ICT or ../shared/ict-facekit)",
+        "(default: $SOFTDECA_ICT or ict-facekit in the data folder)",
     )
 
 

@@ -8,8 +8,8 @@ import os
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
+from softdeca_train import paths
 from softdeca_train.data.ranges import DEFAULT_PROFILE, LEGACY_PROFILE, PROFILES
-from softdeca_train.paths import REPO_ROOT
 
 KINDS = ("static", "dynamic", "sparse")
 TRAIN, TEST = 0, 1
@@ -17,9 +17,8 @@ PAPER_STATIC_SHARE = 0.75  # paper 4.2.1: 75 % static instances, 25 % dynamic (b
 
 
 def default_takes_path() -> Path:
-    """$SOFTDECA_TAKES, else ../shared/recordings/livelinkface-alexdjulin beside the repo."""
-    env = os.environ.get("SOFTDECA_TAKES")
-    return Path(env) if env else REPO_ROOT.parent / "shared/recordings/livelinkface-alexdjulin"
+    """$SOFTDECA_TAKES, else the Live Link Face takes in the data folder."""
+    return paths.default_takes_path()
 
 
 @dataclass(frozen=True)

@@ -100,7 +100,7 @@ def run_ray(
         import ray
     except ImportError as e:
         raise ValueError("--ray-address needs the ray package (pip install ray)") from e
-    keep = ("PYTHONPATH", "SOFTDECA_ICT", "SOFTDECA_CACHE")
+    keep = ("PYTHONPATH", "SOFTDECA_ICT", "SOFTDECA_DATA", "SOFTDECA_CACHE")
     env = {k: os.environ[k] for k in keep if k in os.environ} | SINGLE_THREADED
     if "PYTHONPATH" in env:  # Ray's workers start elsewhere: relative entries would break
         env["PYTHONPATH"] = os.pathsep.join(

@@ -10,11 +10,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from softdeca_train.paths import REPO_ROOT
+from softdeca_train.paths import REPO_ROOT, default_takes_path
 
-DEFAULT_TAKE = (
-    REPO_ROOT.parent / "shared" / "recordings" / "livelinkface-alexdjulin" / "S07-001.csv"
-)
+DEFAULT_TAKE = default_takes_path() / "S07-001.csv"
 CLI = REPO_ROOT / "build" / "release" / "plugin" / "cli" / "softdeca"
 
 

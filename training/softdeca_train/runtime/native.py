@@ -13,6 +13,7 @@ import numpy as np
 from softdeca_train.paths import REPO_ROOT
 
 SOFTDECA_OK = 0
+ABI_VERSION = 1  # SOFTDECA_ABI_VERSION of the header these structs mirror
 PRECISIONS = {"half": 0, "float": 1, "int8": 2}  # softdeca_precision
 STATUS_NAMES = {
     0: "ok",
@@ -36,9 +37,9 @@ class NativeError(RuntimeError):
 
 class ModelOptions(C.Structure):
     _fields_ = [
-        ("size", C.c_uint32),
+        ("struct_size", C.c_uint32),
         ("prepare_threads", C.c_uint32),
-        ("memory_budget_bytes", C.c_uint64),
+        ("memory_budget_mib", C.c_uint32),
     ]
 
 
@@ -46,7 +47,7 @@ class ModelInfo(C.Structure):
     _fields_ = [
         (n, C.c_uint32)
         for n in (
-            "size",
+            "struct_size",
             "format_version",
             "head_vertex_count",
             "skin_vertex_count",
@@ -57,18 +58,17 @@ class ModelInfo(C.Structure):
             "parameter_count",
             "landmark_count",
             "arkit_vertex_count",
-            "has_softdeca",
-            "has_sparse",
-            "untrained",
         )
-    ] + [("dynamics_frame_rate_hz", C.c_float)]
+    ]
+    _fields_ += [(n, C.c_int32) for n in ("has_softdeca", "has_sparse", "untrained")]
+    _fields_ += [("dynamics_frame_rate_hz", C.c_float)]
 
 
 class ParameterInfo(C.Structure):
     """softdeca_parameter_info (shared with the simulator's compiled-in list)."""
 
     _fields_ = [
-        ("struct_size", C.c_size_t),
+        ("struct_size", C.c_uint32),
         ("name", C.c_char_p),
         ("unit", C.c_char_p),
         ("domain", C.c_char_p),
@@ -82,31 +82,31 @@ class ParameterInfo(C.Structure):
 
 class AvatarDesc(C.Structure):
     _fields_ = [
-        ("size", C.c_uint32),
+        ("struct_size", C.c_uint32),
         ("neutral", C.POINTER(C.c_float)),
-        ("vertex_count", C.c_size_t),
+        ("vertex_count", C.c_uint32),
         ("triangles", C.POINTER(C.c_int32)),
-        ("triangle_count", C.c_size_t),
+        ("triangle_count", C.c_uint32),
         ("blendshapes", C.POINTER(C.c_float)),
-        ("blendshape_count", C.c_size_t),
+        ("blendshape_count", C.c_uint32),
         ("threads", C.c_uint32),
-        ("precision", C.c_uint32),
+        ("precision", C.c_int32),
     ]
 
 
 class Output(C.Structure):
     _fields_ = [
-        ("size", C.c_uint32),
+        ("struct_size", C.c_uint32),
         ("vertices", C.POINTER(C.c_float)),
-        ("vertex_capacity", C.c_size_t),
+        ("vertex_capacity", C.c_uint32),
         ("normals", C.POINTER(C.c_float)),
-        ("normal_capacity", C.c_size_t),
+        ("normal_capacity", C.c_uint32),
     ]
 
 
 class Stats(C.Structure):
     _fields_ = [
-        ("size", C.c_uint32),
+        ("struct_size", C.c_uint32),
         ("threads", C.c_uint32),
         ("frames", C.c_uint64),
         ("preparations", C.c_uint64),
@@ -146,9 +146,16 @@ def lib() -> C.CDLL:
         path = library_path()
         if not path.is_file():
             raise FileNotFoundError(f"{path} not found: run `make build`")
-        _lib = C.CDLL(str(path))
-        _lib.softdeca_last_error.restype = C.c_char_p
-        _lib.softdeca_version.restype = C.c_char_p
+        loaded = C.CDLL(str(path))
+        loaded.softdeca_last_error.restype = C.c_char_p
+        loaded.softdeca_version.restype = C.c_char_p
+        loaded.softdeca_abi_version.restype = C.c_uint32
+        loaded.softdeca_model_destroy.restype = None
+        loaded.softdeca_avatar_destroy.restype = None
+        found = loaded.softdeca_abi_version()
+        if found != ABI_VERSION:
+            raise RuntimeError(f"{path} has C ABI version {found}; this binding needs {ABI_VERSION}")
+        _lib = loaded
     return _lib
 
 
@@ -175,7 +182,7 @@ class NativeModel:
             self._data = path
             check(
                 lib().softdeca_model_load_memory(
-                    C.c_char_p(path), C.c_size_t(len(path)), C.byref(opts), C.byref(self.handle)
+                    C.c_char_p(path), C.c_uint32(len(path)), C.byref(opts), C.byref(self.handle)
                 )
             )
         else:
@@ -183,13 +190,13 @@ class NativeModel:
                 lib().softdeca_model_load(str(path).encode(), C.byref(opts), C.byref(self.handle))
             )
         info = ModelInfo()
-        info.size = C.sizeof(ModelInfo)
+        info.struct_size = C.sizeof(ModelInfo)
         check(lib().softdeca_model_get_info(self.handle, C.byref(info)))
         self.info = info
 
     def close(self) -> None:
         if self.handle:
-            check(lib().softdeca_model_destroy(self.handle))
+            lib().softdeca_model_destroy(self.handle)
             self.handle = C.c_void_p()
 
     def __del__(self) -> None:
@@ -211,7 +218,7 @@ class NativeModel:
         out = np.zeros(self.info.landmark_count, dtype=np.int32)
         check(
             lib().softdeca_model_get_landmark_vertices(
-                self.handle, _ptr(out, C.c_int32), C.c_size_t(len(out))
+                self.handle, _ptr(out, C.c_int32), C.c_uint32(len(out))
             )
         )
         return out
@@ -220,7 +227,7 @@ class NativeModel:
         out = np.zeros((self.info.skin_triangle_count, 3), dtype=np.int32)
         check(
             lib().softdeca_model_get_skin_triangles(
-                self.handle, _ptr(out, C.c_int32), C.c_size_t(len(out))
+                self.handle, _ptr(out, C.c_int32), C.c_uint32(len(out))
             )
         )
         return out
@@ -230,7 +237,7 @@ class NativeModel:
         out = np.zeros((self.info.landmark_count, 3), dtype=np.float32)
         check(
             lib().softdeca_model_evaluate_landmarks(
-                self.handle, _ptr(v), len(v), _ptr(out), C.c_size_t(len(out))
+                self.handle, _ptr(v), len(v), _ptr(out), C.c_uint32(len(out))
             )
         )
         return out
@@ -274,7 +281,7 @@ class NativeAvatar:
 
     def close(self) -> None:
         if self.handle:
-            check(lib().softdeca_avatar_destroy(self.handle))
+            lib().softdeca_avatar_destroy(self.handle)
             self.handle = C.c_void_p()
 
     def __del__(self) -> None:
@@ -284,7 +291,7 @@ class NativeAvatar:
     # ---- parameters -----------------------------------------------------------------------
     def set_parameter(self, name: str, value: float) -> None:
         i = self.model.find_parameter(name)
-        check(lib().softdeca_avatar_set_parameter(self.handle, C.c_uint32(i), C.c_float(value)))
+        check(lib().softdeca_avatar_set_parameter(self.handle, C.c_uint32(i), C.c_double(value)))
 
     def set_parameter_faces(self, name: str, values: np.ndarray) -> None:
         v = _f32(values)
@@ -309,7 +316,7 @@ class NativeAvatar:
         check(lib().softdeca_avatar_prepare(self.handle))
 
     def set_dynamics(self, on: bool) -> None:
-        check(lib().softdeca_avatar_set_dynamics(self.handle, int(on)))
+        check(lib().softdeca_avatar_set_dynamics(self.handle, C.c_int32(int(on))))
 
     def reset_dynamics(self) -> None:
         check(lib().softdeca_avatar_reset_dynamics(self.handle))
@@ -358,6 +365,6 @@ class NativeAvatar:
 
     def stats(self) -> Stats:
         s = Stats()
-        s.size = C.sizeof(Stats)
+        s.struct_size = C.sizeof(Stats)
         check(lib().softdeca_avatar_get_stats(self.handle, C.byref(s)))
         return s

@@ -16,15 +16,13 @@ from tqdm import tqdm
 
 from softdeca_train.bench import figure
 from softdeca_train.lhm import LhmConfig
-from softdeca_train.paths import REPO_ROOT
+from softdeca_train.paths import default_takes_path
 from softdeca_train.sim.head import HeadSimulation, build_head_simulation
 from softdeca_train.sim.take import read_take
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
-DEFAULT_TAKE = (
-    REPO_ROOT.parent / "shared" / "recordings" / "livelinkface-alexdjulin" / "alex_rom_3.csv"
-)
+DEFAULT_TAKE = default_takes_path() / "alex_rom_3.csv"
 
 
 def _inputs(hs: HeadSimulation, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -85,7 +85,7 @@ def _source_key(source: Path) -> str:
 def _build_cache(source: Path, target: Path) -> None:
     neutral = polygons = indices = None
     shapes: dict[str, np.ndarray] = {}
-    total = 160 if source.is_dir() else None
+    total = sum(1 for f in source.iterdir() if f.is_file()) if source.is_dir() else None
     for name, data in tqdm(
         _iter_files(source), desc="reading ICT-FaceKit", unit="file", total=total, leave=False
     ):
