@@ -186,8 +186,7 @@ int run_bench_reliability(const Args& args) {
       .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
       .option("--scratch", "DIR", "where the runs write their files", "build/bench");
   if (!o.parse(args)) return 0;
-  for (const std::string& dir : {std::filesystem::path(o.text("--out")).parent_path().string(), o.text("--scratch")})
-    if (!dir.empty()) std::filesystem::create_directories(dir);
+  create_output_folders(o.text("--out"), o.text("--scratch"));
   const long ports = o.integer("--ports"), mib = o.integer("--resync-mib");
   const double flood_s = o.number("--flood-seconds"), slow_s = o.number("--slow-seconds");
   if (ports < 2 || ports > 1000 || mib < 1 || mib > 1024 || !(flood_s > 0) || !(slow_s > 0))

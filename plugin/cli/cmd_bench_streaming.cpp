@@ -192,8 +192,7 @@ int run_bench_streaming(const Args& args) {
       .option("--recording-frames", "N", "frames per recording run", "20000")
       .option("--scratch", "DIR", "where the recording runs write their file", "build/bench");
   if (!o.parse(args)) return 0;
-  for (const std::string& dir : {std::filesystem::path(o.text("--out")).parent_path().string(), o.text("--scratch")})
-    if (!dir.empty()) std::filesystem::create_directories(dir);
+  create_output_folders(o.text("--out"), o.text("--scratch"));
   const long runs = o.integer("--runs"), tp = o.integer("--throughput-frames"), lat = o.integer("--latency-frames"),
              recf = o.integer("--recording-frames");
   const double lat_rate = o.number("--latency-rate");
