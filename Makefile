@@ -58,12 +58,8 @@ test-native: build build-asan ## ctest on both builds
 	@echo "== native tests (ASan+UBSan)"; ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
 
-# The training tests run in a process of their own: after the rest of the suite in one
-# process, the first of them died with SIGSEGV twice (not reproduced by any subset of the
-# modules; see docs/training.md, "Known problems").
 test-python: build ## pytest
-	@echo "== Python tests"; $(PY) -m pytest -q tests/python --ignore=tests/python/test_training.py
-	@echo "== Python tests (training)"; $(PY) -m pytest -q tests/python/test_training.py
+	@echo "== Python tests"; $(PY) -m pytest -q tests/python
 
 test: lint test-native test-fuzz test-python ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest
 
