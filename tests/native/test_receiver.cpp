@@ -23,6 +23,7 @@
 
 using namespace softdeca;
 using namespace softdeca::stream;
+using test::eventually;
 using test::make_frame;
 
 namespace {
@@ -35,15 +36,6 @@ ReceiverConfig loopback(Format format = Format::softdeca, double delay = 0.3) {
   c.delay = delay;
   c.queue_capacity = 4096;
   return c;
-}
-
-// Polls `done` for up to 10 s (generous for a loaded machine); true once it holds.
-bool eventually(const std::function<bool()>& done) {
-  for (int i = 0; i < 2000; ++i) {
-    if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return done();
 }
 
 std::vector<Frame> take_all(Receiver& r) {

@@ -24,6 +24,7 @@
 
 using namespace softdeca;
 using namespace softdeca::stream;
+using test::eventually;
 using test::make_frame;
 
 namespace {
@@ -34,14 +35,6 @@ ReceiverConfig loopback(Format format = Format::softdeca) {
   c.format = format;
   c.queue_capacity = 4096;
   return c;
-}
-
-bool eventually(const std::function<bool()>& done) {
-  for (int i = 0; i < 2000; ++i) {
-    if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return done();
 }
 
 std::size_t drain(Receiver& r) {
@@ -84,7 +77,9 @@ TEST(ReceiverSecurity, SecondSenderCannotTakeOverAHeldSession) {
   // The intruder sends while the owner keeps sending: none of its frames gets through.
   for (uint32_t i = 0; i < 20; ++i) {
     ASSERT_TRUE(intruder.send(make_frame(100 + i)));
-    if (i % 4 == 0) ASSERT_TRUE(owner.send(make_frame(5 + i / 4)));
+    if (i % 4 == 0) {
+      ASSERT_TRUE(owner.send(make_frame(5 + i / 4)));
+    }
   }
   ASSERT_TRUE(eventually([&] { return r.stats().foreign == 20; }));
   EXPECT_EQ(r.stats().session_changes, 0u);
