@@ -3,7 +3,7 @@
 #include <limits>
 #include <map>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::runtime {
 namespace {
