@@ -9,12 +9,12 @@ and its bundle only accepts, the sampled ranges (the manifest records them).
 
 `interactive` samples what a user moves live around the defaults: every constraint weight
 within a decade of its default, target volume and the strain limit within 10 %, skull and jaw
-scale within 2 %, gravity up to 1.2 g and 30 degrees off vertical. Measured on softdeca-l3-v3 (`plausible`):
-69 % of |T - S| of its static frames is an offset shared by the frames of an (identity, p)
-group, independent of the expression (data/offset_structure.py), and with weights spread over
-five decades and skulls scaled by up to 50 % nothing learned it from 120 parameter sets (ridge
-linear in p made the test error worse; SoftDECA stayed within 1 % of no correction,
-docs/training.md)."""
+scale within 2 %, gravity up to 1.2 g and 30 degrees off vertical. Measured on softdeca-l3-v3
+(`plausible`): 69 % of |T - S| of its static frames is an offset shared by the frames of an
+(identity, p) group, independent of the expression (data/offset_structure.py), and with
+weights spread over five decades and skulls scaled by up to 50 % nothing learned it from 120
+parameter sets (ridge linear in p made the test error worse; SoftDECA stayed within 1 % of no
+correction, docs/training.md)."""
 
 from __future__ import annotations
 
