@@ -210,6 +210,9 @@ UNITY_BINARIES ?= build/unity-binaries
 UNITY_VERSION  := $(shell sed -n 's/.*"version": *"\([^"]*\)".*/\1/p' unity_package/package.json 2>/dev/null)
 UNITY_TGZ      := build/unity-package/com.softdeca.facial-animation-$(UNITY_VERSION).tgz
 .PHONY: windows test-windows unity-package
+# A wine prefix of this checkout's own: another checkout's wine server cannot disturb the tests.
+windows test-windows unity-package: export WINEPREFIX := $(CURDIR)/build/wineprefix
+windows test-windows unity-package: export WINEDEBUG := -all
 
 windows: setup ## Windows x64 cross-build (MinGW-w64) in build/windows; installs the cross tools on first use
 	@plugin/platforms/windows/setup-cross.sh
@@ -220,7 +223,7 @@ windows: setup ## Windows x64 cross-build (MinGW-w64) in build/windows; installs
 
 test-windows: windows build ## the Windows build's C ABI, streaming and replay tests under wine
 	@echo "== Windows x64 tests under $$(wine --version)"
-	@WINEDEBUG=-all ctest --test-dir $(WINDOWS) --output-on-failure -j $(JOBS) -R '$(WINDOWS_CTEST)'
+	@ctest --test-dir $(WINDOWS) --output-on-failure -j $(JOBS) -R '$(WINDOWS_CTEST)'
 	@mkdir -p $(CHECK)
 	@[ -f $(CHECK)/avatar/neutral.obj ] || $(PY) -m softdeca_train avatar --seed 1 --out $(CHECK)/avatar
 	@$(BUILD)/plugin/cli/softdeca convert $(CHECK_TAKE) $(CHECK)/take.sdrec > /dev/null
@@ -230,7 +233,7 @@ test-windows: windows build ## the Windows build's C ABI, streaming and replay t
 	@$(BUILD)/tests/native/replay_check models/softdeca-default $(CHECK)/avatar $(CHECK)/take.sdrec $(CHECK_START) \
 	  $(CHECK)/linux/softdeca.pc2 $(CHECK_TOL)
 	@echo "== replay check: Windows softdeca.dll (wine) against the Linux CLI"
-	@WINEDEBUG=-all wine $(WINDOWS)/bin/replay_check.exe models/softdeca-default $(CHECK)/avatar $(CHECK)/take.sdrec \
+	@wine $(WINDOWS)/bin/replay_check.exe models/softdeca-default $(CHECK)/avatar $(CHECK)/take.sdrec \
 	  $(CHECK_START) $(CHECK)/linux/softdeca.pc2 $(CHECK_TOL)
 
 unity-package: build windows ## UPM tarball (Add package from tarball) with the Linux and Windows binaries -> build/unity-package/

@@ -17,11 +17,13 @@ set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 
 # No MinGW runtime DLLs beside ours: libgcc, libstdc++ and winpthread linked in statically.
-# winpthread goes last on every link line, as an archive, so nothing imports libwinpthread-1.dll.
+# winpthread's archive goes whole onto every link line: the compiler driver's own -lpthread then
+# finds nothing left to import, so nothing needs libwinpthread-1.dll.
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-static-libgcc -static-libstdc++")
 set(CMAKE_SHARED_LINKER_FLAGS_INIT "-static-libgcc -static-libstdc++")
-set(CMAKE_C_STANDARD_LIBRARIES "-Wl,-Bstatic -lwinpthread -Wl,-Bdynamic" CACHE STRING "" FORCE)
-set(CMAKE_CXX_STANDARD_LIBRARIES "-Wl,-Bstatic -lwinpthread -Wl,-Bdynamic" CACHE STRING "" FORCE)
+set(SOFTDECA_MINGW_PTHREAD "-Wl,-Bstatic,--whole-archive -lwinpthread -Wl,--no-whole-archive,-Bdynamic")
+set(CMAKE_C_STANDARD_LIBRARIES "${SOFTDECA_MINGW_PTHREAD}" CACHE STRING "" FORCE)
+set(CMAKE_CXX_STANDARD_LIBRARIES "${SOFTDECA_MINGW_PTHREAD}" CACHE STRING "" FORCE)
 
 find_program(SOFTDECA_WINE wine)
 if(SOFTDECA_WINE)

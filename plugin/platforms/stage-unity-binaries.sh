@@ -9,7 +9,7 @@ set -euo pipefail
 [ $# -eq 4 ] || { sed -n 2,8p "$0" >&2; exit 2; }
 platform=$1 build=$2 ort=$3 out=$4
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-cmake --install "$build" --component plugin --prefix "$tmp" > /dev/null
+cmake --install "$build" --component plugin --prefix "$tmp" --strip > /dev/null
 fail() { echo "stage-unity-binaries: $*" >&2; exit 1; }
 
 case "$platform" in
