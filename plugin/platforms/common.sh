@@ -18,3 +18,15 @@ cmake_common=(-G Ninja -DCMAKE_BUILD_TYPE=Release -DSOFTDECA_BUILD_TESTS=OFF -DS
 fetch() {  # fetch URL FILE: download once
   [ -f "$2" ] || { say "downloading $1"; curl -fL --retry 3 -o "$2.part" "$1" && mv "$2.part" "$2"; }
 }
+# ort_package DIR URL UNPACK: ONNX Runtime's package for a platform, downloaded once into
+# .deps/downloads and unpacked into DIR by the function UNPACK (ARCHIVE DIR), once per version.
+ort_package() {
+  local dir=$1 url=$2 unpack=$3
+  local archive=.deps/downloads/${url##*/}
+  [ ! -f "$dir/.stamp-$ort_version" ] || return 0
+  mkdir -p .deps/downloads
+  fetch "$url" "$archive"
+  rm -rf "$dir" && mkdir -p "$dir"
+  "$unpack" "$archive" "$dir"
+  touch "$dir/.stamp-$ort_version"
+}

@@ -20,16 +20,11 @@ eigen_dir=${EIGEN3_DIR:-/usr/share/eigen3/cmake}
 [ -f "$eigen_dir/Eigen3Config.cmake" ] || fail "no Eigen3Config.cmake in $eigen_dir; set EIGEN3_DIR"
 
 ort=.deps/onnxruntime-android
-if [ ! -f "$ort/.stamp-$ort_version" ]; then
-  mkdir -p .deps/downloads
-  aar=.deps/downloads/onnxruntime-android-$ort_version.aar
-  fetch "https://repo1.maven.org/maven2/com/microsoft/onnxruntime/onnxruntime-android/$ort_version/onnxruntime-android-$ort_version.aar" "$aar"
-  tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-  unzip -q "$aar" 'headers/*' 'jni/arm64-v8a/*' -d "$tmp"
-  rm -rf "$ort" && mkdir -p "$ort"
-  mv "$tmp/headers" "$ort/include" && mv "$tmp/jni/arm64-v8a" "$ort/lib"
-  touch "$ort/.stamp-$ort_version"
-fi
+unpack() {  # the AAR's headers/ and jni/arm64-v8a/ as an ONNX Runtime root's include/ and lib/
+  unzip -q "$1" 'headers/*' 'jni/arm64-v8a/*' -d "$2/aar"
+  mv "$2/aar/headers" "$2/include" && mv "$2/aar/jni/arm64-v8a" "$2/lib" && rm -rf "$2/aar"
+}
+ort_package "$ort" "https://repo1.maven.org/maven2/com/microsoft/onnxruntime/onnxruntime-android/$ort_version/onnxruntime-android-$ort_version.aar" unpack
 
 # The NDK's toolchain searches its sysroot only: Eigen's package and ONNX Runtime are named directly.
 cmake -S . -B build/android-arm64 "${cmake_common[@]}" -DCMAKE_TOOLCHAIN_FILE="$ndk/build/cmake/android.toolchain.cmake" \

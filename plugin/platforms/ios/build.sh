@@ -17,14 +17,8 @@ source "$(dirname "$0")/../common.sh"
 [ "$(uname -s)" = Darwin ] || fail "run this on macOS with Xcode"
 
 ort=.deps/onnxruntime-ios
-if [ ! -f "$ort/.stamp-$ort_version" ]; then
-  mkdir -p .deps/downloads
-  archive=.deps/downloads/pod-archive-onnxruntime-c-$ort_version.zip
-  fetch "https://download.onnxruntime.ai/pod-archive-onnxruntime-c-$ort_version.zip" "$archive"
-  rm -rf "$ort" && mkdir -p "$ort"
-  unzip -q "$archive" -d "$ort"
-  touch "$ort/.stamp-$ort_version"
-fi
+unpack() { unzip -q "$1" -d "$2"; }
+ort_package "$ort" "https://download.onnxruntime.ai/pod-archive-onnxruntime-c-$ort_version.zip" unpack
 framework=$(find "$ort" -path '*onnxruntime.xcframework/ios-arm64/onnxruntime.framework' -type d | head -n1)
 [ -n "$framework" ] || fail "no ios-arm64/onnxruntime.framework in $ort"
 

@@ -15,14 +15,8 @@ source "$(dirname "$0")/../common.sh"
 [ "$(uname -s)" = Darwin ] || fail "run this on macOS"
 
 ort=.deps/onnxruntime-macos
-if [ ! -f "$ort/.stamp-$ort_version" ]; then
-  mkdir -p .deps/downloads
-  archive=.deps/downloads/onnxruntime-osx-universal2-$ort_version.tgz
-  fetch "https://github.com/microsoft/onnxruntime/releases/download/v$ort_version/onnxruntime-osx-universal2-$ort_version.tgz" "$archive"
-  rm -rf "$ort" && mkdir -p "$ort"
-  tar -xzf "$archive" -C "$ort" --strip-components 1
-  touch "$ort/.stamp-$ort_version"
-fi
+unpack() { tar -xzf "$1" -C "$2" --strip-components 1; }
+ort_package "$ort" "https://github.com/microsoft/onnxruntime/releases/download/v$ort_version/onnxruntime-osx-universal2-$ort_version.tgz" unpack
 
 cmake -S . -B build/macos "${cmake_common[@]}" -DCMAKE_OSX_ARCHITECTURES="arm64;x86_64" \
   -DCMAKE_OSX_DEPLOYMENT_TARGET=11.0 -DONNXRUNTIME_ROOT="$root/$ort"
