@@ -65,7 +65,7 @@ test-python: build ## pytest
 	@echo "== Python tests"; $(PY) -m pytest -q tests/python --ignore=tests/python/test_training.py
 	@echo "== Python tests (training)"; $(PY) -m pytest -q tests/python/test_training.py
 
-test: lint test-native test-fuzz test-python ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest
+test: lint test-native test-fuzz test-python test-swift test-unity ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, Swift, Unity
 
 # The demo's replay: frames DEMO_START.. of a real Live Link Face take through linear
 # blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,
@@ -87,16 +87,17 @@ demo-bundle: ## check that BUNDLE exists, else say how to make one
 
 demo: demo-bundle build ## template, layers, identities, landmarks, then a real take replayed -> out/demo (OUT)
 	@$(PY) -m softdeca_train demo --ict "$(SOFTDECA_ICT)" --out $(OUT)/demo
-	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(DEMO_TAKE) --bundle $(BUNDLE) \
-	  --seed $(DEMO_SEED) --start $(DEMO_START) --frames $(DEMO_FRAMES) --dynamics --preview \
-	  --localised "$(DEMO_LOCALISED)" --out $(OUT)/demo/replay
+	@$(PY) -m softdeca_train avatar --ict "$(SOFTDECA_ICT)" --seed $(DEMO_SEED) --out $(OUT)/demo/replay/avatar
+	@$(BUILD)/plugin/cli/softdeca replay $(DEMO_TAKE) --bundle $(BUNDLE) --avatar $(OUT)/demo/replay/avatar \
+	  --start $(DEMO_START) --frames $(DEMO_FRAMES) --dynamics --localised "$(DEMO_LOCALISED)" --out $(OUT)/demo/replay
+	@$(PY) -m softdeca_train replay-preview --replay $(OUT)/demo/replay
 	@echo "demo replay ($(BUNDLE), identity seed $(DEMO_SEED), $(DEMO_FRAMES) frames of $(notdir $(DEMO_TAKE))):"
 	@echo "  mesh sequence: $(OUT)/demo/replay/{linear,softdeca,sparse,softdeca_localised}.pc2 over $(OUT)/demo/replay/neutral.obj"
 	@echo "                 (PC2 point caches: Blender Mesh Cache modifier; docs/runtime.md)"
 	@echo "  preview:       $(OUT)/demo/replay/preview.png"
 	@echo "  timings:       $(OUT)/demo/replay/replay.json"
 
-bench: build bench-runtime ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
+bench: build bench-runtime bench-unity ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
@@ -105,7 +106,7 @@ bench: build bench-runtime ## every benchmark -> build/bench/<area>.json (docs/b
 	@$(PY) -m softdeca_train bench-datagen --ict "$(SOFTDECA_ICT)" --out build/bench
 
 lint: setup ## ruff check and format check of the Python code
-	@$(VENV)/bin/ruff check training tests/python && $(VENV)/bin/ruff format --check training tests/python
+	@$(VENV)/bin/ruff check training tests/python tests/unity && $(VENV)/bin/ruff format --check training tests/python tests/unity
 
 clean: ## remove build/ and out/ (OUT)
 	rm -rf build $(OUT)
@@ -154,9 +155,10 @@ bench-runtime: build ## the native runtime per frame -> build/bench/runtime.json
 
 replay-demo: build ## a whole take through both models with an UNTRAINED bundle -> out/replay
 	@$(PY) -m softdeca_train runtime-bundle --ict "$(SOFTDECA_ICT)" --out $(REPLAY_BUNDLE)
-	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca replay $(REPLAY_TAKE) \
-	  --bundle $(REPLAY_BUNDLE) --seed 1 --out $(OUT)/replay --dynamics --preview \
-	  --localised "w_skin_strain=100@0.05,-0.015,0.085,0.03"
+	@$(PY) -m softdeca_train avatar --ict "$(SOFTDECA_ICT)" --seed 1 --out $(OUT)/replay/avatar
+	@$(BUILD)/plugin/cli/softdeca replay $(REPLAY_TAKE) --bundle $(REPLAY_BUNDLE) --avatar $(OUT)/replay/avatar \
+	  --out $(OUT)/replay --dynamics --localised "w_skin_strain=100@0.05,-0.015,0.085,0.03"
+	@$(PY) -m softdeca_train replay-preview --replay $(OUT)/replay
 	@echo "replay (UNTRAINED bundle): $(OUT)/replay/preview.png, $(OUT)/replay/*.pc2 over $(OUT)/replay/neutral.obj, $(OUT)/replay/replay.json"
 
 # ---- Physics ---------------------------------------------------------------------------------
@@ -165,7 +167,7 @@ replay-demo: build ## a whole take through both models with an UNTRAINED bundle 
 SIMULATE_TAKE ?= $(TAKES)/alex_rom_3.csv
 .PHONY: simulate-demo
 simulate-demo: build ## a few frames of a real take through the physics model -> out/simulate
-	@SOFTDECA_PYTHON=$(CURDIR)/$(PY) $(BUILD)/plugin/cli/softdeca simulate $(SIMULATE_TAKE) \
+	@$(PY) -m softdeca_train simulate $(SIMULATE_TAKE) \
 	  --out $(OUT)/simulate --level 3 --start 1300 --frames 6 --stride 100 --obj-every 1
 
 # ---- iOS capture core (Swift package ios_capture/) --------------------------------------------
@@ -174,7 +176,6 @@ simulate-demo: build ## a few frames of a real take through the physics model ->
 # is /opt/swift or `swift` on PATH; without one the tests are skipped, visibly.
 SWIFT ?= $(firstword $(wildcard /opt/swift/usr/bin/swift) $(shell command -v swift 2>/dev/null))
 .PHONY: test-swift
-test: test-swift
 test-swift: build ## the iOS capture core: swift test (skipped without a Swift toolchain)
 	@if [ -z "$(SWIFT)" ]; then \
 	  echo "== Swift tests (ios_capture): SKIPPED, no Swift toolchain (/opt/swift/usr/bin/swift or swift on PATH)"; \
@@ -184,6 +185,17 @@ test-swift: build ## the iOS capture core: swift test (skipped without a Swift t
 	  SOFTDECA_CLI=$(CURDIR)/$(BUILD)/plugin/cli/softdeca SOFTDECA_PYTHON=$(CURDIR)/$(PY) \
 	    $(SWIFT) test --skip-build; \
 	fi
+# ---- Unity package -------------------------------------------------------------------------
+# test-unity: the C# core (unity_package/Runtime/Core) compiled by mono and tested with NUnit
+# against this build's library (tests/unity/run); the Unity layer compiled against the
+# declaration-only reference (tests/unity/compile-check); the package check (metas, GUIDs,
+# asmdefs, package.json). bench-unity: the core's managed overhead per frame (build/bench/unity.json).
+.PHONY: test-unity bench-unity
+test-unity: build ## the Unity package: C# core on mono with NUnit, layer compile check, package check
+	@echo "== Unity core (C# on mono, NUnit)"; PY=$(PY) tests/unity/run $(BUILD)
+	@echo "== Unity layer and package"; tests/unity/compile-check && $(PY) tests/unity/package.py check
+bench-unity: build ## managed call overhead of the C# core per frame -> build/bench/unity.json
+	@PY=$(PY) tests/unity/bench $(BUILD)
 
 # ---- Native binaries per platform and the Unity package tarball (docs/platforms.md) -----------
 # Linux x86_64 is build/release. Windows x64 is cross-built here with MinGW-w64 in build/windows;

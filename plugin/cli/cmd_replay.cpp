@@ -1,8 +1,9 @@
 // softdeca replay: a take (Live Link Face CSV or recording) through plain linear blendshapes, SoftDECA (from the weights) and
 // SparseSoftDECA (from landmarks) onto one avatar. Writes per model a PC2 point cache over the
 // avatar's neutral OBJ (Blender: import neutral.obj, add a Mesh Cache modifier; Unity: the OBJ
-// sequence of --obj-every), replay.json with the timing summary, and (--preview) a contact
-// sheet rendered by the training package.
+// sequence of --obj-every) and replay.json with the timing summary. Native end to end: the avatar
+// (e.g. an ICT identity: python -m softdeca_train avatar) and the contact sheet of the output
+// (python -m softdeca_train replay-preview) come from the training package, before and after.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -147,13 +148,14 @@ unsigned precision_of(const std::string& p) {
 
 int run_replay(const Args& args) {
   Options o("replay", "Replay a take (Live Link Face CSV or a recording) through linear blendshapes, SoftDECA and\n"
-                      "SparseSoftDECA onto one avatar; writes <out>/neutral.obj, <model>.pc2 point caches, replay.json (timings) and,\n"
-                      "with --preview, preview.png. SparseSoftDECA reads landmarks of a tracked face: the avatar's\n"
-                      "user_face rig blended with the take (as a phone would track it), else the avatar's own.");
+                      "SparseSoftDECA onto one avatar; writes <out>/neutral.obj, <model>.pc2 point caches and replay.json (timings).\n"
+                      "SparseSoftDECA reads landmarks of a tracked face: the avatar's user_face rig blended with the\n"
+                      "take (as a phone would track it), else the avatar's own. An ICT identity as avatar:\n"
+                      "python -m softdeca_train avatar --seed N --out DIR; a contact sheet of the result:\n"
+                      "python -m softdeca_train replay-preview --replay OUT.");
   o.positional("TAKE", "Live Link Face CSV (.csv) or a recording of the streaming format")
       .option("--bundle", "DIR", "model bundle folder or .tar")
       .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
-      .option("--seed", "N", "instead of --avatar: the ICT identity of this seed, written to <out>/avatar by the Python helper")
       .option("--out", "DIR", "output folder", "out/replay")
       .option("--models", "LIST", "comma-separated: linear, softdeca, sparse", "linear,softdeca,sparse")
       .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated (value: a number, min, max or default)")
@@ -163,11 +165,10 @@ int run_replay(const Args& args) {
       .option("--threads", "N", "threads per frame (1 or 2)", "1")
       .option("--precision", "P", "hyper-tensor storage: half, float or int8", "half")
       .option("--obj-every", "N", "also write every Nth frame as OBJ (0: none)", "0")
-      .flag("--dynamics", "enable the second-order dynamics")
-      .flag("--preview", "render preview.png (python -m softdeca_train replay-preview)");
+      .flag("--dynamics", "enable the second-order dynamics");
   if (!o.parse(args)) return 0;
   if (!o.given("--bundle")) throw UsageError("--bundle is required");
-  if (o.given("--avatar") == o.given("--seed")) throw UsageError("give exactly one of --avatar and --seed");
+  if (!o.given("--avatar")) throw UsageError("--avatar is required (python -m softdeca_train avatar writes one)");
   const std::string out = o.text("--out");
   make_directories(out);
   const unsigned threads = static_cast<unsigned>(o.integer("--threads"));
@@ -182,11 +183,7 @@ int run_replay(const Args& args) {
   take.weights.erase(take.weights.begin(), take.weights.begin() + start);
   std::fprintf(stderr, "take %s: %zu rows, %zu face-lost rows skipped, %zu unreadable; frames %ld to %zu\n", take.path.c_str(),
                take.rows, take.face_lost, take.invalid, start, static_cast<std::size_t>(start) + take.weights.size() - 1);
-  std::string avatar_dir = o.text("--avatar");
-  if (o.given("--seed")) {
-    avatar_dir = out + "/avatar";
-    if (!file_exists(avatar_dir + "/neutral.obj")) write_identity_avatar(o.integer("--seed"), avatar_dir);
-  }
+  const std::string avatar_dir = o.text("--avatar");
   const FaceRig rig = read_rig(avatar_dir);
   const FaceRig user = read_rig(avatar_dir + "/user_face", true);
 
@@ -296,12 +293,6 @@ int run_replay(const Args& args) {
       .raw("timings", timings.str(true));
   write_text_file(out + "/replay.json", summary.str(true) + "\n");
   std::printf("wrote %s/neutral.obj, %zu point caches (.pc2) and %s/replay.json\n", out.c_str(), models.size(), out.c_str());
-  if (o.on("--preview")) {
-    const char* py = std::getenv("SOFTDECA_PYTHON");
-    const std::string cmd = std::string(py && *py ? py : "python3") + " -m softdeca_train replay-preview --replay '" + out + "'";
-    std::fprintf(stderr, "softdeca: %s\n", cmd.c_str());
-    if (std::system(cmd.c_str()) != 0) throw std::runtime_error("the preview helper failed: " + cmd);
-  }
   return 0;
 }
 

@@ -10,7 +10,6 @@ int run_info(const Args&);
 int run_bench_streaming(const Args&);
 int run_replay(const Args&);
 int run_bench_runtime(const Args&);
-int run_simulate(const Args&);
 
 const std::vector<Command>& commands() {
   static const std::vector<Command> kCommands = {
@@ -23,8 +22,6 @@ const std::vector<Command>& commands() {
        run_bench_streaming},
       {"replay", "replay a take through linear blendshapes, SoftDECA and SparseSoftDECA onto an avatar", run_replay},
       {"bench-runtime", "measure the runtime per frame (both models, 1 and 2 threads) -> JSON", run_bench_runtime},
-      {"simulate", "simulate a take with the physics model: point caches, render, linear vs physics summary",
-       run_simulate},
   };
   return kCommands;
 }

@@ -93,16 +93,6 @@ FaceRig read_rig(const std::string& dir, bool optional) {
   return rig;
 }
 
-void write_identity_avatar(long seed, const std::string& dir) {
-  const char* py = std::getenv("SOFTDECA_PYTHON");
-  const std::string cmd = std::string(py && *py ? py : "python3") + " -m softdeca_train avatar --seed " + std::to_string(seed) +
-                          " --out '" + dir + "'";
-  std::fprintf(stderr, "softdeca: %s\n", cmd.c_str());
-  if (std::system(cmd.c_str()) != 0)
-    throw std::runtime_error("the avatar helper failed (" + cmd +
-                             "); set SOFTDECA_PYTHON to the project's .venv/bin/python and PYTHONPATH to training/");
-}
-
 double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
 
 double percentile(std::vector<double> v, double q) {

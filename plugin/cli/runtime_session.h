@@ -48,10 +48,6 @@ struct FaceRig {  // a neutral mesh and 52 blendshape deltas
 // an empty rig instead of an error.
 FaceRig read_rig(const std::string& dir, bool optional = false);
 
-// Writes the avatar of an ICT identity into `dir` with the training package's helper
-// (`python -m softdeca_train avatar`, python from $SOFTDECA_PYTHON or python3).
-void write_identity_avatar(long seed, const std::string& dir);
-
 bool file_exists(const std::string& path);
 void make_directories(const std::string& path);
 double median(std::vector<double> v);

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "sim/collisions.h"
 #include "sim/simulator.h"
 #include "sim/synthetic.h"

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "fuzz_check.h"
 #include "recording/livelinkface_csv.h"
 

@@ -3,7 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "fuzz_check.h"
 #include "recording/player.h"
 #include "recording/recording_reader.h"

@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/recording_reader.h"
 #include "stream/frame_sender.h"
 #include "stream/ifacialmocap_packet.h"

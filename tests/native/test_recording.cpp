@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/conversions.h"
 #include "recording/frame_interpolation.h"
 #include "recording/livelinkface_csv.h"

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "runtime/blendshapes.h"
 #include "runtime/bundle_files.h"
 #include "runtime/deformation_transfer.h"

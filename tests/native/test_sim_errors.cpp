@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "sim_test_support.h"
 
 using namespace sim_test;

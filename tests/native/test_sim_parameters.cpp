@@ -6,7 +6,7 @@
 #include <set>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "sim/parameters.h"
 
 using namespace softdeca;

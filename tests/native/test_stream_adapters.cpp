@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/livelinkface_csv.h"
 #include "recording/timecode.h"
 #include "stream/arkit_names.h"

@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/byte_io.h"
 #include "stream/wire_format.h"
 #include "stream_test_support.h"

@@ -1,5 +1,5 @@
-"""`softdeca simulate` on a real take (the native CLI runs `python -m softdeca_train
-simulate`), its bad-input errors, and lip collisions on real frames."""
+"""`python -m softdeca_train simulate` on a real take, its bad-input errors, and lip collisions
+on real frames."""
 
 from __future__ import annotations
 
@@ -19,16 +19,16 @@ from softdeca_train.sim.measures import penetrating_points
 from softdeca_train.sim.take import read_take
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
-from streaming_cli import CLI, TAKES
+from streaming_cli import TAKES
 
 TAKE = TAKES / "alex_rom_3.csv"
 LEVEL = 2  # LHM resolution of these tests: fast, same code paths as the default 4
 
 
 def _simulate(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    env = dict(os.environ, SOFTDECA_PYTHON=sys.executable, OMP_NUM_THREADS="1")
+    env = dict(os.environ, OMP_NUM_THREADS="1")
     return subprocess.run(
-        [CLI, "simulate", *args],
+        [sys.executable, "-m", "softdeca_train", "simulate", *args],
         check=False,
         capture_output=True,
         text=True,
@@ -53,7 +53,7 @@ def _take_with_face_lost_row(path: Path, rows: int) -> Path:
 
 @pytest.fixture(scope="module")
 def simulated(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    """`softdeca simulate` on 2 frames of a take with a face-lost row: (output folder, stdout)."""
+    """`softdeca_train simulate` on 2 frames of a take with a face-lost row: (output folder, stdout)."""
     tmp_path = tmp_path_factory.mktemp("simulate")
     take = _take_with_face_lost_row(tmp_path / "take.csv", 40)
     params = tmp_path / "p.json"

@@ -1,4 +1,4 @@
-"""Run inside Blender (not the project's Python): import a `softdeca simulate` / `softdeca
+"""Run inside Blender (not the project's Python): import a `softdeca_train simulate` / `softdeca
 replay` output folder the way docs/physics.md describes and check that what Blender shows is
 the point cache.
 

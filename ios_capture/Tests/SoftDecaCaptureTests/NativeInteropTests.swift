@@ -248,15 +248,17 @@ final class RecorderInteropTests: XCTestCase {
             XCTAssertEqual(got.landmarks, sent.landmarks!.points.flatMap { [$0.x, $0.y, $0.z] })
         }
 
-        // The CSV through the models: `softdeca replay` with the committed bundle.
-        let out = folder.appendingPathComponent("replay")
+        // The CSV through the models: `softdeca replay` with the committed bundle, on the avatar
+        // of ICT identity 1 that the training package writes.
+        let out = folder.appendingPathComponent("replay"), avatar = folder.appendingPathComponent("avatar")
         let env = ProcessInfo.processInfo.environment
         let python = env["SOFTDECA_PYTHON"] ?? TestEnvironment.repoRoot.appendingPathComponent(".venv/bin/python").path
-        var replayEnv = ["SOFTDECA_PYTHON": python]
-        if env["SOFTDECA_ICT"] == nil { replayEnv["SOFTDECA_ICT"] = try TestEnvironment.dataFolder().appendingPathComponent("ict-facekit").path }
-        if env["PYTHONPATH"] == nil { replayEnv["PYTHONPATH"] = TestEnvironment.repoRoot.appendingPathComponent("build/release/python").path + ":" + TestEnvironment.repoRoot.appendingPathComponent("training").path }
+        var pythonEnv: [String: String] = [:]
+        if env["SOFTDECA_ICT"] == nil { pythonEnv["SOFTDECA_ICT"] = try TestEnvironment.dataFolder().appendingPathComponent("ict-facekit").path }
+        if env["PYTHONPATH"] == nil { pythonEnv["PYTHONPATH"] = TestEnvironment.repoRoot.appendingPathComponent("build/release/python").path + ":" + TestEnvironment.repoRoot.appendingPathComponent("training").path }
+        try runTool(URL(fileURLWithPath: python), ["-m", "softdeca_train", "avatar", "--seed", "1", "--out", avatar.path], environment: pythonEnv)
         try runTool(cli, ["replay", r.csvURL.path, "--bundle", TestEnvironment.repoRoot.appendingPathComponent("models/softdeca-default").path,
-                      "--seed", "1", "--frames", "30", "--models", "linear,softdeca", "--out", out.path], environment: replayEnv)
+                      "--avatar", avatar.path, "--frames", "30", "--models", "linear,softdeca", "--out", out.path])
         let summary = try JSONSerialization.jsonObject(with: Data(contentsOf: out.appendingPathComponent("replay.json"))) as! [String: Any]
         XCTAssertFalse(summary.isEmpty)
         for model in ["linear", "softdeca"] {

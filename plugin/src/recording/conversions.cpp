@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/livelinkface_csv.h"
 #include "recording/recording_reader.h"
 #include "recording/recording_writer.h"

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/timecode.h"
 #include "stream/livelinkface_layout.h"
 

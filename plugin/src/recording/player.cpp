@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/frame_interpolation.h"
 
 namespace softdeca::recording {

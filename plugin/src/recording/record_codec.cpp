@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/arkit_names.h"
 #include "stream/pose_io.h"
 

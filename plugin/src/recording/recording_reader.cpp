@@ -4,7 +4,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/record_codec.h"
 #include "stream/crc32.h"
 

@@ -3,7 +3,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "recording/record_codec.h"
 #include "stream/byte_io.h"
 #include "stream/crc32.h"

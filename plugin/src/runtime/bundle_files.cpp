@@ -4,7 +4,7 @@
 #include <fstream>
 #include <sys/stat.h>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::runtime {
 

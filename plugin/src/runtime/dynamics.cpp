@@ -4,7 +4,7 @@
 #include <cstring>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::runtime {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::runtime {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <set>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "runtime/json.h"
 
 namespace softdeca::runtime {

@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::runtime {
 

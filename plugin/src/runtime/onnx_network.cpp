@@ -1,6 +1,6 @@
 #include "runtime/onnx_network.h"
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::runtime {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::runtime {
 

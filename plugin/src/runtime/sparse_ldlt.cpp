@@ -10,7 +10,7 @@
 #include <cmath>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>

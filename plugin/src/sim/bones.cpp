@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::sim {
 

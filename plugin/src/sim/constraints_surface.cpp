@@ -3,7 +3,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "geometry/cotan.h"
 #include "sim/svd3.h"
 

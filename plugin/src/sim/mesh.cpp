@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "geometry/cotan.h"
 
 namespace softdeca::sim {

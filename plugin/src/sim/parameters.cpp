@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::sim {
 namespace {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <utility>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "sim/collisions.h"
 
 namespace softdeca::sim {

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::sim {
 namespace {

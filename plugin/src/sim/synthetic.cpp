@@ -6,7 +6,7 @@
 #include <map>
 #include <cmath>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "geometry/tet_mesh.h"
 
 namespace softdeca::sim {

@@ -8,7 +8,7 @@
 #include <Eigen/MetisSupport>
 #endif
 
-#include "api/error.h"
+#include "core/error.h"
 
 namespace softdeca::sim {
 

@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/ifacialmocap_packet.h"
 #include "stream/steady_clock.h"
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string_view>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/arkit_names.h"
 #include "stream/rotation.h"
 

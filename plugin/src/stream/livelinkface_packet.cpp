@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/byte_io.h"
 #include "stream/crc32.h"
 #include "stream/livelinkface_layout.h"

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/crc32.h"
 #include "stream/percentile.h"
 #include "stream/steady_clock.h"

@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/socket_platform.h"
 
 namespace softdeca::stream {

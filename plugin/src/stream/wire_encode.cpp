@@ -4,7 +4,7 @@
 #include <set>
 #include <string>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "stream/byte_io.h"
 #include "stream/crc32.h"
 #include "stream/pose_io.h"

@@ -150,7 +150,9 @@ def lib() -> C.CDLL:
         loaded.softdeca_avatar_destroy.restype = None
         found = loaded.softdeca_abi_version()
         if found != ABI_VERSION:
-            raise RuntimeError(f"{path} has C ABI version {found}; this binding needs {ABI_VERSION}")
+            raise RuntimeError(
+                f"{path} has C ABI version {found}; this binding needs {ABI_VERSION}"
+            )
         _lib = loaded
     return _lib
 

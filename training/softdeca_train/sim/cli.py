@@ -1,4 +1,4 @@
-"""`python -m softdeca_train simulate` (and `softdeca simulate`, which runs it): φ† on a Live
+"""`python -m softdeca_train simulate`: φ† on a Live
 Link Face take for one identity and parameter set -> point caches, OBJ sequence, render and
 a summary of linear blendshapes against physics."""
 

@@ -1,0 +1,46 @@
+using SoftDeca;
+using UnityEngine;
+
+namespace SoftDeca.Unity
+{
+    /// <summary>Face frames from the network: our protocol, Live Link Face or iFacialMocap over UDP.</summary>
+    [AddComponentMenu("SoftDECA/Network Receiver Input")]
+    public sealed class NetworkReceiverInput : SoftDecaFaceInput
+    {
+        public StreamFormat format = StreamFormat.Auto;
+        [Tooltip("Numeric address to listen on; empty: all IPv4 interfaces")]
+        public string bindAddress = "";
+        public int port = 50110;
+        [Tooltip("Seconds frames wait to be put in order (0: show each as it arrives)")]
+        [Range(0, 0.2f)] public float jitterDelay = 0;
+        [Tooltip("Optional: record every delivered frame to this file (e.g. under Application.persistentDataPath)")]
+        public string recordTo = "";
+
+        private Receiver receiver;
+        private Frame frame;
+
+        public Receiver Receiver { get { return receiver; } }
+
+        private void OnEnable()
+        {
+            frame = Frame.Create();
+            receiver = new Receiver(format, string.IsNullOrEmpty(bindAddress) ? null : bindAddress, port, 256, jitterDelay);
+            if (!string.IsNullOrEmpty(recordTo)) receiver.StartRecording(recordTo, SystemInfo.deviceName, null, "Unity");
+        }
+
+        private void OnDisable()
+        {
+            if (receiver == null) return;
+            if (!string.IsNullOrEmpty(recordTo)) receiver.StopRecording();
+            receiver.Dispose();
+            receiver = null;
+        }
+
+        public override bool TryGetWeights(float[] weights)
+        {
+            if (receiver == null || !receiver.TryLatest(ref frame) || frame.Tracking == (int)Tracking.Lost) return false;
+            frame.CopyWeights(weights);
+            return true;
+        }
+    }
+}
