@@ -58,12 +58,8 @@ test-native: build build-asan ## ctest on both builds
 	@echo "== native tests (ASan+UBSan)"; ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
 
-# The training tests run in a process of their own: after the rest of the suite in one
-# process, the first of them died with SIGSEGV twice (not reproduced by any subset of the
-# modules; see docs/training.md, "Known problems").
 test-python: build ## pytest
-	@echo "== Python tests"; $(PY) -m pytest -q tests/python --ignore=tests/python/test_training.py
-	@echo "== Python tests (training)"; $(PY) -m pytest -q tests/python/test_training.py
+	@echo "== Python tests"; $(PY) -m pytest -q tests/python
 
 test: lint test-native test-fuzz test-python test-swift test-unity ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, Swift, Unity
 
@@ -97,9 +93,10 @@ demo: demo-bundle build ## template, layers, identities, landmarks, then a real 
 	@echo "  preview:       $(OUT)/demo/replay/preview.png"
 	@echo "  timings:       $(OUT)/demo/replay/replay.json"
 
-bench: build bench-runtime bench-unity ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
+bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
+	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
 	@$(PY) -m softdeca_train bench-physics --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
@@ -116,7 +113,8 @@ clean: ## remove build/ and out/ (OUT)
 # test-fuzz: a few seconds each on the committed corpus; fuzz-long: the long runs of
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
 FUZZ         := build/fuzz
-FUZZ_TARGETS := softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader
+FUZZ_TARGETS := softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
+                bundle_tar bundle_folder manifest onnx_model
 FUZZ_SECONDS ?= 620
 
 .PHONY: fuzz-build test-fuzz fuzz-long
@@ -196,6 +194,20 @@ test-unity: build ## the Unity package: C# core on mono with NUnit, layer compil
 	@echo "== Unity layer and package"; tests/unity/compile-check && $(PY) tests/unity/package.py check
 bench-unity: build ## managed call overhead of the C# core per frame -> build/bench/unity.json
 	@PY=$(PY) tests/unity/bench $(BUILD)
+# ---- Physics stress suite -------------------------------------------------------------------
+# `make stress`: extreme expressions / identities / materials / gravity, levels 3 and 4, static
+# and dynamic, plus every take in $(RECORDINGS) (every STRESS_TAKE_STRIDE-th frame, 3
+# identities), judged by the sanity bounds (docs/physics.md) -> $(OUT)/stress/{stress.json,
+# stress.md,stress_worst.png}. `make bench` runs it too and writes build/bench/physics_stress.json.
+RECORDINGS         ?= $(DATA)/recordings
+STRESS_TAKE_STRIDE ?= 10
+.PHONY: stress bench-stress
+stress: build ## the physics stress suite judged by the sanity bounds -> out/stress (report, contact sheet)
+	@nice -n 5 $(PY) -m softdeca_train stress --ict "$(SOFTDECA_ICT)" --recordings "$(RECORDINGS)" \
+	  --take-stride $(STRESS_TAKE_STRIDE) --out $(OUT)/stress
+bench-stress: build ## the stress suite's figures -> build/bench/physics_stress.json
+	@nice -n 5 $(PY) -m softdeca_train stress --ict "$(SOFTDECA_ICT)" --recordings "$(RECORDINGS)" \
+	  --take-stride $(STRESS_TAKE_STRIDE) --out build/stress --bench-out build/bench --quiet
 
 # ---- Native binaries per platform and the Unity package tarball (docs/platforms.md) -----------
 # Linux x86_64 is build/release. Windows x64 is cross-built here with MinGW-w64 in build/windows;

@@ -110,6 +110,28 @@ Options parse(int argc, char** argv) {
   }
   return o;
 }
+// The benchmark JSON ({name: {value, unit, target, better, how}}); false when it cannot be written.
+bool write_figures(const std::string& path, const std::map<std::string, Figure>& figures) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  std::ofstream out(path);
+  if (!out) {
+    std::cerr << "cannot write " << path << "\n";
+    return false;
+  }
+  out << "{\n";
+  std::size_t i = 0;
+  for (const auto& [name, f] : figures) {
+    char value[64];
+    std::snprintf(value, sizeof value, "%.6g", f.value);
+    out << "  " << json_string(name) << ": {\"value\": " << value << ", \"unit\": " << json_string(f.unit)
+        << ", \"target\": " << (std::isnan(f.target) ? std::string("null") : std::to_string(f.target))
+        << ", \"better\": " << json_string(f.better) << ", \"how\": " << json_string(f.how) << "}"
+        << (++i < figures.size() ? "," : "") << "\n";
+  }
+  out << "}\n";
+  return true;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -212,24 +234,7 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
 
-  const std::filesystem::path parent = std::filesystem::path(o.out).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
-  std::ofstream out(o.out);
-  if (!out) {
-    std::cerr << "cannot write " << o.out << "\n";
-    return 1;
-  }
-  out << "{\n";
-  std::size_t i = 0;
-  for (const auto& [name, f] : figures) {
-    char value[64];
-    std::snprintf(value, sizeof value, "%.6g", f.value);
-    out << "  " << json_string(name) << ": {\"value\": " << value << ", \"unit\": " << json_string(f.unit)
-        << ", \"target\": " << (std::isnan(f.target) ? std::string("null") : std::to_string(f.target))
-        << ", \"better\": " << json_string(f.better) << ", \"how\": " << json_string(f.how) << "}"
-        << (++i < figures.size() ? "," : "") << "\n";
-  }
-  out << "}\n";
+  if (!write_figures(o.out, figures)) return 1;
   std::printf("wrote %s\n", o.out.c_str());
   return 0;
 }

@@ -82,6 +82,221 @@ double load_average() {
   in >> l;
   return l;
 }
+// What every measurement reads: the take, the rigs, the bundle, the frames' SparseSoftDECA input,
+// the output buffers and the description recorded with each figure.
+struct Bench {
+  const Take& take;
+  const FaceRig& rig;
+  const FaceRig& user;
+  Model& model;
+  std::size_t frames = 0, warmup = 0;
+  long prepares = 0;
+  std::string how;
+  Frames input;
+  std::vector<float> vertices, normals;
+  softdeca_output output{};
+  JsonObject figures;
+};
+
+// What SparseSoftDECA reads each frame: the user rig's face mesh, or the avatar's own landmarks.
+Frames sparse_inputs(const Take& take, std::size_t frames, const FaceRig& rig, const FaceRig& user, Model& model) {
+  const uint32_t vh = model.info.head_vertex_count;
+  Frames input{take, {}, 0};
+  Avatar a(model, rig.neutral, rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  std::vector<float> head(vh * 3);
+  softdeca_output out{sizeof(softdeca_output), head.data(), vh, nullptr, 0};
+  for (std::size_t f = 0; f < frames; ++f) {
+    if (!user.empty()) {
+      std::vector<float> p(user.neutral.vertices.size());
+      user.blend(take.weights[f].data(), p.data());
+      input.points.push_back(std::move(p));
+      input.point_count = user.neutral.vertex_count();
+    } else {
+      check(softdeca_avatar_evaluate_linear(a.handle, take.weights[f].data(), 52, &out), "linear");
+      std::vector<float> p(3 * model.info.landmark_count);
+      check(softdeca_model_evaluate_landmarks(model.handle, head.data(), vh, p.data(), model.info.landmark_count), "landmarks");
+      input.points.push_back(std::move(p));
+      input.point_count = model.info.landmark_count;
+    }
+  }
+  return input;
+}
+
+// Prepare time, memory per avatar and the cost of a frame relative to the paper (1 thread only).
+void record_prepare_and_memory(Bench& bench, const Avatar& a, const softdeca_stats& first, const std::vector<double>& prep,
+                               double static_ms) {
+  const std::string& how = bench.how;
+  bench.figures.raw("runtime.prepare_ms", figure(median(prep), "ms", "prepare after a parameter change: f_ph, f_ph_v, both f_dyn, "
+                                                                     "compact hyper-tensors; median of " +
+                                                                         std::to_string(prep.size()) + "; " + how));
+  bench.figures.raw("runtime.first_prepare_ms",
+                    figure(first.prepare_ms, "ms", "the first prepare, including the DT assembly and factorisation (" +
+                                                       std::to_string(first.factorisation_ms) + " ms); " + how));
+  bench.figures.raw("runtime.memory_per_avatar_mb",
+                    figure(static_cast<double>(a.stats().memory_bytes) / 1e6, "MB",
+                           "softdeca_stats.memory_bytes after prepare (both models' hyper-tensors in half precision, DT "
+                           "factor, blendshapes, buffers); " + how));
+  bench.figures.raw("runtime.softdeca_static_us_per_face",
+                    figure(static_ms * 1000.0 / bench.model.info.skin_triangle_count, "us/face",
+                           "softdeca_static_ms per skin triangle; paper: " + std::to_string(kPaperStaticMs * 1000 / kPaperFaces) +
+                               " us/face static, " + std::to_string(kPaperDynamicMs * 1000 / kPaperFaces) +
+                               " dynamic (7.45 / 9.87 ms for 71,358 faces, i5-12600K, PyTorch)"));
+}
+
+// Every model per frame with half-precision hyper-tensors on `threads` threads.
+void measure_with_threads(Bench& bench, unsigned threads) {
+  const std::string suffix = threads == 1 ? "" : "_2threads";
+  const std::string tag = threads == 1 ? " (1 thread)" : " (2 threads)";
+  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, threads, SOFTDECA_PRECISION_HALF);
+  check(softdeca_avatar_prepare(a.handle), "prepare");
+  const softdeca_stats first = a.stats();
+  std::vector<double> prep;
+  for (long i = 0; i < bench.prepares; ++i) {
+    check(softdeca_avatar_prepare(a.handle), "prepare");
+    prep.push_back(a.stats().prepare_ms);
+  }
+  if (!bench.user.empty())
+    check(softdeca_avatar_calibrate_landmarks(a.handle, bench.user.neutral.vertices.data(), bench.user.neutral.vertex_count()),
+          "calibration");
+  const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
+  softdeca_output* output = &bench.output;
+  const Frames& input = bench.input;
+  const std::size_t frames = bench.frames, warmup = bench.warmup;
+  const double load_before = load_average();
+  const Times lin = median_ms(frames, warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_linear(a.handle, w(f), 52, output), "linear");
+  });
+  check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_FALSE), "dynamics");
+  const Times st = median_ms(frames, warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, output), "softdeca");
+  });
+  check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_TRUE), "dynamics");
+  const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, output), "softdeca");
+  });
+  const Times sp = median_ms(frames, warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, output), "sparse");
+  });
+  check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_FALSE), "dynamics");
+  const Times sp_static = median_ms(frames, warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, output), "sparse");
+  });
+  const double load = std::max(load_before, load_average());
+  char load_text[96];
+  std::snprintf(load_text, sizeof load_text, "; machine load average %.1f during the run", load);
+  const std::string when = tag + "; " + bench.how + load_text;
+  JsonObject& figures = bench.figures;
+  figures.raw("runtime.softdeca_static_ms" + suffix, figure(st.wall, "ms", "evaluate_weights, dynamics off, with normals, wall-clock" + when, 2.0));
+  figures.raw("runtime.softdeca_dynamic_ms" + suffix, figure(dy.wall, "ms", "evaluate_weights, dynamics on, with normals, wall-clock" + when, 2.0));
+  figures.raw("runtime.sparse_ms" + suffix, figure(sp.wall, "ms", "evaluate_landmarks, dynamics on, with normals, wall-clock" + when, 0.5));
+  figures.raw("runtime.sparse_static_ms" + suffix, figure(sp_static.wall, "ms", "evaluate_landmarks, dynamics off, wall-clock" + when, 0.5));
+  figures.raw("runtime.linear_blendshapes_ms" + suffix,
+              figure(lin.wall, "ms", "evaluate_linear: 52 sparse blendshapes over the whole head, with normals, wall-clock" + when));
+  figures.raw("runtime.softdeca_over_linear" + suffix,
+              figure(st.wall / lin.wall, "x", "softdeca_static_ms / linear_blendshapes_ms, same avatar, same run" + tag, 3.0));
+  if (threads == 1) {  // CPU time of the frame thread: the cost without other processes
+    figures.raw("runtime.softdeca_static_cpu_ms", figure(st.cpu, "ms", "as softdeca_static_ms, thread CPU time" + when, 2.0));
+    figures.raw("runtime.softdeca_dynamic_cpu_ms", figure(dy.cpu, "ms", "as softdeca_dynamic_ms, thread CPU time" + when, 2.0));
+    figures.raw("runtime.sparse_cpu_ms", figure(sp.cpu, "ms", "as sparse_ms, thread CPU time" + when, 0.5));
+    figures.raw("runtime.linear_blendshapes_cpu_ms", figure(lin.cpu, "ms", "as linear_blendshapes_ms, thread CPU time" + when));
+    figures.raw("runtime.softdeca_over_linear_cpu",
+                figure(st.cpu / lin.cpu, "x", "softdeca_static_cpu_ms / linear_blendshapes_cpu_ms" + tag, 3.0));
+  }
+  std::fprintf(stderr,
+               "%u thread(s), load %.1f: wall linear %.3f  softdeca %.3f / dynamic %.3f  sparse %.3f / static %.3f ms (x%.2f); "
+               "cpu linear %.3f softdeca %.3f / %.3f sparse %.3f ms\n",
+               threads, load, lin.wall, st.wall, dy.wall, sp.wall, sp_static.wall, st.wall / lin.wall, lin.cpu, st.cpu, dy.cpu,
+               sp.cpu);
+  if (threads == 1) record_prepare_and_memory(bench, a, first, prep, st.wall);
+}
+
+// The speed of another hyper-tensor storage, single thread (same frames, same run).
+void measure_storage(Bench& bench, unsigned precision) {
+  const char* name = precision == SOFTDECA_PRECISION_INT8 ? "int8" : "float";
+  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, precision);
+  check(softdeca_avatar_prepare(a.handle), "prepare");
+  const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
+  softdeca_output* output = &bench.output;
+  const Times lin = median_ms(bench.frames, bench.warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_linear(a.handle, w(f), 52, output), "linear");
+  });
+  const Times st = median_ms(bench.frames, bench.warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, output), "softdeca");
+  });
+  check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_TRUE), "dynamics");
+  const Times dy = median_ms(bench.frames, bench.warmup, [&](std::size_t f) {
+    check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, output), "softdeca");
+  });
+  char load_text[64];
+  std::snprintf(load_text, sizeof load_text, "; machine load average %.1f", load_average());
+  const std::string& how = bench.how;
+  JsonObject& figures = bench.figures;
+  figures.raw(std::string("runtime.softdeca_static_ms_") + name,
+              figure(st.wall, "ms", std::string("as softdeca_static_ms with ") + name + " hyper-tensors (1 thread); " + how + load_text));
+  figures.raw(std::string("runtime.softdeca_static_cpu_ms_") + name,
+              figure(st.cpu, "ms", std::string("as softdeca_static_cpu_ms with ") + name + " hyper-tensors; " + how + load_text));
+  figures.raw(std::string("runtime.softdeca_dynamic_ms_") + name,
+              figure(dy.wall, "ms", std::string("as softdeca_dynamic_ms with ") + name + " hyper-tensors (1 thread); " + how + load_text));
+  figures.raw(std::string("runtime.softdeca_over_linear_") + name,
+              figure(st.wall / lin.wall, "x", std::string("softdeca_static_ms_") + name + " / linear_blendshapes_ms measured just before on "
+                                              "the same avatar (1 thread); " + how + load_text, 3.0));
+  figures.raw(std::string("runtime.softdeca_over_linear_cpu_") + name,
+              figure(st.cpu / lin.cpu, "x", std::string("the same in thread CPU time; ") + how + load_text, 3.0));
+  std::fprintf(stderr, "%s storage: wall linear %.3f softdeca %.3f / dynamic %.3f ms (x%.2f); cpu linear %.3f softdeca %.3f ms (x%.2f)\n",
+               name, lin.wall, st.wall, dy.wall, st.wall / lin.wall, lin.cpu, st.cpu, st.cpu / lin.cpu);
+}
+
+// Error of the compact storage: the same frames with float, half and int8 hyper-tensors.
+void measure_storage_error(Bench& bench) {
+  const Model& model = bench.model;
+  const std::size_t n = std::min<std::size_t>(bench.frames, 100);
+  double worst[2] = {0, 0}, mean[2] = {0, 0}, worst_sp[2] = {0, 0};
+  const unsigned precisions[3] = {SOFTDECA_PRECISION_FLOAT, SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_INT8};
+  std::vector<std::vector<float>> ref_sd, ref_sp;
+  const std::vector<float>& vertices = bench.vertices;
+  for (int p = 0; p < 3; ++p) {
+    Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, precisions[p]);
+    check(softdeca_avatar_prepare(a.handle), "prepare");
+    if (!bench.user.empty())
+      check(softdeca_avatar_calibrate_landmarks(a.handle, bench.user.neutral.vertices.data(), bench.user.neutral.vertex_count()),
+            "calibration");
+    for (std::size_t f = 0; f < n; ++f) {
+      check(softdeca_avatar_evaluate_weights(a.handle, bench.take.weights[f].data(), 52, &bench.output), "softdeca");
+      std::vector<float> sd(vertices.begin(), vertices.begin() + 3 * model.info.skin_vertex_count);
+      check(softdeca_avatar_evaluate_landmarks(a.handle, bench.input.points[f].data(), bench.input.point_count, &bench.output),
+            "sparse");
+      std::vector<float> sp(vertices.begin(), vertices.begin() + 3 * model.info.skin_vertex_count);
+      if (p == 0) {
+        ref_sd.push_back(std::move(sd));
+        ref_sp.push_back(std::move(sp));
+        continue;
+      }
+      for (std::size_t v = 0; v < model.info.skin_vertex_count; ++v) {
+        double d2 = 0, e2 = 0;
+        for (int c = 0; c < 3; ++c) {
+          d2 += std::pow(sd[3 * v + c] - ref_sd[f][3 * v + c], 2);
+          e2 += std::pow(sp[3 * v + c] - ref_sp[f][3 * v + c], 2);
+        }
+        worst[p - 1] = std::max(worst[p - 1], std::sqrt(d2) * 1e3);
+        mean[p - 1] += std::sqrt(d2) * 1e3 / static_cast<double>(n * model.info.skin_vertex_count);
+        worst_sp[p - 1] = std::max(worst_sp[p - 1], std::sqrt(e2) * 1e3);
+      }
+    }
+  }
+  const char* names[2] = {"half", "int8"};
+  for (int p = 0; p < 2; ++p) {
+    const std::string what = std::string(" storage of the hyper-tensors against float, over ") + std::to_string(n) +
+                             " frames of the take, all skin vertices (untrained networks: the size of their corrections sets this)";
+    bench.figures.raw(std::string("runtime.") + names[p] + "_added_error_max_mm",
+                      figure(worst[p], "mm", std::string("SoftDECA: max |x - x_float|, ") + names[p] + what));
+    bench.figures.raw(std::string("runtime.") + names[p] + "_added_error_mean_mm",
+                      figure(mean[p], "mm", std::string("SoftDECA: mean |x - x_float|, ") + names[p] + what));
+    bench.figures.raw(std::string("runtime.") + names[p] + "_added_error_sparse_max_mm",
+                      figure(worst_sp[p], "mm", std::string("SparseSoftDECA: max |x - x_float|, ") + names[p] + what));
+    std::fprintf(stderr, "%s storage: SoftDECA max %.5f mm, mean %.6f mm; sparse max %.5f mm\n", names[p], worst[p], mean[p],
+                 worst_sp[p]);
+  }
+}
 }  // namespace
 
 int run_bench_runtime(const Args& args) {
@@ -98,206 +313,29 @@ int run_bench_runtime(const Args& args) {
   if (!o.parse(args)) return 0;
   for (const char* req : {"--bundle", "--avatar", "--take"})
     if (!o.given(req)) throw UsageError(std::string(req) + " is required");
-  const std::size_t n_frames = static_cast<std::size_t>(o.integer("--frames"));
-  const std::size_t warmup = static_cast<std::size_t>(o.integer("--warmup"));
-  const Take take = read_take(o.text("--take"), n_frames);
+  const Take take = read_take(o.text("--take"), static_cast<std::size_t>(o.integer("--frames")));
   const std::size_t frames = take.weights.size();
   const FaceRig rig = read_rig(o.text("--avatar"));
   const FaceRig user = read_rig(o.text("--avatar") + "/user_face", true);
   Model model(o.text("--bundle"));
   const uint32_t vh = model.info.head_vertex_count;
-  const std::string how = o.text("--how") + " on " + cpu_name() + " (" + std::to_string(std::thread::hardware_concurrency()) +
-                          " cores); " + std::to_string(frames) + " frames of " + take.path + ", median; " +
-                          std::to_string(model.info.skin_triangle_count) + " skin triangles, " + std::to_string(vh) +
-                          " head vertices" + (model.info.untrained ? ", untrained (random) networks of full size" : "");
+  Bench bench{take, rig, user, model, frames, static_cast<std::size_t>(o.integer("--warmup")), o.integer("--prepares"),
+              o.text("--how") + " on " + cpu_name() + " (" + std::to_string(std::thread::hardware_concurrency()) + " cores); " +
+                  std::to_string(frames) + " frames of " + take.path + ", median; " +
+                  std::to_string(model.info.skin_triangle_count) + " skin triangles, " + std::to_string(vh) + " head vertices" +
+                  (model.info.untrained ? ", untrained (random) networks of full size" : ""),
+              sparse_inputs(take, frames, rig, user, model), std::vector<float>(vh * 3), std::vector<float>(vh * 3), {}, {}};
+  bench.output = {sizeof(softdeca_output), bench.vertices.data(), vh, bench.normals.data(), vh};
 
-  // What SparseSoftDECA reads each frame: the user rig's face mesh, or the avatar's own landmarks.
-  Frames input{take, {}, 0};
-  {
-    Avatar a(model, rig.neutral, rig.deltas, 1, SOFTDECA_PRECISION_HALF);
-    std::vector<float> head(vh * 3);
-    softdeca_output out{sizeof(softdeca_output), head.data(), vh, nullptr, 0};
-    for (std::size_t f = 0; f < frames; ++f) {
-      if (!user.empty()) {
-        std::vector<float> p(user.neutral.vertices.size());
-        user.blend(take.weights[f].data(), p.data());
-        input.points.push_back(std::move(p));
-        input.point_count = user.neutral.vertex_count();
-      } else {
-        check(softdeca_avatar_evaluate_linear(a.handle, take.weights[f].data(), 52, &out), "linear");
-        std::vector<float> p(3 * model.info.landmark_count);
-        check(softdeca_model_evaluate_landmarks(model.handle, head.data(), vh, p.data(), model.info.landmark_count), "landmarks");
-        input.points.push_back(std::move(p));
-        input.point_count = model.info.landmark_count;
-      }
-    }
-  }
+  for (const unsigned threads : {1u, 2u}) measure_with_threads(bench, threads);
+  for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) measure_storage(bench, precision);
+  measure_storage_error(bench);
 
-  JsonObject figures;
-  std::vector<float> vertices(vh * 3), normals(vh * 3);
-  softdeca_output output{sizeof(softdeca_output), vertices.data(), vh, normals.data(), vh};
-  for (const unsigned threads : {1u, 2u}) {
-    const std::string suffix = threads == 1 ? "" : "_2threads";
-    const std::string tag = threads == 1 ? " (1 thread)" : " (2 threads)";
-    Avatar a(model, rig.neutral, rig.deltas, threads, SOFTDECA_PRECISION_HALF);
-    check(softdeca_avatar_prepare(a.handle), "prepare");
-    const softdeca_stats first = a.stats();
-    std::vector<double> prep;
-    for (long i = 0; i < o.integer("--prepares"); ++i) {
-      check(softdeca_avatar_prepare(a.handle), "prepare");
-      prep.push_back(a.stats().prepare_ms);
-    }
-    if (!user.empty())
-      check(softdeca_avatar_calibrate_landmarks(a.handle, user.neutral.vertices.data(), user.neutral.vertex_count()), "calibration");
-    const auto w = [&](std::size_t f) { return take.weights[f].data(); };
-    const double load_before = load_average();
-    const Times lin = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_linear(a.handle, w(f), 52, &output), "linear");
-    });
-    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_FALSE), "dynamics");
-    const Times st = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
-    });
-    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_TRUE), "dynamics");
-    const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &output), "softdeca");
-    });
-    const Times sp = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
-    });
-    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_FALSE), "dynamics");
-    const Times sp_static = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
-    });
-    const double load = std::max(load_before, load_average());
-    char load_text[96];
-    std::snprintf(load_text, sizeof load_text, "; machine load average %.1f during the run", load);
-    const std::string when = tag + "; " + how + load_text;
-    figures.raw("runtime.softdeca_static_ms" + suffix, figure(st.wall, "ms", "evaluate_weights, dynamics off, with normals, wall-clock" + when, 2.0));
-    figures.raw("runtime.softdeca_dynamic_ms" + suffix, figure(dy.wall, "ms", "evaluate_weights, dynamics on, with normals, wall-clock" + when, 2.0));
-    figures.raw("runtime.sparse_ms" + suffix, figure(sp.wall, "ms", "evaluate_landmarks, dynamics on, with normals, wall-clock" + when, 0.5));
-    figures.raw("runtime.sparse_static_ms" + suffix, figure(sp_static.wall, "ms", "evaluate_landmarks, dynamics off, wall-clock" + when, 0.5));
-    figures.raw("runtime.linear_blendshapes_ms" + suffix,
-                figure(lin.wall, "ms", "evaluate_linear: 52 sparse blendshapes over the whole head, with normals, wall-clock" + when));
-    figures.raw("runtime.softdeca_over_linear" + suffix,
-                figure(st.wall / lin.wall, "x", "softdeca_static_ms / linear_blendshapes_ms, same avatar, same run" + tag, 3.0));
-    if (threads == 1) {  // CPU time of the frame thread: the cost without other processes
-      figures.raw("runtime.softdeca_static_cpu_ms", figure(st.cpu, "ms", "as softdeca_static_ms, thread CPU time" + when, 2.0));
-      figures.raw("runtime.softdeca_dynamic_cpu_ms", figure(dy.cpu, "ms", "as softdeca_dynamic_ms, thread CPU time" + when, 2.0));
-      figures.raw("runtime.sparse_cpu_ms", figure(sp.cpu, "ms", "as sparse_ms, thread CPU time" + when, 0.5));
-      figures.raw("runtime.linear_blendshapes_cpu_ms", figure(lin.cpu, "ms", "as linear_blendshapes_ms, thread CPU time" + when));
-      figures.raw("runtime.softdeca_over_linear_cpu",
-                  figure(st.cpu / lin.cpu, "x", "softdeca_static_cpu_ms / linear_blendshapes_cpu_ms" + tag, 3.0));
-    }
-    std::fprintf(stderr,
-                 "%u thread(s), load %.1f: wall linear %.3f  softdeca %.3f / dynamic %.3f  sparse %.3f / static %.3f ms (x%.2f); "
-                 "cpu linear %.3f softdeca %.3f / %.3f sparse %.3f ms\n",
-                 threads, load, lin.wall, st.wall, dy.wall, sp.wall, sp_static.wall, st.wall / lin.wall, lin.cpu, st.cpu, dy.cpu,
-                 sp.cpu);
-    if (threads == 1) {
-      figures.raw("runtime.prepare_ms", figure(median(prep), "ms", "prepare after a parameter change: f_ph, f_ph_v, both f_dyn, "
-                                                                   "compact hyper-tensors; median of " +
-                                                                       std::to_string(prep.size()) + "; " + how));
-      figures.raw("runtime.first_prepare_ms",
-                  figure(first.prepare_ms, "ms", "the first prepare, including the DT assembly and factorisation (" +
-                                                     std::to_string(first.factorisation_ms) + " ms); " + how));
-      figures.raw("runtime.memory_per_avatar_mb",
-                  figure(static_cast<double>(a.stats().memory_bytes) / 1e6, "MB",
-                         "softdeca_stats.memory_bytes after prepare (both models' hyper-tensors in half precision, DT "
-                         "factor, blendshapes, buffers); " + how));
-      figures.raw("runtime.softdeca_static_us_per_face",
-                  figure(st.wall * 1000.0 / model.info.skin_triangle_count, "us/face",
-                         "softdeca_static_ms per skin triangle; paper: " + std::to_string(kPaperStaticMs * 1000 / kPaperFaces) +
-                             " us/face static, " + std::to_string(kPaperDynamicMs * 1000 / kPaperFaces) +
-                             " dynamic (7.45 / 9.87 ms for 71,358 faces, i5-12600K, PyTorch)"));
-    }
-  }
-
-  // The other storages' speed, single thread (same frames, same run).
-  for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) {
-    const char* name = precision == SOFTDECA_PRECISION_INT8 ? "int8" : "float";
-    Avatar a(model, rig.neutral, rig.deltas, 1, precision);
-    check(softdeca_avatar_prepare(a.handle), "prepare");
-    const Times lin = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_linear(a.handle, take.weights[f].data(), 52, &output), "linear");
-    });
-    const Times st = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
-    });
-    check(softdeca_avatar_set_dynamics(a.handle, SOFTDECA_TRUE), "dynamics");
-    const Times dy = median_ms(frames, warmup, [&](std::size_t f) {
-      check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
-    });
-    char load_text[64];
-    std::snprintf(load_text, sizeof load_text, "; machine load average %.1f", load_average());
-    figures.raw(std::string("runtime.softdeca_static_ms_") + name,
-                figure(st.wall, "ms", std::string("as softdeca_static_ms with ") + name + " hyper-tensors (1 thread); " + how + load_text));
-    figures.raw(std::string("runtime.softdeca_static_cpu_ms_") + name,
-                figure(st.cpu, "ms", std::string("as softdeca_static_cpu_ms with ") + name + " hyper-tensors; " + how + load_text));
-    figures.raw(std::string("runtime.softdeca_dynamic_ms_") + name,
-                figure(dy.wall, "ms", std::string("as softdeca_dynamic_ms with ") + name + " hyper-tensors (1 thread); " + how + load_text));
-    figures.raw(std::string("runtime.softdeca_over_linear_") + name,
-                figure(st.wall / lin.wall, "x", std::string("softdeca_static_ms_") + name + " / linear_blendshapes_ms measured just before on "
-                                                "the same avatar (1 thread); " + how + load_text, 3.0));
-    figures.raw(std::string("runtime.softdeca_over_linear_cpu_") + name,
-                figure(st.cpu / lin.cpu, "x", std::string("the same in thread CPU time; ") + how + load_text, 3.0));
-    std::fprintf(stderr, "%s storage: wall linear %.3f softdeca %.3f / dynamic %.3f ms (x%.2f); cpu linear %.3f softdeca %.3f ms (x%.2f)\n",
-                 name, lin.wall, st.wall, dy.wall, st.wall / lin.wall, lin.cpu, st.cpu, st.cpu / lin.cpu);
-  }
-
-  // Error of the compact storage: the same frames with float, half and int8 hyper-tensors.
-  {
-    const std::size_t n = std::min<std::size_t>(frames, 100);
-    std::vector<std::vector<float>> reference;
-    double worst[2] = {0, 0}, mean[2] = {0, 0}, worst_sp[2] = {0, 0};
-    const unsigned precisions[3] = {SOFTDECA_PRECISION_FLOAT, SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_INT8};
-    std::vector<std::vector<float>> ref_sd, ref_sp;
-    for (int p = 0; p < 3; ++p) {
-      Avatar a(model, rig.neutral, rig.deltas, 1, precisions[p]);
-      check(softdeca_avatar_prepare(a.handle), "prepare");
-      if (!user.empty())
-        check(softdeca_avatar_calibrate_landmarks(a.handle, user.neutral.vertices.data(), user.neutral.vertex_count()),
-              "calibration");
-      for (std::size_t f = 0; f < n; ++f) {
-        check(softdeca_avatar_evaluate_weights(a.handle, take.weights[f].data(), 52, &output), "softdeca");
-        std::vector<float> sd(vertices.begin(), vertices.begin() + 3 * model.info.skin_vertex_count);
-        check(softdeca_avatar_evaluate_landmarks(a.handle, input.points[f].data(), input.point_count, &output), "sparse");
-        std::vector<float> sp(vertices.begin(), vertices.begin() + 3 * model.info.skin_vertex_count);
-        if (p == 0) {
-          ref_sd.push_back(std::move(sd));
-          ref_sp.push_back(std::move(sp));
-          continue;
-        }
-        for (std::size_t v = 0; v < model.info.skin_vertex_count; ++v) {
-          double d2 = 0, e2 = 0;
-          for (int c = 0; c < 3; ++c) {
-            d2 += std::pow(sd[3 * v + c] - ref_sd[f][3 * v + c], 2);
-            e2 += std::pow(sp[3 * v + c] - ref_sp[f][3 * v + c], 2);
-          }
-          worst[p - 1] = std::max(worst[p - 1], std::sqrt(d2) * 1e3);
-          mean[p - 1] += std::sqrt(d2) * 1e3 / static_cast<double>(n * model.info.skin_vertex_count);
-          worst_sp[p - 1] = std::max(worst_sp[p - 1], std::sqrt(e2) * 1e3);
-        }
-      }
-    }
-    const char* names[2] = {"half", "int8"};
-    for (int p = 0; p < 2; ++p) {
-      const std::string what = std::string(" storage of the hyper-tensors against float, over ") + std::to_string(n) +
-                               " frames of the take, all skin vertices (untrained networks: the size of their corrections sets this)";
-      figures.raw(std::string("runtime.") + names[p] + "_added_error_max_mm", figure(worst[p], "mm", std::string("SoftDECA: max |x - x_float|, ") + names[p] + what));
-      figures.raw(std::string("runtime.") + names[p] + "_added_error_mean_mm", figure(mean[p], "mm", std::string("SoftDECA: mean |x - x_float|, ") + names[p] + what));
-      figures.raw(std::string("runtime.") + names[p] + "_added_error_sparse_max_mm",
-                  figure(worst_sp[p], "mm", std::string("SparseSoftDECA: max |x - x_float|, ") + names[p] + what));
-      std::fprintf(stderr, "%s storage: SoftDECA max %.5f mm, mean %.6f mm; sparse max %.5f mm\n", names[p], worst[p], mean[p],
-                   worst_sp[p]);
-    }
-  }
   const std::string path = o.text("--out");
   const std::size_t slash = path.rfind('/');
   if (slash != std::string::npos) make_directories(path.substr(0, slash));
-  write_text_file(path, figures.str(true) + "\n");
+  write_text_file(path, bench.figures.str(true) + "\n");
   std::printf("wrote %s\n", path.c_str());
   return 0;
 }
-
 }  // namespace softdeca::cli

@@ -13,6 +13,7 @@
 
 #include <sys/resource.h>
 
+#include "bench_figures.h"
 #include "command.h"
 #include "json.h"
 #include "options.h"
@@ -29,14 +30,6 @@ using stream::percentile;
 using stream::steady_seconds;
 
 constexpr std::size_t kLandmarks = 149;  // SparseSoftDECA's landmark profile (softdeca149)
-
-// The 1-minute load average (Linux), to tell the reader how busy the machine was.
-double load_average() {
-  std::ifstream in("/proc/loadavg");
-  double load = -1;
-  in >> load;
-  return load;
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -183,12 +176,6 @@ RecordingRates recording_run(const std::string& path, std::size_t frames) {
   return {double(frames) / write_s, double(frames) / read_s, bytes / double(frames)};
 }
 
-std::string figure(double value, const char* unit, const std::string& target, const char* better,
-                   const std::string& how) {
-  return JsonObject().number("value", value).text("unit", unit).raw("target", target).text("better", better)
-      .text("how", how).str();
-}
-
 }  // namespace
 
 int run_bench_streaming(const Args& args) {
@@ -205,8 +192,7 @@ int run_bench_streaming(const Args& args) {
       .option("--recording-frames", "N", "frames per recording run", "20000")
       .option("--scratch", "DIR", "where the recording runs write their file", "build/bench");
   if (!o.parse(args)) return 0;
-  for (const std::string& dir : {std::filesystem::path(o.text("--out")).parent_path().string(), o.text("--scratch")})
-    if (!dir.empty()) std::filesystem::create_directories(dir);
+  create_output_folders(o.text("--out"), o.text("--scratch"));
   const long runs = o.integer("--runs"), tp = o.integer("--throughput-frames"), lat = o.integer("--latency-frames"),
              recf = o.integer("--recording-frames");
   const double lat_rate = o.number("--latency-rate");

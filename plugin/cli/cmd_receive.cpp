@@ -45,6 +45,9 @@ std::string stats_json(const stream::ReceiverStats& s, std::size_t recorded) {
   u("session_changes", s.session_changes);
   u("clock_resyncs", s.clock_resyncs);
   u("requests_sent", s.requests_sent);
+  u("foreign", s.foreign);
+  u("rate_limited", s.rate_limited);
+  u("recording_dropped", s.recording_dropped);
   u("recorded", recorded);
   o.number("frame_rate_hz", s.frame_rate_hz);
   o.number("loss_ratio", s.loss_ratio);
@@ -72,7 +75,11 @@ int run_receive(const Args& args) {
             "Frames are ordered in a jitter buffer; with --out every delivered frame is recorded.\n"
             "Stops on Ctrl-C or on --frames / --duration / --idle.");
   o.option("--format", "NAME", "auto, softdeca, livelinkface or ifacialmocap", "auto")
-      .option("--bind", "ADDRESS", "numeric IPv4 or IPv6 address to listen on", "0.0.0.0")
+      .option("--bind", "ADDRESS", "numeric IPv4 or IPv6 address to listen on (default 127.0.0.1; 0.0.0.0 with --listen)")
+      .flag("--listen", "accept datagrams from the network, not only this machine (docs/security.md)")
+      .option("--hold", "SECONDS", "a sender holds the session until quiet this long; others are dropped", "2")
+      .flag("--follow-newest", "a new sender takes the session at once (trusted networks only)")
+      .option("--rate-limit", "HZ", "datagrams per second accepted from each sender (0: no limit)", "1000")
       .option("--port", "PORT", "UDP port; 0: any free port (default: the format's, ours 50110)")
       .option("--delay", "SECONDS", "jitter buffer delay", "0.05")
       .option("--out", "FILE", "record delivered frames into FILE (.sdrec)")
@@ -86,7 +93,11 @@ int run_receive(const Args& args) {
 
   stream::ReceiverConfig config;
   config.format = parse_format(o.text("--format"), true);
-  config.bind_address = o.text("--bind");
+  config.listen_network = o.on("--listen");
+  config.bind_address = o.given("--bind") ? o.text("--bind") : config.listen_network ? "0.0.0.0" : "127.0.0.1";
+  config.session_hold = o.number("--hold");
+  config.follow_newest = o.on("--follow-newest");
+  config.source_rate_limit = o.number("--rate-limit");
   const long port = o.given("--port") ? o.integer("--port") : stream::default_port(config.format);
   if (port < 0 || port > 65535) throw UsageError("--port must be in [0, 65535]");
   config.port = static_cast<uint16_t>(port);

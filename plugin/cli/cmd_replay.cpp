@@ -144,6 +144,111 @@ unsigned precision_of(const std::string& p) {
   if (p == "int8") return SOFTDECA_PRECISION_INT8;
   throw UsageError("--precision must be half, float or int8");
 }
+
+// The take's frames from --start, at most --frames of them.
+Take read_replay_take(const std::string& path, long start, long max_frames) {
+  if (start < 0 || max_frames < 0) throw UsageError("--start and --frames must not be negative");
+  Take take = read_take(path, max_frames ? static_cast<std::size_t>(start + max_frames) : 0);
+  if (static_cast<std::size_t>(start) >= take.weights.size())
+    throw UsageError("--start " + std::to_string(start) + " is past the take's " + std::to_string(take.weights.size()) + " frames");
+  take.weights.erase(take.weights.begin(), take.weights.begin() + start);
+  std::fprintf(stderr, "take %s: %zu rows, %zu face-lost rows skipped, %zu unreadable; frames %ld to %zu\n", take.path.c_str(),
+               take.rows, take.face_lost, take.invalid, start, static_cast<std::size_t>(start) + take.weights.size() - 1);
+  return take;
+}
+
+// --models in order, and the localised SoftDECA pass last when --localised is given.
+std::vector<std::string> models_to_run(const std::string& list, bool localised) {
+  std::vector<std::string> models;
+  std::stringstream ss(list);
+  std::string m;
+  while (std::getline(ss, m, ','))
+    if (!m.empty()) models.push_back(m);
+  if (localised) models.push_back("softdeca_localised");
+  for (const std::string& name : models)
+    if (name != "linear" && name != "softdeca" && name != "sparse" && name != "softdeca_localised")
+      throw UsageError("unknown model '" + name + "' in --models");
+  return models;
+}
+
+// One avatar replaying the take, and the buffers its frames are written through.
+struct Replay {
+  Model& model;
+  Avatar& avatar;
+  const FaceRig& rig;
+  const FaceRig& user;
+  const Take& take;
+  std::string out;
+  long obj_every = 0;
+  std::vector<float> vertices, normals, user_face, linear, landmarks;
+  softdeca_output output{}, linear_out{};
+
+  Replay(Model& m, Avatar& a, const FaceRig& r, const FaceRig& u, const Take& t, std::string dir, long every)
+      : model(m), avatar(a), rig(r), user(u), take(t), out(std::move(dir)), obj_every(every) {
+    const uint32_t vh = model.info.head_vertex_count;
+    vertices.resize(vh * 3);
+    normals.resize(vh * 3);
+    user_face.resize(user.neutral.vertices.size());
+    linear.resize(vh * 3);
+    landmarks.resize(3 * model.info.landmark_count);
+    output = {sizeof(softdeca_output), vertices.data(), vh, normals.data(), vh};
+    linear_out = {sizeof(softdeca_output), linear.data(), vh, nullptr, 0};
+  }
+
+  // The tracked face SparseSoftDECA reads for weights w: a user rig blended with the take, or
+  // the avatar's own landmarks; returns the point count.
+  std::size_t tracked_points(const float* w, const float** points) {
+    if (!user.empty()) {
+      user.blend(w, user_face.data());
+      *points = user_face.data();
+      return user.neutral.vertex_count();
+    }
+    const uint32_t vh = model.info.head_vertex_count;
+    check(softdeca_avatar_evaluate_linear(avatar.handle, w, 52, &linear_out), "linear blend");
+    check(softdeca_model_evaluate_landmarks(model.handle, linear.data(), vh, landmarks.data(), model.info.landmark_count),
+          "landmarks");
+    *points = landmarks.data();
+    return model.info.landmark_count;
+  }
+
+  void write_frame_obj(const std::string& name, std::size_t f) {
+    make_directories(out + "/obj");
+    char file[64];
+    std::snprintf(file, sizeof file, "/obj/%s_%05zu.obj", name.c_str(), f);
+    write_obj(out + file, vertices.data(), model.info.head_vertex_count, normals.data(), rig.neutral.triangles.data(),
+              rig.neutral.triangles.size() / 3, name + " frame " + std::to_string(f));
+  }
+
+  // Every frame of the take through model `name` into <out>/<name>.pc2; returns the timings.
+  Timing run(const std::string& name) {
+    const bool sparse = name == "sparse";
+    if (sparse && !model.info.has_sparse) throw std::runtime_error("the bundle has no SparseSoftDECA model");
+    if (!sparse && name != "linear" && !model.info.has_softdeca) throw std::runtime_error("the bundle has no SoftDECA model");
+    if (sparse && !user.empty())
+      check(softdeca_avatar_calibrate_landmarks(avatar.handle, user.neutral.vertices.data(), user.neutral.vertex_count()),
+            "calibration");
+    check(softdeca_avatar_reset_dynamics(avatar.handle), "reset dynamics");
+    Pc2Writer cache(out + "/" + name + ".pc2", model.info.head_vertex_count);
+    Timing timing;
+    std::fprintf(stderr, "%-18s", name.c_str());
+    for (std::size_t f = 0; f < take.weights.size(); ++f) {
+      const float* w = take.weights[f].data();
+      const float* points = nullptr;
+      const std::size_t point_count = sparse ? tracked_points(w, &points) : 0;
+      const auto t0 = Clock::now();
+      if (name == "linear") check(softdeca_avatar_evaluate_linear(avatar.handle, w, 52, &output), "frame " + std::to_string(f));
+      else if (sparse) check(softdeca_avatar_evaluate_landmarks(avatar.handle, points, point_count, &output), "frame " + std::to_string(f));
+      else check(softdeca_avatar_evaluate_weights(avatar.handle, w, 52, &output), "frame " + std::to_string(f));
+      timing.add(std::chrono::duration<double, std::milli>(Clock::now() - t0).count(), avatar.stats());
+      cache.add(vertices.data());
+      if (obj_every > 0 && f % static_cast<std::size_t>(obj_every) == 0) write_frame_obj(name, f);
+      if (f % 200 == 0) std::fprintf(stderr, ".");
+    }
+    cache.close();
+    std::fprintf(stderr, " %zu frames, median %.3f ms/frame\n", timing.call_ms.size(), median(timing.call_ms));
+    return timing;
+  }
+};
 }  // namespace
 
 int run_replay(const Args& args) {
@@ -173,16 +278,9 @@ int run_replay(const Args& args) {
   make_directories(out);
   const unsigned threads = static_cast<unsigned>(o.integer("--threads"));
   const unsigned precision = precision_of(o.text("--precision"));
-  const long obj_every = o.integer("--obj-every");
-
-  const long start = o.integer("--start"), max_frames = o.integer("--frames");
-  if (start < 0 || max_frames < 0) throw UsageError("--start and --frames must not be negative");
-  Take take = read_take(o.arg(0), max_frames ? static_cast<std::size_t>(start + max_frames) : 0);
-  if (static_cast<std::size_t>(start) >= take.weights.size())
-    throw UsageError("--start " + std::to_string(start) + " is past the take's " + std::to_string(take.weights.size()) + " frames");
-  take.weights.erase(take.weights.begin(), take.weights.begin() + start);
-  std::fprintf(stderr, "take %s: %zu rows, %zu face-lost rows skipped, %zu unreadable; frames %ld to %zu\n", take.path.c_str(),
-               take.rows, take.face_lost, take.invalid, start, static_cast<std::size_t>(start) + take.weights.size() - 1);
+  const long start = o.integer("--start");
+  const Take take = read_replay_take(o.arg(0), start, o.integer("--frames"));
+  const std::vector<std::string> models = models_to_run(o.text("--models"), o.given("--localised"));
   const std::string avatar_dir = o.text("--avatar");
   const FaceRig rig = read_rig(avatar_dir);
   const FaceRig user = read_rig(avatar_dir + "/user_face", true);
@@ -198,75 +296,17 @@ int run_replay(const Args& args) {
   check(softdeca_avatar_prepare(avatar.handle), "prepare");
   const double prepare_ms = avatar.stats().prepare_ms;
 
-  std::vector<std::string> models;
-  {
-    std::stringstream ss(o.text("--models"));
-    std::string m;
-    while (std::getline(ss, m, ','))
-      if (!m.empty()) models.push_back(m);
-    if (o.given("--localised")) models.push_back("softdeca_localised");
-  }
-  std::vector<float> vertices(vh * 3), normals(vh * 3), user_face(user.neutral.vertices.size()), linear(vh * 3),
-      landmarks(3 * model.info.landmark_count);
-  softdeca_output output{sizeof(softdeca_output), vertices.data(), vh, normals.data(), vh};
-  softdeca_output linear_out{sizeof(softdeca_output), linear.data(), vh, nullptr, 0};
-  JsonObject timings, files;
-  std::size_t localised_faces = 0;
   write_obj(out + "/neutral.obj", rig.neutral.vertices.data(), vh, nullptr, rig.neutral.triangles.data(),
             rig.neutral.triangles.size() / 3, "SoftDECA replay: the avatar's neutral (PC2 caches animate it)");
+  Replay replay(model, avatar, rig, user, take, out, o.integer("--obj-every"));
+  JsonObject timings, files;
+  std::size_t localised_faces = 0;
   for (const std::string& name : models) {
     if (name == "softdeca_localised") {
-      const auto changes = parse_changes(o.text("--localised"));
-      localised_faces = apply(model, avatar, rig.neutral, changes);
+      localised_faces = apply(model, avatar, rig.neutral, parse_changes(o.text("--localised")));
       check(softdeca_avatar_prepare(avatar.handle), "prepare (localised)");
-    } else if (name != "linear" && name != "softdeca" && name != "sparse") {
-      throw UsageError("unknown model '" + name + "' in --models");
     }
-    const bool sparse = name == "sparse";
-    if (sparse && !model.info.has_sparse) throw std::runtime_error("the bundle has no SparseSoftDECA model");
-    if (!sparse && name != "linear" && !model.info.has_softdeca) throw std::runtime_error("the bundle has no SoftDECA model");
-    if (sparse && !user.empty()) check(softdeca_avatar_calibrate_landmarks(avatar.handle, user.neutral.vertices.data(),
-                                                                          user.neutral.vertex_count()),
-                                       "calibration");
-    check(softdeca_avatar_reset_dynamics(avatar.handle), "reset dynamics");
-    Pc2Writer cache(out + "/" + name + ".pc2", vh);
-    Timing timing;
-    std::fprintf(stderr, "%-18s", name.c_str());
-    for (std::size_t f = 0; f < take.weights.size(); ++f) {
-      const float* w = take.weights[f].data();
-      const float* points = nullptr;
-      std::size_t point_count = 0;
-      if (sparse) {  // the tracked face: a user rig blended with the take, or the avatar's own landmarks
-        if (!user.empty()) {
-          user.blend(w, user_face.data());
-          points = user_face.data();
-          point_count = user.neutral.vertex_count();
-        } else {
-          check(softdeca_avatar_evaluate_linear(avatar.handle, w, 52, &linear_out), "linear blend");
-          check(softdeca_model_evaluate_landmarks(model.handle, linear.data(), vh, landmarks.data(), model.info.landmark_count),
-                "landmarks");
-          points = landmarks.data();
-          point_count = model.info.landmark_count;
-        }
-      }
-      const auto t0 = Clock::now();
-      if (name == "linear") check(softdeca_avatar_evaluate_linear(avatar.handle, w, 52, &output), "frame " + std::to_string(f));
-      else if (sparse) check(softdeca_avatar_evaluate_landmarks(avatar.handle, points, point_count, &output), "frame " + std::to_string(f));
-      else check(softdeca_avatar_evaluate_weights(avatar.handle, w, 52, &output), "frame " + std::to_string(f));
-      timing.add(std::chrono::duration<double, std::milli>(Clock::now() - t0).count(), avatar.stats());
-      cache.add(vertices.data());
-      if (obj_every > 0 && f % static_cast<std::size_t>(obj_every) == 0) {
-        make_directories(out + "/obj");
-        char file[64];
-        std::snprintf(file, sizeof file, "/obj/%s_%05zu.obj", name.c_str(), f);
-        write_obj(out + file, vertices.data(), vh, normals.data(), rig.neutral.triangles.data(), rig.neutral.triangles.size() / 3,
-                  name + " frame " + std::to_string(f));
-      }
-      if (f % 200 == 0) std::fprintf(stderr, ".");
-    }
-    cache.close();
-    std::fprintf(stderr, " %zu frames, median %.3f ms/frame\n", timing.call_ms.size(), median(timing.call_ms));
-    timings.raw(name, timing.json());
+    timings.raw(name, replay.run(name).json());
     files.text(name, out + "/" + name + ".pc2");
   }
   JsonObject summary;
@@ -295,5 +335,4 @@ int run_replay(const Args& args) {
   std::printf("wrote %s/neutral.obj, %zu point caches (.pc2) and %s/replay.json\n", out.c_str(), models.size(), out.c_str());
   return 0;
 }
-
 }  // namespace softdeca::cli

@@ -8,6 +8,7 @@ int run_play(const Args&);
 int run_convert(const Args&);
 int run_info(const Args&);
 int run_bench_streaming(const Args&);
+int run_bench_reliability(const Args&);
 int run_replay(const Args&);
 int run_bench_runtime(const Args&);
 
@@ -20,6 +21,8 @@ const std::vector<Command>& commands() {
       {"info", "describe a recording: header, frames, duration, damage recovered", run_info},
       {"bench-streaming", "measure receiver throughput and latency and recording rates -> JSON",
        run_bench_streaming},
+      {"bench-reliability", "measure the receiver and recording reader under hostile input -> JSON",
+       run_bench_reliability},
       {"replay", "replay a take through linear blendshapes, SoftDECA and SparseSoftDECA onto an avatar", run_replay},
       {"bench-runtime", "measure the runtime per frame (both models, 1 and 2 threads) -> JSON", run_bench_runtime},
   };

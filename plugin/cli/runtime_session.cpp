@@ -16,7 +16,7 @@ void check(softdeca_status status, const std::string& what) {
 }
 
 Model::Model(const std::string& bundle, unsigned prepare_threads) {
-  softdeca_model_options opts{sizeof(softdeca_model_options), prepare_threads};
+  softdeca_model_options opts{sizeof(softdeca_model_options), prepare_threads, 0};
   check(softdeca_model_load(bundle.c_str(), &opts, &handle), "loading " + bundle);
   info.struct_size = sizeof info;
   check(softdeca_model_get_info(handle, &info), "model info");

@@ -41,6 +41,8 @@ nb::dict stats_dict(const SolveStats& s) {
   d["energy_history"] = s.energy_history;
   d["anderson_rejections"] = s.anderson_rejections;
   d["target_rms"] = s.target_rms;
+  d["max_target_distance"] = s.max_target_distance;
+  d["inverted_elements"] = s.inverted_elements;
   d["local_seconds"] = s.local_seconds;
   d["global_seconds"] = s.global_seconds;
   d["factor_seconds"] = s.factor_seconds;
@@ -50,6 +52,8 @@ nb::dict stats_dict(const SolveStats& s) {
   d["contacts"] = s.contacts;
   d["collision_rounds"] = s.collision_rounds;
   d["max_contact_gap"] = s.max_contact_gap;
+  d["max_contact_correction"] = s.max_contact_correction;
+  d["rejected_collision_rounds"] = s.rejected_collision_rounds;
   d["collision_seconds"] = s.collision_seconds;
   return d;
 }
@@ -258,7 +262,7 @@ void bind_sim(nb::module_& m) {
           "__init__",
           [](Simulator* s, const SimulationMesh& mesh, int max_iterations, double tolerance, int anderson_window,
              int threads, bool paper_strain_rule, int collision_rounds, double collision_weight,
-             double penetration_tolerance) {
+             double penetration_tolerance, bool lips_follow_targets) {
             SolverSettings st;
             st.max_iterations = max_iterations;
             st.tolerance = tolerance;
@@ -268,6 +272,7 @@ void bind_sim(nb::module_& m) {
             st.collision_rounds = collision_rounds;
             st.collision_weight = collision_weight;
             st.penetration_tolerance = penetration_tolerance;
+            st.lips_follow_targets = lips_follow_targets;
             new (s) Simulator(mesh, st);
           },
           nb::arg("mesh"), nb::arg("max_iterations") = SolverSettings{}.max_iterations,
@@ -275,7 +280,8 @@ void bind_sim(nb::module_& m) {
           nb::arg("threads") = 0, nb::arg("paper_strain_rule") = false,
           nb::arg("collision_rounds") = SolverSettings{}.collision_rounds,
           nb::arg("collision_weight") = SolverSettings{}.collision_weight,
-          nb::arg("penetration_tolerance") = SolverSettings{}.penetration_tolerance)
+          nb::arg("penetration_tolerance") = SolverSettings{}.penetration_tolerance,
+          nb::arg("lips_follow_targets") = SolverSettings{}.lips_follow_targets)
       .def("set_parameter", [](Simulator& s, const std::string& name, double v) { s.parameters().set(name, v); },
            nb::arg("name"), nb::arg("value"), "Sets a parameter everywhere (ValueError when out of range).")
       .def("get_parameter", [](const Simulator& s, const std::string& name) {

@@ -16,6 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const Recovery& r = rec.recovery;
     FUZZ_CHECK(rec.frames.size() <= r.records);
     FUZZ_CHECK(r.skipped_bytes + r.truncated_bytes <= size);
+    FUZZ_CHECK(r.checksum_bytes <= size);  // linear: no byte checksummed twice
     if (!rec.frames.empty()) {
       Player p(std::move(rec));
       p.set_loop(true);

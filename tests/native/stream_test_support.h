@@ -5,20 +5,32 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "stream/frame.h"
 #include "stream/rotation.h"
 
 namespace softdeca::test {
+
+// Polls `done` for up to 10 s (generous for a loaded machine); true once it holds.
+inline bool eventually(const std::function<bool()>& done) {
+  for (int i = 0; i < 2000; ++i) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return done();
+}
 
 inline std::string golden_dir() { return std::string(SOFTDECA_REPO_ROOT) + "/tests/golden/streaming/"; }
 // The data folder `make setup` fills; $SOFTDECA_DATA overrides the configured one.

@@ -23,6 +23,7 @@
 
 using namespace softdeca;
 using namespace softdeca::stream;
+using test::eventually;
 using test::make_frame;
 
 namespace {
@@ -35,15 +36,6 @@ ReceiverConfig loopback(Format format = Format::softdeca, double delay = 0.3) {
   c.delay = delay;
   c.queue_capacity = 4096;
   return c;
-}
-
-// Polls `done` for up to 10 s (generous for a loaded machine); true once it holds.
-bool eventually(const std::function<bool()>& done) {
-  for (int i = 0; i < 2000; ++i) {
-    if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return done();
 }
 
 std::vector<Frame> take_all(Receiver& r) {
@@ -170,7 +162,9 @@ TEST(Receiver, HostileDatagramsAreDroppedAndCountedAndTheStreamGoesOn) {
 }
 
 TEST(Receiver, AutomaticFormatTakesLiveLinkFaceAndIFacialMocapToo) {
-  Receiver r(loopback(Format::automatic, 0.0));
+  ReceiverConfig c = loopback(Format::automatic, 0.0);
+  c.follow_newest = true;  // two senders, one after the other (docs/security.md)
+  Receiver r(c);
   const Endpoint to = make_endpoint("127.0.0.1", r.port());
   FrameSender llf(to, Format::livelinkface, 0);
   Frame f = make_frame(4);

@@ -103,7 +103,7 @@ TEST_F(Runtime, LoadingRejectsBadPathsAndArguments) {
   EXPECT_EQ(m, nullptr);
   EXPECT_EQ(softdeca_model_load(nullptr, nullptr, &m), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(softdeca_model_load((data_dir() + "/bundle").c_str(), nullptr, nullptr), SOFTDECA_ERROR_INVALID_ARGUMENT);
-  softdeca_model_options opts{sizeof(softdeca_model_options) - 1, 1};
+  softdeca_model_options opts{sizeof(softdeca_model_options) - 1, 1, 0};
   EXPECT_EQ(softdeca_model_load((data_dir() + "/bundle").c_str(), &opts, &m), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(softdeca_model_load_memory(nullptr, 10, nullptr, &m), SOFTDECA_ERROR_INVALID_ARGUMENT);
   const char junk[3] = {1, 2, 3};

@@ -72,6 +72,26 @@ def test_small_dataset_is_complete_and_self_describing(small) -> None:
     assert meta["kind"] == m["shards"][0]["kind"] and "offsets" in meta["arrays"]
 
 
+def test_every_frame_is_judged_by_the_sanity_bounds(small) -> None:
+    """Failures are stored per frame (bit mask) and counted per reason: nothing is hidden."""
+    from softdeca_train.sim.sanity import REASONS
+
+    out, summary = small
+    frames = 0
+    masks = []
+    for kind in KINDS:
+        a = _all(out, kind)
+        frames += a["failures"].size
+        masks.append(a["failures"].ravel())
+    mask = np.concatenate(masks)
+    assert summary["frames_judged"] == frames > 0
+    assert set(summary["failures"]) == {*REASONS, "failed_frames"}
+    assert summary["failures"]["failed_frames"] == int((mask > 0).sum())
+    for i, reason in enumerate(REASONS):
+        assert summary["failures"][reason] == int((mask & (1 << i) > 0).sum()), reason
+    assert summary["failed_fraction"] == round(int((mask > 0).sum()) / frames, 6)
+
+
 def test_quantisation_error_is_measured_and_small(small) -> None:
     _, summary = small
     # float16 keeps 11 significant bits: half a unit in the last place of the largest offset.

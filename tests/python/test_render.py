@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -100,3 +103,27 @@ def test_bad_input_gives_clear_errors():
         R.render([R.PointLayer(np.zeros((0, 3)))], settings=SMALL)
     with pytest.raises(ValueError, match="opacity"):
         R.render([R.MeshLayer(OCTA_V, OCTA_F, opacity=2.0)], settings=SMALL)
+
+
+def test_rendering_then_a_torch_optimizer_in_one_process(tmp_path) -> None:
+    """Rendering (Mesa's llvmpipe brings the system's libLLVM) and then making a torch
+    optimizer (torch imports triton, which carries its own LLVM) in one process: this used to
+    die with SIGSEGV while loading triton. In a subprocess, so a regression fails this test
+    instead of killing the test session."""
+    script = (
+        "import numpy as np, torch\n"
+        "from softdeca_train import render\n"
+        "layer = render.MeshLayer(np.eye(3), np.array([[0, 1, 2]]))\n"
+        "render.render([layer])\n"
+        "torch.optim.Adam([torch.zeros(1, requires_grad=True)])\n"
+        "print('ok')\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]

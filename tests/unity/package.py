@@ -54,6 +54,7 @@ PLUGINS = [
     Plugin("Plugins/macOS/softdeca.bundle", "OSXUniversal", "AnyCPU", "OSX"),
     Plugin("Plugins/iOS/libsoftdeca.a", "iOS", "AnyCPU", None),
     Plugin("Plugins/Android/arm64-v8a/libsoftdeca.so", "Android", "ARM64", None),
+    Plugin("Plugins/Android/arm64-v8a/libonnxruntime.so", "Android", "ARM64", None),
 ]
 
 
@@ -126,9 +127,22 @@ def plugin_importer(p: Plugin) -> str:
     return "\n".join(lines) + "\n  userData: \n"
 
 
+def plugin_entries() -> list[tuple[str, bool]]:
+    """The native binaries under Plugins/ and their folders: their .meta files (importer settings)
+    are committed; the binaries are build outputs placed there when the package is packed."""
+    out: dict[str, bool] = {}
+    for p in PLUGINS:
+        parts = p.path.split("/")
+        for i in range(1, len(parts)):
+            out["/".join(parts[:i])] = True
+        out[p.path] = False
+    return sorted(out.items())
+
+
 def package_entries(root: Path) -> list[tuple[str, bool]]:
-    """(relative path, is folder) of everything that needs a .meta."""
-    out = []
+    """(relative path, is folder) of everything that needs a .meta: the package's files and
+    folders, and the Plugins/ layout whether or not its binaries are there."""
+    out = dict(plugin_entries())
     for path in sorted(root.rglob("*")):
         rel = path.relative_to(root)
         if (
@@ -141,13 +155,15 @@ def package_entries(root: Path) -> list[tuple[str, bool]]:
             "~"
         ):  # Samples~ itself: Unity ignores it; its contents are imported on demand
             continue
-        out.append((rel.as_posix(), path.is_dir()))
-    return out
+        out[rel.as_posix()] = path.is_dir()
+    return sorted(out.items())
 
 
 def write_metas(root: Path) -> int:
     n = 0
     for rel, is_dir in package_entries(root):
+        if is_dir:
+            (root / rel).mkdir(parents=True, exist_ok=True)
         (root / f"{rel}.meta").write_text(meta_text(rel, is_dir))
         n += 1
     return n

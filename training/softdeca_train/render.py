@@ -8,6 +8,8 @@ shows the face and "side" the subject's left profile.
 
 from __future__ import annotations
 
+import contextlib
+import importlib.util
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -21,6 +23,21 @@ from PIL import Image, ImageDraw, ImageFont
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 Color = str | tuple[float, float, float]
+
+
+def _pyvista():  # -> the pyvista module
+    """pyvista, imported only after triton (when installed). Rendering loads Mesa's llvmpipe,
+    which brings the system's libLLVM into the process with global symbols. Triton carries
+    its own LLVM; loaded afterwards (torch imports it through torch._dynamo the first time an
+    optimizer is made), its static initialisers bind to the system LLVM's symbols and the
+    process dies with SIGSEGV in llvm::cl::Option::addArgument. Loaded first, triton binds to
+    its own copy (Python loads extensions with RTLD_NOW) and both coexist."""
+    if importlib.util.find_spec("triton") is not None:
+        with contextlib.suppress(ImportError):
+            import triton  # noqa: F401
+    import pyvista as pv
+
+    return pv
 
 
 @dataclass(frozen=True)
@@ -149,7 +166,7 @@ def _check_layer(layer: Layer) -> None:
 
 
 def _polydata(layer: Layer):  # -> pv.PolyData | None
-    import pyvista as pv
+    pv = _pyvista()
 
     if isinstance(layer, MeshLayer):
         t = np.asarray(layer.triangles, dtype=np.int64)
@@ -214,7 +231,7 @@ def render(
 ) -> np.ndarray:
     """Render layers from a named (or explicit) view; returns the RGB image (H, W, 3) uint8
     and writes it as PNG to `path` if given."""
-    import pyvista as pv
+    pv = _pyvista()
 
     settings = settings or RenderSettings()
     if isinstance(view, str):

@@ -558,6 +558,27 @@ STEPS["simulate"] = (
 )
 
 
+def _stress_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.sim.stress_cli import add_stress_args
+
+    add_stress_args(p)
+
+
+def _stress_run(args: argparse.Namespace) -> int:
+    from softdeca_train.sim.stress_cli import run_stress_cli
+
+    return run_stress_cli(args)
+
+
+STEPS["stress"] = (
+    "The physics stress suite: extreme expressions, identities, materials, gravity, levels, "
+    "static and dynamic, real takes, judged by the sanity bounds -> stress.json, stress.md, "
+    "stress_worst.png (and physics_stress.json with --bench-out).",
+    _stress_args,
+    _stress_run,
+)
+
+
 def _bench_physics_args(p: argparse.ArgumentParser) -> None:
     _ict_arg(p)
     p.add_argument("--out", default="build/bench", help="folder for physics_lhm.json")

@@ -8,8 +8,12 @@ namespace SoftDeca.Unity
     public sealed class NetworkReceiverInput : SoftDecaFaceInput
     {
         public StreamFormat format = StreamFormat.Auto;
-        [Tooltip("Numeric address to listen on; empty: all IPv4 interfaces")]
+        [Tooltip("Receive from other machines (a phone on the network). Off: this machine only (loopback)")]
+        public bool listenNetwork = false;
+        [Tooltip("Numeric address to listen on; empty: all IPv4 interfaces when listening on the network, else 127.0.0.1")]
         public string bindAddress = "";
+        [Tooltip("A new sender takes over at once (else the first sender keeps the avatar until quiet for 2 s)")]
+        public bool followNewest = false;
         public int port = 50110;
         [Tooltip("Seconds frames wait to be put in order (0: show each as it arrives)")]
         [Range(0, 0.2f)] public float jitterDelay = 0;
@@ -24,7 +28,8 @@ namespace SoftDeca.Unity
         private void OnEnable()
         {
             frame = Frame.Create();
-            receiver = new Receiver(format, string.IsNullOrEmpty(bindAddress) ? null : bindAddress, port, 256, jitterDelay);
+            receiver = new Receiver(format, string.IsNullOrEmpty(bindAddress) ? null : bindAddress, port, 256, jitterDelay,
+                                    listenNetwork, followNewest);
             if (!string.IsNullOrEmpty(recordTo)) receiver.StartRecording(recordTo, SystemInfo.deviceName, null, "Unity");
         }
 

@@ -123,6 +123,8 @@ typedef struct softdeca_avatar softdeca_avatar;
 typedef struct softdeca_model_options {
   uint32_t struct_size;            /* sizeof(softdeca_model_options) */
   uint32_t prepare_threads; /* ONNX Runtime threads for the per-avatar networks; 0: 1 */
+  uint32_t memory_budget_mib; /* most a bundle's networks may ask for, in MiB, checked before
+                               * loading them (docs/security.md); 0: 2048 */
 } softdeca_model_options;
 
 /* Loads a bundle from a folder or from a .tar of its files. `options` may be NULL.
@@ -555,13 +557,21 @@ typedef enum softdeca_stream_format {
 typedef struct softdeca_receiver_config {
   uint32_t struct_size;
   int32_t format;           /* softdeca_stream_format */
-  const char* bind_address; /* numeric IPv4 or IPv6 address; NULL: "0.0.0.0" (all IPv4) */
+  const char* bind_address; /* numeric IPv4 or IPv6 address; NULL: "127.0.0.1" (loopback), or
+                             * "0.0.0.0" (all IPv4) with listen_network */
   uint32_t port;            /* 0: any free port (softdeca_receiver_port tells which) */
   uint32_t queue_capacity;  /* delivered frames kept for softdeca_receiver_next, 1 to 65536 */
   double jitter_delay;      /* seconds in [0, 5] that frames wait to be put in order; 0: none */
+  /* Security (docs/security.md). */
+  softdeca_bool listen_network; /* 1: may bind a network address; 0: loopback addresses only */
+  softdeca_bool follow_newest;  /* 1: a new sender takes the session at once; 0: the first
+                                 * sender holds it until quiet for session_hold seconds */
+  double session_hold;      /* seconds in (0, 3600]; 0: 2 */
+  double source_rate_limit; /* datagrams per second per sender; 0: 1000; negative: no limit */
 } softdeca_receiver_config;
 
-/* Fills a config with the defaults: auto format, 0.0.0.0:50110, 256 frames, no delay. */
+/* Fills a config with the defaults: auto format, 127.0.0.1:50110, 256 frames, no delay, the
+ * first sender holds the session for 2 s of quiet, 1000 datagrams per second per sender. */
 SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_config* config);
 
 typedef struct softdeca_receiver softdeca_receiver;
@@ -611,6 +621,9 @@ typedef struct softdeca_receiver_stats {
   double loss_ratio;         /* lost / expected */
   double latency_p50_ms;     /* arrival at the socket -> frame available, recent frames */
   double latency_p99_ms;
+  uint64_t foreign;           /* dropped: another sender held the session */
+  uint64_t rate_limited;      /* dropped: over the per-sender rate limit */
+  uint64_t recording_dropped; /* frames the recording's disk could not keep up with */
 } softdeca_receiver_stats;
 
 SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver* receiver,

@@ -52,6 +52,18 @@ void report_out(const recording::ConversionReport& r, softdeca_convert_report* o
   out->face_lost_rows = static_cast<uint32_t>(r.face_lost_rows);
   out->malformed_rows = static_cast<uint32_t>(r.malformed_rows);
 }
+
+// A file conversion (Live Link Face CSV <-> recording): its arguments checked, then `convert`
+// (from, to, timecode_rate) run and its report written.
+template <class Convert>
+void convert_file(const char* from, const char* from_name, const char* to, const char* to_name, double timecode_rate,
+                  softdeca_convert_report* out_report, Convert&& convert) {
+  require_not_null(from, from_name);
+  require_not_null(to, to_name);
+  require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000, "timecode_rate must be in [0, 1000]");
+  if (out_report) require_struct(out_report, "out_report");
+  report_out(convert(from, to, timecode_rate), out_report);
+}
 }  // namespace
 
 extern "C" {
@@ -217,12 +229,7 @@ SOFTDECA_API softdeca_status softdeca_convert_livelinkface_csv(const char* csv_p
                                                                double timecode_rate,
                                                                softdeca_convert_report* out_report) {
   return guarded(__func__, [&] {
-    require_not_null(csv_path, "csv_path");
-    require_not_null(recording_path, "recording_path");
-    require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000,
-            "timecode_rate must be in [0, 1000]");
-    if (out_report) require_struct(out_report, "out_report");
-    report_out(recording::csv_to_recording(csv_path, recording_path, timecode_rate), out_report);
+    convert_file(csv_path, "csv_path", recording_path, "recording_path", timecode_rate, out_report, recording::csv_to_recording);
   });
 }
 
@@ -230,12 +237,7 @@ SOFTDECA_API softdeca_status softdeca_export_livelinkface_csv(const char* record
                                                               double timecode_rate,
                                                               softdeca_convert_report* out_report) {
   return guarded(__func__, [&] {
-    require_not_null(recording_path, "recording_path");
-    require_not_null(csv_path, "csv_path");
-    require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000,
-            "timecode_rate must be in [0, 1000]");
-    if (out_report) require_struct(out_report, "out_report");
-    report_out(recording::recording_to_csv(recording_path, csv_path, timecode_rate), out_report);
+    convert_file(recording_path, "recording_path", csv_path, "csv_path", timecode_rate, out_report, recording::recording_to_csv);
   });
 }
 

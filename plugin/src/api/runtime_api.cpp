@@ -50,6 +50,7 @@ runtime::ModelOptions model_options(const softdeca_model_options* o) {
   require_struct(o, "options");
   require(o->prepare_threads <= 64, "options->prepare_threads must be at most 64");
   opts.prepare_threads = o->prepare_threads == 0 ? 1 : static_cast<int>(o->prepare_threads);
+  if (o->memory_budget_mib) opts.memory_budget_bytes = std::uint64_t{o->memory_budget_mib} << 20;
   return opts;
 }
 

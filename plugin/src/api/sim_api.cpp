@@ -191,6 +191,15 @@ Param parameter(uint32_t index) {
   });
   return static_cast<Param>(index);
 }
+// One frame through `step` (a static solve or a dynamic step): stats out, result stored.
+void advance(softdeca_sim* sim, const softdeca_sim_frame* frame, softdeca_sim_stats* stats,
+             FrameResult (Simulator::*step)(const FrameInput&)) {
+  require_not_null(sim, "sim");
+  if (stats) require_struct(stats, "stats");
+  FrameResult r = (sim->sim.get()->*step)(to_frame(*sim, frame));
+  to_stats(r.stats, stats);
+  store(*sim, std::move(r));
+}
 }  // namespace
 
 extern "C" {
@@ -310,24 +319,12 @@ SOFTDECA_API softdeca_status softdeca_sim_set_parameter_field(softdeca_sim* sim,
 
 SOFTDECA_API softdeca_status softdeca_sim_solve_static(softdeca_sim* sim, const softdeca_sim_frame* frame,
                                                        softdeca_sim_stats* stats) {
-  return guarded(__func__, [&] {
-    require_not_null(sim, "sim");
-    if (stats) require_struct(stats, "stats");
-    FrameResult r = sim->sim->solve_static(to_frame(*sim, frame));
-    to_stats(r.stats, stats);
-    store(*sim, std::move(r));
-  });
+  return guarded(__func__, [&] { advance(sim, frame, stats, &Simulator::solve_static); });
 }
 
 SOFTDECA_API softdeca_status softdeca_sim_step_dynamic(softdeca_sim* sim, const softdeca_sim_frame* frame,
                                                        softdeca_sim_stats* stats) {
-  return guarded(__func__, [&] {
-    require_not_null(sim, "sim");
-    if (stats) require_struct(stats, "stats");
-    FrameResult r = sim->sim->step_dynamic(to_frame(*sim, frame));
-    to_stats(r.stats, stats);
-    store(*sim, std::move(r));
-  });
+  return guarded(__func__, [&] { advance(sim, frame, stats, &Simulator::step_dynamic); });
 }
 
 SOFTDECA_API softdeca_status softdeca_sim_reset_dynamics(softdeca_sim* sim) {

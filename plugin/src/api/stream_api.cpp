@@ -44,6 +44,9 @@ SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_con
     config->port = stream::default_port(stream::Format::softdeca);
     config->queue_capacity = 256;
     config->jitter_delay = 0;
+    const stream::ReceiverConfig defaults;
+    config->session_hold = defaults.session_hold;
+    config->source_rate_limit = defaults.source_rate_limit;
   });
 }
 
@@ -56,8 +59,14 @@ SOFTDECA_API softdeca_status softdeca_receiver_create(const softdeca_receiver_co
             "config->format is not a softdeca_stream_format");
     require(config->port <= 65535, "config->port exceeds 65535");
     require(std::isfinite(config->jitter_delay), "config->jitter_delay is not finite", SOFTDECA_ERROR_NON_FINITE);
+    require(std::isfinite(config->session_hold) && std::isfinite(config->source_rate_limit),
+            "config->session_hold and source_rate_limit must be finite", SOFTDECA_ERROR_NON_FINITE);
     stream::ReceiverConfig c;
-    c.bind_address = config->bind_address ? config->bind_address : "0.0.0.0";
+    c.listen_network = config->listen_network != 0;
+    c.bind_address = config->bind_address ? config->bind_address : c.listen_network ? "0.0.0.0" : "127.0.0.1";
+    c.follow_newest = config->follow_newest != 0;
+    if (config->session_hold != 0) c.session_hold = config->session_hold;
+    if (config->source_rate_limit != 0) c.source_rate_limit = config->source_rate_limit < 0 ? 0 : config->source_rate_limit;
     c.port = static_cast<uint16_t>(config->port);
     c.format = static_cast<stream::Format>(config->format);
     c.delay = config->jitter_delay;
@@ -137,6 +146,9 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
     out->loss_ratio = s.loss_ratio;
     out->latency_p50_ms = s.latency_p50_ms;
     out->latency_p99_ms = s.latency_p99_ms;
+    out->foreign = s.foreign;
+    out->rate_limited = s.rate_limited;
+    out->recording_dropped = s.recording_dropped;
   });
 }
 

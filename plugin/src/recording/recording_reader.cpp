@@ -24,16 +24,71 @@ uint32_t load_u32(const uint8_t* p) {
   return v;
 }
 
-// Length of the good record at `at`, or 0 when its magic, length or checksum is wrong or
-// the file ends before the length it declares.
-std::size_t good_record(const uint8_t* data, std::size_t size, std::size_t at) {
+// The record framing at `at` (magic, a length the file holds), or 0: the payload length.
+std::size_t framed_length(const uint8_t* data, std::size_t size, std::size_t at) {
   if (size - at < kRecordHeaderBytes) return 0;
   if (std::memcmp(data + at, kRecordMagic.data(), kRecordMagic.size()) != 0) return 0;
   const uint32_t length = load_u32(data + at + 4);
   if (length == 0 || length > kMaxRecordBytes) return 0;
   if (size - at - kRecordHeaderBytes < length) return 0;
-  // The checksum covers the length field too, so a corrupted length cannot pass.
-  const uint32_t crc = stream::crc32(data + at + kRecordHeaderBytes, length, stream::crc32(data + at + 4, 4));
+  return length;
+}
+
+// CRC-32 of ranges in a window that only moves forward, from prefix checksums: each byte is
+// checksummed once however many candidate records overlap it, so reading and resynchronising
+// after damage stay linear in the file (a crafted file can put a candidate at every byte).
+class PrefixCrc {
+ public:
+  explicit PrefixCrc(const uint8_t* data) : data_(data), ring_(kWindow) {}
+
+  // crc32 of [a, b); a must not lie before the first call's a nor kWindow or more before the
+  // furthest b so far (records are shorter).
+  uint32_t range(std::size_t a, std::size_t b, std::size_t& checksum_bytes) {
+    if (!started_) {  // prefixes count from the first byte asked for; later calls never ask before it
+      filled_ = a;
+      ring_[a & kMask] = 0;
+      started_ = true;
+    }
+    const uint32_t before = prefix(a, checksum_bytes);
+    return stream::crc32_apply(shift(b - a), before) ^ prefix(b, checksum_bytes);
+  }
+
+  // crc32_shift(n) from a table filled on demand (n is at most a record's length): a crafted
+  // file may give every candidate another length.
+  uint32_t shift(std::size_t n) {
+    if (shifts_.empty()) shifts_.push_back(stream::crc32_shift(0));
+    while (shifts_.size() <= n) shifts_.push_back(stream::crc32_apply(shifts_.back(), stream::crc32_shift(1)));
+    return shifts_[n];
+  }
+
+ private:
+  static constexpr std::size_t kWindow = std::size_t{1} << 17;  // > a record's header and payload
+  static constexpr std::size_t kMask = kWindow - 1;
+  // crc32 from the first call's a to i.
+  uint32_t prefix(std::size_t i, std::size_t& checksum_bytes) {
+    if (i <= filled_) return ring_[i & kMask];
+    checksum_bytes += i - filled_;
+    for (; filled_ < i; ++filled_) ring_[(filled_ + 1) & kMask] = stream::crc32(data_ + filled_, 1, ring_[filled_ & kMask]);
+    return ring_[i & kMask];
+  }
+  const uint8_t* data_;
+  std::vector<uint32_t> ring_;
+  std::vector<uint32_t> shifts_;
+  std::size_t filled_ = 0;  // prefixes are known up to here
+  bool started_ = false;
+};
+
+// Length of the good record at `at`, or 0 when its magic, length or checksum is wrong or
+// the file ends before the length it declares. The checksum covers the length field too, so
+// a corrupted length cannot pass.
+std::size_t good_record(const uint8_t* data, std::size_t size, std::size_t at, PrefixCrc& window,
+                        std::size_t& checksum_bytes) {
+  const std::size_t length = framed_length(data, size, at);
+  if (length == 0) return 0;
+  const std::size_t payload = at + kRecordHeaderBytes;
+  const uint32_t length_crc = window.range(at + 4, at + 8, checksum_bytes);  // first: the window moves forward
+  const uint32_t payload_crc = window.range(payload, payload + length, checksum_bytes);
+  const uint32_t crc = stream::crc32_apply(window.shift(length), length_crc) ^ payload_crc;
   return crc == load_u32(data + at + 8) ? kRecordHeaderBytes + length : 0;
 }
 
@@ -101,8 +156,10 @@ Recording parse_recording(const uint8_t* data, std::size_t size) {
   std::vector<int> order;
   std::size_t at = 0;
   read_header(data, size, rec, order, at);
+  std::size_t& checksum_bytes = rec.recovery.checksum_bytes;
+  PrefixCrc window(data);
   while (at < size) {
-    const std::size_t n = good_record(data, size, at);
+    const std::size_t n = good_record(data, size, at, window, checksum_bytes);
     if (n > 0) {
       apply_record(data + at + kRecordHeaderBytes, n - kRecordHeaderBytes, order, rec);
       ++rec.recovery.records;
@@ -114,7 +171,7 @@ Recording parse_recording(const uint8_t* data, std::size_t size) {
     bool found = false;
     for (; next + kRecordHeaderBytes <= size; ++next) {
       if (data[next] != kRecordMagic[0]) continue;
-      if (good_record(data, size, next) > 0) {
+      if (good_record(data, size, next, window, checksum_bytes) > 0) {
         found = true;
         break;
       }

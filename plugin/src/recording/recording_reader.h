@@ -1,6 +1,8 @@
 // Reads a recording (recording_format.h) and recovers what a damaged file still holds:
 // a file cut mid-write loses at most its incomplete last record; a corrupted record is skipped
-// by searching for the next record whose magic, length and checksum are all good.
+// by searching for the next record whose magic, length and checksum are all good. The search
+// is linear in the file: candidates' checksums come from prefix checksums, so no byte is
+// checksummed more than once however many candidates overlap it (docs/security.md).
 #pragma once
 
 #include <cstddef>
@@ -18,6 +20,7 @@ struct Recovery {
   std::size_t skipped_bytes = 0;     // bytes in those stretches
   std::size_t truncated_bytes = 0;   // end of file after the last good record: a cut-off record
   std::size_t unknown_records = 0;   // good records of a type this version does not know
+  std::size_t checksum_bytes = 0;    // bytes run through CRC-32: at most the file's size
 };
 
 struct Recording {

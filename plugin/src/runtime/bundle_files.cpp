@@ -1,29 +1,61 @@
 #include "runtime/bundle_files.h"
 
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
 #include <cstring>
-#include <fstream>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/error.h"
 
 namespace softdeca::runtime {
 
 namespace {
-bool is_directory(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
+
+const char* kind_of(mode_t mode) {
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
 }
 
-Bytes read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw Error(SOFTDECA_ERROR_IO, "cannot read " + path);
+// Reads a regular file. lstat first, then open without following links and without blocking
+// (a FIFO swapped in between opens at once and fails the fstat check): nothing but a regular
+// file is ever read. `label` names the file in messages.
+Bytes read_regular(const std::string& path, const std::string& label, std::uint64_t max_bytes) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) throw Error(SOFTDECA_ERROR_IO, "cannot open " + label);
+  if (!S_ISREG(st.st_mode)) throw Error(SOFTDECA_ERROR_FORMAT, label + " is " + kind_of(st.st_mode) + ", not a regular file");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) throw Error(SOFTDECA_ERROR_IO, "cannot open " + label);
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+    throw Error(SOFTDECA_ERROR_FORMAT, label + " is not a regular file");
+  const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
+  if (size > max_bytes)
+    throw Error(SOFTDECA_ERROR_FORMAT, label + " is " + mib(size) + ", over the limit of " + mib(max_bytes));
   Bytes data(static_cast<std::size_t>(size));
-  in.seekg(0);
-  if (size > 0 && !in.read(reinterpret_cast<char*>(data.data()), size))
-    throw Error(SOFTDECA_ERROR_IO, "cannot read " + path);
+  std::size_t got = 0;
+  while (got < data.size()) {
+    const ssize_t n = ::read(fd, data.data() + got, data.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw Error(SOFTDECA_ERROR_IO, "cannot read " + label);
+    got += static_cast<std::size_t>(n);
+  }
   return data;
+}
+
+std::string canonical(const std::string& path) {
+  char buffer[PATH_MAX];
+  if (!::realpath(path.c_str(), buffer)) return {};
+  return buffer;
 }
 
 // ustar numeric fields: octal text, NUL or space terminated.
@@ -47,24 +79,40 @@ std::string field_text(const std::uint8_t* field, std::size_t n) {
   while (len < n && field[len]) ++len;
   return std::string(reinterpret_cast<const char*>(field), len);
 }
+
+void check_name(const std::string& name) {
+  if (name.empty() || name.find("..") != std::string::npos || name[0] == '/' || name.find('\0') != std::string::npos)
+    throw Error(SOFTDECA_ERROR_FORMAT, "bundle file name '" + name + "' is not a plain relative path");
+}
 }  // namespace
 
-BundleFiles BundleFiles::from_path(const std::string& path) {
-  if (!is_directory(path)) {
-    const Bytes data = read_file(path);
-    BundleFiles b = from_tar(data.data(), data.size());
+BundleFiles BundleFiles::from_path(const std::string& path, const BundleLimits& limits) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
+  if (!S_ISDIR(st.st_mode)) {
+    // A .tar: the path itself may be a link (the caller chose it), its target must be regular.
+    const std::string target = canonical(path);
+    if (target.empty()) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
+    const Bytes data = read_regular(target, path, limits.max_total_bytes);
+    BundleFiles b = from_tar(data.data(), data.size(), limits);
     b.origin_ = path;
     return b;
   }
   BundleFiles b;
   b.origin_ = path;
+  b.root_ = canonical(path);
+  if (b.root_.empty()) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
   b.lazy_ = true;
+  b.limits_ = limits;
   return b;
 }
 
-BundleFiles BundleFiles::from_tar(const std::uint8_t* data, std::size_t size) {
+BundleFiles BundleFiles::from_tar(const std::uint8_t* data, std::size_t size, const BundleLimits& limits) {
   BundleFiles b;
   b.origin_ = "memory";
+  b.limits_ = limits;
+  if (size > limits.max_total_bytes)
+    throw Error(SOFTDECA_ERROR_FORMAT, "tar: the archive is " + mib(size) + ", over the limit of " + mib(limits.max_total_bytes));
   std::size_t pos = 0;
   bool ended = false;
   while (pos + 512 <= size) {
@@ -83,6 +131,9 @@ BundleFiles BundleFiles::from_tar(const std::uint8_t* data, std::size_t size) {
     pos += 512;
     if (n > size - pos) throw Error(SOFTDECA_ERROR_FORMAT, "tar: member " + name + " runs past the end");
     if (type == '0' || type == '\0') {
+      if (n > limits.max_file_bytes)
+        throw Error(SOFTDECA_ERROR_FORMAT, "tar: member " + name + " is " + mib(n) + ", over the limit of " +
+                                               mib(limits.max_file_bytes));
       while (name.compare(0, 2, "./") == 0) name.erase(0, 2);
       b.files_[name] = Bytes(data + pos, data + pos + n);
     }
@@ -105,12 +156,11 @@ BundleFiles BundleFiles::from_tar(const std::uint8_t* data, std::size_t size) {
 bool BundleFiles::has(const std::string& name) const {
   if (!lazy_) return files_.count(name) > 0;
   struct stat st {};
-  return ::stat((origin_ + "/" + name).c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  return ::lstat((root_ + "/" + name).c_str(), &st) == 0 && (S_ISREG(st.st_mode) || S_ISLNK(st.st_mode));
 }
 
 const Bytes& BundleFiles::get(const std::string& name) const {
-  if (name.empty() || name.find("..") != std::string::npos || name[0] == '/')
-    throw Error(SOFTDECA_ERROR_FORMAT, "bundle file name '" + name + "' is not a plain relative path");
+  check_name(name);
   if (!lazy_) {
     const auto it = files_.find(name);
     if (it == files_.end()) throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle has no file " + name);
@@ -118,10 +168,19 @@ const Bytes& BundleFiles::get(const std::string& name) const {
   }
   auto it = cache_.find(name);
   if (it == cache_.end()) {
-    const std::string path = origin_ + "/" + name;
+    const std::string path = root_ + "/" + name;
     struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle has no file " + name);
-    it = cache_.emplace(name, read_file(path)).first;
+    if (::lstat(path.c_str(), &st) != 0) throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle has no file " + name);
+    // Resolve links (in any component) and require the result inside the bundle's folder.
+    const std::string resolved = canonical(path);
+    if (resolved.empty()) throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle file " + name + " is a broken link");
+    if (resolved.compare(0, root_.size() + 1, root_ + "/") != 0)
+      throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle file " + name + " is a link that leaves the bundle");
+    const std::uint64_t left = limits_.max_total_bytes - bytes_read_;
+    Bytes data = read_regular(resolved, origin_ + ": bundle file " + name,
+                              left < limits_.max_file_bytes ? left : limits_.max_file_bytes);
+    bytes_read_ += data.size();
+    it = cache_.emplace(name, std::move(data)).first;
   }
   return it->second;
 }

@@ -207,35 +207,27 @@ __attribute__((target("avx2,fma"))) inline float quantise_coefficients(const Hyp
   return peak / 32767.0f;
 }
 
-template <int W>
-__attribute__((target("avx2,fma"))) inline void contract_int8(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
-  alignas(32) std::int16_t zq[kMaxInt8Latent];
-  const float t = quantise_coefficients(L, z, b, zq);
-  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
-  if (t == 0.0f) return;
-  __m256i acc[W];
-  for (int c = 0; c < W; ++c) acc[c] = _mm256_setzero_si256();
-  const std::int8_t* q = L.int8_data() + b * L.block_stride();
-  const int pairs = (L.latent() + 1) / 2;
-  for (int p = 0; p < pairs; ++p) {
-    std::int32_t pair;
-    std::memcpy(&pair, zq + 2 * p, sizeof pair);
-    const __m256i zp = _mm256_set1_epi32(pair);
-    const std::int8_t* qp = q + static_cast<std::size_t>(p) * W * 2 * kLanes;
-#pragma GCC unroll 9
-    for (int c = 0; c < W; ++c) {
-      const __m256i v = _mm256_cvtepi8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qp + c * 2 * kLanes)));
-      acc[c] = _mm256_add_epi32(acc[c], _mm256_madd_epi16(v, zp));
-    }
+// Two latents of 8 int8 values (widened to int16) times the int16 pair (z_k, z_k+1), summed in
+// int32 and added to acc: pmaddwd + paddd on AVX2, one vpdpwssd with AVX-512 VNNI.
+struct PairsAvx2 {
+  __attribute__((target("avx2"))) static inline __m256i mac(__m256i acc, __m256i v, __m256i zp) {
+    return _mm256_add_epi32(acc, _mm256_madd_epi16(v, zp));
   }
-  const __m256 step = _mm256_set1_ps(t);
-  for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), step);
-}
+};
+struct PairsVnni {
+  __attribute__((target("avx2,avx512f,avx512vl,avx512vnni"))) static inline __m256i mac(__m256i acc, __m256i v, __m256i zp) {
+    return _mm256_dpwssd_epi32(acc, v, zp);
+  }
+};
 
-// The same with AVX-512 VNNI's vpdpwssd (multiply, pair-sum and accumulate in one instruction).
-template <int W>
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512vnni"))) inline void contract_int8_vnni(const HyperTensor& L, const float* z,
-                                                                                             std::size_t b, __m256* out) {
+// The kernels below are templates on the storage (P) and the int8 pair instruction (Pairs).
+// They carry the AVX2 target and are always inlined: a VNNI entry point (which has the AVX-512
+// target) inlines them with PairsVnni, whose instruction then inlines too. A template cannot
+// take its target from a template argument, hence this arrangement.
+#define SOFTDECA_KERNEL __attribute__((target("avx2,fma,f16c"), always_inline)) inline
+
+template <int W, class Pairs>
+SOFTDECA_KERNEL void contract_int8(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
   alignas(32) std::int16_t zq[kMaxInt8Latent];
   const float t = quantise_coefficients(L, z, b, zq);
   for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
@@ -251,15 +243,15 @@ __attribute__((target("avx2,fma,avx512f,avx512vl,avx512vnni"))) inline void cont
     const std::int8_t* qp = q + static_cast<std::size_t>(p) * W * 2 * kLanes;
 #pragma GCC unroll 9
     for (int c = 0; c < W; ++c)
-      acc[c] = _mm256_dpwssd_epi32(acc[c], _mm256_cvtepi8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qp + c * 2 * kLanes))), zp);
+      acc[c] = Pairs::mac(acc[c], _mm256_cvtepi8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qp + c * 2 * kLanes))), zp);
   }
   const __m256 step = _mm256_set1_ps(t);
   for (int c = 0; c < W; ++c) out[c] = _mm256_mul_ps(_mm256_cvtepi32_ps(acc[c]), step);
 }
 
-template <Precision P, int W>
-__attribute__((target("avx2,fma,f16c"))) inline void contract_any(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
-  if constexpr (P == Precision::Int8) contract_int8<W>(L, z, b, out);
+template <Precision P, int W, class Pairs>
+SOFTDECA_KERNEL void contract_any(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  if constexpr (P == Precision::Int8) contract_int8<W, Pairs>(L, z, b, out);
   else contract<P, W>(L, z, b, out);
 }
 
@@ -317,44 +309,48 @@ __attribute__((target("avx2"))) inline void write_offsets(const __m256* a, const
   }
 }
 
-template <Precision P>
-__attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, const FaceBlocks& faces, const float* z,
-                                                         const float* skin, std::size_t b0, std::size_t b1, float* rhs) {
+template <Precision P, class Pairs>
+SOFTDECA_KERNEL void dg_rhs_blocks(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin,
+                                   std::size_t b0, std::size_t b1, float* rhs) {
   for (std::size_t b = b0; b < b1; ++b) {
     __m256 d[9];
-    contract_any<P, 9>(L, z, b, d);
+    contract_any<P, 9, Pairs>(L, z, b, d);
     accumulate_rhs(d, faces, b, skin, rhs);
   }
 }
 
-__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"))) void dg_rhs_vnni(const HyperTensor& L, const FaceBlocks& faces,
-                                                                                    const float* z, const float* skin,
-                                                                                    std::size_t b0, std::size_t b1, float* rhs) {
+template <Precision P, class Pairs>
+SOFTDECA_KERNEL void vertex_offsets_blocks(const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0,
+                                           std::size_t b1, float* out) {
   for (std::size_t b = b0; b < b1; ++b) {
-    __m256 d[9];
-    contract_int8_vnni<9>(L, z, b, d);
-    accumulate_rhs(d, faces, b, skin, rhs);
+    __m256 a[3];
+    contract_any<P, 3, Pairs>(L, z, b, a);
+    write_offsets(a, L, b, base_pos, out);
   }
+}
+#undef SOFTDECA_KERNEL
+
+// The entry points: one per storage on AVX2, int8 only with VNNI.
+template <Precision P>
+__attribute__((target("avx2,fma,f16c"))) void dg_rhs_avx2(const HyperTensor& L, const FaceBlocks& faces, const float* z,
+                                                         const float* skin, std::size_t b0, std::size_t b1, float* rhs) {
+  dg_rhs_blocks<P, PairsAvx2>(L, faces, z, skin, b0, b1, rhs);
+}
+
+__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"), flatten)) void dg_rhs_vnni(
+    const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0, std::size_t b1, float* rhs) {
+  dg_rhs_blocks<Precision::Int8, PairsVnni>(L, faces, z, skin, b0, b1, rhs);
 }
 
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void vertex_offsets_avx2(const HyperTensor& L, const float* z, const float* base_pos,
                                                                  std::size_t b0, std::size_t b1, float* out) {
-  for (std::size_t b = b0; b < b1; ++b) {
-    __m256 a[3];
-    contract_any<P, 3>(L, z, b, a);
-    write_offsets(a, L, b, base_pos, out);
-  }
+  vertex_offsets_blocks<P, PairsAvx2>(L, z, base_pos, b0, b1, out);
 }
 
-__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"))) void vertex_offsets_vnni(const HyperTensor& L, const float* z,
-                                                                                            const float* base_pos, std::size_t b0,
-                                                                                            std::size_t b1, float* out) {
-  for (std::size_t b = b0; b < b1; ++b) {
-    __m256 a[3];
-    contract_int8_vnni<3>(L, z, b, a);
-    write_offsets(a, L, b, base_pos, out);
-  }
+__attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"), flatten)) void vertex_offsets_vnni(
+    const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0, std::size_t b1, float* out) {
+  vertex_offsets_blocks<Precision::Int8, PairsVnni>(L, z, base_pos, b0, b1, out);
 }
 
 bool cpu_has_avx2() {

@@ -46,6 +46,29 @@ class JsonParser {
     while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\n' || s_[pos_] == '\r' || s_[pos_] == '\t'))
       ++pos_;
   }
+  // After the opening '{' or '[': true (and past it) when `close` follows at once.
+  bool empty_list(char close) {
+    ++pos_;
+    skip_space();
+    if (pos_ < s_.size() && s_[pos_] == close) {
+      ++pos_;
+      return true;
+    }
+    return false;
+  }
+  // After an object member or array element: true at ',' (another follows), false at `close`.
+  bool another_item(char close) {
+    skip_space();
+    if (pos_ < s_.size() && s_[pos_] == ',') {
+      ++pos_;
+      return true;
+    }
+    if (pos_ < s_.size() && s_[pos_] == close) {
+      ++pos_;
+      return false;
+    }
+    error(std::string("expected ',' or '") + close + "'");
+  }
   bool consume(const char* word) {
     std::size_t n = 0;
     while (word[n]) ++n;
@@ -62,9 +85,7 @@ class JsonParser {
     const char c = s_[pos_];
     if (c == '{') {
       v.type_ = Json::Type::Object;
-      ++pos_;
-      skip_space();
-      if (pos_ < s_.size() && s_[pos_] == '}') { ++pos_; return v; }
+      if (empty_list('}')) return v;
       for (;;) {
         skip_space();
         if (pos_ >= s_.size() || s_[pos_] != '"') error("expected a member name");
@@ -73,23 +94,15 @@ class JsonParser {
         if (pos_ >= s_.size() || s_[pos_] != ':') error("expected ':'");
         ++pos_;
         v.object_.emplace_back(std::move(key), value(depth + 1));
-        skip_space();
-        if (pos_ < s_.size() && s_[pos_] == ',') { ++pos_; continue; }
-        if (pos_ < s_.size() && s_[pos_] == '}') { ++pos_; return v; }
-        error("expected ',' or '}'");
+        if (!another_item('}')) return v;
       }
     }
     if (c == '[') {
       v.type_ = Json::Type::Array;
-      ++pos_;
-      skip_space();
-      if (pos_ < s_.size() && s_[pos_] == ']') { ++pos_; return v; }
+      if (empty_list(']')) return v;
       for (;;) {
         v.array_.push_back(value(depth + 1));
-        skip_space();
-        if (pos_ < s_.size() && s_[pos_] == ',') { ++pos_; continue; }
-        if (pos_ < s_.size() && s_[pos_] == ']') { ++pos_; return v; }
-        error("expected ',' or ']'");
+        if (!another_item(']')) return v;
       }
     }
     if (c == '"') {

@@ -29,6 +29,14 @@ double finite(const Json& j, const std::string& what) {
 
 constexpr long long kMaxElements = 1 << 24;
 
+std::string sha256_of(const Json& j, const std::string& what) {
+  const std::string h = j.at("sha256", what).string(what + ".sha256");
+  bool hex = h.size() == 64;
+  for (const char c : h) hex = hex && ((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'));
+  check(hex, what + ".sha256 must be 64 lower-case hex digits");
+  return h;
+}
+
 std::vector<std::int64_t> shape_of(const Json& j, const std::string& what) {
   std::vector<std::int64_t> shape;
   for (const Json& d : j.array(what)) {
@@ -179,12 +187,14 @@ Manifest parse_manifest(const std::string& text) {
   const Json& files = doc.at("files", "manifest");
   const Json& tri = files.at("skin_triangles", "files");
   m.skin_triangles_file = tri.at("path", "files.skin_triangles").string("files.skin_triangles.path");
+  m.skin_triangles_sha256 = sha256_of(tri, "files.skin_triangles");
   check(tri.at("dtype", "files.skin_triangles").string("dtype") == "int32", "files.skin_triangles.dtype must be int32");
   check(shape_of(tri.at("shape", "files.skin_triangles"), "files.skin_triangles.shape") ==
             std::vector<std::int64_t>{m.skin_triangles, 3},
         "files.skin_triangles.shape must be [template.skin_triangles, 3]");
   const Json& bones = files.at("non_skin_bones", "files");
   m.non_skin_bones_file = bones.at("path", "files.non_skin_bones").string("files.non_skin_bones.path");
+  m.non_skin_bones_sha256 = sha256_of(bones, "files.non_skin_bones");
   check(bones.at("dtype", "files.non_skin_bones").string("dtype") == "uint8", "files.non_skin_bones.dtype must be uint8");
   const auto bone_shape = shape_of(bones.at("shape", "files.non_skin_bones"), "files.non_skin_bones.shape");
   const std::int64_t non_skin = m.head_vertices - m.skin_vertices;
@@ -221,6 +231,7 @@ Manifest parse_manifest(const std::string& text) {
     NetworkSpec n;
     n.key = key;
     n.file = j.at("file", what).string(what + ".file");
+    n.sha256 = sha256_of(j, what);
     if (j.has("parameter_columns")) {
       for (const Json& c : j.at("parameter_columns", what).array(what + ".parameter_columns")) {
         const int idx = m.find_parameter(c.string(what + ".parameter_columns"));

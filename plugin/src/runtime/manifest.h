@@ -25,6 +25,7 @@ struct TensorSpec {
 struct NetworkSpec {
   std::string key;  // "softdeca.f_ph", ...
   std::string file;
+  std::string sha256;  // lower-case hex, checked before the file is used
   std::vector<TensorSpec> inputs, outputs;
   std::vector<int> parameter_columns;  // indices into Manifest::parameters
 };
@@ -53,6 +54,7 @@ struct Manifest {
   std::vector<LandmarkSpec> landmarks;
   std::vector<int> jaw_anchors;
   std::string skin_triangles_file, non_skin_bones_file;
+  std::string skin_triangles_sha256, non_skin_bones_sha256;
   double dt_regularisation = 0;
   double frame_rate_hz = 0;
   double beta_max = 0, gamma_min = 0, gamma_max = 0;

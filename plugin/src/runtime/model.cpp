@@ -1,8 +1,12 @@
 #include "runtime/model.h"
 
+#include <cstdint>
 #include <cstring>
+#include <iterator>
 
 #include "core/error.h"
+#include "runtime/onnx_model_scan.h"
+#include "runtime/sha256.h"
 
 namespace softdeca::runtime {
 
@@ -11,6 +15,47 @@ namespace {
 
 const char* const kNetworkKeys[] = {"identity_encoder", "softdeca.f_w", "softdeca.f_ph", "softdeca.f_dyn",
                                     "sparse.f_l",       "sparse.f_ph_v", "sparse.f_dyn"};
+
+std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
+
+// A name from the file, made safe to print: printable ASCII, at most 64 characters.
+std::string printable(const std::string& name) {
+  std::string out;
+  for (const char c : name.substr(0, 64)) out += (c >= 32 && c < 127) ? c : '?';
+  return name.size() > 64 ? out + "..." : out;
+}
+
+// The file's bytes, once their sha256 matches the manifest's.
+const Bytes& verified(const BundleFiles& files, const std::string& name, const std::string& sha256) {
+  const Bytes& bytes = files.get(name);
+  if (sha256_hex(bytes.data(), bytes.size()) != sha256)
+    fail(name + ": sha256 does not match the manifest (the file was changed or damaged)");
+  return bytes;
+}
+
+std::uint64_t add_sat(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+
+// Refuses external data and adds what the network may allocate to the estimate.
+void scan_network(const Bytes& bytes, const NetworkSpec& spec, MemoryEstimate& estimate) {
+  const OnnxModelScan scan = [&] {
+    try {
+      return scan_onnx_model(bytes.data(), bytes.size());
+    } catch (const Error& e) {
+      fail(spec.file + ": " + e.what());
+    }
+  }();
+  if (!scan.external_tensors.empty())
+    fail(spec.file + ": tensor '" + printable(scan.external_tensors.front()) +
+         "' keeps its data in another file (ONNX external data); a bundle's networks must hold all their data");
+  std::uint64_t contract = 0;
+  for (const auto* side : {&spec.inputs, &spec.outputs})
+    for (const TensorSpec& t : *side) contract = add_sat(contract, OnnxNetwork::element_count(t, 1) * sizeof(float));
+  estimate.bytes = add_sat(estimate.bytes, add_sat(scan.total_bytes(), contract));
+  if (scan.largest_bytes > estimate.largest_bytes) {
+    estimate.largest_bytes = scan.largest_bytes;
+    estimate.largest = spec.file + " tensor '" + printable(scan.largest_tensor) + "'";
+  }
+}
 }  // namespace
 
 std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOptions& options) {
@@ -19,7 +64,7 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
   m->manifest_ = parse_manifest(std::string(manifest_bytes.begin(), manifest_bytes.end()));
   const Manifest& mf = m->manifest_;
 
-  const Bytes& tri = files.get(mf.skin_triangles_file);
+  const Bytes& tri = verified(files, mf.skin_triangles_file, mf.skin_triangles_sha256);
   const std::size_t n_idx = static_cast<std::size_t>(mf.skin_triangles) * 3;
   if (tri.size() != n_idx * sizeof(std::int32_t))
     fail(mf.skin_triangles_file + ": " + std::to_string(tri.size()) + " bytes, expected " +
@@ -42,7 +87,7 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
     if (!used[v]) fail(mf.skin_triangles_file + ": skin vertex " + std::to_string(v) + " is in no triangle");
 
   const std::size_t non_skin = static_cast<std::size_t>(mf.head_vertices - mf.skin_vertices);
-  const Bytes& bones = files.get(mf.non_skin_bones_file);
+  const Bytes& bones = verified(files, mf.non_skin_bones_file, mf.non_skin_bones_sha256);
   if (bones.size() != non_skin)
     fail(mf.non_skin_bones_file + ": " + std::to_string(bones.size()) + " bytes, expected " + std::to_string(non_skin));
   bool any_jaw = false;
@@ -53,19 +98,39 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
   if (any_jaw && mf.jaw_anchors.size() < 3) fail("manifest: jaw vertices need at least 3 non_skin.jaw_anchors");
   m->non_skin_bones_.assign(bones.begin(), bones.end());
 
+  // Every network is verified and scanned before the first session exists: nothing a bundle
+  // declares is allocated until the whole bundle fits the budget.
+  MemoryEstimate estimate;
+  std::vector<const Bytes*> network_bytes;
+  for (const char* key : kNetworkKeys) {
+    const auto it = mf.networks.find(key);
+    if (it == mf.networks.end()) {
+      network_bytes.push_back(nullptr);
+      continue;
+    }
+    network_bytes.push_back(&verified(files, it->second.file, it->second.sha256));
+    scan_network(*network_bytes.back(), it->second, estimate);
+  }
+  const std::uint64_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : kDefaultMemoryBudget;
+  if (estimate.bytes > budget)
+    fail("the bundle's networks need an estimated " + mib(estimate.bytes) + " (largest: " + estimate.largest + ", " +
+         mib(estimate.largest_bytes) + "), over the memory budget of " + mib(budget) +
+         " (softdeca_model_options.memory_budget_mib; C++ ModelOptions::memory_budget_bytes)");
+
   try {
     m->env_ = std::make_unique<Ort::Env>(ORT_LOGGING_LEVEL_ERROR, "softdeca");
   } catch (const Ort::Exception& e) {
     throw Error(SOFTDECA_ERROR_INTERNAL, std::string("ONNX Runtime environment: ") + e.what());
   }
-  for (const char* key : kNetworkKeys) {
+  for (std::size_t k = 0; k < std::size(kNetworkKeys); ++k) {
+    const char* key = kNetworkKeys[k];
     const auto it = mf.networks.find(key);
     if (it == mf.networks.end()) {
       m->networks_.emplace_back();
       continue;
     }
     const bool per_frame = std::strcmp(key, "softdeca.f_w") == 0 || std::strcmp(key, "sparse.f_l") == 0;
-    m->networks_.push_back(std::make_unique<OnnxNetwork>(*m->env_, files.get(it->second.file), it->second,
+    m->networks_.push_back(std::make_unique<OnnxNetwork>(*m->env_, *network_bytes[k], it->second,
                                                          per_frame ? 1 : options.prepare_threads));
   }
   return m;

@@ -16,12 +16,27 @@
 
 namespace softdeca::runtime {
 
+constexpr std::uint64_t kDefaultMemoryBudget = std::uint64_t{2} << 30;
+
 struct ModelOptions {
   int prepare_threads = 1;  // intra-op threads of the per-avatar networks (f_ph, f_ph_v, f_dyn)
+  // Upper bound on what the bundle's networks may ask for (initializers, declared tensor
+  // shapes, constant-shaped outputs, the contract's tensors), checked before any ONNX Runtime
+  // session is created.
+  std::uint64_t memory_budget_bytes = kDefaultMemoryBudget;
+};
+
+// The estimate the budget is checked against, with the largest single tensor for messages.
+struct MemoryEstimate {
+  std::uint64_t bytes = 0;
+  std::string largest;  // "<file> tensor '<name>'"
+  std::uint64_t largest_bytes = 0;
 };
 
 class Model {
  public:
+  // Checks every file's sha256 against the manifest, refuses ONNX files with external data
+  // and bundles over the memory budget, all before creating a session. Throws Error(FORMAT).
   static std::shared_ptr<const Model> load(const BundleFiles& files, const ModelOptions& options);
 
   const Manifest& manifest() const { return manifest_; }

@@ -95,21 +95,16 @@ void ParameterState::column(const Value& v, bool faces, std::vector<float>& out)
   }
 }
 
-void ParameterState::face_matrix(const std::vector<int>& columns, float* out) const {
-  std::vector<float> col;
-  const std::size_t p = columns.size();
-  for (std::size_t c = 0; c < p; ++c) {
-    column(values_.at(static_cast<std::size_t>(columns[c])), true, col);
-    for (std::size_t f = 0; f < n_faces_; ++f) out[f * p + c] = col[f];
-  }
-}
+void ParameterState::face_matrix(const std::vector<int>& columns, float* out) const { matrix(columns, true, out); }
 
-void ParameterState::vertex_matrix(const std::vector<int>& columns, float* out) const {
+void ParameterState::vertex_matrix(const std::vector<int>& columns, float* out) const { matrix(columns, false, out); }
+
+void ParameterState::matrix(const std::vector<int>& columns, bool faces, float* out) const {
   std::vector<float> col;
-  const std::size_t p = columns.size();
+  const std::size_t p = columns.size(), rows = faces ? n_faces_ : n_vertices_;
   for (std::size_t c = 0; c < p; ++c) {
-    column(values_.at(static_cast<std::size_t>(columns[c])), false, col);
-    for (std::size_t i = 0; i < n_vertices_; ++i) out[i * p + c] = col[i];
+    column(values_.at(static_cast<std::size_t>(columns[c])), faces, col);
+    for (std::size_t r = 0; r < rows; ++r) out[r * p + c] = col[r];
   }
 }
 

@@ -40,6 +40,8 @@ class ParameterState {
   void check_index(int index) const;
   void check_values(int index, const float* values, std::size_t count, std::size_t expected, const char* what) const;
   void column(const Value& v, bool faces, std::vector<float>& out) const;
+  // [rows][columns.size()] row-major, one row per face (faces) or vertex.
+  void matrix(const std::vector<int>& columns, bool faces, float* out) const;
 
   const std::vector<ParameterSpec>* specs_;
   const std::vector<std::int32_t>* triangles_;

@@ -59,14 +59,35 @@ struct CollisionResult {
   Positions skin;  // S after resolution
   int penetrating_before = 0, penetrating_after = 0, contacts = 0, rounds = 0, iterations = 0;
   double max_contact_gap = 0;  // largest distance between the two sides of a contact (m)
+  double max_correction = 0;   // largest move of a skin point by the kept round (m)
+  // Rounds stopped because they moved a point farther than the deepest penetration explains,
+  // and the largest move any round made (m).
+  int rejected_rounds = 0;
+  double largest_round_correction = 0;
   double seconds = 0;
 };
 
+// Lip points' targets for the surface step: S_t (or the blended target of eq. 9) and the
+// target term's element weights (W / 2, J/m^2) per skin point. The layered head model's
+// wraps close over the mouth, so the soft-tissue tets under the lips hold both lips: the
+// volumetric solve cannot open a mouth, and the lips are placed on S instead, where they are
+// separate surfaces.
+struct LipTargets {
+  Positions targets;
+  Eigen::VectorXd weight;
+};
+
 // Detect, tie, solve on S, repeat (at most settings.collision_rounds times). Contacts persist
-// across rounds, one per (set, point), moved to the newest closest point.
+// across rounds, one per (set, point), moved to the newest closest point. The result is the
+// round with the fewest penetrating points among those that reduce them and move no point
+// farther than twice the deepest initial penetration (+ 1 mm); otherwise the uncorrected skin. With
+// `lips`, the collision sets' points first follow their targets on S (strain relative to the
+// targets' shape, the solved skin pinned around the lip region), every frame, and the contacts
+// correct that.
 CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
                                    const Positions& vertices, const Eigen::VectorXd& skin_area,
-                                   const SolverSettings& settings, ThreadPool* pool);
+                                   const SolverSettings& settings, ThreadPool* pool,
+                                   const LipTargets* lips = nullptr);
 
 // Closest point of triangle (a, b, c) to p as barycentric coordinates (Ericson 2004, 5.1.5).
 Eigen::Vector3d closest_point_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,

@@ -21,6 +21,30 @@ void check_positions(const Positions& p, Eigen::Index rows, const char* what) {
                     std::string(what) + "[" + std::to_string(i) + "][" + std::to_string(c) + "] is not finite");
 }
 
+// Tets whose signed volume is not positive: the projections bring an inverted element back,
+// so one left at the end of a solve is a failed frame, reported rather than hidden.
+int inverted_tets(const TetIndices& tets, const Positions& x) {
+  int n = 0;
+  for (Eigen::Index t = 0; t < tets.rows(); ++t) {
+    const Eigen::Vector3d a = x.row(tets(t, 0)).transpose();
+    const Eigen::Vector3d e1 = x.row(tets(t, 1)).transpose() - a, e2 = x.row(tets(t, 2)).transpose() - a,
+                          e3 = x.row(tets(t, 3)).transpose() - a;
+    n += e1.dot(e2.cross(e3)) <= 0 ? 1 : 0;
+  }
+  return n;
+}
+
+// The skin target term's element weights (W / 2) per skin point, from the model's group.
+Eigen::VectorXd skin_target_weights(const Model& m) {
+  for (std::size_t g = 0; g < m.groups.size(); ++g)
+    if (m.row_offset[g] == m.skin_row) {
+      Eigen::VectorXd w(m.groups[g]->rows());
+      m.groups[g]->weights(w);
+      return 0.5 * w;
+    }
+  return {};
+}
+
 void fill_rows(Positions& P, Eigen::Index first, const Positions& values) {
   if (first >= 0 && values.rows() > 0) P.middleRows(first, values.rows()) = values;
 }
@@ -101,17 +125,29 @@ FrameResult Simulator::solve_frame(const Prepared& prep, const FrameInput& in, c
   r.skin = embed(mesh_.skin, x);
   // Collisions: a further projective step on S, until no point penetrates (3.3.2).
   if (!mesh_.collisions.empty()) {
-    CollisionResult c = resolve_collisions(mesh_, collision_topology_, r.skin, x, prep.model.skin_area, settings_, pool);
+    LipTargets lips;
+    if (settings_.lips_follow_targets && prep.model.skin_row >= 0) {
+      lips.targets = skin_targets;
+      lips.weight = skin_target_weights(prep.model);
+    }
+    CollisionResult c = resolve_collisions(mesh_, collision_topology_, r.skin, x, prep.model.skin_area, settings_, pool,
+                                           lips.targets.rows() ? &lips : nullptr);
     r.skin = std::move(c.skin);
     r.stats.penetrating_before = c.penetrating_before;
     r.stats.penetrating_after = c.penetrating_after;
     r.stats.contacts = c.contacts;
     r.stats.collision_rounds = c.rounds;
     r.stats.max_contact_gap = c.max_contact_gap;
+    r.stats.max_contact_correction = c.max_correction;
+    r.stats.rejected_collision_rounds = c.rejected_rounds;
     r.stats.collision_seconds = c.seconds;
   }
-  if (skin_targets.rows() > 0)
-    r.stats.target_rms = std::sqrt((r.skin - skin_targets).rowwise().squaredNorm().mean());
+  if (skin_targets.rows() > 0) {
+    const Eigen::VectorXd d2 = (r.skin - skin_targets).rowwise().squaredNorm();
+    r.stats.target_rms = std::sqrt(d2.mean());
+    r.stats.max_target_distance = std::sqrt(d2.maxCoeff());
+  }
+  r.stats.inverted_elements = inverted_tets(mesh_.soft_tets, x) + inverted_tets(mesh_.muscle_tets, x);
   r.vertices = std::move(x);
   r.stats.total_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r;

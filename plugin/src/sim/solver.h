@@ -31,6 +31,10 @@ struct SolverSettings {
   double collision_weight = 1e6;
   int collision_rounds = 30;
   double penetration_tolerance = 1e-5;
+  // The collision sets' points (the lips) follow their targets on S in the collision step,
+  // every frame, with the target term's weights (collisions.h, LipTargets); false: the lips
+  // keep the volumetric result and only penetrations are corrected.
+  bool lips_follow_targets = true;
 };
 
 // Throws Error when a setting is out of range.
@@ -46,10 +50,14 @@ struct SolveStats {
   std::vector<double> energy_history;  // per accepted iterate, when recorded
   int anderson_rejections = 0;
   double target_rms = 0;     // RMS distance of the skin points to their (blended) targets (m)
+  double max_target_distance = 0;  // largest distance of a skin point to its (blended) target (m)
+  int inverted_elements = 0;       // soft and muscle tets with volume <= 0 at the end of the solve
   double local_seconds = 0, global_seconds = 0, factor_seconds = 0, total_seconds = 0;
   // Collisions: penetrating points before and after resolution, contacts used, rounds.
   int penetrating_before = 0, penetrating_after = 0, contacts = 0, collision_rounds = 0;
   double max_contact_gap = 0;  // largest distance between the two points of a contact (m)
+  double max_contact_correction = 0;  // largest move of a skin point by the contact step (m)
+  int rejected_collision_rounds = 0;  // rounds that moved points beyond the penetration depth
   double collision_seconds = 0;
 };
 

@@ -19,9 +19,20 @@ constexpr std::size_t kLatencyWindow = 2048;
 constexpr std::size_t kMaxProfiles = 16;
 constexpr double kRequestInterval = 1.0;  // at most one profile request per second
 
+bool is_loopback(const std::string& address) {
+  return address.compare(0, 4, "127.") == 0 || address == "::1" || address == "[::1]";
+}
+
 const ReceiverConfig& checked(const ReceiverConfig& c) {
   require(std::isfinite(c.delay) && c.delay >= 0 && c.delay <= 5, "jitter delay must be in [0, 5] seconds");
   require(c.queue_capacity >= 1 && c.queue_capacity <= 65536, "queue capacity must be in [1, 65536]");
+  require(std::isfinite(c.session_hold) && c.session_hold > 0 && c.session_hold <= 3600,
+          "session hold must be in (0, 3600] seconds");
+  require(std::isfinite(c.source_rate_limit) && c.source_rate_limit >= 0 && c.source_rate_limit <= 100000,
+          "source rate limit must be in [0, 100000] datagrams per second");
+  require(c.listen_network || is_loopback(c.bind_address),
+          "binding " + c.bind_address + " listens on the network: that needs listen_network (CLI: --listen)");
+  require(c.recording_queue >= 16 && c.recording_queue <= 65536, "recording queue must be in [16, 65536] records");
   require(c.format == Format::automatic || c.format == Format::softdeca || c.format == Format::livelinkface ||
               c.format == Format::ifacialmocap,
           "unknown stream format");
@@ -31,7 +42,10 @@ const ReceiverConfig& checked(const ReceiverConfig& c) {
 }  // namespace
 
 Receiver::Receiver(const ReceiverConfig& config)
-    : config_(checked(config)), socket_(config.bind_address, config.port), jitter_(config.delay) {
+    : config_(checked(config)),
+      socket_(config.bind_address, config.port),
+      jitter_(config.delay),
+      rate_limit_(config.source_rate_limit) {
   port_ = socket_.local_port();
   thread_ = std::thread([this] { run(); });
 }
@@ -59,10 +73,20 @@ void Receiver::run() {
     for (int i = 0; i < 256 && socket_.receive(buffer.data(), buffer.size(), size, from); ++i)
       handle(buffer.data(), std::min(size, buffer.size()), from, steady_seconds());
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  Frame f;
-  while (jitter_.pop_any(f)) deliver(f, steady_seconds());
-  recorder_.reset();
+  std::unique_ptr<recording::BackgroundRecorder> recorder;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Frame f;
+    while (jitter_.pop_any(f)) deliver(f, steady_seconds());
+    recorder = std::move(recorder_);
+  }
+  if (recorder) {  // the disk may be slow: written outside the lock
+    const std::string error = recorder->finish();
+    std::lock_guard<std::mutex> lock(mutex_);
+    frames_recorded_ = recorder->frames_written();
+    recording_dropped_before_ += recorder->dropped();
+    if (recording_error_.empty()) recording_error_ = error;
+  }
 }
 
 void Receiver::count_drop(DropReason reason) {
@@ -79,15 +103,38 @@ void Receiver::count_drop(DropReason reason) {
   ++stats_.malformed;
 }
 
+// Before anything is decoded: the source's rate, then whether another sender holds the
+// session (it does until it has been quiet for session_hold seconds).
+bool Receiver::admit(const Endpoint& from, double now) {
+  ++stats_.datagrams;
+  if (!rate_limit_.allow(from, now)) {
+    ++stats_.rate_limited;
+    return false;
+  }
+  if (have_holder_ && !config_.follow_newest && now - holder_heard_ < config_.session_hold &&
+      endpoint_key(from) != holder_) {
+    ++stats_.foreign;
+    return false;
+  }
+  return true;
+}
+
 void Receiver::handle(const uint8_t* data, std::size_t size, const Endpoint& from, double now) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!admit(from, now)) return;
+  }
   Datagram d;
   const wire::Verdict verdict = decode_datagram(data, size, config_.format, d);
   std::lock_guard<std::mutex> lock(mutex_);
-  ++stats_.datagrams;
   if (verdict.reason != DropReason::none) {
     count_drop(verdict.reason);
     return;
   }
+  // A well-formed datagram: its sender holds the session from now on.
+  have_holder_ = true;
+  holder_ = endpoint_key(from);
+  holder_heard_ = now;
   // Only our protocol names its session; the others are told apart by device (Live Link Face)
   // or by the sender's address (iFacialMocap).
   uint32_t session = d.message.envelope.session_id;
@@ -118,7 +165,7 @@ void Receiver::handle(const uint8_t* data, std::size_t size, const Endpoint& fro
       const bool fresh = profiles_.find(p.id) == profiles_.end();
       profiles_[p.id] = p;
       newest_profile_ = p.id;
-      if (fresh) record([&](recording::RecordingWriter& w) { w.write_profile(p); });
+      if (fresh && recorder_) recorder_->push(p);
       break;
     }
     case wire::MessageType::neutral_chunk: {
@@ -126,7 +173,7 @@ void Receiver::handle(const uint8_t* data, std::size_t size, const Endpoint& fro
       std::vector<float> xyz;
       if (assembler_.add(d.message.neutral, xyz) && xyz != neutral_) {
         neutral_ = std::move(xyz);
-        record([&](recording::RecordingWriter& w) { w.write_neutral(neutral_); });
+        if (recorder_) recorder_->push(neutral_);
       }
       break;
     }
@@ -194,22 +241,8 @@ void Receiver::deliver(const Frame& f, double now) {
   if (latencies_.size() > kLatencyWindow) latencies_.pop_front();
   delivery_times_.push_back(now);
   if (delivery_times_.size() > kRateWindow) delivery_times_.pop_front();
-  record([&](recording::RecordingWriter& w) {
-    w.write(f);
-    ++frames_recorded_;
-  });
+  if (recorder_) recorder_->push(f);  // never waits for the disk
   delivered_cv_.notify_all();
-}
-
-template <class F>
-void Receiver::record(F&& write) {
-  if (!recorder_) return;
-  try {
-    write(*recorder_);
-  } catch (const std::exception& e) {  // a full disk ends the recording, not the stream
-    recording_error_ = e.what();
-    recorder_.reset();
-  }
 }
 
 void Receiver::send_request(wire::RequestKind what, uint32_t id) {
@@ -253,6 +286,7 @@ ReceiverStats Receiver::stats() const {
   const std::vector<double> lat(latencies_.begin(), latencies_.end());
   s.latency_p50_ms = 1000.0 * percentile(lat, 0.5);
   s.latency_p99_ms = 1000.0 * percentile(lat, 0.99);
+  s.recording_dropped = recording_dropped_before_ + (recorder_ ? recorder_->dropped() : 0);
   return s;
 }
 
@@ -282,25 +316,42 @@ bool Receiver::request_neutral() {
 
 void Receiver::start_recording(const std::string& path, const recording::Header& header) {
   auto writer = std::make_unique<recording::RecordingWriter>(path, header);  // may throw: no lock held
-  std::lock_guard<std::mutex> lock(mutex_);
-  // What the stream already told us goes in first, so that the file is complete on its own.
-  if (!header.has_profile)
-    for (const auto& [id, p] : profiles_) writer->write_profile(p);
-  if (header.neutral.empty() && !neutral_.empty()) writer->write_neutral(neutral_);
-  recorder_ = std::move(writer);
-  recording_error_.clear();
-  frames_recorded_ = 0;
+  auto recorder = std::make_unique<recording::BackgroundRecorder>(std::move(writer), config_.recording_queue);
+  std::unique_ptr<recording::BackgroundRecorder> previous;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // What the stream already told us goes in first, so that the file is complete on its own
+    // (at most kMaxProfiles + 1 records: the queue holds them).
+    if (!header.has_profile)
+      for (const auto& [id, p] : profiles_) recorder->push(p);
+    if (header.neutral.empty() && !neutral_.empty()) recorder->push(neutral_);
+    previous = std::move(recorder_);
+    recorder_ = std::move(recorder);
+    recording_error_.clear();
+    frames_recorded_ = 0;
+  }
+  if (previous) previous->finish();
 }
 
 std::string Receiver::stop_recording() {
+  std::unique_ptr<recording::BackgroundRecorder> recorder;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    recorder = std::move(recorder_);
+  }
+  const std::string error = recorder ? recorder->finish() : std::string();  // outside the lock
   std::lock_guard<std::mutex> lock(mutex_);
-  recorder_.reset();
+  if (recorder) {
+    frames_recorded_ = recorder->frames_written();
+    recording_dropped_before_ += recorder->dropped();
+    if (recording_error_.empty()) recording_error_ = error;
+  }
   return recording_error_;
 }
 
 std::size_t Receiver::frames_recorded() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return frames_recorded_;
+  return recorder_ ? recorder_->frames_written() : frames_recorded_;
 }
 
 }  // namespace softdeca::stream

@@ -1,7 +1,11 @@
 // The stream receiver: a background thread reads datagrams from a UDP socket, decodes them
 // (datagram_decoder.h), drops and counts what is malformed, duplicated or late, tracks loss
 // per sender session, orders frames in a jitter buffer, and hands them out in capture order.
-// Optionally it records every delivered frame (recording_writer.h) from the same thread.
+// It listens on loopback unless told otherwise; the first sender holds the session until it
+// has been quiet for `session_hold` seconds (others are counted and dropped), and every source
+// is rate limited (docs/security.md). Optionally it records every delivered frame through a
+// bounded queue to a writer thread (background_recorder.h): a slow disk drops recorded
+// frames, never stalls the receive thread or a poll.
 #pragma once
 
 #include <atomic>
@@ -16,22 +20,28 @@
 #include <thread>
 #include <vector>
 
-#include "recording/recording_writer.h"
+#include "recording/background_recorder.h"
 #include "stream/datagram_decoder.h"
 #include "stream/jitter_buffer.h"
 #include "stream/neutral_assembler.h"
 #include "stream/receiver_stats.h"
 #include "stream/sequence_tracker.h"
+#include "stream/source_rate_limit.h"
 #include "stream/udp_socket.h"
 
 namespace softdeca::stream {
 
 struct ReceiverConfig {
-  std::string bind_address = "0.0.0.0";
+  std::string bind_address = "127.0.0.1";  // numeric; not loopback only with listen_network
+  bool listen_network = false;             // an explicit choice to accept datagrams from other hosts
   uint16_t port = 50110;  // 0: any free port (see Receiver::port)
   Format format = Format::automatic;
   double delay = 0;                  // jitter buffer delay in seconds, [0, 5]; 0: at once
   std::size_t queue_capacity = 256;  // delivered frames kept for next()
+  double session_hold = 2.0;         // seconds, (0, 3600]: a quiet sender keeps the session this long
+  bool follow_newest = false;        // true: any new sender takes the session at once
+  double source_rate_limit = 1000;   // datagrams per second per source, [0, 100000]; 0: no limit
+  std::size_t recording_queue = 256; // records waiting for the disk, [16, 65536]
 };
 
 class Receiver {
@@ -70,9 +80,8 @@ class Receiver {
   void on_frame(Frame frame, const Datagram& datagram, double now);
   void release_due(double now);
   void deliver(const Frame& frame, double now);
+  bool admit(const Endpoint& from, double now);
   void send_request(wire::RequestKind what, uint32_t id);
-  template <class F>
-  void record(F&& write);
 
   ReceiverConfig config_;
   UdpSocket socket_;
@@ -105,9 +114,14 @@ class Receiver {
   double last_profile_request_ = -1e9;
   std::deque<double> delivery_times_;  // recent, for the rate
   std::deque<double> latencies_;       // recent, seconds
-  std::unique_ptr<recording::RecordingWriter> recorder_;
+  SourceRateLimit rate_limit_;
+  bool have_holder_ = false;  // the sender that holds the session, and when it was last heard
+  std::string holder_;
+  double holder_heard_ = 0;
+  std::unique_ptr<recording::BackgroundRecorder> recorder_;
   std::string recording_error_;
-  std::size_t frames_recorded_ = 0;
+  std::size_t frames_recorded_ = 0;   // of the last recording, once it has ended
+  uint64_t recording_dropped_before_ = 0;
 };
 
 }  // namespace softdeca::stream

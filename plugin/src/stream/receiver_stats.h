@@ -29,6 +29,9 @@ struct ReceiverStats {
   uint64_t session_changes = 0;
   uint64_t clock_resyncs = 0;  // the sender's capture clock jumped
   uint64_t requests_sent = 0;  // profile or neutral requests to the sender
+  uint64_t foreign = 0;        // dropped: from another sender while the session was held
+  uint64_t rate_limited = 0;   // dropped: over the per-source rate limit
+  uint64_t recording_dropped = 0;  // delivered frames (and records) the disk could not take
   double frame_rate_hz = 0;    // delivered frames per second, over the last ~2 s
   double loss_ratio = 0;       // lost / expected
   double latency_p50_ms = 0;   // arrival at the socket -> frame available, recent frames

@@ -34,6 +34,7 @@ def _config(kind: str, shards: int, level: int) -> GenerateConfig:
 def bench_datagen(ict: str | None, level: int, workers: int, shards: int) -> dict:
     cores = os.cpu_count() or 1
     rates, sizes, secs = {}, {}, {}
+    judged = failed = 0
     for kind in tqdm(("static", "dynamic", "sparse"), desc="datagen bench", unit="kind"):
         cfg = _config(kind, shards, level)
         with tempfile.TemporaryDirectory() as tmp:
@@ -42,6 +43,8 @@ def bench_datagen(ict: str | None, level: int, workers: int, shards: int) -> dic
                 cfg, RunSettings(out=Path(tmp) / kind, workers=workers, ict=ict, progress=False)
             )
             wall = time.perf_counter() - t0
+        judged += summary["frames_judged"]
+        failed += summary["failures"].get("failed_frames", 0)
         k = summary["kinds"][kind]
         rates[kind] = k["instances"] * 3600 / wall
         sizes[kind] = k["bytes_per_instance"]
@@ -61,6 +64,12 @@ def bench_datagen(ict: str | None, level: int, workers: int, shards: int) -> dic
         f"{d.sequence_length} (+{d.lead_in} lead-in) at the measured rates"
     )
     return {
+        "datagen.failed_fraction": figure(
+            failed / judged if judged else float("nan"),
+            "share",
+            how + f"; frames failing the sanity bounds (docs/physics.md) of {judged} judged",
+            target=0.001,
+        ),
         "datagen.instances_per_hour": figure(
             rates["static"], "1/h", how + "; static frames", better="higher"
         ),

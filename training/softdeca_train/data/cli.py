@@ -101,9 +101,10 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         help=f"landmark noise sigma, mm ({D.landmark_noise_mm})",
     )
     g.add_argument(
-        "--collisions",
-        action="store_true",
-        help="simulate the lip/teeth collision sets (off: they distort real lips for now)",
+        "--no-collisions",
+        dest="collisions",
+        action="store_false",
+        help="skip the lip/teeth collision sets and the lips on S (on by default)",
     )
     g.add_argument(
         "--tolerance", type=float, default=D.tolerance, help=f"solver tolerance ({D.tolerance})"

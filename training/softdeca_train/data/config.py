@@ -51,9 +51,8 @@ class GenerateConfig:
     test_take: str = "facial"  # Live Link Face take held out entirely for the test split
     landmark_noise_mm: float = 1.0  # sigma of the coordinate-wise Gaussian noise (eq. 24)
     identity_scale: float = 1.0  # identity coefficients h ~ N(0, scale^2) (plausible only)
-    # Lip/teeth collision sets (paper 3.3.2). Off until they behave on real heads: with them
-    # on, lips pressed together distort (see the physics issue); switching on is this flag.
-    collisions: bool = False
+    # Lip/teeth collision sets (paper 3.3.2) and the lips placed on S (docs/physics.md).
+    collisions: bool = True
     tolerance: float = 1e-4  # solver convergence (relative to the head's bounding box)
     # Stiff/soft extremes of p converge slowly or stall just above the tolerance (measured:
     # estimated error ~1.2e-4 after 300 iterations): past this the frame is kept with its

@@ -31,6 +31,12 @@ FRAME = {
         "(n,)",
         "solver's estimated RMS distance to the fixed point / bounding-box diagonal",
     ),
+    "failures": (
+        "uint8",
+        "(n,)",
+        "sanity bounds failed, bit i: sim/sanity.py REASONS[i] (exploded, penetration, "
+        "mouth_open_ratio, inverted_elements, volume, not_converged); 0: passes",
+    ),
 }
 SPARSE = {
     "landmarks": (

@@ -169,6 +169,15 @@ def summarise(m: Manifest) -> dict:
     out["rms_quantisation_error_mm"] = float(f"{np.sqrt(sq / nq) * 1e3:.3g}") if nq else None
     out["max_offset_mm"] = round(max(mags) * 1e3, 3) if mags else None
     out["bytes"] = sum(s["bytes"] for s in shards)
+    # The sanity bounds (docs/physics.md): frames failing each, over the judged frames.
+    judged = sum(s.get("frames_judged", 0) for s in shards)
+    failures: dict[str, int] = {}
+    for s in shards:
+        for reason, count in s.get("failures", {}).items():
+            failures[reason] = failures.get(reason, 0) + count
+    out["frames_judged"] = judged
+    out["failures"] = failures
+    out["failed_fraction"] = round(failures.get("failed_frames", 0) / judged, 6) if judged else None
     return out
 
 

@@ -18,6 +18,8 @@ from softdeca_train.landmarks import SurfaceLandmarks, template_landmarks
 from softdeca_train.lhm import LhmConfig
 from softdeca_train.parameters import load_parameters
 from softdeca_train.sim import HeadSimulation, build_head_simulation
+from softdeca_train.sim.measures import SoftVolume
+from softdeca_train.sim.sanity import REASONS, check_frame
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
@@ -81,6 +83,7 @@ class _Shard:
         self.quant_values = 0
         self.max_offset = 0.0
         self.frames = 0
+        self.failures = dict.fromkeys((*REASONS, "failed_frames"), 0)
 
     def add(self, **arrays: np.ndarray) -> None:
         for k, v in arrays.items():
@@ -93,6 +96,23 @@ class _Shard:
         self.quant_values += err.size
         self.max_offset = max(self.max_offset, mag)
         return q
+
+    def judge(
+        self,
+        hs: HeadSimulation,
+        volume: SoftVolume,
+        targets: np.ndarray,
+        solved: list[tuple[np.ndarray, np.ndarray, dict]],
+    ) -> np.ndarray:
+        """Per frame the sanity bounds' failures as a bit mask (bit i: REASONS[i]), counted."""
+        masks = np.zeros(len(solved), np.uint8)
+        for f, (vertices, skin, st) in enumerate(solved):
+            failed = check_frame(hs, volume, targets[f], skin, vertices, st).failures()
+            for r in failed:
+                masks[f] |= 1 << REASONS.index(r)
+                self.failures[r] += 1
+            self.failures["failed_frames"] += bool(failed)
+        return masks
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {k: np.concatenate(v) for k, v in self.cols.items()}
@@ -119,6 +139,7 @@ def _static_group(
     cfg: GenerateConfig,
     out: _Shard,
     sparse: bool,
+    volume: SoftVolume,
 ) -> None:
     w = g.frames.weights
     targets = ctx.blend.targets(hs.head[:N_SKIN], w)
@@ -141,14 +162,13 @@ def _static_group(
             "donor_id": np.full(n, g.donor_id, np.int32),
             "donor_h": np.repeat(donor_h.astype(np.float32)[None], n, axis=0),
         }
-    skins, stats = [], []
-    for f in range(n):
-        _, skin, st = sim.solve_static(
-            targets[f], landmark_targets=None if lmk is None else lmk[f], jaw=jaws[f]
-        )
-        skins.append(skin)
-        stats.append(st)
+    solved = [
+        sim.solve_static(targets[f], landmark_targets=None if lmk is None else lmk[f], jaw=jaws[f])
+        for f in range(n)
+    ]
+    skins, stats = [s[1] for s in solved], [s[2] for s in solved]
     out.add(
+        failures=out.judge(hs, volume, targets, solved),
         param_id=np.full(n, g.param_id, np.int32),
         p=np.repeat(g.p[None], n, axis=0),
         weights=w,
@@ -169,6 +189,7 @@ def _dynamic_group(
     cfg: GenerateConfig,
     out: _Shard,
     names: list[str],
+    volume: SoftVolume,
 ) -> None:
     w = g.frames.weights  # lead-in + sequence
     targets = ctx.blend.targets(hs.head[:N_SKIN], w)
@@ -179,14 +200,14 @@ def _dynamic_group(
     fixed[names.index("dyn_beta")] = cfg.lead_in_beta
     _set_parameters(sim, names, fixed)
     sim.reset_dynamics()
-    skins, stats = [], []
+    solved = []
     for f in range(len(w)):
         if f == lead:  # the sampled dynamics take over, with the lead-in's velocity
             _set_parameters(sim, names, g.p)
-        _, skin, st = sim.step_dynamic(targets[f], jaw=jaws[f])
-        skins.append(skin)
-        stats.append(st)
+        solved.append(sim.step_dynamic(targets[f], jaw=jaws[f]))
+    skins, stats = [s[1] for s in solved], [s[2] for s in solved]
     offsets = out.offsets(np.stack(skins), targets)
+    failures = out.judge(hs, volume, targets[lead:], solved[lead:])
     seq = slice(lead, None)
     st = _stats(stats[lead:])
     out.add(
@@ -199,6 +220,7 @@ def _dynamic_group(
         prev_weights=w[None, lead - 2 : lead],
         prev_offsets=offsets[None, lead - 2 : lead],
         prev_source_index=g.frames.source_index[None, lead - 2 : lead],
+        failures=failures[None],
         **{k: v[None] for k, v in st.items()},
     )
     out.frames += len(w)
@@ -220,14 +242,15 @@ def simulate_shard(
     sim = native.Simulator(
         mesh, tolerance=cfg.tolerance, max_iterations=cfg.max_iterations, threads=threads
     )
+    volume = SoftVolume(hs)
     t_build = time.perf_counter() - t0
     out = _Shard()
     for g in spec.groups:
         if spec.kind == "dynamic":
-            _dynamic_group(ctx, hs, sim, g, cfg, out, names)
+            _dynamic_group(ctx, hs, sim, g, cfg, out, names, volume)
         else:
             _set_parameters(sim, names, g.p)
-            _static_group(ctx, hs, sim, g, cfg, out, sparse)
+            _static_group(ctx, hs, sim, g, cfg, out, sparse, volume)
     arrays = out.arrays()
     n = len(arrays["param_id"])
     arrays = {
@@ -247,6 +270,8 @@ def simulate_shard(
         "quantisation_sq_sum_m2": out.quant_sq_sum,
         "quantisation_values": out.quant_values,
         "max_offset_m": out.max_offset,
+        "frames_judged": int(arrays["failures"].size),
+        "failures": out.failures,
         "simulated_vertices": int(mesh.vertex_count),
         "factorizations": int(sim.factorizations),
     }

@@ -31,37 +31,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from tqdm import tqdm
 
+from softdeca_train.geometry import Similarity, umeyama
 from softdeca_train.landmarks.topology import face_normals, unique_edges, vertex_normals
 
 JAW_68 = tuple(range(0, 17))
 INTERIOR_68 = tuple(range(17, 68))  # brows, nose, eyes, lips
 INNER_LIPS_68 = tuple(range(60, 68))
 CONSTRAINED_68 = tuple(range(17, 60))  # brows, nose, eyes, outer lips
-
-
-@dataclass(frozen=True)
-class Similarity:
-    scale: float
-    rotation: np.ndarray  # (3, 3), det +1
-    translation: np.ndarray  # (3,)
-
-    def apply(self, points: np.ndarray) -> np.ndarray:
-        return self.scale * np.asarray(points) @ self.rotation.T + self.translation
-
-
-def umeyama(src: np.ndarray, dst: np.ndarray, with_scale: bool = True) -> Similarity:
-    """Least-squares similarity dst ≈ s R src + t (Umeyama 1991), a proper rotation."""
-    src, dst = np.asarray(src, float), np.asarray(dst, float)
-    if src.shape != dst.shape or src.ndim != 2 or src.shape[1] != 3 or len(src) < 3:
-        raise ValueError(f"umeyama needs two (N>=3, 3) arrays, got {src.shape} and {dst.shape}")
-    ms, md = src.mean(axis=0), dst.mean(axis=0)
-    a, b = src - ms, dst - md
-    u, sig, vt = np.linalg.svd(b.T @ a / len(src))
-    d = np.ones(3)
-    d[2] = np.sign(np.linalg.det(u @ vt)) or 1.0
-    r = u @ np.diag(d) @ vt
-    s = float((sig * d).sum() / (a**2).sum() * len(src)) if with_scale else 1.0
-    return Similarity(s, r, md - s * r @ ms)
 
 
 @dataclass(frozen=True)

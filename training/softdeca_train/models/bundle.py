@@ -69,6 +69,8 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
     cols = [s.name for s in nets.specs]
     per_vertex = [_tensor("parameters", [v, p]), _tensor("identity", [1, h])]
     dyn_out = [_tensor("alpha", [v]), _tensor("beta", [v]), _tensor("gamma", [v])]
+    # Both models' dynamics networks have the same signature (a copy each: "file" is added below).
+    dynamics = {"inputs": per_vertex, "outputs": dyn_out, "parameter_columns": cols}
     specs: dict[str, dict[str, Any]] = {
         "identity_encoder": {
             "inputs": [_tensor("neutral", [1, v, 3])],
@@ -85,11 +87,7 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
             "outputs": [_tensor("L", [f, lat, 9])],
             "parameter_columns": cols,
         }
-        specs["softdeca.f_dyn"] = {
-            "inputs": per_vertex,
-            "outputs": dyn_out,
-            "parameter_columns": cols,
-        }
+        specs["softdeca.f_dyn"] = dict(dynamics)
     if nets.sparse is not None:
         specs["sparse.f_l"] = {
             "inputs": [_tensor("landmark_offsets", ["batch", 3 * k])],
@@ -100,11 +98,7 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
             "outputs": [_tensor("L", [v, lat, 3])],
             "parameter_columns": cols,
         }
-        specs["sparse.f_dyn"] = {
-            "inputs": per_vertex,
-            "outputs": dyn_out,
-            "parameter_columns": cols,
-        }
+        specs["sparse.f_dyn"] = dict(dynamics)
     for name, spec in specs.items():
         spec["file"] = name.replace(".", "_") + ".onnx"
     return specs

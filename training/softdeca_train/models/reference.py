@@ -16,6 +16,7 @@ from typing import Literal, Protocol
 import numpy as np
 import torch
 
+from softdeca_train.geometry import Similarity, umeyama
 from softdeca_train.models.dt import DtSystem, deformation_transfer, dt_system
 from softdeca_train.models.networks import BundleNetworks
 from softdeca_train.models.parameters import ParameterSpec, ParameterState
@@ -100,28 +101,6 @@ def vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return np.where(length > 0, n / np.where(length > 0, length, 1.0), 0.0)
 
 
-def kabsch(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation R (det +1) and translation t with dst ≈ R src + t."""
-    ms, md = src.mean(axis=0), dst.mean(axis=0)
-    u, _, vt = np.linalg.svd((dst - md).T @ (src - ms))
-    d = np.ones(3)
-    d[2] = np.sign(np.linalg.det(u @ vt)) or 1.0
-    r = u @ np.diag(d) @ vt
-    return r, md - r @ ms
-
-
-def similarity(src: np.ndarray, dst: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """Umeyama: s, R, t with dst ≈ s R src + t."""
-    ms, md = src.mean(axis=0), dst.mean(axis=0)
-    a, b = src - ms, dst - md
-    u, sig, vt = np.linalg.svd(b.T @ a / len(src))
-    d = np.ones(3)
-    d[2] = np.sign(np.linalg.det(u @ vt)) or 1.0
-    r = u @ np.diag(d) @ vt
-    s = float((sig * d).sum() / ((a**2).sum() / len(src)))
-    return s, r, md - s * r @ ms
-
-
 @dataclass
 class Preparation:
     identity: np.ndarray
@@ -161,7 +140,7 @@ class ReferenceAvatar:
         self.neutral_landmarks = definition.landmarks.evaluate(
             self.neutral[:vs], definition.skin_triangles
         )
-        self.calibration: tuple[float, np.ndarray, np.ndarray] | None = None
+        self.calibration: Similarity | None = None
         self.dynamics = False
         self._state: tuple[Model, np.ndarray, np.ndarray] | None = None
         self.prep: Preparation | None = None
@@ -186,7 +165,7 @@ class ReferenceAvatar:
 
     def calibrate(self, user_neutral: np.ndarray) -> None:
         """The user's neutral landmarks (K, 3): similarity user -> avatar neutral landmarks."""
-        self.calibration = similarity(self._select(user_neutral), self.neutral_landmarks)
+        self.calibration = umeyama(self._select(user_neutral), self.neutral_landmarks)
         self._user_neutral = self._select(user_neutral)
 
     def _select(self, points: np.ndarray) -> np.ndarray:
@@ -221,7 +200,7 @@ class ReferenceAvatar:
         u = self._select(points)
         if self.calibration is None:
             return u - self.neutral_landmarks
-        s, r, _ = self.calibration
+        s, r = self.calibration.scale, self.calibration.rotation
         return s * (u - self._user_neutral) @ r.T
 
     def sparse_static(self, points: np.ndarray) -> np.ndarray:
@@ -259,7 +238,8 @@ class ReferenceAvatar:
             jaw = np.nonzero(self.d.non_skin_bones == JAW)[0] + vs
             if len(jaw):
                 a = self.d.jaw_anchors
-                r, t = kabsch(self.neutral[a], skin[a])
+                fit = umeyama(self.neutral[a], skin[a], with_scale=False)
+                r, t = fit.rotation, fit.translation
                 head[jaw] = self.neutral[jaw] @ r.T + t
         return head, vertex_normals(head, self.head_triangles)
 

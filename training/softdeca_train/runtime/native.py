@@ -36,7 +36,11 @@ class NativeError(RuntimeError):
 
 
 class ModelOptions(C.Structure):
-    _fields_ = [("struct_size", C.c_uint32), ("prepare_threads", C.c_uint32)]
+    _fields_ = [
+        ("struct_size", C.c_uint32),
+        ("prepare_threads", C.c_uint32),
+        ("memory_budget_mib", C.c_uint32),
+    ]
 
 
 class ModelInfo(C.Structure):

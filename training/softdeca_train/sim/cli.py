@@ -170,6 +170,16 @@ def run_simulate(args: argparse.Namespace) -> int:
     }
     (out / "simulate.json").write_text(json.dumps(report, indent=2) + "\n")
     print("\n".join(summary_lines(summary, result.seconds)))
+    for frame, r in zip(take.frames, result.records, strict=True):
+        if r.failures:
+            c = r.check
+            print(
+                f"  frame {int(frame)} fails: {', '.join(r.failures)} (max distance to linear "
+                f"{c.max_displacement_mm:.1f} mm, penetrating lip points linear "
+                f"{c.penetrating_linear} / physics {c.penetrating_physics}, mouth opening "
+                f"{c.opening_linear_mm:.1f} -> {c.opening_physics_mm:.1f} mm, inverted tets "
+                f"{c.inverted_elements})"
+            )
     print(
         f"wrote {out}/neutral.obj, linear.pc2, physics.pc2, simulate.json"
         + (", simulate.png" if rendered else "")

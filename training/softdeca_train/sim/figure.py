@@ -35,21 +35,34 @@ def render_comparison(
     notes: list[str] | None = None,
 ) -> Path:
     chosen = pick_frames(linear, physics, frames)
-    dist_mm = {f: 1e3 * np.linalg.norm(physics[f] - linear[f], axis=1) for f in chosen}
-    top = max(float(np.percentile(d, 99.5)) for d in dist_mm.values())
-    focus = Focus.of([MeshLayer(neutral, triangles)])
+    rows = [(neutral, linear[f], physics[f], labels[f]) for f in chosen]
+    return render_rows(path, triangles, rows, size, notes)
+
+
+def render_rows(
+    path: Path,
+    triangles: np.ndarray,
+    rows: list[tuple[np.ndarray, np.ndarray, np.ndarray, str]],
+    size: int = 360,
+    notes: list[str] | None = None,
+) -> Path:
+    """One row per (neutral, linear, physics, label): linear | physics | distance heat map,
+    framed on the first row's neutral."""
+    dist_mm = [1e3 * np.linalg.norm(p - lin, axis=1) for _, lin, p, _ in rows]
+    top = max(float(np.percentile(d, 99.5)) for d in dist_mm)
+    focus = Focus.of([MeshLayer(rows[0][0], triangles)])
     settings = RenderSettings(size=(size, size))
     images, names = [], []
-    for f in chosen:
+    for (_, lin, phys, label), dist in zip(rows, dist_mm, strict=True):
         for title, layer in (
-            ("linear blendshapes", MeshLayer(linear[f], triangles)),
-            ("physics", MeshLayer(physics[f], triangles)),
+            ("linear blendshapes", MeshLayer(lin, triangles)),
+            ("physics", MeshLayer(phys, triangles)),
             (
                 "|physics - linear|",
                 MeshLayer(
-                    physics[f],
+                    phys,
                     triangles,
-                    scalars=dist_mm[f],
+                    scalars=dist,
                     cmap=HEAT_MAP,
                     clim=(0.0, top),
                     scalar_bar="mm",
@@ -57,7 +70,7 @@ def render_comparison(
             ),
         ):
             images.append(render([layer], "three_quarter", settings=settings, focus=focus))
-            names.append(f"{title} - {labels[f]}")
+            names.append(f"{title} - {label}")
     footer = [
         f"heat map: |physics - linear| per vertex, 0 to {top:.2f} mm (99.5th percentile of "
         "the rows; above it at the top colour)",

@@ -6,13 +6,15 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import softdeca_native as native
 from tqdm import tqdm
 
 from softdeca_train.sim.head import HeadSimulation
-from softdeca_train.sim.measures import SoftVolume, mean_distance_mm, penetrating_points
+from softdeca_train.sim.measures import SoftVolume, mean_distance_mm
+from softdeca_train.sim.sanity import FrameCheck, check_frame, failure_counts
 from softdeca_train.template.model import N_SKIN
 
 STAT_KEYS = ("iterations", "converged", "estimated_error", "collision_rounds", "total_seconds")
@@ -29,9 +31,15 @@ class FrameRecord:
     penetrating_linear: int
     penetrating_physics: int
     distance_mm: float
+    check: FrameCheck
 
-    def as_dict(self) -> dict[str, float | int | bool]:
-        return dict(self.__dict__)
+    @property
+    def failures(self) -> list[str]:
+        return self.check.failures()
+
+    def as_dict(self) -> dict[str, object]:
+        out: dict[str, object] = {k: v for k, v in self.__dict__.items() if k != "check"}
+        return out | {"sanity": self.check.as_dict(), "failures": self.failures}
 
 
 @dataclass
@@ -63,25 +71,26 @@ def simulate_frames(
         vertices, skin, st = solve(target, jaw=jaw)
         out.linear.append(blended.astype(np.float32))
         out.physics.append(hs.whole_head(skin, blended, jaw).astype(np.float32))
-        linear_vertices = volume.linear_vertices(target, vertices)
+        check = check_frame(hs, volume, target, skin, vertices, st)
         out.records.append(
             FrameRecord(
                 iterations=int(st["iterations"]),
                 converged=bool(st["converged"]),
                 collision_rounds=int(st["collision_rounds"]),
                 seconds=float(st["total_seconds"]),
-                volume_linear_percent=volume.change_percent(linear_vertices),
-                volume_physics_percent=volume.change_percent(vertices),
-                penetrating_linear=penetrating_points(hs, target, vertices),
-                penetrating_physics=penetrating_points(hs, skin, vertices),
+                volume_linear_percent=check.volume_linear_percent,
+                volume_physics_percent=check.volume_physics_percent,
+                penetrating_linear=check.penetrating_linear,
+                penetrating_physics=check.penetrating_physics,
                 distance_mm=mean_distance_mm(skin, target),
+                check=check,
             )
         )
     out.seconds = time.perf_counter() - start
     return out
 
 
-def summarise(records: list[FrameRecord]) -> dict[str, float | int]:
+def summarise(records: list[FrameRecord]) -> dict[str, Any]:
     """Means and worst values over the frames (volume: of the absolute change)."""
     if not records:
         return {}
@@ -89,13 +98,15 @@ def summarise(records: list[FrameRecord]) -> dict[str, float | int]:
     def col(name: str) -> np.ndarray:
         return np.array([getattr(r, name) for r in records], dtype=np.float64)
 
-    out: dict[str, float | int] = {
+    out: dict[str, Any] = {
         "frames": len(records),
         "converged": int(col("converged").sum()),
         "iterations_mean": float(col("iterations").mean()),
         "iterations_max": int(col("iterations").max()),
         "solve_seconds_mean": float(col("seconds").mean()),
         "distance_mm_mean": float(col("distance_mm").mean()),
+        "max_displacement_mm": max(r.check.max_displacement_mm for r in records),
+        "failures": failure_counts([r.check for r in records]),
     }
     for kind in ("linear", "physics"):
         v = np.abs(col(f"volume_{kind}_percent"))
@@ -110,7 +121,7 @@ def summarise(records: list[FrameRecord]) -> dict[str, float | int]:
     return out
 
 
-def summary_lines(s: dict[str, float | int], seconds: float) -> list[str]:
+def summary_lines(s: dict[str, Any], seconds: float) -> list[str]:
     """The terminal summary of `summarise`'s figures."""
     return [
         f"{s['frames']} frames ({s['converged']} converged), {s['iterations_mean']:.1f} "
@@ -123,5 +134,15 @@ def summary_lines(s: dict[str, float | int], seconds: float) -> list[str]:
         "penetrating lip vertices per frame mean / max: "
         f"linear {s['penetrating_linear_mean']:.1f} / {s['penetrating_linear_max']}, "
         f"physics {s['penetrating_physics_mean']:.1f} / {s['penetrating_physics_max']}",
-        f"mean distance physics - linear: {s['distance_mm_mean']:.3f} mm",
+        f"mean distance physics - linear: {s['distance_mm_mean']:.3f} mm "
+        f"(max {s['max_displacement_mm']:.1f} mm)",
+        failure_line(s["failures"]),  # type: ignore[arg-type]
     ]
+
+
+def failure_line(counts: dict[str, int]) -> str:
+    """'N frames fail the sanity bounds (reason: n, ...)' or that none does."""
+    if not counts["failed_frames"]:
+        return "sanity bounds: every frame passes"
+    reasons = ", ".join(f"{k} {v}" for k, v in counts.items() if v and k != "failed_frames")
+    return f"sanity bounds: {counts['failed_frames']} frames fail ({reasons})"

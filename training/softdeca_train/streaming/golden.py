@@ -111,14 +111,19 @@ def _frame_full() -> Frame:
     )
 
 
-def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
-    f = _frame_full()
+def _softdeca_expected(kind: str, **fields: object) -> Expected:
+    """The first lines of a SoftDECA packet's expected values: format, kind, then `fields`."""
     e = Expected()
     e.put("format", "softdeca")
-    e.put("kind", "frame")
-    e.put("minor", 0)
-    e.put("session_id", f.session_id)
-    e.put("sequence", f.sequence)
+    e.put("kind", kind)
+    for key, value in fields.items():
+        e.put(key, value)
+    return e
+
+
+def _softdeca_frames(out: dict[str, tuple[bytes, Expected, str]]) -> None:
+    f = _frame_full()
+    e = _softdeca_expected("frame", minor=0, session_id=f.session_id, sequence=f.sequence)
     _put_frame(e, f, quantised=True)
     e.put("reencode", 1)
     out["softdeca_frame_full"] = (
@@ -135,12 +140,7 @@ def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
         has_sequence=True,
         tracking=Tracking.LOST,
     )
-    e = Expected()
-    e.put("format", "softdeca")
-    e.put("kind", "frame")
-    e.put("minor", 0)
-    e.put("session_id", 3)
-    e.put("sequence", 0xFFFFFFFF)
+    e = _softdeca_expected("frame", minor=0, session_id=3, sequence=0xFFFFFFFF)
     _put_frame(e, lost, quantised=True)
     e.put("reencode", 1)
     out["softdeca_frame_minimal"] = (
@@ -161,12 +161,7 @@ def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
     newer[weights_at + 4 + 104 : weights_at + 4 + 104] = b"\x01\x02\x03\x04"
     newer += struct.pack("<HH", 99, 6) + b"future"
     newer[protocol.HEADER_BYTES + 18] += 1  # the block count includes the unknown block
-    e = Expected()
-    e.put("format", "softdeca")
-    e.put("kind", "frame")
-    e.put("minor", 1)
-    e.put("session_id", 9)
-    e.put("sequence", 5)
+    e = _softdeca_expected("frame", minor=1, session_id=9, sequence=5)
     _put_frame(e, Frame(capture_time=1.0, send_time=1.0, weights=_weights(2)), quantised=True)
     e.put("reencode", 0)
     out["softdeca_frame_minor1"] = (
@@ -175,11 +170,9 @@ def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
         "version 1.1: a longer weights block and block type 99 are skipped",
     )
 
-    e = Expected()
-    e.put("format", "softdeca")
-    e.put("kind", "profile")
-    e.put("session_id", 17)
-    e.put("sequence", 2)
+
+def _softdeca_messages(out: dict[str, tuple[bytes, Expected, str]]) -> None:
+    e = _softdeca_expected("profile", session_id=17, sequence=2)
     e.put("profile_id", SYNTHETIC_PROFILE.id)
     e.put("profile_name", SYNTHETIC_PROFILE.name)
     e.put("indices", *SYNTHETIC_PROFILE.indices)
@@ -192,11 +185,7 @@ def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
 
     neutral = _landmarks(1220, 1.1)
     chunk = protocol.split_neutral(neutral)[3]
-    e = Expected()
-    e.put("format", "softdeca")
-    e.put("kind", "neutral_chunk")
-    e.put("session_id", 17)
-    e.put("sequence", 6)
+    e = _softdeca_expected("neutral_chunk", session_id=17, sequence=6)
     e.put("neutral_id", chunk.neutral_id)
     e.put("total_vertices", chunk.total_vertices)
     e.put("first_vertex", chunk.first_vertex)
@@ -208,11 +197,7 @@ def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
         "chunk 3 of a 1,220-vertex neutral mesh",
     )
 
-    e = Expected()
-    e.put("format", "softdeca")
-    e.put("kind", "request")
-    e.put("session_id", 17)
-    e.put("sequence", 0)
+    e = _softdeca_expected("request", session_id=17, sequence=0)
     e.put("request_what", int(protocol.RequestKind.PROFILE))
     e.put("request_id", SYNTHETIC_PROFILE.id)
     e.put("reencode", 1)
@@ -221,27 +206,31 @@ def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
     )
     out["softdeca_request"] = (req, e, "a receiver asking for a profile")
 
+
+def _softdeca_drops(out: dict[str, tuple[bytes, Expected, str]]) -> None:
     future = bytearray(
         protocol.encode_request(1, 1, protocol.Request(protocol.RequestKind.NEUTRAL))
     )
     future[5], future[6] = 1, 9
-    e = Expected()
-    e.put("format", "softdeca")
-    e.put("kind", "drop")
-    e.put("drop_reason", "unknown_type")
     out["softdeca_unknown_type"] = (
         bytes(future),
-        e,
+        _softdeca_expected("drop", drop_reason="unknown_type"),
         "version 1.1 message type 9: ignored, not malformed",
     )
 
     major = bytearray(protocol.encode_frame(_frame_full()))
     major[4] = 2
-    e = Expected()
-    e.put("format", "softdeca")
-    e.put("kind", "drop")
-    e.put("drop_reason", "incompatible_version")
-    out["softdeca_major2"] = (bytes(major), e, "version 2.0: a 1.x receiver refuses it")
+    out["softdeca_major2"] = (
+        bytes(major),
+        _softdeca_expected("drop", drop_reason="incompatible_version"),
+        "version 2.0: a 1.x receiver refuses it",
+    )
+
+
+def _softdeca(out: dict[str, tuple[bytes, Expected, str]]) -> None:
+    _softdeca_frames(out)
+    _softdeca_messages(out)
+    _softdeca_drops(out)
 
 
 def _livelinkface(out: dict[str, tuple[bytes, Expected, str]]) -> None:

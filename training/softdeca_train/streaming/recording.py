@@ -188,6 +188,17 @@ def _read_pose(values: np.ndarray) -> Pose | None:
     return Pose(values[:3].astype(np.float32), rotation)
 
 
+# The header's text fields: tag -> Header attribute.
+_TEXT_FIELDS = {
+    HeaderTag.DEVICE: "device",
+    HeaderTag.SUBJECT: "subject",
+    HeaderTag.SOURCE: "source",
+    HeaderTag.CLOCK: "clock",
+    HeaderTag.UNITS: "units",
+    HeaderTag.COORDINATE_FRAME: "coordinate_frame",
+}
+
+
 def _decode_header_fields(data: bytes, h: Header) -> list[int]:
     order: list[int] | None = None
     pos = 0
@@ -201,18 +212,8 @@ def _decode_header_fields(data: bytes, h: Header) -> list[int]:
         body = data[pos : pos + length]
         pos += length
         text = body.decode("utf-8", errors="replace")
-        if tag == HeaderTag.DEVICE:
-            h.device = text
-        elif tag == HeaderTag.SUBJECT:
-            h.subject = text
-        elif tag == HeaderTag.SOURCE:
-            h.source = text
-        elif tag == HeaderTag.CLOCK:
-            h.clock = text
-        elif tag == HeaderTag.UNITS:
-            h.units = text
-        elif tag == HeaderTag.COORDINATE_FRAME:
-            h.coordinate_frame = text
+        if tag in _TEXT_FIELDS:
+            setattr(h, _TEXT_FIELDS[tag], text)
         elif tag in (HeaderTag.START_UNIX_TIME, HeaderTag.TIMECODE_RATE):
             if len(body) < 8:
                 raise ValueError("short number field")

@@ -1,7 +1,7 @@
 """ARKit's reference face for streams: real blendshape weights drive realistic landmark streams
-through it (geometry = neutral + sum_i w_i (shape_i - neutral)). A view over the one reader of
-that data, softdeca_train.landmarks.arkit_reference.ArkitFace, plus the landmark profiles a
-stream can name."""
+through it (geometry = neutral + sum_i w_i (shape_i - neutral)). The one reader of that data,
+softdeca_train.landmarks.arkit_reference.ArkitFace, extended with blending of chosen vertices
+and the landmark profiles a stream can name."""
 
 from __future__ import annotations
 
@@ -19,32 +19,12 @@ PROFILES = ("softdeca149", "arkit68", "none")
 
 
 @dataclass(frozen=True)
-class ReferenceFace:
-    face: ArkitFace
-
+class ReferenceFace(ArkitFace):
     @classmethod
-    def load(cls, folder: str | os.PathLike[str] | None = None) -> ReferenceFace:
-        return cls(ArkitFace.load(folder))
-
-    @property
-    def neutral(self) -> np.ndarray:
-        return self.face.neutral
-
-    @property
-    def deltas(self) -> np.ndarray:
-        return self.face.deltas
-
-    @property
-    def present(self) -> np.ndarray:
-        return self.face.present
-
-    @property
-    def landmarks68(self) -> np.ndarray:
-        return self.face.landmarks68
-
-    @property
-    def neutral_file_deviation(self) -> float:
-        return self.face.neutral_file_deviation
+    def load(cls, path: str | os.PathLike[str] | None = None) -> ReferenceFace:
+        face = super().load(path)
+        assert isinstance(face, ReferenceFace)
+        return face
 
     def blend(self, weights: np.ndarray, vertices: np.ndarray | None = None) -> np.ndarray:
         """neutral + sum_i w_i delta_i, for all vertices or the given ones."""

@@ -95,6 +95,20 @@ class Dataset:
             if s["kind"] == kind and s.get("split", TRAIN) in want
         ]
 
+    def left_out(self, kind: str, split: str, max_error: float | None = None) -> dict[str, int]:
+        """Instances of one kind and split that `batches` yields (`kept`) and leaves out for
+        their solver error (`left_out`, same limit as `batches`): reported, never silent."""
+        limit = 3 * self.tolerance if max_error is None else max_error
+        kept = left = 0
+        for f in self.shards(kind, split):
+            with np.load(self.folder / f) as z:
+                err = z["estimated_error"]
+            n = len(err) if err.ndim else 1
+            ok = (err.reshape(n, -1) <= limit).all(axis=1)
+            kept += int(ok.sum())
+            left += int((~ok).sum())
+        return {"kept": kept, "left_out": left, "max_error": limit}  # type: ignore[dict-item]
+
     def batches(
         self,
         kind: str,

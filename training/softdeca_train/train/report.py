@@ -214,17 +214,36 @@ def write_report(
     sd = models["softdeca"]
     assert isinstance(sd, SoftDeca)
     local = localisation_figure(run, sd, out / "localisation.png")
+    # Frames the evaluation leaves out because the volumetric solver's estimated error is
+    # above 3x the dataset's tolerance (the same filter as training).
+    left_out = {
+        f"{kind}/{split}": run.data.left_out(kind, split)
+        for kind in ("static", "sparse", "dynamic")
+        for split in ("train", "test")
+    }
     result = {
         "errors": errors,
         "ms_per_frame": times,
         "bundle": bundle_rows,
         "localisation": local,
+        "left_out_by_solver_error": left_out,
     }
     (out / "evaluation.json").write_text(json.dumps(result, indent=1) + "\n")
     (out / "README.md").write_text(_markdown(run, bundle, result))
     if bench is not None:
         _write_bench(bench, result, run)
     return out / "README.md"
+
+
+def _left_out_line(left: dict[str, dict[str, int]]) -> str:
+    """Frames training and evaluation leave out for the volumetric solver's error."""
+    if not left:
+        return "Frames left out for the solver's estimated error: not counted."
+    parts = [f"{k} {v['left_out']} of {v['kept'] + v['left_out']}" for k, v in left.items()]
+    return (
+        "Frames left out of training and evaluation because the volumetric solver's estimated "
+        f"error exceeds 3x the dataset's tolerance: {', '.join(parts)}."
+    )
 
 
 def _markdown(run: Run, bundle: Path, r: dict) -> str:
@@ -245,6 +264,8 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "",
         "Reproduce: `python -m softdeca_train evaluate --run "
         f"{run.folder} --bundle {bundle}` (see docs/training.md for the training commands).",
+        "",
+        _left_out_line(r.get("left_out_by_solver_error", {})),
         "",
         "## Table 1 analogue: static frames",
         "",

@@ -59,11 +59,12 @@ namespace SoftDeca
         }
 
         /// <summary>Loads a bundle folder or a .tar of it.</summary>
-        public static Model Load(string path, uint prepareThreads = 1)
+        /// <param name="memoryBudgetMib">most the bundle's networks may ask for, checked before loading; 0: 2048</param>
+        public static Model Load(string path, uint prepareThreads = 1, uint memoryBudgetMib = 0)
         {
             Library.EnsureCompatible();
             byte[] p = Utf8.ToNative(path, "path");
-            var options = ModelOptions.Create(prepareThreads);
+            var options = ModelOptions.Create(prepareThreads, memoryBudgetMib);
             IntPtr native;
             Status s;
             fixed (byte* pp = p) s = NativeMethods.softdeca_model_load(pp, ref options, out native);
@@ -72,11 +73,11 @@ namespace SoftDeca
         }
 
         /// <summary>Loads a bundle from the bytes of an uncompressed tar (e.g. a TextAsset's bytes).</summary>
-        public static Model LoadMemory(byte[] tar, uint prepareThreads = 1)
+        public static Model LoadMemory(byte[] tar, uint prepareThreads = 1, uint memoryBudgetMib = 0)
         {
             Library.EnsureCompatible();
             if (tar == null) throw new ArgumentNullException("tar");
-            var options = ModelOptions.Create(prepareThreads);
+            var options = ModelOptions.Create(prepareThreads, memoryBudgetMib);
             IntPtr native;
             Status s;
             fixed (byte* d = tar) s = NativeMethods.softdeca_model_load_memory(d, (uint)tar.Length, ref options, out native);

@@ -50,10 +50,15 @@ namespace SoftDeca
     {
         public uint StructSize;
         public uint PrepareThreads;
+        public uint MemoryBudgetMib;
 
-        public static ModelOptions Create(uint prepareThreads = 1)
+        /// <param name="memoryBudgetMib">most the bundle's networks may ask for; 0: the library's default (2048)</param>
+        public static ModelOptions Create(uint prepareThreads = 1, uint memoryBudgetMib = 0)
         {
-            return new ModelOptions { StructSize = (uint)sizeof(ModelOptions), PrepareThreads = prepareThreads };
+            return new ModelOptions
+            {
+                StructSize = (uint)sizeof(ModelOptions), PrepareThreads = prepareThreads, MemoryBudgetMib = memoryBudgetMib,
+            };
         }
     }
 
@@ -237,6 +242,10 @@ namespace SoftDeca
         public uint Port;
         public uint QueueCapacity;
         public double JitterDelay;
+        public int ListenNetwork;
+        public int FollowNewest;
+        public double SessionHold;
+        public double SourceRateLimit;
     }
 
     [StructLayout(LayoutKind.Sequential)]
@@ -269,6 +278,9 @@ namespace SoftDeca
         public double LossRatio;
         public double LatencyP50Ms;
         public double LatencyP99Ms;
+        public ulong Foreign;
+        public ulong RateLimited;
+        public ulong RecordingDropped;
 
         public static ReceiverStats Create()
         {

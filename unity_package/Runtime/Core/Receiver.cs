@@ -13,10 +13,16 @@ namespace SoftDeca
 
         private ReceiverHandle Handle { get { handle.ThrowIfClosed("Receiver"); return handle; } }
 
-        /// <param name="bindAddress">numeric IPv4 or IPv6 address; null: all IPv4 interfaces</param>
+        /// <param name="bindAddress">numeric IPv4 or IPv6 address; null: 127.0.0.1, or all IPv4
+        /// interfaces when listenNetwork is set</param>
         /// <param name="port">0: any free port (see Port)</param>
+        /// <param name="listenNetwork">allow a non-loopback address: needed to receive from a phone</param>
+        /// <param name="followNewest">a new sender takes the session at once (else the first holds it)</param>
+        /// <param name="sessionHold">seconds of quiet after which another sender may take the session; 0: 2</param>
+        /// <param name="sourceRateLimit">datagrams per second per sender; 0: 1000; negative: no limit</param>
         public Receiver(StreamFormat format = StreamFormat.Auto, string bindAddress = null, int port = 50110,
-                        int queueCapacity = 256, double jitterDelay = 0)
+                        int queueCapacity = 256, double jitterDelay = 0, bool listenNetwork = false,
+                        bool followNewest = false, double sessionHold = 0, double sourceRateLimit = 0)
         {
             Library.EnsureCompatible();
             if (port < 0 || port > 65535) throw new ArgumentOutOfRangeException("port", "a port is in [0, 65535]");
@@ -27,6 +33,10 @@ namespace SoftDeca
             config.Port = (uint)port;
             config.QueueCapacity = (uint)queueCapacity;
             config.JitterDelay = jitterDelay;
+            config.ListenNetwork = listenNetwork ? 1 : 0;
+            config.FollowNewest = followNewest ? 1 : 0;
+            config.SessionHold = sessionHold;
+            config.SourceRateLimit = sourceRateLimit;
             byte[] address = bindAddress == null ? null : Utf8.ToNative(bindAddress, "bindAddress");
             IntPtr native;
             Status s;

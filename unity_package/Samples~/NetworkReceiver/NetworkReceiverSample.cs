@@ -21,9 +21,14 @@ namespace SoftDeca.Samples
 
         private void Awake()
         {
+            // AddComponent enables the input at once (on the default port, loopback only): disable it,
+            // configure it, enable it again so that its receiver opens with these settings.
             input = avatar.gameObject.AddComponent<NetworkReceiverInput>();
+            input.enabled = false;
             input.format = format;
             input.port = port;
+            input.listenNetwork = true;  // the phone is another machine on the network
+            input.enabled = true;
             avatar.input = input;
         }
 
@@ -32,8 +37,8 @@ namespace SoftDeca.Samples
             if (input.Receiver == null || Time.time < nextReport) return;
             nextReport = Time.time + reportEvery;
             ReceiverStats s = input.Receiver.Stats();
-            Debug.Log(string.Format("SoftDECA receiver on port {0}: {1} frames, {2:F1} fps, loss {3:P1}, latency p50 {4:F1} ms",
-                                    input.Receiver.Port, s.Delivered, s.FrameRateHz, s.LossRatio, s.LatencyP50Ms));
+            Debug.Log(string.Format("SoftDECA receiver on port {0}: {1} frames, {2:F1} fps, loss {3:P1}, latency p50 {4:F1} ms, {5} datagrams from other senders dropped",
+                                    input.Receiver.Port, s.Delivered, s.FrameRateHz, s.LossRatio, s.LatencyP50Ms, s.Foreign));
         }
     }
 }

@@ -1,0 +1,237 @@
+// softdeca bench-reliability: the receiver and the recording reader under hostile input on
+// this machine -> build/bench/reliability.json. A flood of iFacialMocap datagrams from many
+// source ports on loopback while recording; a crafted damaged recording; a recording whose
+// disk cannot keep up while a consumer polls.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench_figures.h"
+#include "command.h"
+#include "json.h"
+#include "options.h"
+#include "recording/recording_reader.h"
+#include "recording/recording_writer.h"
+#include "stream/frame_sender.h"
+#include "stream/percentile.h"
+#include "stream/receiver.h"
+#include "stream/steady_clock.h"
+
+namespace softdeca::cli {
+namespace {
+using stream::steady_seconds;
+
+stream::ReceiverConfig loopback(stream::Format format) {
+  stream::ReceiverConfig c;
+  c.port = 0;
+  c.format = format;
+  c.queue_capacity = 65536;
+  return c;
+}
+
+struct Flood {
+  uint64_t session_changes = 0, delivered = 0, foreign = 0, rate_limited = 0, datagrams_sent = 0;
+  std::size_t recorded = 0;
+  double recording_mb = 0;
+};
+
+// `ports` senders, round robin, as fast as the socket takes them, for `seconds`, recording.
+Flood flood_run(const std::string& path, int ports, double seconds) {
+  stream::Receiver r(loopback(stream::Format::ifacialmocap));
+  recording::Header h;
+  h.source = "bench-reliability flood";
+  r.start_recording(path, h);
+  std::atomic<bool> done{false};
+  std::thread consumer([&] {
+    stream::Frame f;
+    while (!done.load()) r.next(0.01, f);
+  });
+  const stream::Endpoint to = stream::make_endpoint("127.0.0.1", r.port());
+  std::vector<std::unique_ptr<stream::FrameSender>> senders;
+  for (int i = 0; i < ports; ++i)
+    senders.push_back(std::make_unique<stream::FrameSender>(to, stream::Format::ifacialmocap, 0));
+  const std::string text = "jawOpen-40|mouthSmile_L-10|eyeBlink_R-3|browInnerUp-25|";
+  Flood out;
+  const double start = steady_seconds();
+  while (steady_seconds() - start < seconds)
+    for (auto& s : senders) {
+      s->send_raw(reinterpret_cast<const uint8_t*>(text.data()), text.size());
+      ++out.datagrams_sent;
+    }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  r.stop();
+  r.stop_recording();
+  done.store(true);
+  consumer.join();
+  const stream::ReceiverStats s = r.stats();
+  out.session_changes = s.session_changes;
+  out.delivered = s.delivered;
+  out.foreign = s.foreign;
+  out.rate_limited = s.rate_limited;
+  out.recorded = r.frames_recorded();
+  out.recording_mb = double(std::filesystem::file_size(path)) / 1e6;
+  std::filesystem::remove(path);
+  return out;
+}
+
+// A recording of a few good frames, `mib` MiB of record headers that each claim 64 KiB with a
+// wrong checksum (a candidate every 12 bytes), then good frames again. Seconds per MiB read.
+double resync_run(const std::string& path, std::size_t mib) {
+  {
+    recording::RecordingWriter w(path, recording::Header{});
+    stream::Frame f;
+    f.capture_time = 1;
+    w.write(f);
+  }
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<uint8_t> head((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<uint8_t> bytes = head;
+  const uint8_t candidate[12] = {'S', 'D', 'R', 'C', 0x00, 0x00, 0x01, 0x00, 0xEF, 0xBE, 0xAD, 0xDE};
+  while (bytes.size() < head.size() + (mib << 20)) bytes.insert(bytes.end(), candidate, candidate + 12);
+  const double start = steady_seconds();
+  const recording::Recording rec = recording::parse_recording(bytes.data(), bytes.size());
+  const double elapsed = steady_seconds() - start;
+  std::filesystem::remove(path);
+  if (rec.frames.size() != 1) throw std::runtime_error("the crafted recording lost its good frame");
+  return elapsed / (double(bytes.size()) / double(1 << 20));
+}
+
+struct SlowDisk {
+  double poll_p99_ms = 0, poll_max_ms = 0;
+  uint64_t delivered = 0, recording_dropped = 0;
+  std::size_t recorded = 0;
+};
+
+// The recording goes into a FIFO drained at `drain_bytes_per_s` (a disk far slower than the
+// stream); frames arrive at `rate` Hz; a consumer polls latest() and next(0) every millisecond.
+SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, double drain_bytes_per_s) {
+  std::filesystem::remove(fifo);
+  if (::mkfifo(fifo.c_str(), 0600) != 0) throw std::runtime_error("cannot make a FIFO at " + fifo);
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  if (reader < 0) throw std::runtime_error("cannot open " + fifo);
+  std::atomic<bool> done{false}, draining_all{false};
+  std::thread drain([&] {
+    char buf[4096];
+    const double chunk_s = double(sizeof buf) / drain_bytes_per_s;
+    while (!done.load()) {
+      if (::read(reader, buf, sizeof buf) <= 0 || !draining_all.load())
+        std::this_thread::sleep_for(std::chrono::duration<double>(draining_all.load() ? 0.001 : chunk_s));
+    }
+  });
+  stream::ReceiverConfig c = loopback(stream::Format::softdeca);
+  c.source_rate_limit = 0;
+  stream::Receiver r(c);
+  r.start_recording(fifo, recording::Header{});
+  stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.port()), stream::Format::softdeca, 3);
+  std::vector<double> polls;
+  stream::Frame f;
+  f.landmark_count = 149;
+  const double start = steady_seconds();
+  for (std::size_t i = 0; steady_seconds() - start < seconds; ++i) {
+    const double due = start + double(i) / rate;
+    while (steady_seconds() < due) {
+      const double t0 = steady_seconds();
+      stream::Frame got;
+      r.latest(got);
+      r.next(0, got);
+      polls.push_back(steady_seconds() - t0);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    f.capture_time = 10 + double(i) / rate;
+    sender.send(f);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  SlowDisk out;
+  const stream::ReceiverStats s = r.stats();
+  out.delivered = s.delivered;
+  out.recording_dropped = s.recording_dropped;
+  draining_all.store(true);
+  r.stop();
+  r.stop_recording();
+  out.recorded = r.frames_recorded();
+  done.store(true);
+  drain.join();
+  ::close(reader);
+  std::filesystem::remove(fifo);
+  out.poll_p99_ms = 1000 * stream::percentile(polls, 0.99);
+  out.poll_max_ms = 1000 * *std::max_element(polls.begin(), polls.end());
+  return out;
+}
+
+}  // namespace
+
+int run_bench_reliability(const Args& args) {
+  Options o("bench-reliability",
+            "Measure the receiver and the recording reader under hostile input (docs/security.md): an\n"
+            "iFacialMocap flood from many source ports on 127.0.0.1 while recording (session changes,\n"
+            "recording growth), the reader on a crafted damaged recording (seconds per MiB), and the\n"
+            "consumer's poll while the recording's disk cannot keep up (p99 poll time).");
+  o.option("--out", "FILE", "JSON output", "build/bench/reliability.json")
+      .option("--ports", "N", "source ports of the flood", "200")
+      .option("--flood-seconds", "S", "how long the flood lasts", "3")
+      .option("--resync-mib", "N", "MiB of crafted damage", "16")
+      .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
+      .option("--scratch", "DIR", "where the runs write their files", "build/bench");
+  if (!o.parse(args)) return 0;
+  create_output_folders(o.text("--out"), o.text("--scratch"));
+  const long ports = o.integer("--ports"), mib = o.integer("--resync-mib");
+  const double flood_s = o.number("--flood-seconds"), slow_s = o.number("--slow-seconds");
+  if (ports < 2 || ports > 1000 || mib < 1 || mib > 1024 || !(flood_s > 0) || !(slow_s > 0))
+    throw UsageError("2 to 1000 ports, 1 to 1024 MiB and positive durations, please");
+  const std::string scratch = o.text("--scratch");
+  double load = load_average();
+
+  std::fprintf(stderr, "bench-reliability: flood");
+  const Flood flood = flood_run(scratch + "/bench-reliability-flood.sdrec", static_cast<int>(ports), flood_s);
+  load = std::max(load, load_average());
+  std::fprintf(stderr, ", resync");
+  const double resync = resync_run(scratch + "/bench-reliability-resync.sdrec", static_cast<std::size_t>(mib));
+  std::fprintf(stderr, ", slow disk\n");
+  const SlowDisk slow = slow_disk_run(scratch + "/bench-reliability-slow.fifo", slow_s, 240, 16384);
+  load = std::max(load, load_average());
+
+  char load_text[80];
+  std::snprintf(load_text, sizeof load_text, " (machine load average up to %.1f during the runs)", load);
+  const std::string how = std::string("softdeca bench-reliability") + load_text + ": ";
+  char flood_text[400];
+  std::snprintf(flood_text, sizeof flood_text,
+                "%ld source ports on 127.0.0.1 sent %llu iFacialMocap datagrams in %.1f s while recording; "
+                "%llu frames delivered, %zu recorded, %llu dropped from other senders, %llu over the rate limit",
+                ports, static_cast<unsigned long long>(flood.datagrams_sent), flood_s,
+                static_cast<unsigned long long>(flood.delivered), flood.recorded,
+                static_cast<unsigned long long>(flood.foreign), static_cast<unsigned long long>(flood.rate_limited));
+  char slow_text[400];
+  std::snprintf(slow_text, sizeof slow_text,
+                "frames with 149 landmarks at 240 Hz for %.0f s recorded into a FIFO drained at 16 KiB/s; the "
+                "consumer polled latest() and next(0) every ms; %llu delivered, %zu recorded, %llu recording drops; "
+                "worst poll %.3f ms",
+                slow_s, static_cast<unsigned long long>(slow.delivered), slow.recorded,
+                static_cast<unsigned long long>(slow.recording_dropped), slow.poll_max_ms);
+  JsonObject out;
+  out.raw("reliability.flood_session_changes",
+          figure(double(flood.session_changes), "changes", "2", "lower", how + flood_text));
+  out.raw("reliability.flood_recording_mb", figure(flood.recording_mb, "MB", "1", "lower", how + flood_text));
+  out.raw("reliability.resync_s_per_mib",
+          figure(resync, "s/MiB", "0.5", "lower",
+                 how + std::to_string(mib) + " MiB of record headers claiming 64 KiB with wrong checksums, one "
+                       "every 12 bytes, parsed in memory"));
+  out.raw("reliability.poll_p99_ms_slow_disk", figure(slow.poll_p99_ms, "ms", "1", "lower", how + slow_text));
+  write_text_file(o.text("--out"), out.str(true) + "\n");
+  std::printf("%s\n", out.str(true).c_str());
+  return 0;
+}
+
+}  // namespace softdeca::cli

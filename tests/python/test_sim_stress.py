@@ -1,0 +1,186 @@
+"""The physics sanity bounds and the stress suite: the bounds' definitions, the expression
+library, a reduced suite (LHM level 3, two identities) and the snarl frame that once exploded."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from softdeca_train.sim.expressions import (
+    COMBINATIONS,
+    SNARL,
+    combinations,
+    single_shapes,
+)
+from softdeca_train.sim.sanity import BOUNDS, FrameCheck, bench_figures, failure_counts
+from softdeca_train.sim.stress import StressCase, StressPlan, build_cases, run_stress
+from softdeca_train.template import Template
+from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
+
+LEVEL = 3
+IDENTITIES = ("template", "seed 1")
+
+
+def _check(**changes: object) -> FrameCheck:
+    base: dict[str, object] = {
+        "converged": True,
+        "iterations": 10,
+        "max_displacement_mm": 2.0,
+        "explained_mm": 0.0,
+        "max_target_distance_mm": 2.0,
+        "penetrating_linear": 3,
+        "penetrating_physics": 0,
+        "opening_linear_mm": 10.0,
+        "opening_physics_mm": 10.0,
+        "inverted_elements": 0,
+        "volume_linear_percent": 1.0,
+        "volume_physics_percent": 0.5,
+    }
+    return FrameCheck(**(base | changes))  # type: ignore[arg-type]
+
+
+def test_bounds_name_each_failure() -> None:
+    assert _check().failures() == []
+    assert _check(max_displacement_mm=15.5).failures() == ["exploded"]
+    # A contact may undo the linear blend's own penetration depth.
+    assert _check(max_displacement_mm=15.5, explained_mm=1.0).failures() == []
+    assert _check(penetrating_physics=4).failures() == ["penetration"]
+    assert _check(opening_physics_mm=8.9).failures() == ["mouth_open_ratio"]
+    assert _check(opening_physics_mm=11.1).failures() == ["mouth_open_ratio"]
+    # A closed linear mouth has no ratio to keep.
+    closed = _check(opening_linear_mm=BOUNDS.open_mm, opening_physics_mm=0.1)
+    assert math.isnan(closed.open_ratio) and closed.failures() == []
+    assert _check(inverted_elements=1).failures() == ["inverted_elements"]
+    assert _check(volume_physics_percent=-1.2).failures() == ["volume"]
+    assert _check(converged=False).failures() == ["not_converged"]
+    both = [_check(), _check(penetrating_physics=9, inverted_elements=2)]
+    counts = failure_counts(both)
+    assert (
+        counts["failed_frames"] == 1
+        and counts["penetration"] == counts["inverted_elements"] == 1
+    )
+    fig = bench_figures(both)
+    assert (
+        fig["stress_penetration_worse_frames"] == 1
+        and fig["stress_exploded_frames"] == 0
+    )
+    assert fig["mouth_open_ratio_min"] == fig["mouth_open_ratio_max"] == 1.0
+
+
+def test_expression_library() -> None:
+    singles = single_shapes()
+    assert len(singles) == len(ARKIT_BLENDSHAPES) == 52
+    assert all(w.sum() == 1.0 for w in singles.values())
+    combos = combinations()
+    assert len(combos) >= 20
+    snarl = combos["snarl"]
+    assert snarl[ARKIT_BLENDSHAPES.index("noseSneerLeft")] == pytest.approx(0.8)
+    assert snarl[ARKIT_BLENDSHAPES.index("jawOpen")] == pytest.approx(0.4)
+    assert COMBINATIONS["snarl"] is SNARL
+    for name, w in combos.items():
+        assert (w >= 0).all() and (w <= 1).all(), name
+
+
+def test_plan_covers_the_suite() -> None:
+    cases = build_cases(StressPlan())
+    groups = {c.group for c in cases}
+    assert {
+        "expressions",
+        "level 4",
+        "materials soft",
+        "materials stiff",
+        "dynamic",
+    } <= groups
+    assert sum(g.startswith("gravity 2 g") for g in groups) >= 3
+    assert {c.identity for c in cases} >= {
+        "template",
+        "seed 1",
+        "seed 2",
+        "h+2.5σ",
+        "h-2.5σ",
+    }
+    dynamic = next(c for c in cases if c.dynamic)
+    assert dynamic.judge_every > 1 and len(dynamic.frames) % dynamic.judge_every == 0
+
+
+@pytest.fixture(scope="module")
+def reduced(template: Template) -> list:
+    """The reduced suite: every combination and every mouth/jaw shape alone, level 3, two
+    identities, static, default parameters, collisions on."""
+    mouth = {
+        k: v
+        for k, v in single_shapes().items()
+        if k.startswith(("mouth", "jaw", "tongue", "cheekPuff"))
+    }
+    frames = list((combinations() | mouth).items())
+    cases = [StressCase("reduced", who, LEVEL, frames) for who in IDENTITIES]
+    return run_stress(template, cases, keep_worst=0, progress=False).frames
+
+
+def _failures(frames: list, reason: str) -> list[str]:
+    return [
+        f"{f.identity} {f.label}: {f.check.as_dict()}"
+        for f in frames
+        if reason in f.check.failures()
+    ]
+
+
+# Known failures, measured and kept visible (strict: the test fails once they are fixed, so
+# the mark must go): the volumetric solve inverts muscle tets where the skull wrap runs across
+# cranium and jaw (docs/physics.md, Known limits), which also moves the soft-tissue volume.
+_KNOWN = (
+    "the LHM's wraps close over the mouth and span cranium and jaw (docs/physics.md)"
+)
+# Rolled lips (mouthRollLower and mouthRollUpper at 1, seed 1): the linear blend has 355 lip
+# points up to 2.8 mm inside the other lip; every contact round moves points farther than the
+# bound allows and is rejected, and joining the lips to the volumetric result adds one more.
+_ROLLED = (
+    "rolled lips: contact rounds rejected by the correction bound (docs/physics.md)"
+)
+
+
+@pytest.mark.parametrize(
+    "reason",
+    [
+        "exploded",
+        pytest.param(
+            "penetration", marks=pytest.mark.xfail(strict=True, reason=_ROLLED)
+        ),
+        pytest.param(
+            "inverted_elements", marks=pytest.mark.xfail(strict=True, reason=_KNOWN)
+        ),
+        pytest.param("volume", marks=pytest.mark.xfail(strict=True, reason=_KNOWN)),
+    ],
+)
+def test_reduced_suite_holds_the_bounds(reduced: list, reason: str) -> None:
+    bad = _failures(reduced, reason)
+    assert not bad, (
+        f"{len(bad)} of {len(reduced)} frames fail '{reason}':\n" + "\n".join(bad[:10])
+    )
+
+
+def test_open_mouths_stay_open_unless_the_lips_are_pressed(reduced: list) -> None:
+    """The opening bound is the only one with an exception the contact model explains: where
+    the linear blend presses one lip into the other (mouthShrugLower 1 on the template: 267
+    penetrating lip points, deepest 3.5 mm), resolving the contact moves the lip middles; a
+    tie moves both sides, so by at most twice the deepest penetration."""
+    for f in reduced:
+        c = f.check
+        if "mouth_open_ratio" in c.failures():
+            change = abs(c.opening_physics_mm - c.opening_linear_mm)
+            assert c.penetrating_linear > 0 and change <= 2 * c.explained_mm + 1.0, (
+                c.as_dict()
+            )
+
+
+def test_snarl_frame_does_not_explode(template: Template) -> None:
+    """A real take's strong snarl (identity seed 1, level 3, static, collisions on) once
+    moved lip points 349 mm and made lip penetration worse than linear blendshapes."""
+    case = StressCase("snarl", "seed 1", LEVEL, [("snarl", combinations()["snarl"])])
+    (frame,) = run_stress(template, [case], keep_worst=0, progress=False).frames
+    c = frame.check
+    assert c.max_displacement_mm <= BOUNDS.exploded_mm + c.explained_mm, c.as_dict()
+    assert c.penetrating_physics <= c.penetrating_linear, c.as_dict()
+    assert 0.9 <= c.open_ratio <= 1.1, c.as_dict()  # 27 mm open in the linear blend
+    assert np.isfinite(c.max_target_distance_mm)

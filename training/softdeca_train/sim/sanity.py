@@ -1,0 +1,164 @@
+"""The sanity bounds of a simulated frame, defined once: `simulate`, the stress suite, the
+benchmarks, data generation and the tests all judge frames here (docs/physics.md, "Sanity
+bounds"). A frame is compared with the linear blend S_t it was simulated from:
+
+- exploded: a skin point farther than `exploded_mm` from the linear blend, beyond what a
+  contact correction explains (the linear blend's deepest lip penetration, which a contact
+  may undo);
+- penetration: more penetrating lip points (inside the other lip or the teeth) than the
+  linear blend has;
+- mouth opening: where the linear blend's lips are more than `open_mm` apart (inner middle of
+  the upper lip to that of the lower lip, ICT landmarks 62 and 66), physics / linear opening
+  outside `open_ratio`;
+- inverted elements: any soft or muscle tet with volume <= 0 at the end of the solve;
+- volume: |soft-tissue volume change| above the linear blend's (refit, measures.py) by more
+  than `volume_slack_percent` (percentage points: both are ~0 near rest);
+- not converged: the volumetric solve stopped at its iteration cap.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import softdeca_native as native
+
+from softdeca_train.sim.head import HeadSimulation
+from softdeca_train.sim.measures import PENETRATION_TOLERANCE, SoftVolume
+
+UPPER_LIP_MIDDLE, LOWER_LIP_MIDDLE = 62, 66  # ICT 68-landmark ids of the inner lip middles
+
+
+@dataclass(frozen=True)
+class SanityBounds:
+    exploded_mm: float = 15.0
+    open_mm: float = 3.0
+    open_ratio: tuple[float, float] = (0.9, 1.1)
+    volume_slack_percent: float = 0.1
+
+
+BOUNDS = SanityBounds()
+REASONS = (
+    "exploded",
+    "penetration",
+    "mouth_open_ratio",
+    "inverted_elements",
+    "volume",
+    "not_converged",
+)
+
+
+@dataclass
+class FrameCheck:
+    """One frame's figures against its linear blend and the reasons it fails (if any)."""
+
+    converged: bool
+    iterations: int
+    max_displacement_mm: float  # largest |S_physics - S_linear| over S
+    explained_mm: float  # deepest lip penetration of the linear blend
+    max_target_distance_mm: float  # the solver's own: largest |S - target| (blended target)
+    penetrating_linear: int
+    penetrating_physics: int
+    opening_linear_mm: float
+    opening_physics_mm: float
+    inverted_elements: int
+    volume_linear_percent: float
+    volume_physics_percent: float
+
+    @property
+    def open_ratio(self) -> float:
+        """physics / linear mouth opening; NaN where the linear blend's mouth is closed."""
+        if self.opening_linear_mm <= BOUNDS.open_mm:
+            return math.nan
+        return self.opening_physics_mm / self.opening_linear_mm
+
+    def failures(self, bounds: SanityBounds = BOUNDS) -> list[str]:
+        out = []
+        if self.max_displacement_mm > bounds.exploded_mm + self.explained_mm:
+            out.append("exploded")
+        if self.penetrating_physics > self.penetrating_linear:
+            out.append("penetration")
+        r = self.open_ratio
+        if not math.isnan(r) and not bounds.open_ratio[0] <= r <= bounds.open_ratio[1]:
+            out.append("mouth_open_ratio")
+        if self.inverted_elements > 0:
+            out.append("inverted_elements")
+        if abs(self.volume_physics_percent) > (
+            abs(self.volume_linear_percent) + bounds.volume_slack_percent
+        ):
+            out.append("volume")
+        if not self.converged:
+            out.append("not_converged")
+        return out
+
+    def as_dict(self) -> dict[str, object]:
+        return asdict(self) | {"open_ratio": self.open_ratio, "failures": self.failures()}
+
+
+def _penetrations(hs: HeadSimulation, skin: np.ndarray, vertices: np.ndarray) -> dict[int, float]:
+    """Deepest penetration (m) per penetrating lip point."""
+    out: dict[int, float] = {}
+    skin, vertices = np.asarray(skin, np.float64), np.asarray(vertices, np.float64)
+    for _, point, depth in native.find_penetrations(hs.mesh, skin, vertices, PENETRATION_TOLERANCE):
+        out[point] = max(out.get(point, 0.0), depth)
+    return out
+
+
+def lip_opening_mm(hs: HeadSimulation, skin: np.ndarray) -> float:
+    lm = hs.template.landmarks68
+    return 1e3 * float(np.linalg.norm(skin[lm[UPPER_LIP_MIDDLE]] - skin[lm[LOWER_LIP_MIDDLE]]))
+
+
+def check_frame(
+    hs: HeadSimulation,
+    volume: SoftVolume,
+    target: np.ndarray,
+    skin: np.ndarray,
+    vertices: np.ndarray,
+    stats: dict[str, object],
+) -> FrameCheck:
+    """`target`: the linear blend's S (S_t); skin / vertices / stats: the solver's result."""
+    linear_pen = _penetrations(hs, target, vertices)
+    physics_pen = _penetrations(hs, skin, vertices)
+    linear_vertices = volume.linear_vertices(target, vertices)
+    return FrameCheck(
+        converged=bool(stats["converged"]),
+        iterations=int(stats["iterations"]),  # type: ignore[call-overload]
+        max_displacement_mm=1e3 * float(np.linalg.norm(skin - target, axis=1).max()),
+        explained_mm=1e3 * max(linear_pen.values(), default=0.0),
+        max_target_distance_mm=1e3 * float(stats["max_target_distance"]),  # type: ignore[arg-type]
+        penetrating_linear=len(linear_pen),
+        penetrating_physics=len(physics_pen),
+        opening_linear_mm=lip_opening_mm(hs, target),
+        opening_physics_mm=lip_opening_mm(hs, skin),
+        inverted_elements=int(stats["inverted_elements"]),  # type: ignore[call-overload]
+        volume_linear_percent=volume.change_percent(linear_vertices),
+        volume_physics_percent=volume.change_percent(vertices),
+    )
+
+
+def failure_counts(checks: list[FrameCheck]) -> dict[str, int]:
+    """Frames failing each reason (a frame may count under several) and in all."""
+    c: Counter[str] = Counter()
+    for ch in checks:
+        f = ch.failures()
+        c.update(f)
+        c["failed_frames"] += bool(f)
+    return {r: c[r] for r in (*REASONS, "failed_frames")}
+
+
+def bench_figures(checks: list[FrameCheck]) -> dict[str, float | int]:
+    """The stress figures of `make bench` over a set of frames."""
+    ratios = [c.open_ratio for c in checks if not math.isnan(c.open_ratio)]
+    return {
+        "stress_frames": len(checks),
+        "stress_exploded_frames": sum("exploded" in c.failures() for c in checks),
+        "stress_penetration_worse_frames": sum("penetration" in c.failures() for c in checks),
+        "mouth_open_frames": len(ratios),
+        "mouth_open_ratio_min": min(ratios, default=math.nan),
+        "mouth_open_ratio_max": max(ratios, default=math.nan),
+        "stress_failed_frames": sum(bool(c.failures()) for c in checks),
+        "max_displacement_mm": max((c.max_displacement_mm for c in checks), default=0.0),
+    }
