@@ -191,8 +191,9 @@ SOFTDECA_API softdeca_status softdeca_receiver_start_recording(softdeca_receiver
 SOFTDECA_API softdeca_status softdeca_receiver_stop_recording(softdeca_receiver* receiver, uint32_t* out_frames) {
   return guarded(__func__, [&] {
     auto& r = receiver_of(receiver);
-    const std::size_t frames = r.frames_recorded();
+    // Counted after stopping: frames still queued for the writer thread are written by then.
     const std::string error = r.stop_recording();
+    const std::size_t frames = r.frames_recorded();
     if (out_frames) *out_frames = static_cast<uint32_t>(frames);
     require(error.empty(), "the recording stopped early: " + error, SOFTDECA_ERROR_IO);
   });
