@@ -90,7 +90,8 @@ int run(int argc, char** argv) {
   const double tolerance = std::strtod(argv[6], nullptr);
 
   softdeca_model* model = nullptr;
-  softdeca_model_options options{sizeof(softdeca_model_options), 0};
+  softdeca_model_options options{};
+  options.struct_size = sizeof options;
   check(softdeca_model_load(bundle.c_str(), &options, &model), "loading " + bundle);
   softdeca_model_info info{};
   info.struct_size = sizeof info;
