@@ -8,24 +8,16 @@ import json
 import os
 from pathlib import Path
 
+from softdeca_train.commands import Command, add_ict_argument
 from softdeca_train.data.config import GenerateConfig, RunSettings, default_takes_path
 from softdeca_train.data.ranges import PROFILES
 
 D = GenerateConfig()
 
 
-def _ict(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--ict",
-        default=None,
-        help="ICT-FaceKit checkout, FaceXModel folder or .tar.xz archive "
-        "(default: $SOFTDECA_ICT or ict-facekit in the data folder)",
-    )
-
-
 def add_generate_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="dataset folder (created; resumed if present)")
-    _ict(p)
+    add_ict_argument(p)
     p.add_argument(
         "--takes",
         default=None,
@@ -190,7 +182,7 @@ def run_generate(args: argparse.Namespace) -> int:
 def add_report_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("dataset", help="dataset folder (with manifest.json)")
     p.add_argument("--out", default=None, help="report folder (default: <dataset>/report)")
-    _ict(p)
+    add_ict_argument(p)
 
 
 def run_report(args: argparse.Namespace) -> int:
@@ -203,7 +195,7 @@ def run_report(args: argparse.Namespace) -> int:
 
 def add_bench_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="build/bench", help="folder for datagen.json (build/bench)")
-    _ict(p)
+    add_ict_argument(p)
     p.add_argument("--level", type=int, default=D.level, help=f"LHM level ({D.level})")
     p.add_argument(
         "--workers", type=int, default=os.cpu_count() or 1, help="worker processes (all cores)"
@@ -222,3 +214,27 @@ def run_bench(args: argparse.Namespace) -> int:
         print(f"  {name:40s} {f['value']:>12.1f} {f['unit']}")
     print(f"wrote {path}")
     return 0
+
+
+COMMANDS = [
+    Command(
+        "generate",
+        "Generate (or resume) the training dataset: static, dynamic and sparse instances "
+        "simulated by the physics, in parallel (processes or Ray), as shards + manifest.",
+        add_generate_args,
+        run_generate,
+    ),
+    Command(
+        "report-data",
+        "Report on a generated dataset: markdown + plots (parameter, weight and identity "
+        "distributions; |T - S| per region).",
+        add_report_args,
+        run_report,
+    ),
+    Command(
+        "bench-datagen",
+        "Benchmark data generation on this machine into build/bench/datagen.json.",
+        add_bench_args,
+        run_bench,
+    ),
+]
