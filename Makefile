@@ -208,3 +208,60 @@ stress: build ## the physics stress suite judged by the sanity bounds -> out/str
 bench-stress: build ## the stress suite's figures -> build/bench/physics_stress.json
 	@nice -n 5 $(PY) -m softdeca_train stress --ict "$(SOFTDECA_ICT)" --recordings "$(RECORDINGS)" \
 	  --take-stride $(STRESS_TAKE_STRIDE) --out build/stress --bench-out build/bench --quiet
+
+# ---- Native binaries per platform and the Unity package tarball (docs/platforms.md) -----------
+# Linux x86_64 is build/release. Windows x64 is cross-built here with MinGW-w64 in build/windows;
+# the cross compilers, wine and ONNX Runtime's Windows DLL are installed on first use by
+# plugin/platforms/windows/setup-cross.sh, not by `make setup`. `make test-windows` runs the
+# Windows build's tests under wine; `make test` does not (a second full build of the library), it
+# checks the Linux staging of the package's binaries (tests/python/test_unity_binaries.py).
+# macOS, iOS and Android: plugin/platforms/<platform>/build.sh, untested here; what they stage
+# into UNITY_BINARIES on their machines, `make unity-package` packs too.
+WINDOWS        := build/windows
+WINDOWS_ORT    := $(CURDIR)/.deps/onnxruntime-win
+WINDOWS_TESTS  := test_c_abi test_stream abi_header_check_c abi_header_check_cpp replay_check
+# The Windows tests that run under wine: the C ABI, the streaming and recording stack (UDP over
+# loopback included), the header checks against softdeca.dll, its export table.
+WINDOWS_CTEST  := ^(CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver)\.|^abi_header_check_|^dll_exports_only_c_abi$$
+# The replay check: frames of a real take through models/softdeca-default on the identity of
+# seed 1, by the Linux CLI and by the Windows DLL under wine, compared vertex by vertex.
+CHECK          := build/platform-check
+CHECK_TAKE     ?= $(TAKES)/S07-001.csv
+CHECK_START    ?= 360
+CHECK_FRAMES   ?= 12
+CHECK_TOL      ?= 1e-4
+UNITY_BINARIES ?= build/unity-binaries
+UNITY_VERSION  := $(shell sed -n 's/.*"version": *"\([^"]*\)".*/\1/p' unity_package/package.json 2>/dev/null)
+UNITY_TGZ      := build/unity-package/com.softdeca.facial-animation-$(UNITY_VERSION).tgz
+.PHONY: windows test-windows unity-package
+# A wine prefix of this checkout's own: another checkout's wine server cannot disturb the tests.
+windows test-windows unity-package: export WINEPREFIX := $(CURDIR)/build/wineprefix
+windows test-windows unity-package: export WINEDEBUG := -all
+
+windows: setup ## Windows x64 cross-build (MinGW-w64) in build/windows; installs the cross tools on first use
+	@plugin/platforms/windows/setup-cross.sh
+	@mkdir -p build; cmake -S . -B $(WINDOWS) -G Ninja $(LAUNCHER) -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/mingw-w64-x86_64.cmake \
+	  -DCMAKE_BUILD_TYPE=Release -DONNXRUNTIME_ROOT=$(WINDOWS_ORT) -DSOFTDECA_BUILD_PYTHON=OFF \
+	  > $(WINDOWS).configure.log 2>&1 || { cat $(WINDOWS).configure.log; exit 1; }
+	@cmake --build $(WINDOWS) -j $(JOBS) --target softdeca $(WINDOWS_TESTS)
+
+test-windows: windows build ## the Windows build's C ABI, streaming and replay tests under wine
+	@echo "== Windows x64 tests under $$(wine --version)"
+	@ctest --test-dir $(WINDOWS) --output-on-failure -j $(JOBS) -R '$(WINDOWS_CTEST)'
+	@mkdir -p $(CHECK)
+	@[ -f $(CHECK)/avatar/neutral.obj ] || $(PY) -m softdeca_train avatar --seed 1 --out $(CHECK)/avatar
+	@$(BUILD)/plugin/cli/softdeca convert $(CHECK_TAKE) $(CHECK)/take.sdrec > /dev/null
+	@$(BUILD)/plugin/cli/softdeca replay $(CHECK)/take.sdrec --bundle models/softdeca-default --avatar $(CHECK)/avatar \
+	  --models softdeca --start $(CHECK_START) --frames $(CHECK_FRAMES) --out $(CHECK)/linux > $(CHECK)/linux.log
+	@echo "== replay check: Linux libsoftdeca.so against the Linux CLI"
+	@$(BUILD)/tests/native/replay_check models/softdeca-default $(CHECK)/avatar $(CHECK)/take.sdrec $(CHECK_START) \
+	  $(CHECK)/linux/softdeca.pc2 $(CHECK_TOL)
+	@echo "== replay check: Windows softdeca.dll (wine) against the Linux CLI"
+	@wine $(WINDOWS)/bin/replay_check.exe models/softdeca-default $(CHECK)/avatar $(CHECK)/take.sdrec \
+	  $(CHECK_START) $(CHECK)/linux/softdeca.pc2 $(CHECK_TOL)
+
+unity-package: build windows ## UPM tarball (Add package from tarball) with the Linux and Windows binaries -> build/unity-package/
+	@plugin/platforms/stage-unity-binaries.sh linux $(BUILD) $(ORT_ROOT) $(UNITY_BINARIES)
+	@plugin/platforms/stage-unity-binaries.sh windows $(WINDOWS) $(WINDOWS_ORT) $(UNITY_BINARIES)
+	@$(PY) tests/unity/package.py pack --binaries $(UNITY_BINARIES) --out $(UNITY_TGZ)
+	@echo "Unity: Window > Package Manager > + > Add package from tarball... > $(UNITY_TGZ)"

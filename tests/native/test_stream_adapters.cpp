@@ -233,5 +233,5 @@ TEST(Rotation, ConventionsRoundTrip) {
   EXPECT_NEAR(q[3], std::cos(0.25), 1e-7);
   // Unity's left-handed yaw becomes the opposite turn about ARKit's +Y.
   const auto u = quaternion_from_unity_euler_degrees(0, 30, 0);
-  EXPECT_NEAR(u[1], -std::sin(M_PI / 12), 1e-7);
+  EXPECT_NEAR(u[1], -std::sin(std::acos(-1.0) / 12), 1e-7);
 }

@@ -6,13 +6,11 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdlib>
 #include <cstring>
 #include <new>
 #include <utility>
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
+
+#include "runtime/aligned_memory.h"
 
 namespace softdeca::runtime {
 
@@ -29,18 +27,18 @@ class AlignedArray {
       : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)), allocated_(std::exchange(o.allocated_, 0)) {}
   AlignedArray& operator=(AlignedArray&& o) noexcept {
     if (this != &o) {
-      std::free(data_);
+      aligned_release(data_);
       data_ = std::exchange(o.data_, nullptr);
       size_ = std::exchange(o.size_, 0);
       allocated_ = std::exchange(o.allocated_, 0);
     }
     return *this;
   }
-  ~AlignedArray() { std::free(data_); }
+  ~AlignedArray() { aligned_release(data_); }
 
   // Zero-filled; throws std::bad_alloc.
   void resize(std::size_t n) {
-    std::free(data_);
+    aligned_release(data_);
     data_ = nullptr;
     size_ = 0;
     allocated_ = 0;
@@ -48,11 +46,9 @@ class AlignedArray {
     const bool huge = n * sizeof(T) >= kHugePage;
     const std::size_t align = huge ? kHugePage : 64;
     const std::size_t bytes = (n * sizeof(T) + align - 1) / align * align;
-    data_ = static_cast<T*>(std::aligned_alloc(align, bytes));
+    data_ = static_cast<T*>(aligned_allocate(align, bytes));
     if (!data_) throw std::bad_alloc();
-#ifdef __linux__
-    if (huge) madvise(data_, bytes, MADV_HUGEPAGE);  // advice only: failure is harmless
-#endif
+    if (huge) advise_huge_pages(data_, bytes);
     std::memset(static_cast<void*>(data_), 0, bytes);
     size_ = n;
     allocated_ = bytes;

@@ -1,23 +1,18 @@
 // A non-blocking UDP socket (IPv4 or IPv6, numeric addresses only: no name lookups on the
-// frame path). POSIX sockets; Windows through Winsock's equivalents.
+// frame path). The system calls live in socket_posix.cpp and socket_windows.cpp (Winsock).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
-#ifdef _WIN32
-#include <winsock2.h>
-#include <ws2tcpip.h>
-#else
-#include <sys/socket.h>
-#endif
-
 namespace softdeca::stream {
 
 struct Endpoint {
-  sockaddr_storage address{};
-  socklen_t length = 0;
+  // The bytes of a sockaddr_storage (128 on every platform), opaque here so that this header
+  // needs no system socket header.
+  alignas(8) unsigned char address[128]{};
+  uint32_t length = 0;
   std::string text() const;  // "127.0.0.1:50110", "[::1]:50110"
 };
 
@@ -39,7 +34,8 @@ class UdpSocket {
   // Waits until a datagram is readable or `timeout_ms` passes; false on timeout.
   bool wait_readable(int timeout_ms) const;
   // One datagram into buf; false when none is waiting. `size` is its full length even when it
-  // was longer than `capacity` (then truncated).
+  // was longer than `capacity` (then truncated; where the system does not tell the full length,
+  // capacity + 1).
   bool receive(uint8_t* buf, std::size_t capacity, std::size_t& size, Endpoint& from);
   // True when the datagram went out whole.
   bool send(const uint8_t* data, std::size_t size, const Endpoint& to);
@@ -47,11 +43,7 @@ class UdpSocket {
  private:
   void open(int family);
   void close();
-#ifdef _WIN32
-  SOCKET fd_ = INVALID_SOCKET;
-#else
-  int fd_ = -1;
-#endif
+  std::intptr_t fd_ = -1;  // a file descriptor, or a Winsock SOCKET (INVALID_SOCKET is -1 too)
 };
 
 }  // namespace softdeca::stream

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# What the Windows x64 cross-build needs on Debian, installed idempotently (called by
+# `make windows`; plain `make setup` does not install it):
+#   1. Debian packages: the MinGW-w64 compilers with the posix thread model (the win32 model has
+#      no std::thread), mingw-w64-tools, and wine (runs the Windows tests; `wine64` alone puts
+#      no `wine` on PATH).
+#   2. An ONNX Runtime root for Windows in .deps/onnxruntime-win: onnxruntime.dll from the
+#      win_amd64 PyPI wheel of the version the Linux build uses (.deps/onnxruntime/VERSION), and
+#      the headers of .deps/onnxruntime/include (the wheel has neither headers nor an import
+#      library; GNU ld links against the DLL itself, C API only).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../../.." && pwd)
+cd "$root"
+say() { printf '\033[1m[windows]\033[0m %s\n' "$*"; }
+
+pkgs=(g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix mingw-w64-tools wine wine64)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  say "installing Debian packages: ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+linux_ort=.deps/onnxruntime
+[ -f "$linux_ort/VERSION" ] || { echo "windows: no $linux_ort/VERSION; run \`make setup\` first" >&2; exit 1; }
+ver=$(cat "$linux_ort/VERSION")
+ort=.deps/onnxruntime-win
+if [ ! -f "$ort/.stamp-$ver" ]; then
+  say "assembling the ONNX Runtime $ver root for Windows in $ort"
+  tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+  .venv/bin/python -m pip download -q --no-deps --only-binary=:all: --platform win_amd64 \
+    --python-version 3.11 "onnxruntime==$ver" -d "$tmp"
+  unzip -q -j "$tmp"/onnxruntime-"$ver"-*win_amd64.whl 'onnxruntime/capi/onnxruntime.dll' -d "$tmp/dll"
+  rm -rf "$ort"; mkdir -p "$ort/include" "$ort/lib"
+  cp "$linux_ort"/include/*.h "$ort/include/"
+  cp "$tmp/dll/onnxruntime.dll" "$ort/lib/"
+  echo "$ver" > "$ort/VERSION"
+  touch "$ort/.stamp-$ver"
+fi
+say "ready: $(x86_64-w64-mingw32-g++-posix --version | head -n1), $(wine --version), ONNX Runtime $ver ($ort)"

@@ -1,0 +1,172 @@
+// A replay through the shared library's C ABI alone, compared with a `softdeca replay` point cache
+// made by another build: the Windows DLL run under wine against the Linux replay of the same
+// bundle, avatar and frames (tests/platforms/windows_replay_check.sh). Uses nothing but
+// softdeca.h, so it builds wherever the library does.
+//
+// usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES
+//   AVATAR_DIR: neutral.obj and blendshapes/<ARKit name>.obj (as `softdeca replay --avatar` reads)
+//   EXPECTED.pc2: `softdeca replay TAKE.sdrec --models softdeca --start FIRST_FRAME ...`
+// Prints the largest vertex difference; exit status 0 when within the tolerance.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "softdeca/softdeca.h"
+
+namespace {
+
+void check(softdeca_status status, const std::string& what) {
+  if (status != SOFTDECA_OK)
+    throw std::runtime_error(what + ": " + softdeca_status_name(status) + ": " + softdeca_last_error());
+}
+
+struct Obj {
+  std::vector<float> vertices;   // xyz
+  std::vector<int32_t> triangles;  // faces fanned into triangles
+};
+
+// "v x y z" and "f a[/t/n] b c ..." lines; everything else is ignored.
+Obj read_obj(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  Obj obj;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string tag;
+    s >> tag;
+    if (tag == "v") {
+      float x = 0, y = 0, z = 0;
+      if (!(s >> x >> y >> z)) throw std::runtime_error(path + ": bad vertex line '" + line + "'");
+      obj.vertices.insert(obj.vertices.end(), {x, y, z});
+    } else if (tag == "f") {
+      std::vector<int32_t> corners;
+      std::string corner;
+      while (s >> corner) corners.push_back(std::atoi(corner.c_str()) - 1);
+      for (std::size_t k = 1; k + 1 < corners.size(); ++k)
+        obj.triangles.insert(obj.triangles.end(), {corners[0], corners[k], corners[k + 1]});
+    }
+  }
+  return obj;
+}
+
+struct Pc2 {
+  uint32_t points = 0, frames = 0;
+  std::vector<float> xyz;  // frames * points * 3
+};
+
+Pc2 read_pc2(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char signature[12] = {};
+  int32_t version = 0, points = 0, frames = 0;
+  float start = 0, rate = 0;
+  in.read(signature, 12);
+  in.read(reinterpret_cast<char*>(&version), 4).read(reinterpret_cast<char*>(&points), 4);
+  in.read(reinterpret_cast<char*>(&start), 4).read(reinterpret_cast<char*>(&rate), 4);
+  in.read(reinterpret_cast<char*>(&frames), 4);
+  if (!in || std::strcmp(signature, "POINTCACHE2") != 0 || points <= 0 || frames <= 0)
+    throw std::runtime_error(path + " is not a PC2 point cache");
+  Pc2 pc2{static_cast<uint32_t>(points), static_cast<uint32_t>(frames), {}};
+  pc2.xyz.resize(std::size_t{pc2.points} * pc2.frames * 3);
+  if (!in.read(reinterpret_cast<char*>(pc2.xyz.data()), static_cast<std::streamsize>(pc2.xyz.size() * sizeof(float))))
+    throw std::runtime_error(path + ": fewer frames than its header says");
+  return pc2;
+}
+
+int run(int argc, char** argv) {
+  if (argc != 7) {
+    std::fprintf(stderr, "usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES\n");
+    return 2;
+  }
+  const std::string bundle = argv[1], avatar_dir = argv[2], take = argv[3], expected_path = argv[5];
+  const uint32_t first = static_cast<uint32_t>(std::strtoul(argv[4], nullptr, 10));
+  const double tolerance = std::strtod(argv[6], nullptr);
+
+  softdeca_model* model = nullptr;
+  softdeca_model_options options{sizeof(softdeca_model_options), 0};
+  check(softdeca_model_load(bundle.c_str(), &options, &model), "loading " + bundle);
+  softdeca_model_info info{};
+  info.struct_size = sizeof info;
+  check(softdeca_model_get_info(model, &info), "model info");
+
+  const Obj neutral = read_obj(avatar_dir + "/neutral.obj");
+  const std::size_t n = neutral.vertices.size();
+  std::vector<float> deltas(SOFTDECA_BLENDSHAPE_COUNT * n, 0.0f);
+  for (uint32_t b = 0; b < SOFTDECA_BLENDSHAPE_COUNT; ++b) {
+    const std::string path = avatar_dir + "/blendshapes/" + softdeca_blendshape_name(b) + ".obj";
+    if (!std::ifstream(path)) continue;  // a shape the avatar lacks: no motion (as softdeca replay)
+    const Obj shape = read_obj(path);
+    if (shape.vertices.size() != n) throw std::runtime_error(path + ": vertex count differs from the neutral");
+    for (std::size_t i = 0; i < n; ++i) deltas[b * n + i] = shape.vertices[i] - neutral.vertices[i];
+  }
+  softdeca_avatar_desc desc{};
+  desc.struct_size = sizeof desc;
+  desc.neutral = neutral.vertices.data();
+  desc.vertex_count = static_cast<uint32_t>(n / 3);
+  desc.triangles = neutral.triangles.data();
+  desc.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
+  desc.blendshapes = deltas.data();
+  desc.blendshape_count = SOFTDECA_BLENDSHAPE_COUNT;
+  softdeca_avatar* avatar = nullptr;
+  check(softdeca_avatar_create(model, &desc, &avatar), "creating the avatar");
+  check(softdeca_avatar_prepare(avatar), "prepare");
+
+  softdeca_player* player = nullptr;
+  check(softdeca_player_open(take.c_str(), &player), "opening " + take);
+  const Pc2 expected = read_pc2(expected_path);
+  if (expected.points != info.head_vertex_count)
+    throw std::runtime_error(expected_path + " has " + std::to_string(expected.points) + " points, the bundle's head " +
+                             std::to_string(info.head_vertex_count));
+
+  std::vector<float> vertices(std::size_t{info.head_vertex_count} * 3);
+  softdeca_output output{sizeof(softdeca_output), vertices.data(), info.head_vertex_count, nullptr, 0};
+  softdeca_frame frame{};
+  double worst = 0, motion = 0;
+  for (uint32_t f = 0; f < expected.frames; ++f) {
+    frame.struct_size = sizeof frame;
+    check(softdeca_player_frame(player, first + f, &frame), "take frame " + std::to_string(first + f));
+    check(softdeca_avatar_evaluate_weights(avatar, frame.weights, SOFTDECA_BLENDSHAPE_COUNT, &output),
+          "frame " + std::to_string(f));
+    const float* want = expected.xyz.data() + std::size_t{f} * expected.points * 3;
+    for (std::size_t v = 0; v < expected.points; ++v) {
+      double d2 = 0, m2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double d = double(vertices[3 * v + k]) - want[3 * v + k];
+        const double m = double(vertices[3 * v + k]) - neutral.vertices[3 * v + k];
+        d2 += d * d;
+        m2 += m * m;
+      }
+      worst = std::max(worst, std::sqrt(d2));
+      motion = std::max(motion, std::sqrt(m2));
+    }
+  }
+  softdeca_player_destroy(player);
+  softdeca_avatar_destroy(avatar);
+  softdeca_model_destroy(model);
+
+  // The largest motion off the neutral shows the frames animate (a comparison of two rest poses
+  // would pass trivially).
+  const bool ok = worst <= tolerance && motion > 10 * tolerance;
+  std::printf("replay_check (softdeca %s): %u frames x %u vertices, largest difference %.3g m (tolerance %.3g m), "
+              "largest motion %.3g m: %s\n",
+              softdeca_version(), expected.frames, expected.points, worst, tolerance, motion, ok ? "OK" : "FAILED");
+  return ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "replay_check: %s\n", e.what());
+    return 1;
+  }
+}
