@@ -115,9 +115,33 @@ FrameInput frame_input(const Positions& skin, const std::optional<Positions>& la
 }
 
 nb::tuple single(const FrameResult& r) { return nb::make_tuple(r.vertices, r.skin, stats_dict(r.stats)); }
-}  // namespace
 
-void bind_sim(nb::module_& m) {
+// One frame through a Simulator member (static or dynamic) with the GIL released.
+template <FrameResult (Simulator::*solve)(const FrameInput&)>
+nb::tuple solve_one(Simulator& s, const Positions& skin, std::optional<Positions> landmarks, std::optional<Mat4> cranium,
+                    std::optional<Mat4> jaw, std::optional<Positions> warm_start) {
+  const FrameInput in = frame_input(skin, landmarks, cranium, jaw, warm_start);
+  FrameResult r;
+  {
+    nb::gil_scoped_release release;
+    r = (s.*solve)(in);
+  }
+  return single(r);
+}
+
+// A stack of frames through a Simulator member (batch or sequence) with the GIL released.
+template <std::vector<FrameResult> (Simulator::*solve)(const std::vector<FrameInput>&)>
+nb::tuple solve_many(Simulator& s, const Stack& skin, std::optional<Stack> landmarks, std::optional<Transforms> jaw) {
+  const std::vector<FrameInput> in = frames_of(skin, landmarks, jaw);
+  std::vector<FrameResult> r;
+  {
+    nb::gil_scoped_release release;
+    r = (s.*solve)(in);
+  }
+  return results(r);
+}
+
+void register_error_translator() {
   // softdeca::Error (bad input) surfaces as ValueError with the library's message.
   nb::register_exception_translator([](const std::exception_ptr& p, void*) {
     try {
@@ -126,6 +150,9 @@ void bind_sim(nb::module_& m) {
       PyErr_SetString(PyExc_ValueError, e.what());
     }
   });
+}
+
+void bind_parameters(nb::module_& m) {
 
   m.def("parameter_table", [] {
     nb::list out;
@@ -147,7 +174,9 @@ void bind_sim(nb::module_& m) {
   }, "The material parameters p as compiled in from plugin/data/parameters.json.");
   m.def("parameters_json", [] { return std::string(parameters_json()); },
         "plugin/data/parameters.json verbatim, as compiled in.");
+}
 
+void bind_collision_set(nb::module_& m) {
   nb::class_<CollisionSet>(m, "CollisionSet",
                            "Skin points that must stay on the outer side of an oriented surface (lips, teeth).")
       .def(
@@ -161,7 +190,9 @@ void bind_sim(nb::module_& m) {
       .def_ro("name", &CollisionSet::name)
       .def_ro("points", &CollisionSet::points)
       .def_ro("surface", &CollisionSet::surface);
+}
 
+void bind_simulation_mesh(nb::module_& m) {
   nb::class_<SimulationMesh>(m, "SimulationMesh",
                              "The simulation mesh: simulated vertices, tet groups, skull, bones, embedded skin S.")
       .def(
@@ -220,7 +251,9 @@ void bind_sim(nb::module_& m) {
       .def_prop_ro("landmark_count", &SimulationMesh::landmark_count)
       .def("embed_skin", [](const SimulationMesh& m, const Positions& x) { return embed(m.skin, x); }, nb::arg("vertices"),
            "Skin point positions for simulated vertex positions.");
+}
 
+void bind_mesh_functions(nb::module_& m) {
   m.def(
       "find_penetrations",
       [](const SimulationMesh& mesh, const Positions& skin, const Positions& vertices, double tolerance) {
@@ -256,7 +289,9 @@ void bind_sim(nb::module_& m) {
       nb::arg("landmark_stride") = 0,
       "A synthetic layered head: concentric icosphere wraps (radii 10, 8.5, 7.5 cm), prism tets, a skull sphere "
       "(7 cm) split into cranium and jaw, S a finer sphere embedded in the soft layer.");
+}
 
+void bind_simulator(nb::module_& m) {
   nb::class_<Simulator>(m, "Simulator", "phi†: the projective-dynamics simulator of one layered head.")
       .def(
           "__init__",
@@ -297,61 +332,23 @@ void bind_sim(nb::module_& m) {
              return d;
            }, "Global values of all parameters.")
       .def(
-          "solve_static",
-          [](Simulator& s, const Positions& skin, std::optional<Positions> landmarks, std::optional<Mat4> cranium,
-             std::optional<Mat4> jaw, std::optional<Positions> warm_start) {
-            const FrameInput in = frame_input(skin, landmarks, cranium, jaw, warm_start);
-            FrameResult r;
-            {
-              nb::gil_scoped_release release;
-              r = s.solve_static(in);
-            }
-            return single(r);
-          },
+          "solve_static", &solve_one<&Simulator::solve_static>,
           nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(), nb::arg("cranium") = nb::none(),
           nb::arg("jaw") = nb::none(), nb::arg("warm_start") = nb::none(),
           "One static frame -> (vertices, skin, stats). cranium/jaw: 4x4 rigid transforms of pinned bones.")
       .def(
-          "step_dynamic",
-          [](Simulator& s, const Positions& skin, std::optional<Positions> landmarks, std::optional<Mat4> cranium,
-             std::optional<Mat4> jaw, std::optional<Positions> warm_start) {
-            const FrameInput in = frame_input(skin, landmarks, cranium, jaw, warm_start);
-            FrameResult r;
-            {
-              nb::gil_scoped_release release;
-              r = s.step_dynamic(in);
-            }
-            return single(r);
-          },
+          "step_dynamic", &solve_one<&Simulator::step_dynamic>,
           nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(), nb::arg("cranium") = nb::none(),
           nb::arg("jaw") = nb::none(), nb::arg("warm_start") = nb::none(),
           "The next dynamic frame (eq. 9) -> (vertices, skin, stats).")
       .def("reset_dynamics", &Simulator::reset_dynamics)
       .def(
-          "solve_static_batch",
-          [](Simulator& s, const Stack& skin, std::optional<Stack> landmarks, std::optional<Transforms> jaw) {
-            const std::vector<FrameInput> in = frames_of(skin, landmarks, jaw);
-            std::vector<FrameResult> r;
-            {
-              nb::gil_scoped_release release;
-              r = s.solve_static_batch(in);
-            }
-            return results(r);
-          },
+          "solve_static_batch", &solve_many<&Simulator::solve_static_batch>,
           nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(), nb::arg("jaw") = nb::none(),
           "Static frames (F, n, 3) (jaw: (F, 4, 4) rigid transforms) over one factorisation on all threads -> "
           "(skin (F, n, 3), vertices (F, N, 3), stats list).")
       .def(
-          "solve_sequence",
-          [](Simulator& s, const Stack& skin, std::optional<Stack> landmarks, std::optional<Transforms> jaw) {
-            const std::vector<FrameInput> in = frames_of(skin, landmarks, jaw);
-            std::vector<FrameResult> r;
-            {
-              nb::gil_scoped_release release;
-              r = s.solve_sequence(in);
-            }
-            return results(r);
-          },
+          "solve_sequence", &solve_many<&Simulator::solve_sequence>,
           nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(), nb::arg("jaw") = nb::none(),
           "A dynamic sequence from rest of the dynamics -> (skin, vertices, stats list).")
       .def("rest_positions", &Simulator::rest_positions)
@@ -359,4 +356,14 @@ void bind_sim(nb::module_& m) {
       .def_prop_ro("factorizations", &Simulator::factorizations)
       .def_prop_ro("thread_count", &Simulator::thread_count)
       .def_prop_ro("mesh", &Simulator::mesh, nb::rv_policy::reference_internal);
+}
+}  // namespace
+
+void bind_sim(nb::module_& m) {
+  register_error_translator();
+  bind_parameters(m);
+  bind_collision_set(m);
+  bind_simulation_mesh(m);
+  bind_mesh_functions(m);
+  bind_simulator(m);
 }

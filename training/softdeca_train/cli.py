@@ -1,19 +1,37 @@
-"""Command line of the training pipeline: one sub-command per step, each with --help."""
+"""Command line of the training pipeline: one sub-command per step, each with --help.
+
+The commands live with their pipeline stage, each stage's `cli` module listing them in
+`COMMANDS` (see softdeca_train.commands); STAGES gives the order `--help` shows them in."""
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
-# Steps register themselves here: name -> (help, add_arguments, run).
-Step = tuple[str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]
+from softdeca_train.commands import Command
+
+STAGES = (
+    "softdeca_train.template.cli",
+    "softdeca_train.lhm_cli",
+    "softdeca_train.landmarks.cli",
+    "softdeca_train.sim.cli",
+    "softdeca_train.data.cli",
+    "softdeca_train.train.cli",
+    "softdeca_train.runtime.cli",
+    "softdeca_train.streaming.cli",
+)
 
 
-def _steps() -> dict[str, Step]:
-    from softdeca_train import steps
-
-    return steps.STEPS
+def commands() -> dict[str, Command]:
+    out: dict[str, Command] = {}
+    for stage in STAGES:
+        for c in importlib.import_module(stage).COMMANDS:
+            if c.name in out:
+                raise RuntimeError(f"command {c.name} is registered twice ({stage})")
+            out[c.name] = c
+    return out
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -22,13 +40,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         description="SoftDECA training pipeline: template, layered head model, data, networks.",
     )
     sub = parser.add_subparsers(dest="step", metavar="<step>", required=True)
-    steps = _steps()
-    for name, (help_text, add_args, _) in steps.items():
-        p = sub.add_parser(name, help=help_text, description=help_text)
-        add_args(p)
+    table = commands()
+    for c in table.values():
+        c.add_arguments(sub.add_parser(c.name, help=c.help, description=c.help))
     args = parser.parse_args(argv)
     try:
-        return steps[args.step][2](args)
+        return table[args.step].run(args)
     except (FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "recording/timecode.h"
 #include "stream/livelinkface_layout.h"
+#include "stream/text_fields.h"
 
 namespace softdeca::recording {
 namespace {
@@ -60,12 +61,9 @@ CsvTake parse_livelinkface_csv(std::string_view text, double rate) {
   value_col.fill(-1);
   std::size_t columns = 0;
   bool header = true;
-  std::size_t begin = 0;
-  while (begin < text.size()) {
-    std::size_t end = text.find('\n', begin);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(begin, end - begin);
-    begin = end + 1;
+  stream::TextFields lines(text, '\n');
+  std::string_view line;
+  while (lines.next(line)) {
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.empty()) continue;
     const auto fields = split(line);

@@ -106,10 +106,12 @@ NetworkSpec expected_network(const Manifest& m, const std::string& key, int p) {
   return n;
 }
 
-Manifest parse_manifest(const std::string& text) {
-  const Json doc = Json::parse(text);
+namespace {
+// parse_manifest's steps, in the order the manifest is read: later steps check against what the
+// earlier ones filled in (sizes, parameters), so the order matters.
+
+void parse_header(const Json& doc, Manifest& m) {
   check(doc.is_object(), "the manifest must be a JSON object");
-  Manifest m;
   const std::string format = doc.has("format") && doc.at("format", "manifest").is_string()
                                  ? doc.at("format", "manifest").string("format")
                                  : std::string("?");
@@ -122,7 +124,9 @@ Manifest parse_manifest(const std::string& text) {
   if (doc.has("description") && doc.at("description", "manifest").is_string())
     m.description = doc.at("description", "manifest").string("description");
   check(doc.at("units", "manifest").string("units") == "metre", "units must be \"metre\"");
+}
 
+void parse_sizes(const Json& doc, Manifest& m) {
   const Json& t = doc.at("template", "manifest");
   m.template_name = t.at("name", "template").string("template.name");
   m.head_vertices = bounded_int(t.at("head_vertices", "template"), "template.head_vertices", 3, kMaxElements);
@@ -137,53 +141,61 @@ Manifest parse_manifest(const std::string& text) {
     check(names[static_cast<std::size_t>(i)].string("blendshapes") == stream::blendshape_name(static_cast<std::size_t>(i)),
           "blendshapes[" + std::to_string(i) + "] must be " + stream::blendshape_name(static_cast<std::size_t>(i)) +
               " (canonical ARKit order)");
+}
 
-  std::set<std::string> seen;
-  for (const Json& p : doc.at("parameters", "manifest").array("parameters")) {
-    ParameterSpec s;
-    s.name = p.at("name", "parameter").string("parameter.name");
-    const std::string what = "parameter " + s.name;
-    check(!s.name.empty() && seen.insert(s.name).second, what + ": names must be unique and non-empty");
-    s.default_value = finite(p.at("default", what), what + ".default");
-    s.min = finite(p.at("min", what), what + ".min");
-    s.max = finite(p.at("max", what), what + ".max");
-    const std::string scale = p.at("scale", what).string(what + ".scale");
-    check(scale == "linear" || scale == "log", what + ": scale must be linear or log");
-    s.log_scale = scale == "log";
-    s.localisable = p.at("localisable", what).boolean(what + ".localisable");
-    if (p.has("unit")) s.unit = p.at("unit", what).string(what + ".unit");
-    if (p.has("symbol")) s.symbol = p.at("symbol", what).string(what + ".symbol");
-    if (p.has("domain")) s.domain = p.at("domain", what).string(what + ".domain");
-    if (p.has("description")) s.description = p.at("description", what).string(what + ".description");
-    check(s.min < s.max && s.default_value >= s.min && s.default_value <= s.max, what + ": needs min < max and default in range");
-    check(!s.log_scale || s.min > 0, what + ": log scale needs min > 0");
-    m.parameters.push_back(std::move(s));
+ParameterSpec parse_parameter(const Json& p, std::set<std::string>& seen) {
+  ParameterSpec s;
+  s.name = p.at("name", "parameter").string("parameter.name");
+  const std::string what = "parameter " + s.name;
+  check(!s.name.empty() && seen.insert(s.name).second, what + ": names must be unique and non-empty");
+  s.default_value = finite(p.at("default", what), what + ".default");
+  s.min = finite(p.at("min", what), what + ".min");
+  s.max = finite(p.at("max", what), what + ".max");
+  const std::string scale = p.at("scale", what).string(what + ".scale");
+  check(scale == "linear" || scale == "log", what + ": scale must be linear or log");
+  s.log_scale = scale == "log";
+  s.localisable = p.at("localisable", what).boolean(what + ".localisable");
+  if (p.has("unit")) s.unit = p.at("unit", what).string(what + ".unit");
+  if (p.has("symbol")) s.symbol = p.at("symbol", what).string(what + ".symbol");
+  if (p.has("domain")) s.domain = p.at("domain", what).string(what + ".domain");
+  if (p.has("description")) s.description = p.at("description", what).string(what + ".description");
+  check(s.min < s.max && s.default_value >= s.min && s.default_value <= s.max, what + ": needs min < max and default in range");
+  check(!s.log_scale || s.min > 0, what + ": log scale needs min > 0");
+  return s;
+}
+
+LandmarkSpec parse_landmark(const Json& p, const Manifest& m) {
+  LandmarkSpec s;
+  s.name = p.at("name", "landmark").string("landmark.name");
+  const std::string what = "landmark " + s.name;
+  s.arkit_vertex = bounded_int(p.at("arkit_vertex", what), what + ".arkit_vertex", 0, m.arkit_vertex_count - 1);
+  s.triangle = bounded_int(p.at("triangle", what), what + ".triangle", 0, m.skin_triangles - 1);
+  const auto& b = p.at("bary", what).array(what + ".bary");
+  check(b.size() == 3, what + ".bary must have 3 entries");
+  double sum = 0;
+  for (int k = 0; k < 3; ++k) {
+    s.bary[k] = finite(b[static_cast<std::size_t>(k)], what + ".bary");
+    check(s.bary[k] >= -1e-6 && s.bary[k] <= 1 + 1e-6, what + ".bary entries must lie in [0, 1]");
+    sum += s.bary[k];
   }
+  check(std::fabs(sum - 1.0) < 1e-4, what + ".bary must sum to 1");
+  return s;
+}
+
+void parse_parameters_and_landmarks(const Json& doc, Manifest& m) {
+  std::set<std::string> seen;
+  for (const Json& p : doc.at("parameters", "manifest").array("parameters")) m.parameters.push_back(parse_parameter(p, seen));
   check(!m.parameters.empty(), "at least one parameter is needed");
 
   const Json& lm = doc.at("landmarks", "manifest");
   m.arkit_vertex_count = bounded_int(lm.at("arkit_vertex_count", "landmarks"), "landmarks.arkit_vertex_count", 1, kMaxElements);
-  for (const Json& p : lm.at("points", "landmarks").array("landmarks.points")) {
-    LandmarkSpec s;
-    s.name = p.at("name", "landmark").string("landmark.name");
-    const std::string what = "landmark " + s.name;
-    s.arkit_vertex = bounded_int(p.at("arkit_vertex", what), what + ".arkit_vertex", 0, m.arkit_vertex_count - 1);
-    s.triangle = bounded_int(p.at("triangle", what), what + ".triangle", 0, m.skin_triangles - 1);
-    const auto& b = p.at("bary", what).array(what + ".bary");
-    check(b.size() == 3, what + ".bary must have 3 entries");
-    double sum = 0;
-    for (int k = 0; k < 3; ++k) {
-      s.bary[k] = finite(b[static_cast<std::size_t>(k)], what + ".bary");
-      check(s.bary[k] >= -1e-6 && s.bary[k] <= 1 + 1e-6, what + ".bary entries must lie in [0, 1]");
-      sum += s.bary[k];
-    }
-    check(std::fabs(sum - 1.0) < 1e-4, what + ".bary must sum to 1");
-    m.landmarks.push_back(std::move(s));
-  }
+  for (const Json& p : lm.at("points", "landmarks").array("landmarks.points")) m.landmarks.push_back(parse_landmark(p, m));
   check(static_cast<long long>(m.landmarks.size()) == lm.at("count", "landmarks").integer("landmarks.count"),
         "landmarks.count does not match the points");
   check(m.landmarks.size() >= 3, "at least 3 landmarks are needed");
+}
 
+void parse_files(const Json& doc, Manifest& m) {
   const Json& files = doc.at("files", "manifest");
   const Json& tri = files.at("skin_triangles", "files");
   m.skin_triangles_file = tri.at("path", "files.skin_triangles").string("files.skin_triangles.path");
@@ -204,7 +216,9 @@ Manifest parse_manifest(const std::string& text) {
 
   for (const Json& a : doc.at("non_skin", "manifest").at("jaw_anchors", "non_skin").array("non_skin.jaw_anchors"))
     m.jaw_anchors.push_back(bounded_int(a, "non_skin.jaw_anchors", 0, m.skin_vertices - 1));
+}
 
+void parse_deformation_and_dynamics(const Json& doc, Manifest& m) {
   const Json& dt = doc.at("deformation_transfer", "manifest");
   const std::string formulation = dt.at("formulation", "deformation_transfer").string("deformation_transfer.formulation");
   check(formulation == kDtFormulation, "deformation_transfer.formulation '" + formulation + "' is unknown (this runtime implements '" +
@@ -221,38 +235,42 @@ Manifest parse_manifest(const std::string& text) {
   m.gamma_max = finite(gr[1], "dynamics.gamma_range");
   check(m.beta_max >= 0 && m.beta_max < 1 && m.gamma_min > 0 && m.gamma_max < 2 && m.gamma_min <= m.gamma_max,
         "dynamics: the declared ranges are outside the stable set (0 <= beta < 1, 0 < gamma < 2)");
+}
 
+NetworkSpec parse_network(const Json& j, const char* key, const Manifest& m) {
+  const std::string what = std::string("networks.") + key;
+  NetworkSpec n;
+  n.key = key;
+  n.file = j.at("file", what).string(what + ".file");
+  n.sha256 = sha256_of(j, what);
+  if (j.has("parameter_columns")) {
+    for (const Json& c : j.at("parameter_columns", what).array(what + ".parameter_columns")) {
+      const int idx = m.find_parameter(c.string(what + ".parameter_columns"));
+      check(idx >= 0, what + ": parameter column '" + c.string("") + "' is not a bundle parameter");
+      n.parameter_columns.push_back(idx);
+    }
+  }
+  for (const char* side : {"inputs", "outputs"})
+    for (const Json& tj : j.at(side, what).array(what + "." + side)) {
+      TensorSpec ts;
+      ts.name = tj.at("name", what).string(what + ".name");
+      check(tj.at("dtype", what).string(what + ".dtype") == "float32", what + "." + ts.name + ": dtype must be float32");
+      ts.shape = shape_of(tj.at("shape", what), what + "." + ts.name + ".shape");
+      (std::string(side) == "inputs" ? n.inputs : n.outputs).push_back(std::move(ts));
+    }
+  const NetworkSpec want = expected_network(m, key, static_cast<int>(n.parameter_columns.size()));
+  check_tensors(n.inputs, want.inputs, what + ".inputs");
+  check_tensors(n.outputs, want.outputs, what + ".outputs");
+  const bool per_element = want.inputs[0].name == "parameters";
+  check(per_element == !n.parameter_columns.empty(), what + ": parameter_columns must be given exactly for per-element networks");
+  return n;
+}
+
+void parse_networks(const Json& doc, Manifest& m) {
   const Json& nets = doc.at("networks", "manifest");
   for (const char* key : {"identity_encoder", "softdeca.f_w", "softdeca.f_ph", "softdeca.f_dyn", "sparse.f_l",
                           "sparse.f_ph_v", "sparse.f_dyn"}) {
-    if (!nets.has(key)) continue;
-    const Json& j = nets.at(key, "networks");
-    const std::string what = std::string("networks.") + key;
-    NetworkSpec n;
-    n.key = key;
-    n.file = j.at("file", what).string(what + ".file");
-    n.sha256 = sha256_of(j, what);
-    if (j.has("parameter_columns")) {
-      for (const Json& c : j.at("parameter_columns", what).array(what + ".parameter_columns")) {
-        const int idx = m.find_parameter(c.string(what + ".parameter_columns"));
-        check(idx >= 0, what + ": parameter column '" + c.string("") + "' is not a bundle parameter");
-        n.parameter_columns.push_back(idx);
-      }
-    }
-    for (const char* side : {"inputs", "outputs"})
-      for (const Json& tj : j.at(side, what).array(what + "." + side)) {
-        TensorSpec ts;
-        ts.name = tj.at("name", what).string(what + ".name");
-        check(tj.at("dtype", what).string(what + ".dtype") == "float32", what + "." + ts.name + ": dtype must be float32");
-        ts.shape = shape_of(tj.at("shape", what), what + "." + ts.name + ".shape");
-        (std::string(side) == "inputs" ? n.inputs : n.outputs).push_back(std::move(ts));
-      }
-    const NetworkSpec want = expected_network(m, key, static_cast<int>(n.parameter_columns.size()));
-    check_tensors(n.inputs, want.inputs, what + ".inputs");
-    check_tensors(n.outputs, want.outputs, what + ".outputs");
-    const bool per_element = want.inputs[0].name == "parameters";
-    check(per_element == !n.parameter_columns.empty(), what + ": parameter_columns must be given exactly for per-element networks");
-    m.networks[key] = std::move(n);
+    if (nets.has(key)) m.networks[key] = parse_network(nets.at(key, "networks"), key, m);
   }
   check(m.networks.count("identity_encoder") > 0, "networks.identity_encoder is required");
   const auto count = [&](std::initializer_list<const char*> keys) {
@@ -267,6 +285,18 @@ Manifest parse_manifest(const std::string& text) {
   m.has_softdeca = sd == 3;
   m.has_sparse = sp == 3;
   check(m.has_softdeca || m.has_sparse, "the bundle holds neither model");
+}
+}  // namespace
+
+Manifest parse_manifest(const std::string& text) {
+  const Json doc = Json::parse(text);
+  Manifest m;
+  parse_header(doc, m);
+  parse_sizes(doc, m);
+  parse_parameters_and_landmarks(doc, m);
+  parse_files(doc, m);
+  parse_deformation_and_dynamics(doc, m);
+  parse_networks(doc, m);
   return m;
 }
 

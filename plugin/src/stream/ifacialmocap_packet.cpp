@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "stream/arkit_names.h"
 #include "stream/rotation.h"
+#include "stream/text_fields.h"
 
 namespace softdeca::stream::ifacialmocap {
 namespace {
@@ -68,12 +69,9 @@ wire::Verdict decode_packet(const uint8_t* data, std::size_t size, Frame& f, Pre
   f = Frame{};
   present.fill(false);
   std::size_t known = 0;
-  std::size_t begin = 0;
-  while (begin < text.size()) {
-    std::size_t end = text.find('|', begin);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view field = text.substr(begin, end - begin);
-    begin = end + 1;
+  TextFields fields(text, '|');
+  std::string_view field;
+  while (fields.next(field)) {
     if (!field.empty() && field.front() == '=') field.remove_prefix(1);  // weights | transforms
     if (field.empty()) continue;
     const std::size_t hash = field.find('#');

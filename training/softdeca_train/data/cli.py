@@ -8,24 +8,66 @@ import json
 import os
 from pathlib import Path
 
+from softdeca_train.commands import Command, add_ict_argument
 from softdeca_train.data.config import GenerateConfig, RunSettings, default_takes_path
 from softdeca_train.data.ranges import PROFILES
 
 D = GenerateConfig()
 
 
-def _ict(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--ict",
-        default=None,
-        help="ICT-FaceKit checkout, FaceXModel folder or .tar.xz archive "
-        "(default: $SOFTDECA_ICT or ict-facekit in the data folder)",
-    )
+# The dataset's options that set one GenerateConfig field each: (option, field, help with `{}`
+# where the default goes). Type and default come from GenerateConfig's defaults.
+_COUNTS = (
+    ("--static", "static", "static instances ({})"),
+    ("--dynamic", "dynamic", "dynamic sequences ({})"),
+    ("--sparse", "sparse", "sparse instances ({})"),
+)
+_SAMPLING = (
+    ("--seed", "seed", "dataset seed ({})"),
+    ("--test-share", "test_share", "test identities ({})"),
+    (
+        "--level",
+        "level",
+        "LHM wrap resolution ({}: a reduced scale for this machine; 4-5 on a cluster)",
+    ),
+    (
+        "--frames-per-params",
+        "frames_per_params",
+        "static/sparse frames per (identity, p) group ({})",
+    ),
+    ("--params-per-identity", "params_per_identity", "static/sparse groups per identity ({})"),
+    ("--sequences-per-identity", "sequences_per_identity", "dynamic sequences per identity ({})"),
+    ("--sequence-length", "sequence_length", "frames per dynamic sequence ({})"),
+    ("--lead-in", "lead_in", "frames simulated with fixed dynamics before a sequence ({})"),
+    ("--real-share", "real_share", "share of static/sparse frames from real takes ({})"),
+    ("--test-take", "test_take", "take held out for testing ({})"),
+    ("--noise-mm", "landmark_noise_mm", "landmark noise sigma, mm ({})"),
+)
+_SOLVER = (
+    ("--tolerance", "tolerance", "solver tolerance ({})"),
+    (
+        "--max-iterations",
+        "max_iterations",
+        "solver iterations per frame at most; slower frames are flagged ({})",
+    ),
+)
+
+
+def _dest(option: str) -> str:
+    return option.removeprefix("--").replace("-", "_")
+
+
+def _add_config_options(
+    g: argparse._ArgumentGroup, options: tuple[tuple[str, str, str], ...]
+) -> None:
+    for option, field, help_text in options:
+        default = getattr(D, field)
+        g.add_argument(option, type=type(default), default=default, help=help_text.format(default))
 
 
 def add_generate_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="dataset folder (created; resumed if present)")
-    _ict(p)
+    add_ict_argument(p)
     p.add_argument(
         "--takes",
         default=None,
@@ -33,11 +75,7 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         f"(default: $SOFTDECA_TAKES or {default_takes_path()})",
     )
     g = p.add_argument_group("what to generate (fixes the dataset; a resume must match)")
-    g.add_argument("--static", type=int, default=D.static, help=f"static instances ({D.static})")
-    g.add_argument(
-        "--dynamic", type=int, default=D.dynamic, help=f"dynamic sequences ({D.dynamic})"
-    )
-    g.add_argument("--sparse", type=int, default=D.sparse, help=f"sparse instances ({D.sparse})")
+    _add_config_options(g, _COUNTS)
     g.add_argument(
         "--instances",
         type=int,
@@ -45,76 +83,14 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         help="instead of --static/--dynamic: this many frames, 75 %% static and 25 %% in "
         "dynamic sequences (the paper's mix)",
     )
-    g.add_argument("--seed", type=int, default=D.seed, help=f"dataset seed ({D.seed})")
-    g.add_argument(
-        "--test-share", type=float, default=D.test_share, help=f"test identities ({D.test_share})"
-    )
-    g.add_argument(
-        "--level",
-        type=int,
-        default=D.level,
-        help=f"LHM wrap resolution ({D.level}: a reduced scale for this machine; 4-5 on a cluster)",
-    )
-    g.add_argument(
-        "--frames-per-params",
-        type=int,
-        default=D.frames_per_params,
-        help=f"static/sparse frames per (identity, p) group ({D.frames_per_params})",
-    )
-    g.add_argument(
-        "--params-per-identity",
-        type=int,
-        default=D.params_per_identity,
-        help=f"static/sparse groups per identity ({D.params_per_identity})",
-    )
-    g.add_argument(
-        "--sequences-per-identity",
-        type=int,
-        default=D.sequences_per_identity,
-        help=f"dynamic sequences per identity ({D.sequences_per_identity})",
-    )
-    g.add_argument(
-        "--sequence-length",
-        type=int,
-        default=D.sequence_length,
-        help=f"frames per dynamic sequence ({D.sequence_length})",
-    )
-    g.add_argument(
-        "--lead-in",
-        type=int,
-        default=D.lead_in,
-        help=f"frames simulated with fixed dynamics before a sequence ({D.lead_in})",
-    )
-    g.add_argument(
-        "--real-share",
-        type=float,
-        default=D.real_share,
-        help=f"share of static/sparse frames from real takes ({D.real_share})",
-    )
-    g.add_argument(
-        "--test-take", default=D.test_take, help=f"take held out for testing ({D.test_take})"
-    )
-    g.add_argument(
-        "--noise-mm",
-        type=float,
-        default=D.landmark_noise_mm,
-        help=f"landmark noise sigma, mm ({D.landmark_noise_mm})",
-    )
+    _add_config_options(g, _SAMPLING)
     g.add_argument(
         "--no-collisions",
         dest="collisions",
         action="store_false",
         help="skip the lip/teeth collision sets and the lips on S (on by default)",
     )
-    g.add_argument(
-        "--tolerance", type=float, default=D.tolerance, help=f"solver tolerance ({D.tolerance})"
-    )
-    g.add_argument(
-        "--max-iterations",
-        type=int,
-        default=D.max_iterations,
-        help=f"solver iterations per frame at most; slower frames are flagged ({D.max_iterations})",
-    )
+    _add_config_options(g, _SOLVER)
     g.add_argument(
         "--ranges",
         choices=sorted(PROFILES),
@@ -139,23 +115,8 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
 
 
 def config_from_args(args: argparse.Namespace) -> GenerateConfig:
-    kw = {
-        "seed": args.seed,
-        "test_share": args.test_share,
-        "level": args.level,
-        "frames_per_params": args.frames_per_params,
-        "params_per_identity": args.params_per_identity,
-        "sequences_per_identity": args.sequences_per_identity,
-        "sequence_length": args.sequence_length,
-        "lead_in": args.lead_in,
-        "real_share": args.real_share,
-        "test_take": args.test_take,
-        "landmark_noise_mm": args.noise_mm,
-        "collisions": args.collisions,
-        "tolerance": args.tolerance,
-        "max_iterations": args.max_iterations,
-        "ranges": args.ranges,
-    }
+    kw = {field: getattr(args, _dest(option)) for option, field, _ in (*_SAMPLING, *_SOLVER)}
+    kw |= {"collisions": args.collisions, "ranges": args.ranges}
     if args.instances is not None:
         return GenerateConfig.from_total(args.instances, args.sparse, **kw)
     return GenerateConfig(static=args.static, dynamic=args.dynamic, sparse=args.sparse, **kw)
@@ -190,7 +151,7 @@ def run_generate(args: argparse.Namespace) -> int:
 def add_report_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("dataset", help="dataset folder (with manifest.json)")
     p.add_argument("--out", default=None, help="report folder (default: <dataset>/report)")
-    _ict(p)
+    add_ict_argument(p)
 
 
 def run_report(args: argparse.Namespace) -> int:
@@ -203,7 +164,7 @@ def run_report(args: argparse.Namespace) -> int:
 
 def add_bench_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="build/bench", help="folder for datagen.json (build/bench)")
-    _ict(p)
+    add_ict_argument(p)
     p.add_argument("--level", type=int, default=D.level, help=f"LHM level ({D.level})")
     p.add_argument(
         "--workers", type=int, default=os.cpu_count() or 1, help="worker processes (all cores)"
@@ -222,3 +183,27 @@ def run_bench(args: argparse.Namespace) -> int:
         print(f"  {name:40s} {f['value']:>12.1f} {f['unit']}")
     print(f"wrote {path}")
     return 0
+
+
+COMMANDS = [
+    Command(
+        "generate",
+        "Generate (or resume) the training dataset: static, dynamic and sparse instances "
+        "simulated by the physics, in parallel (processes or Ray), as shards + manifest.",
+        add_generate_args,
+        run_generate,
+    ),
+    Command(
+        "report-data",
+        "Report on a generated dataset: markdown + plots (parameter, weight and identity "
+        "distributions; |T - S| per region).",
+        add_report_args,
+        run_report,
+    ),
+    Command(
+        "bench-datagen",
+        "Benchmark data generation on this machine into build/bench/datagen.json.",
+        add_bench_args,
+        run_bench,
+    ),
+]

@@ -9,7 +9,7 @@ import ctypes
 import multiprocessing as mp
 import os
 import signal
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from typing import Any
 
@@ -45,6 +45,34 @@ def _die_with_parent() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
+def _in_flight(
+    specs: list[ShardSpec],
+    limit: int,
+    submit: Callable[[ShardSpec], Any],
+    finished: Callable[[list[Any]], Iterable[Any]],
+    result: Callable[[Any], tuple[dict, dict]],
+) -> Iterator[Result]:
+    """At most `limit` shards in flight (so a kill loses little), each yielded as it finishes:
+    `submit` starts one, `finished` waits for some of the pending handles, `result` reads one."""
+    todo = iter(specs)
+    pending: dict[Any, ShardSpec] = {}
+
+    def fill() -> None:
+        while len(pending) < limit:
+            spec = next(todo, None)
+            if spec is None:
+                return
+            pending[submit(spec)] = spec
+
+    fill()
+    while pending:
+        for handle in finished(list(pending)):
+            spec = pending.pop(handle)
+            arrays, info = result(handle)
+            yield spec, arrays, info
+        fill()
+
+
 def run_inline(
     specs: list[ShardSpec], cfg: GenerateConfig, ict: str | None, threads: int
 ) -> Iterator[Result]:
@@ -65,24 +93,13 @@ def run_processes(
         _environment(SINGLE_THREADED),
         ProcessPoolExecutor(workers, mp_context=ctx, initializer=_die_with_parent) as pool,
     ):
-        todo = iter(specs)
-        pending: dict[Future, ShardSpec] = {}
-
-        def fill() -> None:
-            while len(pending) < 2 * workers:
-                spec = next(todo, None)
-                if spec is None:
-                    return
-                pending[pool.submit(simulate_shard, spec, cfg, ict, threads)] = spec
-
-        fill()
-        while pending:
-            done, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in done:
-                spec = pending.pop(fut)
-                arrays, info = fut.result()
-                yield spec, arrays, info
-            fill()
+        yield from _in_flight(
+            specs,
+            2 * workers,
+            lambda spec: pool.submit(simulate_shard, spec, cfg, ict, threads),
+            lambda pending: wait(pending, return_when=FIRST_COMPLETED)[0],
+            Future.result,
+        )
 
 
 def run_ray(
@@ -114,23 +131,12 @@ def run_ray(
     try:
         task = ray.remote(num_cpus=threads)(simulate_shard)
         capacity = max(1, int(ray.cluster_resources().get("CPU", 1)) // threads)
-        todo = iter(specs)
-        pending: dict[Any, ShardSpec] = {}
-
-        def fill() -> None:
-            while len(pending) < 2 * capacity:
-                spec = next(todo, None)
-                if spec is None:
-                    return
-                pending[task.remote(spec, cfg, ict, threads)] = spec
-
-        fill()
-        while pending:
-            done, _ = ray.wait(list(pending), num_returns=1)
-            for ref in done:
-                spec = pending.pop(ref)
-                arrays, info = ray.get(ref)
-                yield spec, arrays, info
-            fill()
+        yield from _in_flight(
+            specs,
+            2 * capacity,
+            lambda spec: task.remote(spec, cfg, ict, threads),
+            lambda pending: ray.wait(pending, num_returns=1)[0],
+            ray.get,
+        )
     finally:
         ray.shutdown()

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import matplotlib
@@ -277,73 +278,78 @@ def _sanity_line(summary: dict) -> str:
     )
 
 
-def write_report(
-    folder: Path, out: Path, ict: str | None = None, takes_dir: Path | None = None
-) -> Path:
-    from softdeca_train.data.config import default_takes_path
+@dataclass
+class _Stats:
+    """Everything the report reads from the shards, gathered in one pass."""
 
-    folder, out = Path(folder), Path(out)
-    manifest = json.loads((folder / "manifest.json").read_text())
-    template = Template.load(ict)
+    disp: dict[str, Displacements]
+    kept: dict[str, Displacements]  # the frames the loader yields by default
+    p_norm: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    conv: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    its: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    errs: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    drivers: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(
+        default_factory=dict
+    )
+    weights: list[np.ndarray] = field(default_factory=list)
+    h_rows: list[np.ndarray] = field(default_factory=list)
+    h_split: list[int] = field(default_factory=list)
+    h_seen: set[int] = field(default_factory=set)
+    landmark_stats: list[np.ndarray] = field(default_factory=list)
+
+    @property
+    def kinds(self) -> list[str]:
+        return [k for k in KINDS if self.disp[k].frames]
+
+    def add_identities(self, a: dict) -> None:
+        ids = [(a["identity_id"], a["h"])]
+        if "donor_id" in a:
+            ids.append((a["donor_id"], a["donor_h"]))
+        for id_col, h_col in ids:
+            for i, hid in enumerate(id_col):
+                if int(hid) not in self.h_seen:
+                    self.h_seen.add(int(hid))
+                    self.h_rows.append(h_col[i])
+                    self.h_split.append(int(a["split"][i]))
+
+
+def _collect(folder: Path, template: Template, params: ParameterSet, tol: float) -> _Stats:
+    """Stream every shard once into the report's statistics."""
     labels = region_labels(template)
-    params = dataset_parameters(manifest)
-    out.mkdir(parents=True, exist_ok=True)
-    disp: dict[str, Displacements] = {}
-    p_norm: dict[str, list[np.ndarray]] = {}
-    weights, h_rows, h_split, h_seen = [], [], [], set()
-    conv: dict[str, list[np.ndarray]] = {}
-    its: dict[str, list[np.ndarray]] = {}
-    errs: dict[str, list[np.ndarray]] = {}
-    tol = manifest["header"]["config"]["tolerance"]
     lms, blend = template_landmarks(template), SkinBlend.of(template)
-    landmark_stats: list[np.ndarray] = []
-    kept: dict[str, Displacements] = {}  # the frames the loader yields by default
-    drivers: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = {}
+    st = _Stats(
+        disp={k: Displacements(labels) for k in KINDS},
+        kept={k: Displacements(labels) for k in KINDS},
+    )
     for kind in KINDS:
-        disp[kind] = Displacements(labels)
-        kept[kind] = Displacements(labels)
-        drivers[kind] = []
-        p_norm[kind], conv[kind], its[kind], errs[kind] = [], [], [], []
+        st.drivers[kind] = []
+        st.p_norm[kind], st.conv[kind], st.its[kind], st.errs[kind] = [], [], [], []
         for a in iter_shards(folder, kind):
-            disp[kind].add(a["offsets"])
+            st.disp[kind].add(a["offsets"])
             n = len(a["p"])
             ok = (a["estimated_error"].reshape(n, -1) <= 3 * tol).all(axis=1)
-            kept[kind].add(a["offsets"][ok])
+            st.kept[kind].add(a["offsets"][ok])
             worst = np.abs(a["offsets"].reshape(n, -1)).max(axis=1).astype(np.float64)
             err = a["estimated_error"].reshape(n, -1).max(axis=1).astype(np.float64)
-            drivers[kind].append((np.asarray(params.normalise(a["p"])), err, worst))
+            st.drivers[kind].append((np.asarray(params.normalise(a["p"])), err, worst))
             if kind == "sparse":
-                landmark_stats.append(_landmark_distances(template, lms, blend, a))
-            p_norm[kind].append(np.asarray(params.normalise(a["p"])))
-            weights.append(a["weights"].reshape(-1, 52))
-            conv[kind].append(a["converged"].ravel())
-            its[kind].append(a["iterations"].ravel())
-            errs[kind].append(a["estimated_error"].ravel())
-            ids = [(a["identity_id"], a["h"])]
-            if "donor_id" in a:
-                ids.append((a["donor_id"], a["donor_h"]))
-            for id_col, h_col in ids:
-                for i, hid in enumerate(id_col):
-                    if int(hid) not in h_seen:
-                        h_seen.add(int(hid))
-                        h_rows.append(h_col[i])
-                        h_split.append(int(a["split"][i]))
-    kinds = [k for k in KINDS if disp[k].frames]
-    tables = {k: kept[k].table() for k in kinds if kept[k].frames}
-    tables_all = {k: disp[k].table() for k in kinds}
-    pn = {k: np.concatenate(p_norm[k]) for k in kinds}
-    w = np.concatenate(weights)
-    h = np.stack(h_rows)
-    spread = np.array(
+                st.landmark_stats.append(_landmark_distances(template, lms, blend, a))
+            st.p_norm[kind].append(np.asarray(params.normalise(a["p"])))
+            st.weights.append(a["weights"].reshape(-1, 52))
+            st.conv[kind].append(a["converged"].ravel())
+            st.its[kind].append(a["iterations"].ravel())
+            st.errs[kind].append(a["estimated_error"].ravel())
+            st.add_identities(a)
+    return st
+
+
+def _identity_spread(template: Template, h: np.ndarray) -> np.ndarray:
+    """RMS distance (mm) of each identity's neutral skin to the template's."""
+    ref = template.neutral[:N_SKIN]
+    return np.array(
         [
             np.sqrt(
-                (
-                    (
-                        template.identity_neutral(x.astype(np.float64))[:N_SKIN]
-                        - template.neutral[:N_SKIN]
-                    )
-                    ** 2
-                )
+                ((template.identity_neutral(x.astype(np.float64))[:N_SKIN] - ref) ** 2)
                 .sum(axis=1)
                 .mean()
             )
@@ -351,12 +357,10 @@ def write_report(
             for x in h
         ]
     )
-    takes_dir = takes_dir or default_takes_path()
-    _plot_parameters(pn, manifest, out / "parameters.png")
-    _plot_weights(w, _target_weights(manifest, takes_dir), out / "weights.png")
-    _plot_identities(h, np.array(h_split), spread, out / "identities.png")
-    _plot_displacements(tables, out / "displacement.png")
 
+
+def _overview_lines(folder: Path, manifest: dict, st: _Stats) -> list[str]:
+    """Title, configuration, contents table, splits, storage and solver summary."""
     cfg = manifest["header"]["config"]
     summary = manifest.get("summary", {})
     ds = manifest["dataset"]
@@ -398,15 +402,22 @@ def write_report(
         "estimated error = estimated RMS distance to the fixed point / bounding-box diagonal; "
         "the loader skips frames above 3x the tolerance by default): "
         + "; ".join(
-            f"{k} {100 * np.concatenate(conv[k]).mean():.1f} % converged, "
-            f"{100 * (np.concatenate(errs[k]) <= 3 * cfg['tolerance']).mean():.1f} % within 3x, "
-            f"median {np.median(np.concatenate(its[k])):.0f} iterations, estimated error "
-            f"median {np.median(np.concatenate(errs[k])):.1e} / p99 "
-            f"{np.percentile(np.concatenate(errs[k]), 99):.1e}"
-            for k in kinds
+            f"{k} {100 * np.concatenate(st.conv[k]).mean():.1f} % converged, "
+            f"{100 * (np.concatenate(st.errs[k]) <= 3 * cfg['tolerance']).mean():.1f} % within "
+            f"3x, median {np.median(np.concatenate(st.its[k])):.0f} iterations, estimated error "
+            f"median {np.median(np.concatenate(st.errs[k])):.1e} / p99 "
+            f"{np.percentile(np.concatenate(st.errs[k]), 99):.1e}"
+            for k in st.kinds
         )
         + ".",
         "",
+    ]
+    return lines
+
+
+def _displacement_lines(st: _Stats, tables: dict, tables_all: dict) -> list[str]:
+    """|T - S| per region: the kept frames, then all frames."""
+    lines = [
         "## How much the physics moves S: |T - S| in mm",
         "",
         "Per vertex and frame (dynamic: all sequence frames). Regions: data/regions.py. "
@@ -415,18 +426,21 @@ def write_report(
     ]
     for k in tables:
         lines += [
-            f"### {k}: {kept[k].frames} of {disp[k].frames} frames (estimated error <= 3x tol)",
+            f"### {k}: {st.kept[k].frames} of {st.disp[k].frames} frames (estimated error "
+            "<= 3x tol)",
             "",
             *_fmt_table(tables[k]),
             "",
         ]
-    lines += [
-        "All frames, including those the solver left above 3x the tolerance:",
-        "",
-    ]
-    for k in kinds:
-        lines += [f"### {k}, all {disp[k].frames} frames", "", *_fmt_table(tables_all[k]), ""]
-    lines += [
+    lines += ["All frames, including those the solver left above 3x the tolerance:", ""]
+    for k in st.kinds:
+        lines += [f"### {k}, all {st.disp[k].frames} frames", "", *_fmt_table(tables_all[k]), ""]
+    return lines
+
+
+def _driver_lines(st: _Stats, params: ParameterSet) -> list[str]:
+    """The parameters most correlated with large offsets and with solver error."""
+    lines = [
         "## What drives |T - S| and slow convergence",
         "",
         "Correlation (over instances) of each normalised parameter with log(largest |T - S| "
@@ -435,12 +449,12 @@ def write_report(
         "| kind | largest offset grows with | shrinks with | error grows with | shrinks with |",
         "| --- | --- | --- | --- | --- |",
     ]
-    for k in kinds:
-        pn_k = np.concatenate([d[0] for d in drivers[k]])
+    for k in st.kinds:
+        pn_k = np.concatenate([d[0] for d in st.drivers[k]])
         cols = []
         for y in (
-            np.concatenate([d[2] for d in drivers[k]]),
-            np.concatenate([d[1] for d in drivers[k]]),
+            np.concatenate([d[2] for d in st.drivers[k]]),
+            np.concatenate([d[1] for d in st.drivers[k]]),
         ):
             ly = np.log(np.maximum(y, 1e-12))
             c = [
@@ -453,28 +467,36 @@ def write_report(
             cols.append(", ".join(f"{n} {v:+.2f}" for v, n in c[:3]))
         lines.append(f"| {k} | " + " | ".join(cols) + " |")
     lines.append("")
-    lines += _offset_structure_lines(folder, kinds, params, 3 * tol)
-    if landmark_stats:
-        ls = np.concatenate(landmark_stats, axis=1) * 1e3
-        names = (  # pipes escaped: these sit in a markdown table
-            "expression motion of the landmarks on S (\\|L(S_t) - L(S_0)\\|)",
-            "personalised donor landmarks vs the head's own (\\|L_clean - L(S_t)\\|)",
-            "noisy landmarks vs the head's own (\\|L - L(S_t)\\|)",
-            "noisy landmarks vs the simulated result (\\|L - L(T)\\|)",
-        )
-        lines += [
-            "### Sparse landmarks (mm, per landmark and frame)",
-            "",
-            "| distance | mean | p50 | p95 | max |",
-            "| --- | ---: | ---: | ---: | ---: |",
-            *(
-                f"| {name} | {row.mean():.2f} | {np.median(row):.2f} | "
-                f"{np.percentile(row, 95):.2f} | {row.max():.2f} |"
-                for name, row in zip(names, ls, strict=True)
-            ),
-            "",
-        ]
-    lines += [
+    return lines
+
+
+def _landmark_lines(st: _Stats) -> list[str]:
+    """Distances between the sparse kind's landmark sets."""
+    if not st.landmark_stats:
+        return []
+    ls = np.concatenate(st.landmark_stats, axis=1) * 1e3
+    names = (  # pipes escaped: these sit in a markdown table
+        "expression motion of the landmarks on S (\\|L(S_t) - L(S_0)\\|)",
+        "personalised donor landmarks vs the head's own (\\|L_clean - L(S_t)\\|)",
+        "noisy landmarks vs the head's own (\\|L - L(S_t)\\|)",
+        "noisy landmarks vs the simulated result (\\|L - L(T)\\|)",
+    )
+    return [
+        "### Sparse landmarks (mm, per landmark and frame)",
+        "",
+        "| distance | mean | p50 | p95 | max |",
+        "| --- | ---: | ---: | ---: | ---: |",
+        *(
+            f"| {name} | {row.mean():.2f} | {np.median(row):.2f} | "
+            f"{np.percentile(row, 95):.2f} | {row.max():.2f} |"
+            for name, row in zip(names, ls, strict=True)
+        ),
+        "",
+    ]
+
+
+def _distribution_lines(n_identities: int, spread: np.ndarray) -> list[str]:
+    return [
         "![displacement](displacement.png)",
         "",
         "## Distributions",
@@ -487,13 +509,46 @@ def write_report(
         "",
         "![weights](weights.png)",
         "",
-        f"Identities ({len(h)}): coefficients against N(0, 1) (the sampler keeps only "
+        f"Identities ({n_identities}): coefficients against N(0, 1) (the sampler keeps only "
         "plausible heads, so the tails are thinner), first two modes by split, and the spread "
         f"of the neutral heads (RMS distance to the template: median {np.median(spread):.1f} mm).",
         "",
         "![identities](identities.png)",
         "",
     ]
+
+
+def write_report(
+    folder: Path, out: Path, ict: str | None = None, takes_dir: Path | None = None
+) -> Path:
+    from softdeca_train.data.config import default_takes_path
+
+    folder, out = Path(folder), Path(out)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    template = Template.load(ict)
+    params = dataset_parameters(manifest)
+    out.mkdir(parents=True, exist_ok=True)
+    tol = manifest["header"]["config"]["tolerance"]
+    st = _collect(folder, template, params, tol)
+    kinds = st.kinds
+    tables = {k: st.kept[k].table() for k in kinds if st.kept[k].frames}
+    tables_all = {k: st.disp[k].table() for k in kinds}
+    h = np.stack(st.h_rows)
+    spread = _identity_spread(template, h)
+    takes_dir = takes_dir or default_takes_path()
+    pn = {k: np.concatenate(st.p_norm[k]) for k in kinds}
+    _plot_parameters(pn, manifest, out / "parameters.png")
+    w = np.concatenate(st.weights)
+    _plot_weights(w, _target_weights(manifest, takes_dir), out / "weights.png")
+    _plot_identities(h, np.array(st.h_split), spread, out / "identities.png")
+    _plot_displacements(tables, out / "displacement.png")
+
+    lines = _overview_lines(folder, manifest, st)
+    lines += _displacement_lines(st, tables, tables_all)
+    lines += _driver_lines(st, params)
+    lines += _offset_structure_lines(folder, kinds, params, 3 * tol)
+    lines += _landmark_lines(st)
+    lines += _distribution_lines(len(h), spread)
     (out / "report.md").write_text("\n".join(lines))
     (out / "displacement.json").write_text(
         json.dumps({"kept": tables, "all": tables_all}, indent=1) + "\n"

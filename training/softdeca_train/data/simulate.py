@@ -134,16 +134,20 @@ def _stats(stats: list[dict]) -> dict[str, np.ndarray]:
     }
 
 
-def _static_group(
-    ctx: WorkerContext,
-    hs: HeadSimulation,
-    sim: native.Simulator,
-    g: GroupSpec,
-    cfg: GenerateConfig,
-    out: _Shard,
-    sparse: bool,
-    volume: SoftVolume,
-) -> None:
+@dataclass
+class _Head:
+    """One shard's head under simulation, and where its frames go."""
+
+    ctx: WorkerContext
+    hs: HeadSimulation
+    sim: native.Simulator
+    cfg: GenerateConfig
+    out: _Shard
+    volume: SoftVolume
+
+
+def _static_group(head: _Head, g: GroupSpec, sparse: bool) -> None:
+    ctx, hs, sim, cfg, out, volume = (head.ctx, head.hs, head.sim, head.cfg, head.out, head.volume)
     w = g.frames.weights
     targets = ctx.blend.targets(hs.head[:N_SKIN], w)
     jaws = hs.jaw_transforms(hs.blend(w))
@@ -184,16 +188,8 @@ def _static_group(
     out.frames += n
 
 
-def _dynamic_group(
-    ctx: WorkerContext,
-    hs: HeadSimulation,
-    sim: native.Simulator,
-    g: GroupSpec,
-    cfg: GenerateConfig,
-    out: _Shard,
-    names: list[str],
-    volume: SoftVolume,
-) -> None:
+def _dynamic_group(head: _Head, g: GroupSpec, names: list[str]) -> None:
+    ctx, hs, sim, cfg, out, volume = (head.ctx, head.hs, head.sim, head.cfg, head.out, head.volume)
     w = g.frames.weights  # lead-in + sequence
     targets = ctx.blend.targets(hs.head[:N_SKIN], w)
     jaws = hs.jaw_transforms(hs.blend(w))
@@ -250,12 +246,13 @@ def simulate_shard(
     volume = SoftVolume(hs)
     t_build = time.perf_counter() - t0
     out = _Shard()
+    head = _Head(ctx, hs, sim, cfg, out, volume)
     for g in spec.groups:
         if spec.kind == "dynamic":
-            _dynamic_group(ctx, hs, sim, g, cfg, out, names, volume)
+            _dynamic_group(head, g, names)
         else:
             _set_parameters(sim, names, g.p)
-            _static_group(ctx, hs, sim, g, cfg, out, sparse, volume)
+            _static_group(head, g, sparse)
     arrays = out.arrays()
     n = len(arrays["param_id"])
     arrays = {

@@ -12,6 +12,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from softdeca_train.commands import Command, add_ict_argument
+from softdeca_train.sim.stress_cli import add_stress_args, run_stress_cli
+
 if TYPE_CHECKING:
     import softdeca_native as native
 
@@ -185,3 +188,50 @@ def run_simulate(args: argparse.Namespace) -> int:
         + (", simulate.png" if rendered else "")
     )
     return 0
+
+
+def _bench_physics_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--out", default="build/bench", help="folder for physics_lhm.json")
+    p.add_argument("--take", default=None, help="Live Link Face CSV (default: alex_rom_3)")
+    p.add_argument("--levels", type=int, nargs="+", default=[3, 4], help="LHM levels (3 4)")
+    p.add_argument("--stride", type=int, default=400, help="every Nth frame (400)")
+
+
+def _bench_physics_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.bench import report_area
+    from softdeca_train.sim.bench import DEFAULT_TAKE, bench_physics_lhm
+
+    take = Path(args.take) if args.take else DEFAULT_TAKE
+    figures = bench_physics_lhm(args.ict, take, tuple(args.levels), args.stride)
+    report_area(Path(args.out), "physics_lhm", figures)
+    return 0
+
+
+COMMANDS = [
+    Command(
+        "simulate",
+        "Simulate a Live Link Face take with the physics model for one identity: neutral.obj + "
+        "linear.pc2/physics.pc2 point caches, simulate.png (linear | physics | distance), "
+        "simulate.json (iterations, time, volume change, lip penetrations, distance).",
+        add_simulate_args,
+        run_simulate,
+    ),
+    Command(
+        "stress",
+        "The physics stress suite: extreme expressions, identities, materials, gravity, levels, "
+        "static and dynamic, real takes, judged by the sanity bounds -> stress.json, stress.md, "
+        "stress_worst.png (and physics_stress.json with --bench-out).",
+        add_stress_args,
+        run_stress_cli,
+    ),
+    Command(
+        "bench-physics",
+        "Benchmark the physics model on the real layered head model and real frames "
+        "-> build/bench/physics_lhm.json.",
+        _bench_physics_args,
+        _bench_physics_run,
+    ),
+]

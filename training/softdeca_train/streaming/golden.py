@@ -121,15 +121,19 @@ def _softdeca_expected(kind: str, **fields: object) -> Expected:
     return e
 
 
-def _softdeca_frames(out: dict[str, tuple[bytes, Expected, str]]) -> None:
-    f = _frame_full()
+def _reencoded_frame(
+    out: dict[str, tuple[bytes, Expected, str]], name: str, f: Frame, description: str
+) -> None:
+    """A frame of the current version: decoding it gives `f` back, and so does re-encoding."""
     e = _softdeca_expected("frame", minor=0, session_id=f.session_id, sequence=f.sequence)
     _put_frame(e, f, quantised=True)
     e.put("reencode", 1)
-    out["softdeca_frame_full"] = (
-        protocol.encode_frame(f),
-        e,
-        "a full frame: weights, head, eyes, 68 landmarks",
+    out[name] = (protocol.encode_frame(f), e, description)
+
+
+def _softdeca_frames(out: dict[str, tuple[bytes, Expected, str]]) -> None:
+    _reencoded_frame(
+        out, "softdeca_frame_full", _frame_full(), "a full frame: weights, head, eyes, 68 landmarks"
     )
 
     lost = Frame(
@@ -140,13 +144,8 @@ def _softdeca_frames(out: dict[str, tuple[bytes, Expected, str]]) -> None:
         has_sequence=True,
         tracking=Tracking.LOST,
     )
-    e = _softdeca_expected("frame", minor=0, session_id=3, sequence=0xFFFFFFFF)
-    _put_frame(e, lost, quantised=True)
-    e.put("reencode", 1)
-    out["softdeca_frame_minimal"] = (
-        protocol.encode_frame(lost),
-        e,
-        "the smallest frame: weights only, face lost",
+    _reencoded_frame(
+        out, "softdeca_frame_minimal", lost, "the smallest frame: weights only, face lost"
     )
 
     # A newer minor version: a longer weights block and an unknown block, both skipped over.

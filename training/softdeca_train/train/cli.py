@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from softdeca_train.commands import Command
 from softdeca_train.train.registry import MODELS
 
 DEFAULT_RUN = "out/train/default"
@@ -128,3 +129,27 @@ def run_evaluate(args: argparse.Namespace) -> int:
     path = write_report(run, Path(args.bundle), Path(args.out), Path(args.bench))
     print(f"report written to {path}")
     return 0
+
+
+COMMANDS = [
+    Command(
+        "train-bundle",
+        "Train every network of a model bundle (identity encoder, SoftDECA, SparseSoftDECA, "
+        "their dynamics) on a generated dataset, resumably, and export the bundle.",
+        add_bundle_args,
+        run_bundle,
+    ),
+    Command(
+        "train-model",
+        "Train one model of the registry in a run folder (e.g. a Table 1 baseline).",
+        add_model_args,
+        run_model,
+    ),
+    Command(
+        "evaluate",
+        "Evaluate a training run and its bundle on the test split: report (markdown, plots, "
+        "error heat maps) and build/bench/models.json.",
+        add_evaluate_args,
+        run_evaluate,
+    ),
+]

@@ -1,0 +1,132 @@
+"""The layered head model stage's commands: `lhm` (fit, check, save and render one
+identity's model), `demo` (the template's layers, sampled identities, landmarks) and `bench`
+(LHM fitting per resolution)."""
+
+from __future__ import annotations
+
+import argparse
+
+from softdeca_train.commands import Command, add_ict_argument
+
+
+def _bench_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--out", default="build/bench", help="folder for <area>.json (build/bench)")
+    p.add_argument("--heads", type=int, default=8, help="identities per LHM resolution (8)")
+
+
+def _bench_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.bench import bench_lhm, report_area
+
+    report_area(Path(args.out), "lhm", bench_lhm(args.ict, heads=args.heads))
+    return 0
+
+
+def _lhm_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--seed", type=int, default=None, help="identity seed (default: the template)")
+    p.add_argument("--level", type=int, default=4, help="wrap resolution: icosphere level (4)")
+    p.add_argument("--soft-layers", type=int, default=1, help="tet layers skin..muscle (1)")
+    p.add_argument("--muscle-layers", type=int, default=1, help="tet layers muscle..skull (1)")
+    p.add_argument("--out", default="out/lhm", help="output folder (out/lhm)")
+
+
+def _lhm_run(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from softdeca_train.lhm import LhmConfig, check_lhm, fit_lhm
+    from softdeca_train.lhm.figures import render_layers
+    from softdeca_train.template import Template
+    from softdeca_train.template.model import N_SKIN
+
+    t = Template.load(args.ict)
+    h = None if args.seed is None else t.sample_identity(args.seed)
+    cfg = LhmConfig(
+        level=args.level, soft_layers=args.soft_layers, muscle_layers=args.muscle_layers
+    )
+    model = fit_lhm(t, h, cfg)
+    report = check_lhm(model, t.identity_neutral(h)[:N_SKIN], t.skin_triangles)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    name = "template" if args.seed is None else f"seed{args.seed}"
+    model.save(out / f"lhm_{name}.npz")
+    (out / f"lhm_{name}_report.json").write_text(json.dumps(report.as_dict(), indent=2) + "\n")
+    render_layers(t, model, out / f"lhm_{name}.png", head=t.identity_neutral(h))
+    print(json.dumps(report.as_dict(), indent=2))
+    problems = report.failures()
+    print("valid" if not problems else "INVALID: " + "; ".join(problems))
+    print(f"wrote {out}/lhm_{name}.npz, .png and _report.json")
+    return 0 if not problems else 1
+
+
+def _demo_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--out", default="out/demo", help="output folder (out/demo)")
+    p.add_argument(
+        "--seeds", type=int, nargs="+", default=[1, 2, 3], help="identity seeds to show (1 2 3)"
+    )
+
+
+def _demo_run(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from softdeca_train.landmarks.figure import render_registration
+    from softdeca_train.lhm import check_lhm, fit_lhm
+    from softdeca_train.lhm.figures import render_identities, render_layers
+    from softdeca_train.template import Template
+    from softdeca_train.template.model import N_SKIN
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    with tqdm(total=4, desc="demo", unit="figure") as bar:
+        t = Template.load(args.ict)
+        model = fit_lhm(t)
+        written.append(render_layers(t, model, out / "template_layers.png"))
+        bar.update()
+        written.append(render_identities(t, list(args.seeds), out / "identities.png"))
+        bar.update()
+        written.append(render_registration(out))
+        bar.update()
+        reports = {"template": check_lhm(model, t.neutral[:N_SKIN], t.skin_triangles).as_dict()}
+        for seed in args.seeds:
+            h = t.sample_identity(seed)
+            reports[f"seed {seed}"] = check_lhm(
+                fit_lhm(t, h), t.identity_neutral(h)[:N_SKIN], t.skin_triangles
+            ).as_dict()
+        report_path = out / "lhm_reports.json"
+        report_path.write_text(json.dumps(reports, indent=2) + "\n")
+        written.append(report_path)
+        bar.update()
+    print("demo outputs:")
+    for p in written:
+        print(f"  {p.resolve()}")
+    return 0
+
+
+COMMANDS = [
+    Command(
+        "lhm",
+        "Fit the layered head model of one identity, check it, save it and render it.",
+        _lhm_args,
+        _lhm_run,
+    ),
+    Command(
+        "demo",
+        "The demo: renders of the template's layers, sampled identities, landmarks.",
+        _demo_args,
+        _demo_run,
+    ),
+    Command(
+        "bench",
+        "Benchmark the pipeline (LHM fitting per resolution) into build/bench/<area>.json.",
+        _bench_args,
+        _bench_run,
+    ),
+]

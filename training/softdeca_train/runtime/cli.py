@@ -1,0 +1,153 @@
+"""The runtime stage's commands: the untrained bundle, avatars, replay previews, the native
+tests' inputs and the runtime benchmark."""
+
+from __future__ import annotations
+
+import argparse
+
+from softdeca_train.commands import Command, add_ict_argument
+
+
+def _runtime_bundle_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--out", default="build/bundles/random-untrained", help="bundle folder")
+    p.add_argument(
+        "--parameters",
+        default=None,
+        help="parameter specs in parameters.json's format (default plugin/data/parameters.json)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="random weights seed (0)")
+    p.add_argument(
+        "--synthetic", action="store_true", help="a small synthetic head instead of the template"
+    )
+    p.add_argument("--tar", action="store_true", help="also write <out>.tar (one-file bundle)")
+
+
+def _runtime_bundle_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.models import (
+        FULL_SIZES,
+        TEST_SIZES,
+        BundleInfo,
+        build_random,
+        export_bundle,
+        pack_bundle,
+    )
+    from softdeca_train.models.parameters import specs_or_test_list
+
+    specs = specs_or_test_list(args.parameters)
+    if args.synthetic:
+        from softdeca_train.models.synthetic import synthetic_head
+
+        definition, sizes = synthetic_head().definition, TEST_SIZES
+    else:
+        from softdeca_train.models.topology import from_template
+        from softdeca_train.template import Template
+
+        definition, sizes = from_template(Template.load(args.ict)), FULL_SIZES
+    nets = build_random(definition, specs, sizes, seed=args.seed)
+    info = BundleInfo(
+        untrained=True,
+        description="UNTRAINED: random-weight networks of the contract's shapes, for tests, "
+        "benchmarks and replays that must not depend on a trained bundle",
+    )
+    out = export_bundle(Path(args.out), definition, nets, info)
+    if args.tar:
+        Path(str(out) + ".tar").write_bytes(pack_bundle(out))
+    print(f"wrote untrained bundle {out} ({definition.name}, {len(specs)} parameters)")
+    return 0
+
+
+def _avatar_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--seed", type=int, required=True, help="identity seed")
+    p.add_argument("--out", required=True, help="avatar folder for `softdeca replay`")
+
+
+def _avatar_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.runtime.files import write_identity_avatar
+
+    out = write_identity_avatar(args.seed, Path(args.out), args.ict)
+    print(f"wrote avatar of identity seed {args.seed} to {out}")
+    return 0
+
+
+def _replay_preview_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--replay", required=True, help="output folder of `softdeca replay`")
+    p.add_argument("--frames", type=int, default=4, help="rows of the contact sheet (4)")
+
+
+def _replay_preview_run(args: argparse.Namespace) -> int:
+    from softdeca_train.runtime.preview import render_preview
+
+    print(f"wrote {render_preview(args.replay, args.frames)}")
+    return 0
+
+
+def _runtime_test_data_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", required=True, help="folder for the native runtime tests' inputs")
+
+
+def _runtime_test_data_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.runtime.testdata import write_test_data
+
+    print(f"wrote {write_test_data(Path(args.out))}")
+    return 0
+
+
+def _runtime_bench_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--out", default="build/bench", help="folder for runtime.json (build/bench)")
+    p.add_argument("--frames", type=int, default=600, help="frames per figure (600)")
+    p.add_argument("--take", default=None, help="Live Link Face CSV (default: S07-001)")
+    p.add_argument("--parameters", default=None, help="parameter specs (parameters.json format)")
+
+
+def _runtime_bench_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from softdeca_train.runtime.bench import DEFAULT_TAKE, bench_runtime
+
+    take = Path(args.take) if args.take else DEFAULT_TAKE
+    print(f"wrote {bench_runtime(Path(args.out), args.ict, take, args.frames, args.parameters)}")
+    return 0
+
+
+COMMANDS = [
+    Command(
+        "runtime-bundle",
+        "Export an UNTRAINED model bundle (random networks of the contract's shapes).",
+        _runtime_bundle_args,
+        _runtime_bundle_run,
+    ),
+    Command(
+        "avatar",
+        "Write an ICT identity's avatar folder (neutral, 52 shapes, ARKit user face) "
+        "for `softdeca replay`.",
+        _avatar_args,
+        _avatar_run,
+    ),
+    Command(
+        "replay-preview",
+        "Render the contact sheet of a `softdeca replay` output folder.",
+        _replay_preview_args,
+        _replay_preview_run,
+    ),
+    Command(
+        "runtime-test-data",
+        "Write the native runtime tests' inputs (synthetic bundle, avatar, take).",
+        _runtime_test_data_args,
+        _runtime_test_data_run,
+    ),
+    Command(
+        "runtime-bench",
+        "Benchmark the native runtime per frame -> build/bench/runtime.json.",
+        _runtime_bench_args,
+        _runtime_bench_run,
+    ),
+]
