@@ -228,36 +228,10 @@ std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const Collisi
   return out;
 }
 
-CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
-                                   const Positions& vertices, const Eigen::VectorXd& skin_area,
-                                   const SolverSettings& settings, ThreadPool* pool, const LipTargets* lips) {
-  const auto t0 = std::chrono::steady_clock::now();
-  CollisionResult r;
-  r.skin = skin;
-  const bool on_surface = lips != nullptr && lips->targets.rows() == skin.rows() && settings.collision_rounds > 0;
-  std::vector<Contact> found;
-  if (!on_surface) {
-    found = find_penetrations(mesh, topology, skin, vertices, settings.penetration_tolerance);
-    r.penetrating_before = static_cast<int>(found.size());
-    if (found.empty() || settings.collision_rounds == 0) {
-      r.penetrating_after = r.penetrating_before;
-      return r;
-    }
-  }
-  const PhysicalConstants& k = physical_constants();
-  const double pa = k.pascal_per_weight_unit;
-  const std::vector<char> active = active_points(mesh);
-  const double length = (skin.colwise().maxCoeff() - skin.colwise().minCoeff()).norm();
-  // Shape of the skin (strain relative to it), a weak pull back to the solved skin, stiff
-  // contacts. With lip targets the lip points follow their targets instead, and the shape is
-  // the targets' own: the volumetric result is not a shape to keep there (see collisions.h).
-  constexpr double kShapeKpa = 1.0, kAnchorKpa = 0.01;
-  constexpr double kCorrectionSlack = 1e-3;  // m, beyond the deepest penetration
-  const Positions& shape_of = on_surface ? lips->targets : skin;
-  std::vector<char> lip_point(active.size(), 0);
-  if (on_surface)
-    for (const CollisionSet& set : mesh.collisions)
-      for (int32_t p : set.points) lip_point[static_cast<std::size_t>(p)] = 1;
+namespace {
+// Skin-strain elements of S's triangles touching an active point, at rest in `shape_of`.
+std::vector<TriangleElement> shape_elements(const SimulationMesh& mesh, const std::vector<char>& active,
+                                            const Positions& shape_of, double weight) {
   std::vector<TriangleElement> shape;
   for (Eigen::Index t = 0; t < mesh.skin_triangles.rows(); ++t) {
     TriangleElement e;
@@ -271,24 +245,30 @@ CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTo
     TriangleStrainGroup::set_rest(e, shape_of.row(mesh.skin_triangles(t, 0)).transpose(),
                                   shape_of.row(mesh.skin_triangles(t, 1)).transpose(),
                                   shape_of.row(mesh.skin_triangles(t, 2)).transpose());
-    e.weight = kShapeKpa * k.skin_thickness_m;
+    e.weight = weight;
     shape.push_back(std::move(e));
   }
-  std::vector<TargetElement> anchor;
-  Positions anchor_targets(0, 3);
-  std::vector<Eigen::RowVector3d> anchor_rows;
-  for (std::size_t p = 0; p < active.size(); ++p)
-    if (active[p]) {
-      const auto i = static_cast<Eigen::Index>(p);
-      const bool lip = lip_point[p] != 0;
-      const double w = lip ? lips->weight[i] : pa * kAnchorKpa * skin_area[i] / k.target_layer_thickness_m;
-      anchor.push_back({PointRow{{static_cast<int32_t>(p)}, {1.0}}, w});
-      anchor_rows.push_back(lip ? lips->targets.row(i) : skin.row(i));
-    }
+  return shape;
+}
 
-  std::map<std::pair<int, int32_t>, Contact> contacts;  // one per (set, point)
-  // One projective solve on S's active points with the current contacts, from r.skin.
-  auto solve_surface = [&](SolveStats& stats) {
+// The contact step's fixed part on S's active points: shape, anchors (lip points to their
+// targets, the others weakly to the solved skin); `solve` adds the current contacts.
+struct SurfaceProblem {
+  const SimulationMesh& mesh;
+  const Positions& vertices;
+  const Eigen::VectorXd& skin_area;
+  const SolverSettings& settings;
+  ThreadPool* pool;
+  double length = 1;
+  std::vector<char> active;
+  std::vector<TriangleElement> shape;
+  std::vector<TargetElement> anchor;
+  std::vector<Eigen::RowVector3d> anchor_rows;
+
+  // One projective solve with `contacts`, from and into `skin`.
+  void solve(const std::map<std::pair<int, int32_t>, Contact>& contacts, Positions& skin, SolveStats& stats) const {
+    const PhysicalConstants& k = physical_constants();
+    const double pa = k.pascal_per_weight_unit;
     Model m;
     m.pinned.resize(active.size());
     for (std::size_t p = 0; p < active.size(); ++p) m.pinned[p] = !active[p];
@@ -311,14 +291,84 @@ CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTo
     if (tie_targets.rows() > 0) P.middleRows(tie_row, tie_targets.rows()) = tie_targets;
     SolverSettings st = settings;
     st.record_energy = false;
-    run_projective_dynamics(FrameProblem{&m, &sys, nullptr, nullptr, length}, P, r.skin, st, pool, stats);
-  };
+    run_projective_dynamics(FrameProblem{&m, &sys, nullptr, nullptr, length}, P, skin, st, pool, stats);
+  }
+};
+
+// Shape of the skin (strain relative to it), a weak pull back to the solved skin, stiff
+// contacts. With lip targets the lip points follow their targets instead, and the shape is
+// the targets' own: the volumetric result is not a shape to keep there (see collisions.h).
+SurfaceProblem surface_problem(const SimulationMesh& mesh, const Positions& skin, const Positions& vertices,
+                               const Eigen::VectorXd& skin_area, const SolverSettings& settings, ThreadPool* pool,
+                               const LipTargets* lips) {
+  constexpr double kShapeKpa = 1.0, kAnchorKpa = 0.01;
+  const PhysicalConstants& k = physical_constants();
+  SurfaceProblem sp{mesh, vertices, skin_area, settings, pool,
+                    (skin.colwise().maxCoeff() - skin.colwise().minCoeff()).norm(), active_points(mesh), {}, {}, {}};
+  std::vector<char> lip_point(sp.active.size(), 0);
+  if (lips)
+    for (const CollisionSet& set : mesh.collisions)
+      for (int32_t p : set.points) lip_point[static_cast<std::size_t>(p)] = 1;
+  sp.shape = shape_elements(mesh, sp.active, lips ? lips->targets : skin, kShapeKpa * k.skin_thickness_m);
+  for (std::size_t p = 0; p < sp.active.size(); ++p)
+    if (sp.active[p]) {
+      const auto i = static_cast<Eigen::Index>(p);
+      const bool lip = lip_point[p] != 0;
+      const double w =
+          lip ? lips->weight[i] : k.pascal_per_weight_unit * kAnchorKpa * skin_area[i] / k.target_layer_thickness_m;
+      sp.anchor.push_back({PointRow{{static_cast<int32_t>(p)}, {1.0}}, w});
+      sp.anchor_rows.push_back(lip ? lips->targets.row(i) : skin.row(i));
+    }
+  return sp;
+}
+
+// Contacts slide: each persisting one moves to its point's newest closest surface point,
+// and is released once the point is clearly outside (pulled there by other contacts);
+// holding it at a stale place over-constrains lips that touch each other and the teeth.
+void slide_contacts(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
+                    const Positions& vertices, double tolerance, std::map<std::pair<int, int32_t>, Contact>& contacts) {
+  if (contacts.empty()) return;
+  std::vector<std::vector<Eigen::AlignedBox3d>> boxes;
+  for (const CollisionSet& set : mesh.collisions) boxes.push_back(surface_boxes(set, surface_positions(set, skin, vertices)));
+  for (auto it = contacts.begin(); it != contacts.end();) {
+    Contact now{};
+    const auto si = static_cast<std::size_t>(it->second.set);
+    if (locate(mesh, topology, si, it->second.point, skin, vertices, boxes[si], now) && now.depth > -tolerance) {
+      it->second = now;
+      ++it;
+    } else {
+      it = contacts.erase(it);
+    }
+  }
+}
+}  // namespace
+
+CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
+                                   const Positions& vertices, const Eigen::VectorXd& skin_area,
+                                   const SolverSettings& settings, ThreadPool* pool, const LipTargets* lips) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CollisionResult r;
+  r.skin = skin;
+  const bool on_surface = lips != nullptr && lips->targets.rows() == skin.rows() && settings.collision_rounds > 0;
+  std::vector<Contact> found;
+  if (!on_surface) {
+    found = find_penetrations(mesh, topology, skin, vertices, settings.penetration_tolerance);
+    r.penetrating_before = static_cast<int>(found.size());
+    if (found.empty() || settings.collision_rounds == 0) {
+      r.penetrating_after = r.penetrating_before;
+      return r;
+    }
+  }
+  constexpr double kCorrectionSlack = 1e-3;  // m, beyond the deepest penetration
+  const SurfaceProblem surface =
+      surface_problem(mesh, skin, vertices, skin_area, settings, pool, on_surface ? lips : nullptr);
+  std::map<std::pair<int, int32_t>, Contact> contacts;  // one per (set, point)
   // What the contacts correct: the solved skin, or with lip targets the lips on their targets
   // (joined to the solved skin around them).
   Positions base = skin;
   if (on_surface) {
     SolveStats stats;
-    solve_surface(stats);
+    surface.solve(contacts, r.skin, stats);
     r.iterations += stats.iterations;
     base = r.skin;
     found = find_penetrations(mesh, topology, base, vertices, settings.penetration_tolerance);
@@ -339,27 +389,10 @@ CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTo
   int best_contacts = 0;
   double best_gap = 0, best_correction = 0;
   while (!found.empty() && r.rounds < settings.collision_rounds) {
-    // Contacts slide: each persisting one moves to its point's newest closest surface point,
-    // and is released once the point is clearly outside (pulled there by other contacts);
-    // holding it at a stale place over-constrains lips that touch each other and the teeth.
-    if (!contacts.empty()) {
-      std::vector<std::vector<Eigen::AlignedBox3d>> boxes;
-      for (const CollisionSet& set : mesh.collisions) boxes.push_back(surface_boxes(set, surface_positions(set, r.skin, vertices)));
-      for (auto it = contacts.begin(); it != contacts.end();) {
-        Contact now{};
-        const auto si = static_cast<std::size_t>(it->second.set);
-        if (locate(mesh, topology, si, it->second.point, r.skin, vertices, boxes[si], now) &&
-            now.depth > -settings.penetration_tolerance) {
-          it->second = now;
-          ++it;
-        } else {
-          it = contacts.erase(it);
-        }
-      }
-    }
+    slide_contacts(mesh, topology, r.skin, vertices, settings.penetration_tolerance, contacts);
     for (const Contact& c : found) contacts[{c.set, c.point}] = c;
     SolveStats stats;
-    solve_surface(stats);
+    surface.solve(contacts, r.skin, stats);
     r.iterations += stats.iterations;
     ++r.rounds;
     const double correction = std::sqrt((r.skin - base).rowwise().squaredNorm().maxCoeff());

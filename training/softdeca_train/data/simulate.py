@@ -103,11 +103,14 @@ class _Shard:
         volume: SoftVolume,
         targets: np.ndarray,
         solved: list[tuple[np.ndarray, np.ndarray, dict]],
+        target_volume: float,
     ) -> np.ndarray:
         """Per frame the sanity bounds' failures as a bit mask (bit i: REASONS[i]), counted."""
         masks = np.zeros(len(solved), np.uint8)
         for f, (vertices, skin, st) in enumerate(solved):
-            failed = check_frame(hs, volume, targets[f], skin, vertices, st).failures()
+            failed = check_frame(
+                hs, volume, targets[f], skin, vertices, st, target_volume
+            ).failures()
             for r in failed:
                 masks[f] |= 1 << REASONS.index(r)
                 self.failures[r] += 1
@@ -168,7 +171,7 @@ def _static_group(
     ]
     skins, stats = [s[1] for s in solved], [s[2] for s in solved]
     out.add(
-        failures=out.judge(hs, volume, targets, solved),
+        failures=out.judge(hs, volume, targets, solved, sim.get_parameter("target_volume")),
         param_id=np.full(n, g.param_id, np.int32),
         p=np.repeat(g.p[None], n, axis=0),
         weights=w,
@@ -207,7 +210,9 @@ def _dynamic_group(
         solved.append(sim.step_dynamic(targets[f], jaw=jaws[f]))
     skins, stats = [s[1] for s in solved], [s[2] for s in solved]
     offsets = out.offsets(np.stack(skins), targets)
-    failures = out.judge(hs, volume, targets[lead:], solved[lead:])
+    failures = out.judge(
+        hs, volume, targets[lead:], solved[lead:], sim.get_parameter("target_volume")
+    )
     seq = slice(lead, None)
     st = _stats(stats[lead:])
     out.add(

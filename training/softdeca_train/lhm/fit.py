@@ -227,10 +227,18 @@ def fit_lhm(
     ) * depth_t + cfg.muscle_relative_share * depth_t * total / total_t
     gap = cfg.min_layer_gap
     # Smooth the wish, then clamp: min() keeps every bound (nesting, S outside the muscle wrap).
-    r_muscle = radial.smooth(rad.skin - depth, nbrs, cfg.inner_smoothing)
-    r_muscle = np.minimum(np.minimum(r_muscle, rad.inner), rad.skin - gap)
-    r_skull = radial.smooth(np.minimum(rad.skull_prior, r_muscle - gap), nbrs, cfg.inner_smoothing)
-    r_skull = np.maximum(np.minimum(r_skull, r_muscle - gap), cfg.min_skull_radius)
+    wish = radial.smooth(rad.skin - depth, nbrs, cfg.inner_smoothing)
+    r_muscle = np.minimum(np.minimum(wish, rad.inner), rad.skin - gap)
+    # Where S's cavities (mouth, eye sockets) push the muscle wrap below its wish, the skull
+    # prior no longer applies (it would lie above the muscle wrap): keep the muscle layer at
+    # least min_muscle_thickness thick there instead of min_layer_gap.
+    pushed = wish > r_muscle + gap
+    muscle_gap = np.where(pushed, max(gap, cfg.min_muscle_thickness), gap)
+    r_skull = radial.smooth(
+        np.minimum(rad.skull_prior, r_muscle - muscle_gap), nbrs, cfg.inner_smoothing
+    )
+    r_skull = np.maximum(np.minimum(r_skull, r_muscle - muscle_gap), cfg.min_skull_radius)
+    r_skull = np.minimum(r_skull, r_muscle - gap)
     if np.any(r_skull > r_muscle - gap + 1e-12):
         raise ValueError("the head is too thin for the layers: lower min_skull_radius or gaps")
 

@@ -22,6 +22,10 @@ class LhmConfig:
     inner_margin: float = 1.0e-3  # S lies at least this far outside the muscle wrap
     sample_spacing: float = 3.0e-3  # S is sampled this densely to fit the wraps against it
     min_layer_gap: float = 2.0e-3  # minimum radial thickness of each tissue layer
+    # Where S's cavities push the muscle wrap deep (behind the oral cavity and the eye
+    # sockets), the skull wrap keeps at least this far below it (min_layer_gap stays the hard
+    # bound): a muscle layer of min_layer_gap there inverts under the skin's shear.
+    min_muscle_thickness: float = 10.0e-3
     muscle_fraction: float = 0.5  # template muscle wrap depth, as a share of skin-to-skull
     muscle_relative_share: float = 0.1  # paper: 10 % of the relative change is followed
     min_skull_radius: float = 0.02  # the skull wrap keeps this far from the head centre

@@ -10,7 +10,7 @@ import softdeca_native as native
 
 from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
 from softdeca_train.lhm.fit import jaw_motion
-from softdeca_train.lhm.model import CRANIUM, JAW
+from softdeca_train.lhm.model import JAW
 from softdeca_train.sim.lips import LipSets, lip_sets
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
@@ -59,6 +59,22 @@ class HeadSimulation:
         return out
 
 
+# A skull wrap vertex of a jaw direction rides the jaw only where it lies on the mandible:
+# no deeper below the skin wrap than the tissue-depth prior plus this tolerance (metres).
+JAW_DEPTH_TOLERANCE = 0.02
+
+
+def jaw_skull_vertices(lhm: LayeredHeadModel) -> np.ndarray:
+    """Per wrap vertex: whether the skull wrap vertex is pinned to the jaw. The radial wraps
+    pass behind the oral cavity, so along most jaw directions (skin riding the jaw) the skull
+    wrap lies 6-10 cm under the skin, level with the palate, not on the mandible; moved
+    rigidly with the jaw it pushes outward along the rays through the muscle layer, which the
+    skin above holds, and inverts the muscle tets. Those vertices stay with the cranium."""
+    depth = np.linalg.norm(lhm.skin_wrap - lhm.skull_wrap, axis=1)
+    on_bone = depth <= lhm.tissue_depth + JAW_DEPTH_TOLERANCE
+    return (lhm.skull_labels == JAW) & on_bone
+
+
 def build_head_simulation(
     template: Template,
     identity: np.ndarray | None = None,
@@ -77,8 +93,9 @@ def build_head_simulation(
     rest = np.vstack([lhm.vertices, head[up.slice], head[lo.slice]])
     skull = lhm.wrap_triangles + (lhm.n_layers - 1) * lhm.n_wrap
     skull_ids = (lhm.n_layers - 1) * lhm.n_wrap + np.arange(lhm.n_wrap)
-    cranium = np.concatenate([skull_ids[lhm.skull_labels == CRANIUM], teeth_upper])
-    jaw = np.concatenate([skull_ids[lhm.skull_labels == JAW], teeth_lower])
+    on_jaw = jaw_skull_vertices(lhm)
+    cranium = np.concatenate([skull_ids[~on_jaw], teeth_upper])
+    jaw = np.concatenate([skull_ids[on_jaw], teeth_lower])
     skin_vertices, skin_weights = native.skin_embedding_from_tets(
         lhm.soft_tets, lhm.skin_tet.tolist(), lhm.skin_bary
     )

@@ -71,7 +71,9 @@ def simulate_frames(
         vertices, skin, st = solve(target, jaw=jaw)
         out.linear.append(blended.astype(np.float32))
         out.physics.append(hs.whole_head(skin, blended, jaw).astype(np.float32))
-        check = check_frame(hs, volume, target, skin, vertices, st)
+        check = check_frame(
+            hs, volume, target, skin, vertices, st, sim.get_parameter("target_volume")
+        )
         out.records.append(
             FrameRecord(
                 iterations=int(st["iterations"]),

@@ -11,8 +11,9 @@ bounds"). A frame is compared with the linear blend S_t it was simulated from:
   the upper lip to that of the lower lip, ICT landmarks 62 and 66), physics / linear opening
   outside `open_ratio`;
 - inverted elements: any soft or muscle tet with volume <= 0 at the end of the solve;
-- volume: |soft-tissue volume change| above the linear blend's (refit, measures.py) by more
-  than `volume_slack_percent` (percentage points: both are ~0 near rest);
+- volume: the soft tissue's volume change farther from the requested one (`target_volume`)
+  than the linear blend's (refit, measures.py) by more than `volume_slack_percent`
+  (percentage points: both are ~0 near rest at the default target_volume 1);
 - not converged: the volumetric solve stopped at its iteration cap.
 """
 
@@ -66,6 +67,9 @@ class FrameCheck:
     inverted_elements: int
     volume_linear_percent: float
     volume_physics_percent: float
+    # The soft tissue's requested change, 100 (target_volume - 1): the physics grows or
+    # shrinks the tissue toward it, so both changes are measured from it.
+    volume_requested_percent: float = 0.0
 
     @property
     def open_ratio(self) -> float:
@@ -85,8 +89,9 @@ class FrameCheck:
             out.append("mouth_open_ratio")
         if self.inverted_elements > 0:
             out.append("inverted_elements")
-        if abs(self.volume_physics_percent) > (
-            abs(self.volume_linear_percent) + bounds.volume_slack_percent
+        req = self.volume_requested_percent
+        if abs(self.volume_physics_percent - req) > (
+            abs(self.volume_linear_percent - req) + bounds.volume_slack_percent
         ):
             out.append("volume")
         if not self.converged:
@@ -118,8 +123,10 @@ def check_frame(
     skin: np.ndarray,
     vertices: np.ndarray,
     stats: dict[str, object],
+    target_volume: float = 1.0,
 ) -> FrameCheck:
-    """`target`: the linear blend's S (S_t); skin / vertices / stats: the solver's result."""
+    """`target`: the linear blend's S (S_t); skin / vertices / stats: the solver's result;
+    `target_volume`: the soft tissue's parameter of that name for the frame."""
     linear_pen = _penetrations(hs, target, vertices)
     physics_pen = _penetrations(hs, skin, vertices)
     linear_vertices = volume.linear_vertices(target, vertices)
@@ -136,6 +143,7 @@ def check_frame(
         inverted_elements=int(stats["inverted_elements"]),  # type: ignore[call-overload]
         volume_linear_percent=volume.change_percent(linear_vertices),
         volume_physics_percent=volume.change_percent(vertices),
+        volume_requested_percent=100.0 * (target_volume - 1.0),
     )
 
 

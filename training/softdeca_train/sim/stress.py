@@ -204,7 +204,9 @@ def run_stress(
             bar.update(1)
             if (i + 1) % case.judge_every:
                 continue
-            check = check_frame(hs, volume, target, skin, vertices, st)
+            check = check_frame(
+                hs, volume, target, skin, vertices, st, sim.get_parameter("target_volume")
+            )
             label = case.frames[i][0]
             out.frames.append(StressFrame(case.group, case.identity, case.level, label, check))
             score = _severity(check)
