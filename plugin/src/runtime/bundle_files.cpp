@@ -1,61 +1,41 @@
 #include "runtime/bundle_files.h"
 
-#include <cerrno>
-#include <climits>
-#include <cstdlib>
 #include <cstring>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "core/error.h"
+#include "runtime/bundle_folder_io.h"
 
 namespace softdeca::runtime {
 
 namespace {
 std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
 
-const char* kind_of(mode_t mode) {
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISDIR(mode)) return "a folder";
-  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
+const char* kind_name(EntryKind kind) {
+  switch (kind) {
+    case EntryKind::fifo: return "a FIFO";
+    case EntryKind::folder: return "a folder";
+    case EntryKind::device: return "a device";
+    case EntryKind::socket: return "a socket";
+    default: return "not a regular file";
+  }
 }
 
-// Reads a regular file. lstat first, then open without following links and without blocking
-// (a FIFO swapped in between opens at once and fails the fstat check): nothing but a regular
+// Reads a regular file. Its kind first, then an open that follows no link and does not block
+// (a FIFO swapped in between opens at once and fails the second check): nothing but a regular
 // file is ever read. `label` names the file in messages.
 Bytes read_regular(const std::string& path, const std::string& label, std::uint64_t max_bytes) {
-  struct stat st {};
-  if (::lstat(path.c_str(), &st) != 0) throw Error(SOFTDECA_ERROR_IO, "cannot open " + label);
-  if (!S_ISREG(st.st_mode)) throw Error(SOFTDECA_ERROR_FORMAT, label + " is " + kind_of(st.st_mode) + ", not a regular file");
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0) throw Error(SOFTDECA_ERROR_IO, "cannot open " + label);
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
-    throw Error(SOFTDECA_ERROR_FORMAT, label + " is not a regular file");
-  const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
+  const EntryKind kind = entry_kind(path);
+  if (kind == EntryKind::missing) throw Error(SOFTDECA_ERROR_IO, "cannot open " + label);
+  if (kind != EntryKind::regular) throw Error(SOFTDECA_ERROR_FORMAT, label + " is " + kind_name(kind) + ", not a regular file");
+  ReadOnlyFile file(path);
+  if (!file.is_open()) throw Error(SOFTDECA_ERROR_IO, "cannot open " + label);
+  if (!file.is_regular()) throw Error(SOFTDECA_ERROR_FORMAT, label + " is not a regular file");
+  const std::uint64_t size = file.size();
   if (size > max_bytes)
     throw Error(SOFTDECA_ERROR_FORMAT, label + " is " + mib(size) + ", over the limit of " + mib(max_bytes));
   Bytes data(static_cast<std::size_t>(size));
-  std::size_t got = 0;
-  while (got < data.size()) {
-    const ssize_t n = ::read(fd, data.data() + got, data.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw Error(SOFTDECA_ERROR_IO, "cannot read " + label);
-    got += static_cast<std::size_t>(n);
-  }
+  if (!file.read(data.data(), data.size())) throw Error(SOFTDECA_ERROR_IO, "cannot read " + label);
   return data;
-}
-
-std::string canonical(const std::string& path) {
-  char buffer[PATH_MAX];
-  if (!::realpath(path.c_str(), buffer)) return {};
-  return buffer;
 }
 
 // ustar numeric fields: octal text, NUL or space terminated.
@@ -87,11 +67,11 @@ void check_name(const std::string& name) {
 }  // namespace
 
 BundleFiles BundleFiles::from_path(const std::string& path, const BundleLimits& limits) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
-  if (!S_ISDIR(st.st_mode)) {
+  const EntryKind kind = target_kind(path);
+  if (kind == EntryKind::missing) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
+  if (kind != EntryKind::folder) {
     // A .tar: the path itself may be a link (the caller chose it), its target must be regular.
-    const std::string target = canonical(path);
+    const std::string target = resolve_path(path);
     if (target.empty()) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
     const Bytes data = read_regular(target, path, limits.max_total_bytes);
     BundleFiles b = from_tar(data.data(), data.size(), limits);
@@ -100,7 +80,7 @@ BundleFiles BundleFiles::from_path(const std::string& path, const BundleLimits& 
   }
   BundleFiles b;
   b.origin_ = path;
-  b.root_ = canonical(path);
+  b.root_ = resolve_path(path);
   if (b.root_.empty()) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
   b.lazy_ = true;
   b.limits_ = limits;
@@ -155,8 +135,8 @@ BundleFiles BundleFiles::from_tar(const std::uint8_t* data, std::size_t size, co
 
 bool BundleFiles::has(const std::string& name) const {
   if (!lazy_) return files_.count(name) > 0;
-  struct stat st {};
-  return ::lstat((root_ + "/" + name).c_str(), &st) == 0 && (S_ISREG(st.st_mode) || S_ISLNK(st.st_mode));
+  const EntryKind kind = entry_kind(join_path(root_, name));
+  return kind == EntryKind::regular || kind == EntryKind::link;
 }
 
 const Bytes& BundleFiles::get(const std::string& name) const {
@@ -168,17 +148,18 @@ const Bytes& BundleFiles::get(const std::string& name) const {
   }
   auto it = cache_.find(name);
   if (it == cache_.end()) {
-    const std::string path = root_ + "/" + name;
-    struct stat st {};
-    if (::lstat(path.c_str(), &st) != 0) throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle has no file " + name);
+    const std::string path = join_path(root_, name);
+    const std::string label = origin_ + ": bundle file " + name;
+    const EntryKind kind = entry_kind(path);
+    if (kind == EntryKind::missing) throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle has no file " + name);
+    if (kind != EntryKind::regular && kind != EntryKind::link)
+      throw Error(SOFTDECA_ERROR_FORMAT, label + " is " + kind_name(kind) + ", not a regular file");
     // Resolve links (in any component) and require the result inside the bundle's folder.
-    const std::string resolved = canonical(path);
-    if (resolved.empty()) throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle file " + name + " is a broken link");
-    if (resolved.compare(0, root_.size() + 1, root_ + "/") != 0)
-      throw Error(SOFTDECA_ERROR_FORMAT, origin_ + ": bundle file " + name + " is a link that leaves the bundle");
+    const std::string resolved = resolve_path(path);
+    if (resolved.empty()) throw Error(SOFTDECA_ERROR_FORMAT, label + " is a broken link");
+    if (!path_inside(root_, resolved)) throw Error(SOFTDECA_ERROR_FORMAT, label + " is a link that leaves the bundle");
     const std::uint64_t left = limits_.max_total_bytes - bytes_read_;
-    Bytes data = read_regular(resolved, origin_ + ": bundle file " + name,
-                              left < limits_.max_file_bytes ? left : limits_.max_file_bytes);
+    Bytes data = read_regular(resolved, label, left < limits_.max_file_bytes ? left : limits_.max_file_bytes);
     bytes_read_ += data.size();
     it = cache_.emplace(name, std::move(data)).first;
   }
