@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from softdeca_train.data.ranges import DEFAULT_PROFILE, PROFILES
 from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.networks import BETA_MAX
 from softdeca_train.paths import REPO_ROOT
@@ -143,7 +144,7 @@ def test_bundle_pipeline_exports_a_bundle_onnxruntime_agrees_with(
     w_target = next(p for p in m["parameters"] if p["name"] == "w_target")
     assert w_target["min"] == 1.0
     skull = next(p for p in m["parameters"] if p["name"] == "cranium_scale_x")
-    assert (skull["min"], skull["max"]) == (0.9, 1.1)
+    assert (skull["min"], skull["max"]) == PROFILES[DEFAULT_PROFILE]["cranium_scale_x"]
     nets = OnnxNetworks(bundle)
     assert nets.has("softdeca") and nets.has("sparse")
 
