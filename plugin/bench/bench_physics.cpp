@@ -1,7 +1,7 @@
 // Micro-benchmark of the physics model phi† on synthetic layered heads at several wrap
 // resolutions: time per static frame to convergence, per dynamic frame, iterations, the
 // share of local and global steps, factorisation time, batched frames per second.
-// Writes a JSON object of figures {"value", "unit", "target", "better", "how"} (DESIGN §3).
+// Writes a JSON object of figures {"value", "unit", "target", "better", "how"} (docs/ARCHITECTURE.md, Conventions).
 //
 //   bench_physics [--out build/bench/physics.json] [--levels 3,4,5] [--default 4]
 //                 [--frames 8] [--repeats 3] [--threads 0]

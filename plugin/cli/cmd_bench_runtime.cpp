@@ -2,7 +2,7 @@
 // a real take: plain linear blendshapes, SoftDECA static and dynamic, SparseSoftDECA, with one
 // and with two threads; prepare time, memory per avatar, and the error the compact hyper-tensor
 // storage adds (half and int8 against float, same frames). Writes the benchmark JSON of
-// DESIGN §3 ({figure: {value, unit, target, better, how}}).
+// docs/ARCHITECTURE.md, Conventions ({figure: {value, unit, target, better, how}}).
 #include <chrono>
 #include <ctime>
 #include <cmath>
@@ -301,7 +301,7 @@ void measure_storage_error(Bench& bench) {
 
 int run_bench_runtime(const Args& args) {
   Options o("bench-runtime", "Measure the runtime per frame on the frames of a take (medians), single- and two-threaded,\n"
-                             "and write the benchmark JSON (DESIGN §3).");
+                             "and write the benchmark JSON (docs/ARCHITECTURE.md, Conventions).");
   o.option("--bundle", "DIR", "model bundle folder or .tar")
       .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
       .option("--take", "FILE", "Live Link Face CSV or recording whose frames drive the measurement")

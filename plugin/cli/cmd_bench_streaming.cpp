@@ -183,7 +183,7 @@ int run_bench_streaming(const Args& args) {
             "Measure the streaming path on this machine: receiver throughput on 127.0.0.1 (frames blasted\n"
             "as fast as the socket takes them), latency from send to frame available (frames paced),\n"
             "decoder cost, recording write and read rates. Medians over --runs runs; writes the figures\n"
-            "as JSON (DESIGN §3's benchmark format).");
+            "as JSON (the benchmark format of docs/ARCHITECTURE.md, Conventions).");
   o.option("--out", "FILE", "JSON output", "build/bench/streaming.json")
       .option("--runs", "N", "repetitions of each measurement", "5")
       .option("--throughput-frames", "N", "frames blasted per throughput run", "100000")

@@ -1,9 +1,9 @@
 """Headless renders of meshes, point sets and polylines (pyvista/VTK offscreen, EGL), and tiling
 of several renders into one labelled PNG. Shared by every step that writes pictures.
 
-Coordinates are the product's frame (DESIGN §3): metres, +Y up, +Z out of the face, +X the
-subject's own left. Named views look at the subject from that frame's directions, so "front"
-shows the face and "side" the subject's left profile.
+Coordinates are the product's frame (docs/ARCHITECTURE.md, Conventions): metres, +Y up,
++Z out of the face, +X the subject's own left. Named views look at the subject from that
+frame's directions, so "front" shows the face and "side" the subject's left profile.
 """
 
 from __future__ import annotations

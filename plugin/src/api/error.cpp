@@ -2,7 +2,7 @@
 
 namespace softdeca {
 namespace {
-// Thread-local by design (DESIGN §3): each host thread sees its own last failure.
+// Thread-local (the C ABI convention of softdeca.h): each host thread sees its own last failure.
 std::string& last_error_slot() {
   thread_local std::string text;
   return text;

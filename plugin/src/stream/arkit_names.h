@@ -1,4 +1,4 @@
-// ARKit's 52 blendshape names in the canonical order of every interface (DESIGN §3): the
+// ARKit's 52 blendshape names in the canonical order of every interface (docs/ARCHITECTURE.md, Conventions): the
 // alphabetical order of ARFaceAnchor.BlendShapeLocation, browDownLeft = 0 ... tongueOut = 51.
 // This is the one C++ definition; adapters map their own orders and spellings onto it.
 #pragma once

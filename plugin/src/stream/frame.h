@@ -1,5 +1,5 @@
 // The canonical frame every source (our protocol, Live Link Face, iFacialMocap, recordings)
-// is converted into. Units and frame follow DESIGN §3: metres; ARKit's right-handed face-anchor
+// is converted into. Units and frame follow docs/ARCHITECTURE.md, Conventions: metres; ARKit's right-handed face-anchor
 // frame (+Y up, +Z out of the face); weights in canonical order (arkit_names.h), in [0, 1].
 #pragma once
 

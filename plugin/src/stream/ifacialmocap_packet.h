@@ -1,4 +1,4 @@
-// iFacialMocap's UDP text packet (DESIGN §7): "name-value|...|=head#rx,ry,rz,px,py,pz|
+// iFacialMocap's UDP text packet (docs/protocol.md): "name-value|...|=head#rx,ry,rz,px,py,pz|
 // rightEye#rx,ry,rz|leftEye#rx,ry,rz|", values 0-100, names with _L/_R, angles in degrees.
 // Version 2 of the app separates name and value with '&' instead of '-'; both are accepted.
 #pragma once

@@ -1,4 +1,4 @@
-// Live Link Face's UDP packet, version 6 (DESIGN §7), big-endian: version byte, device id and
+// Live Link Face's UDP packet, version 6 (docs/protocol.md), big-endian: version byte, device id and
 // subject name (int32 length + UTF-8 each), frame time (int32 frame, float subframe, int32 fps
 // numerator and denominator), a value count byte and that many float32 values (livelinkface_layout.h).
 #pragma once

@@ -1,9 +1,9 @@
 """The augmentation σ of the sparse data (paper eq. 24): landmarks observed on another head,
 personalised to the simulated head, then coordinate-wise Gaussian noise.
 
-Personalisation is the same map as the runtime's retargeting (DESIGN §3, landmarks): the
-donor's landmark offsets from its own neutral, L'_t - L'_0, are carried over by the
-similarity (s, R) that best maps the donor's neutral landmarks onto the simulated head's
+Personalisation is the same map as the runtime's retargeting (docs/ARCHITECTURE.md,
+Conventions): the donor's landmark offsets from its own neutral, L'_t - L'_0, are carried
+over by the similarity (s, R) that best maps the donor's neutral landmarks onto the simulated head's
 neutral landmarks (Umeyama, least squares over all landmarks), and added to the simulated
 head's neutral landmarks:
 

@@ -30,7 +30,8 @@ from softdeca_train.landmarks.topology import (
 
 DEFINITION_FORMAT = 1
 DEFINITION_PATH = Path(__file__).with_name("definition.json")
-SIDE_REGIONS = {"left": +1, "right": -1}  # +x is the subject's own left (DESIGN §3)
+# +x is the subject's own left (docs/ARCHITECTURE.md, Conventions)
+SIDE_REGIONS = {"left": +1, "right": -1}
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """`make bench`'s runtime figures: a full-size untrained bundle on the template topology, the
 avatar of identity seed 1, and `softdeca bench-runtime` on the frames of a real take
--> build/bench/runtime.json (DESIGN §3)."""
+-> build/bench/runtime.json (docs/ARCHITECTURE.md, Conventions)."""
 
 from __future__ import annotations
 

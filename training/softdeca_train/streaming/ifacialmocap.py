@@ -1,4 +1,4 @@
-"""iFacialMocap's UDP text packets (DESIGN §7): "name-value|...|=head#rx,ry,rz,px,py,pz|
+"""iFacialMocap's UDP text packets (docs/protocol.md): "name-value|...|=head#rx,ry,rz,px,py,pz|
 rightEye#rx,ry,rz|leftEye#rx,ry,rz|", values 0-100, names with _L/_R, angles in degrees;
 version 2 separates name and value with '&'. Twin of plugin/src/stream/ifacialmocap_packet.cpp."""
 
