@@ -20,9 +20,12 @@ export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
 export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
 # ccache, when installed, makes rebuilds and other checkouts of the same tree cheap; the build
-# never needs it. Paths under the checkout are hashed relative to it so checkouts share hits.
+# never needs it. Paths under the checkout are hashed relative to it, and the working directory
+# is left out of the hash (it only names the debug info's compilation directory), so checkouts
+# share hits.
 LAUNCHER  := $(if $(shell command -v ccache),-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := 1
 
 .PHONY: help setup build build-asan test test-native test-python demo bench lint clean
 
