@@ -58,7 +58,7 @@ TEST(SimErrors, OutOfRangeParameterIsRefusedAndNothingChanges) {
   const SimulationMesh mesh = small_head();
   Simulator sim(mesh);
   expect_error([&] { sim.parameters().set("gravity_strength", 3.0); }, SOFTDECA_ERROR_INVALID_ARGUMENT,
-               "'gravity_strength' = 3 is outside its range [1, 2]");
+               "'gravity_strength' = 3 is outside its range [0, 2]");
   EXPECT_EQ(sim.parameters().global(Param::gravity_strength), 1.0);
   expect_error([&] { sim.parameters().set_field("w_target", Eigen::VectorXd::Ones(3)); },
                SOFTDECA_ERROR_INVALID_ARGUMENT, "skin_point has " + std::to_string(mesh.skin_count()));

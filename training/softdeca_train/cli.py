@@ -19,6 +19,7 @@ STAGES = (
     "softdeca_train.sim.cli",
     "softdeca_train.data.cli",
     "softdeca_train.train.cli",
+    "softdeca_train.controls.cli",
     "softdeca_train.runtime.cli",
     "softdeca_train.streaming.cli",
 )

@@ -1,10 +1,15 @@
 """The material parameter vector p, read from its single definition plugin/data/parameters.json
-(the same file the C++ simulator embeds at build time, and the bundle manifest copies)."""
+(the same file the C++ simulator embeds at build time, and the bundle manifest copies).
+
+Each entry holds both of its ranges: `lo`/`hi`, where the physics accepts a value, and
+`control`, the range a user moves it in (what datasets sample by default and a bundle trained
+on them accepts), or null for a parameter that acts on nothing in the head model: the models
+do not take those (docs/controls.md)."""
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
 
@@ -24,6 +29,7 @@ class ParameterSpec:
     scale: str  # "linear" or "log": how to sample uniformly between lo and hi
     unit: str
     domain: str  # "global" or the element kind per-element values are given for
+    control: tuple[float, float] | None = None  # the control range; None: not a control
 
     def sample(self, rng: np.random.Generator, size: int | None = None) -> np.ndarray | float:
         if self.scale == "log":
@@ -51,6 +57,16 @@ class ParameterSet:
     def sample(self, rng: np.random.Generator) -> np.ndarray:
         """One parameter vector, each entry uniform or log-uniform in its range (Appendix A)."""
         return np.array([s.sample(rng) for s in self.specs])
+
+    def controls(self) -> ParameterSet:
+        """The controls only (what the models take), each over its control range with its
+        default clamped into it."""
+        out = []
+        for s in self.specs:
+            if s.control is not None:
+                lo, hi = s.control
+                out.append(replace(s, lo=lo, hi=hi, default=min(max(s.default, lo), hi)))
+        return ParameterSet(tuple(out))
 
     def validate(self, p: np.ndarray) -> None:
         p = np.asarray(p, dtype=np.float64)
@@ -83,7 +99,18 @@ def load_parameters(path: Path = DEFINITION) -> ParameterSet:
             p["scale"],
             p.get("unit", ""),
             p.get("domain", "global"),
+            _control(p),
         )
         for p in doc["parameters"]
     )
     return ParameterSet(specs)
+
+
+def _control(entry: dict) -> tuple[float, float] | None:
+    c = entry.get("control")
+    if c is None:
+        return None
+    lo, hi = float(c["lo"]), float(c["hi"])
+    if not float(entry["lo"]) <= lo < hi <= float(entry["hi"]):
+        raise ValueError(f"{entry['name']}: control range [{lo}, {hi}] outside the physics' range")
+    return lo, hi

@@ -1,0 +1,170 @@
+"""`controls`: the controls gallery. Every control moved from one end of its range to the other
+on unseen identities and expressions, through the physics and through a model bundle; per
+control its figures (controls/metrics.py), heat maps of the change, and a markdown page."""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase, expressions
+from softdeca_train.controls.definitions import (
+    REGION_PARAMETERS,
+    Control,
+    global_controls,
+    region_controls,
+)
+from softdeca_train.controls.metrics import control_response
+from softdeca_train.data.regions import REGIONS
+from softdeca_train.parameters import ParameterSet, load_parameters
+from softdeca_train.paths import REPO_ROOT, default_takes_path
+
+RANGES = ("control", "physics")
+
+
+@dataclass(frozen=True)
+class GalleryConfig:
+    out: Path = REPO_ROOT / "docs" / "controls"
+    bundle: Path | None = REPO_ROOT / "models" / "softdeca-default"  # None: physics only
+    level: int = 3
+    identities: int = 2
+    expressions: int = 3
+    only: tuple[str, ...] = ()  # control names; empty: every control
+    region_parameters: tuple[str, ...] = REGION_PARAMETERS
+    ranges: str = "control"  # control: the control ranges; physics: the physics' own
+    pictures: bool = True
+    takes: Path = field(default_factory=default_takes_path)
+    ict: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.ranges not in RANGES:
+            raise ValueError(f"ranges must be one of {RANGES}")
+        if not 1 <= self.identities <= len(IDENTITY_SEEDS):
+            raise ValueError(f"identities must be in 1..{len(IDENTITY_SEEDS)}")
+
+
+def controls_of(cfg: GalleryConfig) -> tuple[list[Control], dict[str, float]]:
+    """The controls to measure and the default value of every physics parameter."""
+    physics = load_parameters()
+    params: ParameterSet = physics.controls() if cfg.ranges == "control" else physics
+    defaults = {s.name: s.default for s in physics.specs}
+    defaults.update({s.name: s.default for s in params.specs})
+    out = global_controls(params) + region_controls(params, cfg.region_parameters)
+    if cfg.only:
+        unknown = set(cfg.only) - {c.name for c in out}
+        if unknown:
+            raise ValueError(f"unknown controls {sorted(unknown)}; known: {[c.name for c in out]}")
+        out = [c for c in out if c.name in cfg.only]
+    return out, defaults
+
+
+@dataclass
+class _Collected:
+    physics: dict[str, list[np.ndarray]] = field(default_factory=dict)  # name -> per case dP
+    model: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    shown: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)  # first case
+    clamped: set[str] = field(default_factory=set)
+
+
+def _measure_case(
+    cfg: GalleryConfig,
+    case: PhysicsCase,
+    controls: list[Control],
+    defaults: dict[str, float],
+    acc: _Collected,
+    bar: tqdm,
+) -> None:
+    domains = {s.name: s.domain for s in load_parameters().specs}
+    model = None
+    if cfg.bundle is not None:
+        from softdeca_train.models.bundle import OnnxNetworks
+
+        model = ModelCase(OnnxNetworks(cfg.bundle), case)
+    first = not acc.shown
+    for c in controls:
+        lo, hi = (case.solve(s, defaults, domains) for s in c.ends)
+        acc.physics.setdefault(c.name, []).append(hi - lo)
+        m_lo = m_hi = None
+        if model is not None:
+            m_lo, m_hi = (model.solve(s) for s in c.ends)
+            acc.model.setdefault(c.name, []).append(m_hi - m_lo)
+        if first:
+            acc.shown[c.name] = {"physics": hi, "lo": lo}
+            if m_hi is not None and m_lo is not None:
+                acc.shown[c.name].update({"model": m_hi, "model_lo": m_lo})
+        bar.update(1)
+    if model is not None:
+        acc.clamped |= model.clamped
+
+
+def _entry(c: Control, acc: _Collected, labels: np.ndarray) -> dict:
+    dp = np.concatenate(acc.physics[c.name])
+    dm = np.concatenate(acc.model[c.name]) if c.name in acc.model else np.zeros_like(dp)
+    inside = None if c.region is None else labels == REGIONS.index(c.region)
+    r = control_response(dp, dm, inside)
+    return {
+        "name": c.name,
+        "parameter": c.parameter,
+        "region": c.region,
+        "lo": c.lo,
+        "hi": c.hi,
+        "unit": c.unit,
+        "fixed": dict(c.fixed),
+        **asdict(r),
+        "model_clamped": c.parameter in acc.clamped,
+    }
+
+
+def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
+    """Measure every control (and draw its pictures); returns the gallery's JSON."""
+    from softdeca_train.template import Template
+
+    t0 = time.perf_counter()
+    controls, defaults = controls_of(cfg)
+    template = Template.load(cfg.ict)
+    weights = expressions(cfg.takes, count=cfg.expressions)
+    acc = _Collected()
+    total = cfg.identities * len(controls)
+    with tqdm(total=total, desc="controls", unit="control", disable=not progress) as bar:
+        for seed in IDENTITY_SEEDS[: cfg.identities]:
+            h = template.sample_identity(seed)
+            case = PhysicsCase(template, h, weights, cfg.level)
+            _measure_case(cfg, case, controls, defaults, acc, bar)
+            if cfg.pictures and seed == IDENTITY_SEEDS[0]:
+                shown_case = case
+    labels = shown_case.labels if cfg.pictures else PhysicsCase(template, h, weights).labels
+    entries = [_entry(c, acc, labels) for c in controls]
+    result = {
+        "config": {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()},
+        "identity_seeds": list(IDENTITY_SEEDS[: cfg.identities]),
+        "expressions": weights.tolist(),
+        "controls": entries,
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+    if cfg.pictures:
+        from softdeca_train.controls.pictures import draw_gallery
+
+        draw_gallery(cfg.out, controls, acc.shown, shown_case, entries, progress)
+    return result
+
+
+def report_entries(result: dict) -> list[dict]:
+    """The evaluation report's `controls` list: {name, region, physics_max_mm,
+    response_error, leakage} per control."""
+    keys = ("name", "region", "physics_max_mm", "response_error", "leakage")
+    return [{k: e[k] for k in keys} for e in result["controls"]]
+
+
+def write_gallery(cfg: GalleryConfig, result: dict) -> Path:
+    from softdeca_train.controls.pictures import markdown
+
+    cfg.out.mkdir(parents=True, exist_ok=True)
+    (cfg.out / "controls.json").write_text(json.dumps(result, indent=1) + "\n")
+    path = cfg.out / "README.md"
+    path.write_text(markdown(cfg, result))
+    return path

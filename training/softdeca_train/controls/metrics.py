@@ -1,0 +1,68 @@
+"""What one control does, as numbers: the change between the two ends of its range on the
+physics and on a model, and the figures of the gallery and the evaluation report. Pure numpy,
+so the figures are tested on tiny cases without a simulator."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Response:
+    """The figures of one control over its cases (identities x expressions)."""
+
+    physics_max_mm: float  # largest |change| of the physics at any vertex of the region
+    physics_mean_mm: float  # mean |change| of the physics over the region's vertices
+    model_max_mm: float
+    response_error: float | None  # |dM - dP| / |dP| over all cases; None when dP is zero
+    leakage: float | None  # model: mean |dM| outside the region / inside; None for global
+    physics_leakage: float | None  # the same for the physics (how local the control is)
+
+
+def _norms(delta: np.ndarray) -> np.ndarray:
+    """(..., V, 3) metres -> (..., V) millimetres."""
+    return 1e3 * np.linalg.norm(np.asarray(delta, np.float64), axis=-1)
+
+
+def response_error(delta_model: np.ndarray, delta_physics: np.ndarray) -> float | None:
+    """‖ΔM − ΔP‖ / ‖ΔP‖ (Frobenius over every case and vertex); None when the physics does
+    not move (the ratio is undefined, and the control is dead there)."""
+    dp = np.asarray(delta_physics, np.float64)
+    ref = float(np.linalg.norm(dp))
+    if ref == 0.0:
+        return None
+    return float(np.linalg.norm(np.asarray(delta_model, np.float64) - dp)) / ref
+
+
+def leakage(delta: np.ndarray, inside: np.ndarray | None) -> float | None:
+    """Mean |change| outside the region over mean |change| inside it; None for a global
+    control (no region) or when nothing moves inside."""
+    if inside is None:
+        return None
+    inside = np.asarray(inside, bool)
+    if inside.all() or not inside.any():
+        raise ValueError("a region must hold some vertices but not all")
+    d = _norms(delta).reshape(-1, inside.size)
+    inner = float(d[:, inside].mean())
+    if inner == 0.0:
+        return None
+    return float(d[:, ~inside].mean()) / inner
+
+
+def control_response(
+    delta_physics: np.ndarray, delta_model: np.ndarray, inside: np.ndarray | None
+) -> Response:
+    """Figures of one control from its changes (cases, V, 3) in metres; `inside`: (V,) mask of
+    its region, None for a global control (then every vertex counts as its region)."""
+    dp, dm = _norms(delta_physics), _norms(delta_model)
+    region = np.ones(dp.shape[-1], bool) if inside is None else np.asarray(inside, bool)
+    return Response(
+        physics_max_mm=float(dp[..., region].max()),
+        physics_mean_mm=float(dp[..., region].mean()),
+        model_max_mm=float(dm[..., region].max()),
+        response_error=response_error(delta_model, delta_physics),
+        leakage=leakage(delta_model, inside),
+        physics_leakage=leakage(delta_physics, inside),
+    )

@@ -1,0 +1,142 @@
+"""The gallery's pictures and page: per control the change between the ends of its range on
+the physics and on the model (one colour scale), and at the top end the distance of the model
+and of the linear blendshapes to the physics; the summary figures over all controls."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from softdeca_train.controls.cases import PhysicsCase
+from softdeca_train.controls.definitions import Control
+
+SIZE = (220, 220)
+
+
+def _fmt(x: float | None, digits: int = 3) -> str:
+    return "–" if x is None else f"{x:.{digits}f}"
+
+
+def _heat(shape: np.ndarray, tris: np.ndarray, mm: np.ndarray, vmax: float) -> np.ndarray:
+    from softdeca_train.render import MeshLayer, RenderSettings, render
+
+    layer = MeshLayer(shape, tris, scalars=mm, clim=(0.0, vmax), scalar_bar="mm")
+    return render([layer], "three_quarter", settings=RenderSettings(size=SIZE))
+
+
+def control_picture(
+    path: Path, c: Control, shown: dict[str, np.ndarray], case: PhysicsCase
+) -> None:
+    """One row per expression: physics change, model change, and at the top of the range
+    |model - physics| and |linear - physics| (mm)."""
+    from softdeca_train.render import TileSettings, tile
+
+    tris = case.template.skin_triangles
+    d_phys = 1e3 * np.linalg.norm(shown["physics"] - shown["lo"], axis=-1)
+    has_model = "model" in shown
+    d_model = (
+        1e3 * np.linalg.norm(shown["model"] - shown["model_lo"], axis=-1) if has_model else None
+    )
+    vmax = max(float(np.percentile(d_phys, 99.5)), 1e-3)
+    images, labels = [], []
+    for e in range(len(d_phys)):
+        shape = shown["physics"][e]
+        images.append(_heat(shape, tris, d_phys[e], vmax))
+        labels.append(f"physics change, max {d_phys[e].max():.2f}")
+        if d_model is not None:
+            images.append(_heat(shape, tris, d_model[e], vmax))
+            labels.append(f"SoftDECA change, max {d_model[e].max():.2f}")
+            err = 1e3 * np.linalg.norm(shown["model"][e] - shape, axis=-1)
+            images.append(_heat(shape, tris, err, vmax))
+            labels.append(f"|SoftDECA - physics|, mean {err.mean():.2f}")
+        lin = 1e3 * np.linalg.norm(case.targets[e] - shape, axis=-1)
+        images.append(_heat(shape, tris, lin, vmax))
+        labels.append(f"|linear - physics|, mean {lin.mean():.2f}")
+    cols = 4 if d_model is not None else 2
+    footer = f"{c.name}: {c.lo:g} -> {c.hi:g} {c.unit}; colour scale 0-{vmax:.2f} mm"
+    tile(
+        images,
+        labels,
+        path,
+        TileSettings(columns=cols, font_size=13, label_height=20, extra_labels=[footer]),
+    )
+
+
+def summary_figure(path: Path, entries: list[dict]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = [e["name"] for e in entries]
+    fig, axes = plt.subplots(3, 1, figsize=(10, 9), sharex=True)
+    y = np.arange(len(names))
+    axes[0].bar(y, [e["physics_max_mm"] for e in entries], color="tab:blue")
+    axes[0].axhline(1.0, color="k", lw=0.8, ls="--")
+    axes[0].set_ylabel("physics max change (mm)")
+    axes[0].set_yscale("log")
+    axes[1].bar(
+        y, [np.nan if e["response_error"] is None else e["response_error"] for e in entries]
+    )
+    axes[1].axhline(0.3, color="k", lw=0.8, ls="--")
+    axes[1].set_ylabel("response error")
+    axes[2].bar(
+        y, [np.nan if e["leakage"] is None else e["leakage"] for e in entries], color="tab:red"
+    )
+    axes[2].axhline(0.2, color="k", lw=0.8, ls="--")
+    axes[2].set_ylabel("leakage (SoftDECA)")
+    axes[2].set_xticks(y, names, rotation=70, ha="right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def draw_gallery(
+    out: Path,
+    controls: list[Control],
+    shown: dict[str, dict[str, np.ndarray]],
+    case: PhysicsCase,
+    entries: list[dict],
+    progress: bool = True,
+) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    for c in tqdm(controls, desc="pictures", disable=not progress):
+        control_picture(out / f"{c.name.replace('@', '-')}.png", c, shown[c.name], case)
+    summary_figure(out / "summary.png", entries)
+
+
+def markdown(cfg, result: dict) -> str:  # cfg: GalleryConfig
+    c = result["config"]
+    lines = [
+        "# Controls gallery",
+        "",
+        "Every control moved from the bottom to the top of its range, everything else at its "
+        f"default, on {len(result['identity_seeds'])} identities no dataset holds (seeds "
+        f"{', '.join(map(str, result['identity_seeds']))}) x {len(result['expressions'])} "
+        "expressions of the held-out take (widest jaw opening, broadest smile, strongest "
+        f"pucker); LHM level {c['level']}, static frames, {c['ranges']} ranges; model: "
+        f"`{c['bundle']}`. Written by `python -m softdeca_train controls` "
+        f"({result['seconds']:.0f} s); docs/controls.md says what the figures mean.",
+        "",
+        "| control | region | range | physics max (mm) | physics mean (mm) | SoftDECA max (mm) "
+        "| response error | leakage | physics leakage |",
+        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for e in result["controls"]:
+        rng = f"{e['lo']:g} – {e['hi']:g} {e['unit']}".strip()
+        if e.get("model_clamped"):
+            rng += " (model clamped to its trained range)"
+        lines.append(
+            f"| {e['name']} | {e['region'] or 'global'} | {rng} | {_fmt(e['physics_max_mm'])} "
+            f"| {_fmt(e['physics_mean_mm'])} | {_fmt(e['model_max_mm'])} "
+            f"| {_fmt(e['response_error'], 2)} | {_fmt(e['leakage'], 2)} "
+            f"| {_fmt(e['physics_leakage'], 2)} |"
+        )
+    if cfg.pictures:
+        lines += ["", "![summary](summary.png)", ""]
+        for e in result["controls"]:
+            name = e["name"].replace("@", "-")
+            lines += [f"## {e['name']}", "", f"![{e['name']}]({name}.png)", ""]
+    return "\n".join(lines) + "\n"
