@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from softdeca_train.controls.definitions import Setting
-from softdeca_train.data.regions import REGIONS, region_labels
+from softdeca_train.data.regions import REGIONS, element_regions, region_labels
 from softdeca_train.template import Template
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 from softdeca_train.template.model import N_SKIN
@@ -40,12 +40,6 @@ def expressions(takes_folder: Path, take: str = "facial", count: int = 3) -> np.
     if not 1 <= count <= len(scores):
         raise ValueError(f"expressions: count must be in 1..{len(scores)}")
     return np.stack([w[int(np.argmax(s))] for s in scores[:count]]).astype(np.float32)
-
-
-def _nearest(points: np.ndarray, skin: np.ndarray) -> np.ndarray:
-    from scipy.spatial import cKDTree
-
-    return cKDTree(skin).query(points)[1]
 
 
 @dataclass
@@ -88,18 +82,7 @@ class PhysicsCase:
         return region_labels(self.template)
 
     def element_regions(self, domain: str) -> np.ndarray:
-        """Region index of every element of a parameter domain: tets by the skin vertex nearest
-        their centroid at rest, skin triangles by their first corner, skin points directly."""
-        mesh = self.head.mesh
-        rest = np.asarray(mesh.rest)
-        if domain in ("soft_tet", "muscle_tet"):
-            tets = np.asarray(mesh.soft_tets if domain == "soft_tet" else mesh.muscle_tets)
-            return self.labels[_nearest(rest[tets].mean(axis=1), self.head.head[:N_SKIN])]
-        if domain == "skin_triangle":
-            return self.labels[np.asarray(mesh.skin_triangles)[:, 0]]
-        if domain == "skin_point":
-            return self.labels
-        raise ValueError(f"no per-region values for domain {domain!r}")
+        return element_regions(self.labels, self.head.mesh, self.head.head[:N_SKIN], domain)
 
     def solve(self, setting: Setting, defaults: dict[str, float], domains: dict[str, str]):
         """(E, N_SKIN, 3) simulated skin for every expression under `setting`."""

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from softdeca_train.commands import Command, add_ict_argument
 from softdeca_train.data.config import GenerateConfig, RunSettings, default_takes_path
-from softdeca_train.data.ranges import PROFILES
+from softdeca_train.data.ranges import FROM_DEFINITION, PROFILES
 
 D = GenerateConfig()
 
@@ -40,6 +40,11 @@ _SAMPLING = (
     ("--sequence-length", "sequence_length", "frames per dynamic sequence ({})"),
     ("--lead-in", "lead_in", "frames simulated with fixed dynamics before a sequence ({})"),
     ("--real-share", "real_share", "share of static/sparse frames from real takes ({})"),
+    (
+        "--region-share",
+        "region_share",
+        "share of static/sparse groups with per-region parameter values ({})",
+    ),
     ("--test-take", "test_take", "take held out for testing ({})"),
     ("--noise-mm", "landmark_noise_mm", "landmark noise sigma, mm ({})"),
 )
@@ -93,9 +98,10 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
     _add_config_options(g, _SOLVER)
     g.add_argument(
         "--ranges",
-        choices=sorted(PROFILES),
+        choices=sorted([*PROFILES, *FROM_DEFINITION]),
         default=D.ranges,
-        help=f"parameter sampling ranges (data/ranges.py; {D.ranges})",
+        help=f"parameter sampling ranges (data/ranges.py; default {D.ranges}: the control "
+        "ranges of plugin/data/parameters.json)",
     )
     r = p.add_argument_group("how to run (free to change on resume)")
     r.add_argument(

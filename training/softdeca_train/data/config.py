@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
 from softdeca_train import paths
-from softdeca_train.data.ranges import DEFAULT_PROFILE, LEGACY_PROFILE, PROFILES
+from softdeca_train.data.ranges import DEFAULT_PROFILE, LEGACY_PROFILE, is_profile
 
 KINDS = ("static", "dynamic", "sparse")
 TRAIN, TEST = 0, 1
@@ -37,8 +37,10 @@ class GenerateConfig:
     # points) at every level: it is embedded in the tets.
     level: int = 3
     # Frames that share (identity, p) share one factorisation: solved in a row on one simulator.
-    frames_per_params: int = 8  # static and sparse frames per (identity, p) group
-    params_per_identity: int = 2  # (identity, p) groups per shard; one identity per shard
+    # 1 (the default): every static and sparse instance has its own p, so a batch of training
+    # frames spans as many parameter sets as frames (datasets up to softdeca-l3-i2 used 2-8).
+    frames_per_params: int = 1  # static and sparse frames per (identity, p) group
+    params_per_identity: int = 8  # (identity, p) groups per shard; one identity per shard
     sequences_per_identity: int = 2  # dynamic: sequences (each its own p) per shard
     sequence_length: int = 16  # paper 4.2.1
     # Dynamic sequences start with a velocity: `lead_in` preceding frames of the take are
@@ -62,6 +64,9 @@ class GenerateConfig:
     # defaults (what the shipped bundle covers), "plausible" narrows only the weakest
     # constraint weights of Appendix A, "appendix-a" samples the physics' own ranges.
     ranges: str = DEFAULT_PROFILE
+    # Share of static and sparse groups with a regional pattern: localisable parameters set
+    # per region of S (data/plan.py regional_pattern), what region controls do at run time.
+    region_share: float = 0.5
 
     def __post_init__(self) -> None:
         problems = []
@@ -83,6 +88,8 @@ class GenerateConfig:
             problems.append("test_share must be in [0, 1)")
         if not 0.0 <= self.real_share <= 1.0:
             problems.append("real_share must be in [0, 1]")
+        if not 0.0 <= self.region_share <= 1.0:
+            problems.append("region_share must be in [0, 1]")
         if not 1 <= self.level <= 6:
             problems.append("level must be in 1..6")
         if self.landmark_noise_mm < 0 or self.identity_scale <= 0 or self.tolerance <= 0:
@@ -91,8 +98,8 @@ class GenerateConfig:
             problems.append("lead-in dynamics need gamma in (0, 1], beta in [0, 1)")
         if self.dynamic and self.lead_in < 2:
             problems.append("dynamic sequences need lead_in >= 2 (the two previous frames)")
-        if self.ranges not in PROFILES:
-            problems.append(f"ranges must be one of {sorted(PROFILES)}")
+        if not is_profile(self.ranges):
+            problems.append(f"unknown range profile {self.ranges!r}")
         if problems:
             raise ValueError("bad generate configuration: " + "; ".join(problems))
 
@@ -120,7 +127,8 @@ class GenerateConfig:
     @classmethod
     def from_dict(cls, d: dict) -> GenerateConfig:
         names = {f.name for f in fields(cls)}
-        d = {"ranges": LEGACY_PROFILE, **d}  # written before range profiles existed
+        # written before range profiles and regional patterns existed
+        d = {"ranges": LEGACY_PROFILE, "region_share": 0.0, **d}
         return cls(**{k: v for k, v in d.items() if k in names})
 
 

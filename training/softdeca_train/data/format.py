@@ -38,6 +38,14 @@ FRAME = {
         "mouth_open_ratio, inverted_elements, volume, not_converged); 0: passes",
     ),
 }
+REGIONAL = {
+    "p_regions": (
+        "float64",
+        "(n, 10, 25)",
+        "parameters per region of S (data/regions.py REGIONS order): a regional pattern, or p "
+        "in every region",
+    ),
+}
 SPARSE = {
     "landmarks": (
         "float32",
@@ -69,9 +77,9 @@ DYNAMIC = {
 }
 
 ARRAYS = {
-    "static": {**COMMON, **FRAME},
+    "static": {**COMMON, **FRAME, **REGIONAL},
     "dynamic": {**COMMON, **DYNAMIC},
-    "sparse": {**COMMON, **FRAME, **SPARSE},
+    "sparse": {**COMMON, **FRAME, **REGIONAL, **SPARSE},
 }
 
 

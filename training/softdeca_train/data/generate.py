@@ -22,7 +22,7 @@ from softdeca_train.data.config import KINDS, TEST, GenerateConfig, RunSettings
 from softdeca_train.data.expressions import Take, expression_sources, load_takes
 from softdeca_train.data.format import describe, shard_meta
 from softdeca_train.data.plan import FIXED, ShardSpec, make_plan
-from softdeca_train.data.ranges import sampling_parameters
+from softdeca_train.data.ranges import fixed_outside_profile, sampling_parameters
 from softdeca_train.data.shards import Manifest, write_shard
 from softdeca_train.parameters import DEFINITION, load_parameters
 from softdeca_train.paths import REPO_ROOT
@@ -86,7 +86,9 @@ def describe_plan(cfg: GenerateConfig, plan: list[ShardSpec], takes: list[Take])
                     splits[name]["identities"].append(g.donor_id)
                 splits[name]["coverage_draws"] += int((g.frames.source_take < 0).sum())
         k["arrays"] = describe(kind)
-        k["fixed_parameters"] = list(FIXED[kind])
+        k["fixed_parameters"] = [*FIXED[kind], *fixed_outside_profile(params, cfg.ranges)]
+        if kind != "dynamic":
+            k["regional_patterns"] = sum(g.p_regions is not None for s in shards for g in s.groups)
         per_kind[kind] = k
     splits["train"]["takes"] = [t.name for i, t in enumerate(takes) if i != test_take]
     splits["test"]["takes"] = [cfg.test_take]

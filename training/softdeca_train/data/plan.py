@@ -18,6 +18,7 @@ import numpy as np
 
 from softdeca_train.data.config import KINDS, TEST, TRAIN, GenerateConfig
 from softdeca_train.data.expressions import Draws, ExpressionSource
+from softdeca_train.data.ranges import fixed_outside_profile
 from softdeca_train.parameters import ParameterSet
 
 KIND_CODE = {k: i for i, k in enumerate(KINDS)}
@@ -45,6 +46,9 @@ class GroupSpec:
     donor_id: int = -1  # sparse: identity whose expression landmarks are personalised
     donor_seed: int = -1
     noise_seed: int = -1
+    # static/sparse: the value of every parameter per region of S (len(REGIONS), n_params)
+    # where the group has a regional pattern; None: p everywhere
+    p_regions: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -67,15 +71,43 @@ class ShardSpec:
         return self.first_instance + np.arange(self.instances, dtype=np.int64)
 
 
-def sample_parameters(params: ParameterSet, kind: str, rng: np.random.Generator) -> np.ndarray:
+def sample_parameters(
+    params: ParameterSet, kind: str, rng: np.random.Generator, fixed: tuple[str, ...] = ()
+) -> np.ndarray:
+    """One parameter vector; the kind's FIXED entries and `fixed` at their defaults."""
     p = params.sample(rng)
     # exp(log(hi)) may round past hi: keep every value inside its range exactly.
     p = np.clip(p, [s.lo for s in params.specs], [s.hi for s in params.specs])
     defaults = params.defaults()
-    for name in FIXED[kind]:
+    for name in (*FIXED[kind], *fixed):
         k = params.names.index(name)
         p[k] = defaults[k]
     return p
+
+
+def regional_pattern(
+    params: ParameterSet,
+    p: np.ndarray,
+    fixed: tuple[str, ...],
+    rng: np.random.Generator,
+    share: float,
+) -> np.ndarray | None:
+    """With probability `share`, a regional pattern over p: each localisable parameter (one
+    the physics defines per element) that is not fixed gets, with probability 1/2, its own
+    value in every region of the face a control can set (drawn from its range like p), the
+    others keep p's value everywhere. None: p everywhere."""
+    from softdeca_train.controls.definitions import CONTROL_REGIONS
+    from softdeca_train.data.regions import REGIONS
+
+    if rng.random() >= share:
+        return None
+    pattern = np.repeat(p[None], len(REGIONS), axis=0)
+    rows = [REGIONS.index(r) for r in CONTROL_REGIONS]
+    for k, s in enumerate(params.specs):
+        if s.domain == "global" or s.name in fixed or rng.random() < 0.5:
+            continue
+        pattern[rows, k] = np.clip(s.sample(rng, len(rows)), s.lo, s.hi)
+    return pattern
 
 
 def _test_shards(n_shards: int, share: float, rng: np.random.Generator) -> set[int]:
@@ -97,6 +129,8 @@ def make_plan(
         code = KIND_CODE[kind]
         test = _test_shards(n_shards, cfg.test_share, np.random.default_rng([cfg.seed, 20, code]))
         rng_p = np.random.default_rng([cfg.seed, 21, code])
+        rng_r = np.random.default_rng([cfg.seed, 22, code])  # regional patterns
+        fixed = fixed_outside_profile(params, cfg.ranges)
         for s in range(n_shards):
             split = TEST if s in test else TRAIN
             left = min(per_shard, n - s * per_shard)
@@ -106,7 +140,11 @@ def make_plan(
             while left > 0:
                 k = min(per_group, left) if kind != "dynamic" else 1
                 left -= k
-                p = sample_parameters(params, kind, rng_p)
+                p = sample_parameters(params, kind, rng_p, fixed)
+                p_regions = None
+                if kind != "dynamic" and cfg.region_share > 0:
+                    held = (*FIXED[kind], *fixed)
+                    p_regions = regional_pattern(params, p, held, rng_r, cfg.region_share)
                 src = sources[split]
                 if kind == "dynamic":
                     frames = src.window(cfg.lead_in + cfg.sequence_length)
@@ -118,7 +156,9 @@ def make_plan(
                     next_identity += 1
                     donor_seed = derived_seed(cfg.seed, 1, donor_id)
                     noise_seed = derived_seed(cfg.seed, 3, next_param)
-                groups.append(GroupSpec(next_param, p, frames, donor_id, donor_seed, noise_seed))
+                groups.append(
+                    GroupSpec(next_param, p, frames, donor_id, donor_seed, noise_seed, p_regions)
+                )
                 next_param += 1
             spec = ShardSpec(
                 kind=kind,

@@ -14,13 +14,18 @@ scale within 2 %, gravity up to 1.2 g and 30 degrees off vertical. Measured on s
 (identity, p) group, independent of the expression (data/offset_structure.py), and with
 weights spread over five decades and skulls scaled by up to 50 % nothing learned it from 120
 parameter sets (ridge linear in p made the test error worse; SoftDECA stayed within 1 % of no
-correction, docs/training.md)."""
+correction, docs/training.md).
+
+`controls` (the default) samples every control over its control range, the one list in
+plugin/data/parameters.json (`control`: the range a user moves it in, measured to move the
+physics by at least 1 mm where it acts, docs/controls.md) and keeps the parameters that are
+no controls (they act on nothing in the head model) at their defaults."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
-from softdeca_train.parameters import ParameterSet
+from softdeca_train.parameters import ParameterSet, load_parameters
 
 
 def _decade(default: float) -> tuple[float, float]:
@@ -60,16 +65,42 @@ PROFILES: dict[str, dict[str, tuple[float, float]]] = {
         "jaw_scale_z": _BONE_SCALE,
     },
 }
-DEFAULT_PROFILE = "interactive"
+# Profiles read from parameters.json: sampling ranges are the parameters' control ranges.
+FROM_DEFINITION = ("controls",)
+DEFAULT_PROFILE = "controls"
 # Datasets written before profiles existed sampled the physics' own ranges.
 LEGACY_PROFILE = "appendix-a"
 
 
+def profile_ranges(params: ParameterSet, profile: str) -> dict[str, tuple[float, float]]:
+    """The ranges a profile narrows, by parameter name."""
+    if profile in FROM_DEFINITION:
+        return {s.name: s.control for s in params.specs if s.control is not None}
+    if profile not in PROFILES:
+        known = sorted([*PROFILES, *FROM_DEFINITION])
+        raise ValueError(f"unknown range profile {profile!r}; known: {known}")
+    return PROFILES[profile]
+
+
+def fixed_outside_profile(params: ParameterSet, profile: str) -> tuple[str, ...]:
+    """Parameters a profile keeps at their defaults: the ones that are no controls."""
+    if profile in FROM_DEFINITION:
+        return tuple(s.name for s in params.specs if s.control is None)
+    return ()
+
+
+def is_profile(profile: str) -> bool:
+    return profile in PROFILES or profile in FROM_DEFINITION
+
+
+def control_names() -> tuple[str, ...]:
+    """The parameters the models take (every control of parameters.json)."""
+    return tuple(load_parameters().controls().names)
+
+
 def sampling_parameters(params: ParameterSet, profile: str) -> ParameterSet:
     """`params` with the profile's ranges (defaults clamped into them)."""
-    if profile not in PROFILES:
-        raise ValueError(f"unknown range profile {profile!r}; known: {sorted(PROFILES)}")
-    narrowed = PROFILES[profile]
+    narrowed = profile_ranges(params, profile)
     unknown = set(narrowed) - set(params.names)
     if unknown:
         raise ValueError(f"range profile {profile!r} names unknown parameters {sorted(unknown)}")

@@ -56,3 +56,30 @@ def region_labels(template: Template) -> np.ndarray:
     )
     assert (labels >= 0).all()
     return labels
+
+
+def element_regions(
+    labels: np.ndarray, mesh: object, neutral_skin: np.ndarray, domain: str
+) -> np.ndarray:
+    """Region index of every element of a parameter domain of a simulation mesh
+    (softdeca_native.SimulationMesh): tets by the vertex of S nearest their centroid at rest,
+    skin triangles by their first corner, skin points by their own label. `labels`: (N_SKIN,)
+    from `region_labels`; `neutral_skin`: the identity's S at rest (N_SKIN, 3)."""
+    if domain in ("soft_tet", "muscle_tet"):
+        from scipy.spatial import cKDTree
+
+        rest = np.asarray(mesh.rest)  # type: ignore[attr-defined]
+        tets = np.asarray(mesh.soft_tets if domain == "soft_tet" else mesh.muscle_tets)  # type: ignore[attr-defined]
+        return labels[cKDTree(neutral_skin).query(rest[tets].mean(axis=1))[1]]
+    if domain == "skin_triangle":
+        return labels[np.asarray(mesh.skin_triangles)[:, 0]]  # type: ignore[attr-defined]
+    if domain == "skin_point":
+        return labels
+    raise ValueError(f"no per-region values for domain {domain!r}")
+
+
+def regional_field(
+    values: np.ndarray, labels: np.ndarray, mesh: object, neutral_skin: np.ndarray, domain: str
+) -> np.ndarray:
+    """Per-element values of one parameter from its value per region (len(REGIONS),)."""
+    return np.asarray(values, np.float64)[element_regions(labels, mesh, neutral_skin, domain)]

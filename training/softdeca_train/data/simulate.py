@@ -126,6 +126,24 @@ def _set_parameters(sim: native.Simulator, names: list[str], p: np.ndarray) -> N
         sim.set_parameter(name, float(value))
 
 
+def _set_regional(head: _Head, g: GroupSpec, names: list[str]) -> np.ndarray:
+    """The group's regional pattern on the simulator (fields over the parameters' element
+    domains); returns the pattern stored with the instances (p in every region without one)."""
+    from softdeca_train.data.regions import REGIONS, region_labels, regional_field
+
+    if g.p_regions is None:
+        return np.repeat(g.p[None], len(REGIONS), axis=0)
+    labels = region_labels(head.ctx.template)
+    domains = {s.name: s.domain for s in load_parameters().specs}
+    skin = head.hs.head[:N_SKIN]
+    for k, name in enumerate(names):
+        column = g.p_regions[:, k]
+        if np.any(column != g.p[k]):
+            field = regional_field(column, labels, head.sim.mesh, skin, domains[name])
+            head.sim.set_parameter_field(name, field)
+    return g.p_regions
+
+
 def _stats(stats: list[dict]) -> dict[str, np.ndarray]:
     return {
         "iterations": np.array([s["iterations"] for s in stats], np.int16),
@@ -146,8 +164,10 @@ class _Head:
     volume: SoftVolume
 
 
-def _static_group(head: _Head, g: GroupSpec, sparse: bool) -> None:
+def _static_group(head: _Head, g: GroupSpec, sparse: bool, names: list[str]) -> None:
     ctx, hs, sim, cfg, out, volume = (head.ctx, head.hs, head.sim, head.cfg, head.out, head.volume)
+    _set_parameters(sim, names, g.p)
+    p_regions = _set_regional(head, g, names)
     w = g.frames.weights
     targets = ctx.blend.targets(hs.head[:N_SKIN], w)
     jaws = hs.jaw_transforms(hs.blend(w))
@@ -178,6 +198,7 @@ def _static_group(head: _Head, g: GroupSpec, sparse: bool) -> None:
         failures=out.judge(hs, volume, targets, solved, sim.get_parameter("target_volume")),
         param_id=np.full(n, g.param_id, np.int32),
         p=np.repeat(g.p[None], n, axis=0),
+        p_regions=np.repeat(p_regions[None], n, axis=0),
         weights=w,
         source_take=g.frames.source_take,
         source_index=g.frames.source_index,
@@ -251,8 +272,7 @@ def simulate_shard(
         if spec.kind == "dynamic":
             _dynamic_group(head, g, names)
         else:
-            _set_parameters(sim, names, g.p)
-            _static_group(head, g, sparse)
+            _static_group(head, g, sparse, names)
     arrays = out.arrays()
     n = len(arrays["param_id"])
     arrays = {

@@ -85,9 +85,11 @@ class ParameterSpec:
 
 def load_parameter_specs(
     source: str | os.PathLike[str] | Sequence[ParameterSpec | dict[str, Any]] | None = None,
+    controls_only: bool = False,
 ) -> tuple[ParameterSpec, ...]:
     """Parameter specs from a parameters.json file, a list of specs or dicts, or (None) the
-    repository's plugin/data/parameters.json."""
+    repository's plugin/data/parameters.json. `controls_only`: leave out the entries marked as
+    no control (`"control": null`: they act on nothing in the head model)."""
     if source is None:
         if not PARAMETERS_JSON.is_file():
             raise FileNotFoundError(
@@ -98,6 +100,8 @@ def load_parameter_specs(
     if isinstance(source, (str, os.PathLike)):
         doc = json.loads(Path(source).read_text())
         entries = doc["parameters"] if isinstance(doc, dict) else doc
+        if controls_only:
+            entries = [e for e in entries if not ("control" in e and e["control"] is None)]
         specs = tuple(ParameterSpec.from_dict(e) for e in entries)
     else:
         specs = tuple(
@@ -110,8 +114,8 @@ def load_parameter_specs(
 
 
 def specs_or_test_list(source: str | None) -> tuple[ParameterSpec, ...]:
-    """For tools that must run before the physics' list exists: `source`, else
-    plugin/data/parameters.json, else (with a note on stderr) the 5-parameter test list."""
+    """For tools that must run before the physics' list exists: `source`, else the controls
+    of plugin/data/parameters.json, else (with a note on stderr) the 5-parameter test list."""
     if source is None and not PARAMETERS_JSON.is_file():
         import sys
 
@@ -121,7 +125,7 @@ def specs_or_test_list(source: str | None) -> tuple[ParameterSpec, ...]:
             f"note: {PARAMETERS_JSON} is missing: using the 5-parameter test list", file=sys.stderr
         )
         return load_parameter_specs(TEST_PARAMETERS)
-    return load_parameter_specs(source)
+    return load_parameter_specs(source, controls_only=True)
 
 
 @dataclass

@@ -30,7 +30,7 @@ class Batch:
     kind: str
     identity_id: int
     param_id: int
-    p: torch.Tensor  # (1, P) raw parameter values
+    p: torch.Tensor  # (1, P) raw parameter values, the model's columns
     h: torch.Tensor  # (1, H)
     neutral: torch.Tensor  # (V, 3) the identity's neutral skin
     weights: torch.Tensor  # (B, 52)
@@ -43,10 +43,25 @@ class Batch:
     prev_T: torch.Tensor | None = None
     prev_weights: torch.Tensor | None = None  # dynamic: (2, 52)
     source_take: np.ndarray | None = None  # (B,) take index or -1 (coverage)
+    # static/sparse: (len(REGIONS), P) the group's values per region of S (data/regions.py),
+    # p in every region without a regional pattern; None in datasets written without them
+    p_regions: torch.Tensor | None = None
+    p_faces: torch.Tensor | None = None  # (F, P) p_regions on the skin triangles
+    p_vertices: torch.Tensor | None = None  # (V, P) p_regions on the skin vertices
 
     @property
     def frames(self) -> int:
         return len(self.weights)
+
+    def face_parameters(self, n: int) -> torch.Tensor:
+        """(n, P) parameters per skin triangle: the regional pattern, or p everywhere."""
+        return self.p_faces if self.p_faces is not None else self.p.expand(n, self.p.shape[-1])
+
+    def vertex_parameters(self, n: int) -> torch.Tensor:
+        """(n, P) parameters per skin vertex: the regional pattern, or p everywhere."""
+        if self.p_vertices is not None:
+            return self.p_vertices
+        return self.p.expand(n, self.p.shape[-1])
 
 
 class IdentityCache:
@@ -71,7 +86,14 @@ class IdentityCache:
 class Dataset:
     """A generated dataset: its manifest and the shards of one kind and split."""
 
-    def __init__(self, folder: str | Path, template: Template | None = None) -> None:
+    def __init__(
+        self,
+        folder: str | Path,
+        template: Template | None = None,
+        parameters: list[str] | None = None,
+    ) -> None:
+        """`parameters`: the columns of p a model takes, by name (default: all of them, in
+        plugin/data/parameters.json order, which is the order of the stored p)."""
         self.folder = Path(folder)
         path = self.folder / "manifest.json"
         if not path.is_file():
@@ -82,6 +104,15 @@ class Dataset:
         self.blend = SkinBlend.of(self.template)
         self.cache = IdentityCache(self.template, self.template.skin_triangles)
         self.tolerance = float(self.manifest["header"]["config"]["tolerance"])
+        from softdeca_train.parameters import load_parameters
+
+        names = load_parameters().names
+        unknown = set(parameters or ()) - set(names)
+        if unknown:
+            raise ValueError(f"unknown parameters {sorted(unknown)}")
+        self.columns = (
+            [names.index(n) for n in parameters] if parameters else list(range(len(names)))
+        )
 
     def refresh(self) -> None:
         """Re-read the manifest: a dataset still being generated lists more finished shards."""
@@ -151,7 +182,7 @@ class Dataset:
             kind=kind,
             identity_id=int(a["identity_id"][i0]),
             param_id=int(a["param_id"][i0]),
-            p=f32(a["p"][i0][None]),
+            p=f32(a["p"][i0][None][:, self.columns]),
             h=f32(a["h"][i0][None]),
             neutral=f32(neutral),
             weights=f32(w),
@@ -160,6 +191,12 @@ class Dataset:
             dt=system,
             source_take=a["source_take"][idx].reshape(-1),
         )
+        if "p_regions" in a:
+            pr = a["p_regions"][i0][:, self.columns]
+            if np.any(pr != a["p"][i0][self.columns]):  # a regional pattern
+                batch.p_regions = f32(pr)
+                batch.p_vertices = f32(pr[self.labels])
+                batch.p_faces = f32(pr[self.labels[self.template.skin_triangles[:, 0]]])
         if "landmarks" in a:
             batch.landmarks = f32(a["landmarks"][idx])
             batch.landmarks_clean = f32(a["landmarks_clean"][idx])

@@ -171,7 +171,7 @@ class SoftDeca(Trainable):
         init_basis(self.f_ph, self.f_w.net, w, dg.reshape(len(g), -1), 1.0, readout=False)
 
     def deformation_gradients(self, batch: Batch) -> torch.Tensor:
-        hyper = self.f_ph(expand(batch.p, self.n_faces), batch.h)  # (F, latent, 9)
+        hyper = self.f_ph(batch.face_parameters(self.n_faces), batch.h)  # (F, latent, 9)
         z = self.f_w(batch.weights)  # (B, latent)
         return torch.einsum("bk,fkn->bfn", z, hyper).reshape(len(z), self.n_faces, 3, 3)
 
@@ -196,7 +196,7 @@ class SoftDecaVertex(Trainable):
         init_basis(self.f_ph_v, self.f_w.net, w, off.reshape(len(off), -1), CM)
 
     def predict(self, batch: Batch) -> torch.Tensor:
-        hyper = self.f_ph_v(expand(batch.p, self.n_vertices), batch.h)  # (V, latent, 3)
+        hyper = self.f_ph_v(batch.vertex_parameters(self.n_vertices), batch.h)  # (V, latent, 3)
         return batch.S + torch.einsum("bk,vkn->bvn", self.f_w(batch.weights), hyper)
 
 
@@ -250,7 +250,7 @@ class SparseSoftDeca(Trainable):
     def predict(self, batch: Batch) -> torch.Tensor:
         offsets = self.offsets(batch)
         z = self.f_l(offsets)
-        hyper = self.f_ph_v(expand(batch.p, self.n_vertices), batch.h)
+        hyper = self.f_ph_v(batch.vertex_parameters(self.n_vertices), batch.h)
         return batch.neutral + torch.einsum("bk,vkn->bvn", z, hyper)
 
 
@@ -310,7 +310,7 @@ class Dynamics(OverStatic):
 
     def predict(self, batch: Batch) -> torch.Tensor:
         y_all = self.static_frames(batch)
-        alpha, beta, gamma = self.f_dyn(expand(batch.p, self.n_vertices), batch.h)
+        alpha, beta, gamma = self.f_dyn(batch.vertex_parameters(self.n_vertices), batch.h)
         a, b, g = alpha[:, None], beta[:, None], gamma[:, None]
         x2, x1, y = y_all[0], y_all[1], y_all[2:]
         out = []
@@ -358,7 +358,7 @@ class FaceMlp(Trainable):
         self.from_weights = nn.Linear(len(d.blendshapes), sizes.hyper_hidden[0], bias=False)
 
     def predict(self, batch: Batch) -> torch.Tensor:
-        p = expand(batch.p, self.n_faces)
+        p = batch.face_parameters(self.n_faces)
         base = (
             self.body.from_parameters(self.body.normalise(p))
             + self.body.from_positional(self.body.positional)

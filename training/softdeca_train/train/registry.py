@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
-from softdeca_train.data.ranges import sampling_parameters
+from softdeca_train.data.ranges import fixed_outside_profile, sampling_parameters
 from softdeca_train.models.networks import NetworkSizes
 from softdeca_train.models.parameters import ParameterSpec, load_parameter_specs
 from softdeca_train.models.topology import TemplateDefinition
@@ -106,9 +106,13 @@ BUNDLE_STAGES = ("softdeca", "softdeca-dynamics", "sparse", "sparse-dynamics")
 
 def dataset_specs(range_profile: str) -> tuple[ParameterSpec, ...]:
     """The bundle's parameter specs: the physics' list with the ranges the data sampled (a
-    network is only valid there, so the runtime refuses values outside them)."""
-    sampled = {s.name: s for s in sampling_parameters(load_parameters(), range_profile).specs}
+    network is only valid there, so the runtime refuses values outside them). Parameters the
+    profile keeps at their defaults because they are no controls are not model inputs."""
+    physics = load_parameters()
+    sampled = {s.name: s for s in sampling_parameters(physics, range_profile).specs}
+    fixed = set(fixed_outside_profile(physics, range_profile))
     return tuple(
         replace(s, min=sampled[s.name].lo, max=sampled[s.name].hi, default=sampled[s.name].default)
         for s in load_parameter_specs()
+        if s.name not in fixed
     )

@@ -70,7 +70,7 @@ class Run:
 
     @cached_property
     def data(self) -> Dataset:
-        return Dataset(self.config.dataset, self.template)
+        return Dataset(self.config.dataset, self.template, [s.name for s in self.specs])
 
     @cached_property
     def definition(self) -> TemplateDefinition:
@@ -82,7 +82,9 @@ class Run:
 
     @cached_property
     def specs(self) -> tuple[ParameterSpec, ...]:
-        cfg = GenerateConfig.from_dict(self.data.manifest["header"]["config"])
+        # read from the manifest itself: the Dataset takes the model's columns from here
+        manifest = json.loads((Path(self.config.dataset) / "manifest.json").read_text())
+        cfg = GenerateConfig.from_dict(manifest["header"]["config"])
         return dataset_specs(cfg.ranges)
 
     def checkpoint(self, name: str) -> Path:
