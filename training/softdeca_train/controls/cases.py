@@ -81,6 +81,14 @@ class PhysicsCase:
     def labels(self) -> np.ndarray:
         return region_labels(self.template)
 
+    def with_weights(self, weights: np.ndarray) -> PhysicsCase:
+        """The same identity (head and simulator shared) with other expressions."""
+        other = PhysicsCase(
+            self.template, self.identity, weights, self.level, self.tolerance, self.max_iterations
+        )
+        other.__dict__.update(head=self.head, sim=self.sim, labels=self.labels)
+        return other
+
     def element_regions(self, domain: str) -> np.ndarray:
         return element_regions(self.labels, self.head.mesh, self.head.head[:N_SKIN], domain)
 
@@ -125,6 +133,12 @@ class ModelCase:
         if v != value:
             self.clamped.add(name)
         return v
+
+    def use(self, case: PhysicsCase) -> None:
+        """Other expressions of the same identity (PhysicsCase.with_weights)."""
+        if case.identity is not self.case.identity:
+            raise ValueError("a model case keeps its identity")
+        self.case = case
 
     def solve(self, setting: Setting) -> np.ndarray:
         params = self.avatar.params

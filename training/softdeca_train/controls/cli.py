@@ -83,11 +83,87 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def add_report_arguments(p: argparse.ArgumentParser, standalone: bool = True) -> None:
+    """Options of the report's `controls` and `real_takes` (also on `evaluate`)."""
+    from softdeca_train.paths import data_dir
+
+    if standalone:
+        p.add_argument(
+            "--report",
+            type=Path,
+            default=Path("docs/evaluation/evaluation.json"),
+            help="evaluation report to add them to (keeps its `errors`)",
+        )
+        p.add_argument(
+            "--bundle",
+            type=Path,
+            default=Path("models/softdeca-default"),
+            help="model bundle (default models/softdeca-default)",
+        )
+    p.add_argument(
+        "--controls-json",
+        type=Path,
+        default=None,
+        help="take `controls` from a gallery's controls.json instead of measuring "
+        "them (static, level 3, 2 identities x 3 expressions, no pictures)",
+    )
+    p.add_argument(
+        "--recordings",
+        type=Path,
+        default=data_dir() / "recordings",
+        help="every *.csv below it is a take for `real_takes` (default: the data "
+        "folder's recordings)",
+    )
+    p.add_argument("--real-every", type=int, default=10, help="every n-th frame (default 10)")
+    p.add_argument("--real-identities", type=int, default=3, help="identities, 1-3 (default 3)")
+    p.add_argument("--no-real-takes", action="store_true", help="leave `real_takes` as it is")
+
+
+def report_parts(args: argparse.Namespace, bundle: Path) -> tuple[list[dict], dict | None]:
+    """The report's `controls` (measured, or read from --controls-json) and `real_takes`."""
+    import json
+
+    from softdeca_train.controls.gallery import GalleryConfig, report_entries, run_gallery
+    from softdeca_train.controls.report import RealTakes, real_takes
+
+    if args.controls_json is not None:
+        gallery = json.loads(Path(args.controls_json).read_text())
+    else:
+        gallery = run_gallery(GalleryConfig(bundle=bundle, pictures=False))
+    real = None
+    if not args.no_real_takes:
+        cfg = RealTakes(args.recordings, args.real_identities, args.real_every)
+        real = real_takes(cfg, bundle)
+    return report_entries(gallery), real
+
+
+def _run_report(args: argparse.Namespace) -> int:
+    from softdeca_train.controls.report import merge_into_report, validate_report
+
+    controls, real = report_parts(args, args.bundle)
+    doc = merge_into_report(args.report, controls, real)
+    if "real_takes" in doc:
+        validate_report(doc)
+        r = doc["real_takes"]
+        print(
+            f"real takes: {r['frames']} frames, SoftDECA {r['softdeca_mm']:.3f} mm, "
+            f"linear {r['linear_mm']:.3f} mm"
+        )
+    print(f"wrote {args.report}")
+    return 0
+
+
 COMMANDS = (
     Command(
         "controls",
         "controls gallery: every material control on the physics and a model bundle",
         _add,
         _run,
+    ),
+    Command(
+        "controls-report",
+        "add the controls' figures and the real takes' distances to an evaluation report",
+        add_report_arguments,
+        _run_report,
     ),
 )

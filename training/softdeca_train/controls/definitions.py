@@ -54,16 +54,19 @@ class Control:
 def global_controls(params: ParameterSet, names: list[str] | None = None) -> list[Control]:
     """One control per parameter of `params` (in its order) that acts on static frames, over
     the range `params` gives it. The gravity azimuth only turns a tilted gravity: it is
-    measured with the tilt at the top of its range."""
+    measured with the tilt at the top of its range, and over half a turn (a full turn ends
+    where it starts)."""
     out = []
     spec = {s.name: s for s in params.specs}
     for s in params.specs:
         if s.name in NOT_STATIC or (names is not None and s.name not in names):
             continue
         fixed: tuple[tuple[str, float], ...] = ()
+        lo, hi = s.lo, s.hi
         if s.name == "gravity_azimuth" and "gravity_tilt" in spec:
             fixed = (("gravity_tilt", spec["gravity_tilt"].hi),)
-        out.append(Control(s.name, s.name, s.lo, s.hi, s.unit, None, fixed))
+            lo, hi = (lo / 2, hi / 2) if hi - lo >= 360.0 else (lo, hi)
+        out.append(Control(s.name, s.name, lo, hi, s.unit, None, fixed))
     return out
 
 

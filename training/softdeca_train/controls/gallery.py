@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -16,11 +17,12 @@ from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase
 from softdeca_train.controls.definitions import (
     REGION_PARAMETERS,
     Control,
+    Setting,
     global_controls,
     region_controls,
 )
 from softdeca_train.controls.metrics import control_response
-from softdeca_train.data.regions import REGIONS
+from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.paths import REPO_ROOT, default_takes_path
 
@@ -64,11 +66,32 @@ def controls_of(cfg: GalleryConfig) -> tuple[list[Control], dict[str, float]]:
 
 
 @dataclass
-class _Collected:
+class Collected:
     physics: dict[str, list[np.ndarray]] = field(default_factory=dict)  # name -> per case dP
     model: dict[str, list[np.ndarray]] = field(default_factory=dict)
     shown: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)  # first case
     clamped: set[str] = field(default_factory=set)
+
+
+Solve = Callable[[Setting], np.ndarray]  # a Setting -> skin (E, V, 3) for every expression
+
+
+def measure_controls(
+    controls: list[Control], physics: Solve, model: Solve | None, acc: Collected
+) -> None:
+    """Both ends of every control through the physics and the model (when given); the changes
+    go into `acc`, and the first case's shapes are kept for the pictures."""
+    first = not acc.shown
+    for c in controls:
+        lo, hi = (physics(s) for s in c.ends)
+        acc.physics.setdefault(c.name, []).append(hi - lo)
+        if first:
+            acc.shown[c.name] = {"physics": hi, "lo": lo}
+        if model is not None:
+            m_lo, m_hi = (model(s) for s in c.ends)
+            acc.model.setdefault(c.name, []).append(m_hi - m_lo)
+            if first:
+                acc.shown[c.name].update({"model": m_hi, "model_lo": m_lo})
 
 
 def _measure_case(
@@ -76,7 +99,7 @@ def _measure_case(
     case: PhysicsCase,
     controls: list[Control],
     defaults: dict[str, float],
-    acc: _Collected,
+    acc: Collected,
     bar: tqdm,
 ) -> None:
     domains = {s.name: s.domain for s in load_parameters().specs}
@@ -85,24 +108,19 @@ def _measure_case(
         from softdeca_train.models.bundle import OnnxNetworks
 
         model = ModelCase(OnnxNetworks(cfg.bundle), case)
-    first = not acc.shown
+
+    def physics(s: Setting) -> np.ndarray:
+        return case.solve(s, defaults, domains)
+
     for c in controls:
-        lo, hi = (case.solve(s, defaults, domains) for s in c.ends)
-        acc.physics.setdefault(c.name, []).append(hi - lo)
-        m_lo = m_hi = None
-        if model is not None:
-            m_lo, m_hi = (model.solve(s) for s in c.ends)
-            acc.model.setdefault(c.name, []).append(m_hi - m_lo)
-        if first:
-            acc.shown[c.name] = {"physics": hi, "lo": lo}
-            if m_hi is not None and m_lo is not None:
-                acc.shown[c.name].update({"model": m_hi, "model_lo": m_lo})
+        measure_controls([c], physics, None if model is None else model.solve, acc)
         bar.update(1)
     if model is not None:
         acc.clamped |= model.clamped
 
 
-def _entry(c: Control, acc: _Collected, labels: np.ndarray) -> dict:
+def control_entry(c: Control, acc: Collected, labels: np.ndarray) -> dict:
+    """The gallery's figures of one control over every case measured."""
     dp = np.concatenate(acc.physics[c.name])
     dm = np.concatenate(acc.model[c.name]) if c.name in acc.model else np.zeros_like(dp)
     inside = None if c.region is None else labels == REGIONS.index(c.region)
@@ -128,17 +146,17 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
     controls, defaults = controls_of(cfg)
     template = Template.load(cfg.ict)
     weights = expressions(cfg.takes, count=cfg.expressions)
-    acc = _Collected()
+    acc = Collected()
     total = cfg.identities * len(controls)
+    cases = [
+        PhysicsCase(template, template.sample_identity(seed), weights, cfg.level)
+        for seed in IDENTITY_SEEDS[: cfg.identities]
+    ]
     with tqdm(total=total, desc="controls", unit="control", disable=not progress) as bar:
-        for seed in IDENTITY_SEEDS[: cfg.identities]:
-            h = template.sample_identity(seed)
-            case = PhysicsCase(template, h, weights, cfg.level)
+        for case in cases:
             _measure_case(cfg, case, controls, defaults, acc, bar)
-            if cfg.pictures and seed == IDENTITY_SEEDS[0]:
-                shown_case = case
-    labels = shown_case.labels if cfg.pictures else PhysicsCase(template, h, weights).labels
-    entries = [_entry(c, acc, labels) for c in controls]
+    labels = region_labels(template)
+    entries = [control_entry(c, acc, labels) for c in controls]
     result = {
         "config": {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()},
         "identity_seeds": list(IDENTITY_SEEDS[: cfg.identities]),
@@ -149,7 +167,7 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
     if cfg.pictures:
         from softdeca_train.controls.pictures import draw_gallery
 
-        draw_gallery(cfg.out, controls, acc.shown, shown_case, entries, progress)
+        draw_gallery(cfg.out, controls, acc.shown, cases[0], entries, progress)
     return result
 
 

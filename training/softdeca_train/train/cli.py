@@ -120,13 +120,22 @@ def add_evaluate_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--bundle", default=DEFAULT_BUNDLE, help=f"bundle to check ({DEFAULT_BUNDLE})")
     p.add_argument("--out", default="docs/evaluation", help="report folder (docs/evaluation)")
     p.add_argument("--bench", default="build/bench", help="folder for models.json (build/bench)")
+    from softdeca_train.controls.cli import add_report_arguments
+
+    add_report_arguments(p, standalone=False)
 
 
 def run_evaluate(args: argparse.Namespace) -> int:
+    from softdeca_train.controls.cli import report_parts
+    from softdeca_train.controls.report import merge_into_report, validate_report
     from softdeca_train.train.report import write_report
 
     run = _open_run(args)
     path = write_report(run, Path(args.bundle), Path(args.out), Path(args.bench))
+    controls, real = report_parts(args, Path(args.bundle))
+    doc = merge_into_report(Path(args.out) / "evaluation.json", controls, real)
+    if real is not None:
+        validate_report(doc)
     print(f"report written to {path}")
     return 0
 

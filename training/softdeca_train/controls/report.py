@@ -1,0 +1,134 @@
+"""The evaluation report's material-control parts (docs/evaluation/evaluation.json): `controls`
+(the gallery's figures per control) and `real_takes` (SoftDECA and the linear blendshapes
+against the physics on every n-th frame of every recorded take, for unseen identities), their
+schema, and merging them into a report that keeps its `errors`."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase
+from softdeca_train.controls.definitions import Setting
+
+CONTROL_KEYS = ("name", "region", "physics_max_mm", "response_error", "leakage")
+REAL_TAKE_KEYS = ("frames", "identities", "softdeca_mm", "linear_mm")
+
+
+def _number_or_none(x: object) -> bool:
+    return x is None or (isinstance(x, (int, float)) and math.isfinite(x))
+
+
+def validate_report(doc: dict) -> None:
+    """ValueError naming the first problem, unless `doc` has `errors` (a table keyed by model),
+    `controls` (a list of {name, region, physics_max_mm, response_error, leakage}) and
+    `real_takes` ({frames, identities, softdeca_mm, linear_mm})."""
+    if not isinstance(doc.get("errors"), dict) or not doc["errors"]:
+        raise ValueError("report: `errors` must be a non-empty table")
+    controls = doc.get("controls")
+    if not isinstance(controls, list) or not controls:
+        raise ValueError("report: `controls` must be a non-empty list")
+    for c in controls:
+        if not isinstance(c, dict) or set(c) != set(CONTROL_KEYS):
+            raise ValueError(f"report: a control needs exactly {CONTROL_KEYS}: {c}")
+        if not isinstance(c["name"], str) or not (
+            c["region"] is None or isinstance(c["region"], str)
+        ):
+            raise ValueError(f"report: control name/region must be strings: {c}")
+        if not (isinstance(c["physics_max_mm"], (int, float)) and c["physics_max_mm"] >= 0):
+            raise ValueError(f"report: physics_max_mm must be a number >= 0: {c}")
+        if not (_number_or_none(c["response_error"]) and _number_or_none(c["leakage"])):
+            raise ValueError(f"report: response_error and leakage are numbers or null: {c}")
+        if c["region"] is None and c["leakage"] is not None:
+            raise ValueError(f"report: a global control has no leakage: {c}")
+    real = doc.get("real_takes")
+    if not isinstance(real, dict) or set(real) != set(REAL_TAKE_KEYS):
+        raise ValueError(f"report: `real_takes` needs exactly {REAL_TAKE_KEYS}")
+    if not (isinstance(real["frames"], int) and real["frames"] > 0):
+        raise ValueError("report: real_takes.frames must be a positive count")
+    if not (isinstance(real["identities"], int) and real["identities"] > 0):
+        raise ValueError("report: real_takes.identities must be a positive count")
+    for k in ("softdeca_mm", "linear_mm"):
+        if not (isinstance(real[k], (int, float)) and math.isfinite(real[k]) and real[k] >= 0):
+            raise ValueError(f"report: real_takes.{k} must be a distance in mm")
+
+
+@dataclass(frozen=True)
+class RealTakes:
+    recordings: Path  # every *.csv below it is a take
+    identities: int = 3
+    every: int = 10
+    level: int = 3
+    chunk: int = 32  # frames solved per batch (memory)
+
+
+def take_frames(recordings: Path, every: int) -> np.ndarray:
+    """(n, 52) every `every`-th tracked frame of every Live Link Face take below `recordings`."""
+    from softdeca_train.streaming.livelinkface import read_csv
+
+    paths = sorted(Path(recordings).rglob("*.csv"))
+    if not paths:
+        raise FileNotFoundError(f"no Live Link Face takes (*.csv) below {recordings}")
+    frames = []
+    for p in paths:
+        w = np.stack([f.weights for f in read_csv(p).frames]).astype(np.float32)
+        frames.append(w[::every])
+    return np.concatenate(frames)
+
+
+def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
+    """Mean distance (mm) of SoftDECA (the bundle, default parameters) and of the linear
+    blendshapes to the physics (default parameters), over every vertex of S and every frame."""
+    from softdeca_train.models.bundle import OnnxNetworks
+    from softdeca_train.parameters import load_parameters
+    from softdeca_train.template import Template
+
+    if not 1 <= cfg.identities <= len(IDENTITY_SEEDS) or cfg.every < 1:
+        raise ValueError(f"identities must be in 1..{len(IDENTITY_SEEDS)}, every >= 1")
+    weights = take_frames(cfg.recordings, cfg.every)
+    template = Template.load()
+    nets = OnnxNetworks(bundle)
+    physics = load_parameters()
+    defaults = {s.name: s.default for s in physics.specs}
+    defaults.update({s.name: s.default for s in physics.controls().specs})
+    domains = {s.name: s.domain for s in physics.specs}
+    sums = {"softdeca": 0.0, "linear": 0.0}
+    count = 0
+    total = cfg.identities * len(weights)
+    with tqdm(total=total, desc="real takes", unit="frame", disable=not progress) as bar:
+        for seed in IDENTITY_SEEDS[: cfg.identities]:
+            first = PhysicsCase(template, template.sample_identity(seed), weights[:1], cfg.level)
+            model = ModelCase(nets, first)
+            for start in range(0, len(weights), cfg.chunk):
+                case = first.with_weights(weights[start : start + cfg.chunk])
+                model.use(case)
+                t = case.solve(Setting(), defaults, domains)
+                x = model.solve(Setting())
+                sums["softdeca"] += float(np.linalg.norm(x - t, axis=-1).mean(axis=1).sum())
+                sums["linear"] += float(
+                    np.linalg.norm(case.targets - t, axis=-1).mean(axis=1).sum()
+                )
+                count += len(t)
+                bar.update(len(t))
+    return {
+        "frames": count,
+        "identities": cfg.identities,
+        "softdeca_mm": 1e3 * sums["softdeca"] / count,
+        "linear_mm": 1e3 * sums["linear"] / count,
+    }
+
+
+def merge_into_report(path: Path, controls: list[dict] | None, real: dict | None) -> dict:
+    """Add (or replace) `controls` and `real_takes` in an existing report, keeping the rest."""
+    doc = json.loads(Path(path).read_text())
+    if controls is not None:
+        doc["controls"] = controls
+    if real is not None:
+        doc["real_takes"] = real
+    Path(path).write_text(json.dumps(doc, indent=1) + "\n")
+    return doc
