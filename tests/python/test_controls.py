@@ -1,0 +1,220 @@
+"""The controls gallery's machinery on tiny cases (no simulator: the physics and the model are
+small functions of the setting), the evaluation report's schema, the control ranges of
+plugin/data/parameters.json, and the data plan's per-instance and regional parameters."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from softdeca_train.controls.definitions import (
+    CONTROL_REGIONS,
+    Control,
+    Setting,
+    global_controls,
+    region_controls,
+)
+from softdeca_train.controls.gallery import Collected, control_entry, measure_controls
+from softdeca_train.controls.metrics import control_response, leakage, response_error
+from softdeca_train.controls.report import validate_report
+from softdeca_train.data.regions import REGIONS
+from softdeca_train.parameters import load_parameters
+
+REPO = Path(__file__).resolve().parents[2]
+# A tiny "face": 6 vertices, the first two in the lips.
+LABELS = np.array([REGIONS.index("lips")] * 2 + [REGIONS.index("nose")] * 4)
+BASE = np.zeros((2, 6, 3))  # 2 expressions
+
+
+def _physics(setting: Setting) -> np.ndarray:
+    """Moves every vertex along x by the global value of "a" (mm), and the vertices of a
+    region along y by its local value."""
+    out = BASE.copy()
+    out[..., 0] += 1e-3 * setting.globals.get("a", 0.0)
+    if setting.local is not None:
+        _, region, value = setting.local
+        out[:, LABELS == REGIONS.index(region), 1] += 1e-3 * value
+    return out
+
+
+def _model(scale: float, leak: float):
+    """A model that follows the physics by `scale` and leaks `leak` of a local change
+    to every vertex outside the region."""
+
+    def solve(setting: Setting) -> np.ndarray:
+        out = BASE + scale * (_physics(setting) - BASE)
+        if setting.local is not None:
+            _, region, value = setting.local
+            out[:, LABELS != REGIONS.index(region), 1] += 1e-3 * leak * value
+        return out
+
+    return solve
+
+
+def _entries(controls: list[Control], model) -> dict[str, dict]:
+    acc = Collected()
+    measure_controls(controls, _physics, model, acc)
+    return {c.name: control_entry(c, acc, LABELS) for c in controls}
+
+
+def test_a_control_with_zero_range_gives_zero_response() -> None:
+    flat = Control("a", "a", 2.0, 2.0)
+    flat_local = Control("b@lips", "b", 3.0, 3.0, region="lips")
+    e = _entries([flat, flat_local], _model(1.0, 0.5))
+    for name in ("a", "b@lips"):
+        assert e[name]["physics_max_mm"] == 0.0 and e[name]["model_max_mm"] == 0.0
+        assert e[name]["response_error"] is None  # undefined: the physics does not move
+    assert e["b@lips"]["leakage"] is None
+
+
+def test_response_error_and_leakage_of_global_and_region_controls() -> None:
+    wide = Control("a", "a", 0.0, 2.0)
+    lips = Control("b@lips", "b", 0.0, 4.0, region="lips")
+    e = _entries([wide, lips], _model(0.5, 0.25))
+    assert e["a"]["physics_max_mm"] == pytest.approx(2.0)
+    assert e["a"]["response_error"] == pytest.approx(0.5)  # follows half the change
+    assert (
+        e["a"]["leakage"] is None and e["a"]["physics_leakage"] is None
+    )  # global: none
+    assert e["b@lips"]["physics_max_mm"] == pytest.approx(4.0)
+    # inside the model moves 0.5 * 4 mm, outside 0.25 * 4 mm: leakage 0.5; the physics none
+    assert e["b@lips"]["leakage"] == pytest.approx(0.5)
+    assert e["b@lips"]["physics_leakage"] == pytest.approx(0.0)
+    # a model that does not move: response error 1
+    still = _entries([wide], lambda s: BASE.copy())
+    assert still["a"]["response_error"] == pytest.approx(1.0)
+
+
+def test_metrics_reject_a_region_without_vertices() -> None:
+    d = np.ones((1, 4, 3))
+    with pytest.raises(ValueError, match="some vertices"):
+        leakage(d, np.zeros(4, bool))
+    assert response_error(d, np.zeros_like(d)) is None
+    r = control_response(d, d, None)
+    assert r.response_error == 0.0 and r.leakage is None
+
+
+def test_controls_come_from_the_parameter_definition() -> None:
+    physics = load_parameters()
+    controls = physics.controls()
+    # the four parameters with no elements in the head model are no controls
+    for dead in (
+        "w_connect_volume",
+        "w_connect_strain",
+        "w_skull_strain",
+        "w_skull_bending",
+    ):
+        assert dead in physics.names and dead not in controls.names
+    for s in controls.specs:
+        full = physics.specs[physics.names.index(s.name)]
+        assert full.lo <= s.lo < s.hi <= full.hi and s.lo <= s.default <= s.hi
+    names = [c.name for c in global_controls(controls)]
+    assert "gravity_strength" in names and "dyn_gamma" not in names  # static gallery
+    azimuth = next(c for c in global_controls(controls) if c.name == "gravity_azimuth")
+    assert azimuth.hi - azimuth.lo == 180.0 and dict(azimuth.fixed)["gravity_tilt"] > 0
+    regional = region_controls(controls, ("target_volume",))
+    assert [c.region for c in regional] == list(CONTROL_REGIONS)
+    with pytest.raises(ValueError, match="global"):
+        region_controls(controls, ("gravity_strength",))
+
+
+def _report() -> dict:
+    return {
+        "errors": {"softdeca": {"mean_mm": 0.4}},
+        "controls": [
+            {
+                "name": "gravity_strength",
+                "region": None,
+                "physics_max_mm": 1.2,
+                "response_error": 0.8,
+                "leakage": None,
+            },
+            {
+                "name": "target_volume@lips",
+                "region": "lips",
+                "physics_max_mm": 1.0,
+                "response_error": None,
+                "leakage": 0.3,
+            },
+        ],
+        "real_takes": {
+            "frames": 10,
+            "identities": 3,
+            "softdeca_mm": 0.4,
+            "linear_mm": 0.6,
+        },
+    }
+
+
+def test_the_report_schema() -> None:
+    validate_report(_report())
+    broken = []
+    for change in (
+        lambda d: d.pop("errors"),
+        lambda d: d.pop("controls"),
+        lambda d: d["controls"][0].pop("leakage"),
+        lambda d: d["controls"][0].update(
+            leakage=0.1
+        ),  # a global control has no leakage
+        lambda d: d["controls"][1].update(physics_max_mm=-1.0),
+        lambda d: d["controls"][1].update(response_error=float("nan")),
+        lambda d: d["real_takes"].pop("linear_mm"),
+        lambda d: d["real_takes"].update(frames=0),
+    ):
+        d = copy.deepcopy(_report())
+        change(d)
+        broken.append(d)
+    for d in broken:
+        with pytest.raises(ValueError, match="report"):
+            validate_report(d)
+
+
+@pytest.mark.skipif(
+    "controls"
+    not in json.loads((REPO / "docs/evaluation/evaluation.json").read_text()),
+    reason="the committed report has no controls yet",
+)
+def test_the_committed_report_follows_the_schema() -> None:
+    doc = json.loads((REPO / "docs" / "evaluation" / "evaluation.json").read_text())
+    validate_report(doc)
+
+
+def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:
+    from softdeca_train.data.config import GenerateConfig
+    from softdeca_train.data.expressions import expression_sources, load_takes
+    from softdeca_train.data.plan import FIXED, make_plan
+    from softdeca_train.data.ranges import sampling_parameters
+    from softdeca_train.paths import default_takes_path
+
+    cfg = GenerateConfig(static=24, dynamic=0, sparse=8, region_share=0.5, seed=3)
+    assert cfg.frames_per_params == 1 and cfg.ranges == "controls"
+    params = sampling_parameters(load_parameters(), cfg.ranges)
+    sources, _ = expression_sources(
+        load_takes(default_takes_path()), cfg.test_take, cfg.seed, cfg.test_share
+    )
+    plan = make_plan(cfg, params, sources)
+    groups = [(s.kind, g) for s in plan for g in s.groups]
+    assert all(len(g.frames.weights) == 1 for _, g in groups)  # one p per instance
+    ps = np.stack([g.p for _, g in groups])
+    assert len({row.tobytes() for row in ps}) == len(ps)
+    names = params.names
+    dead = [names.index(n) for n in ("w_skull_strain", "w_connect_volume")]
+    assert np.all(ps[:, dead] == params.defaults()[dead])  # no controls: defaults
+    patterns = [(k, g) for k, g in groups if g.p_regions is not None]
+    assert 0 < len(patterns) < len(groups)
+    rows = [REGIONS.index(r) for r in CONTROL_REGIONS]
+    others = [i for i in range(len(REGIONS)) if i not in rows]
+    for kind, g in patterns:
+        params.validate(g.p_regions)
+        assert np.all(g.p_regions[others] == g.p)  # inner regions keep p
+        varied = np.flatnonzero(np.any(g.p_regions != g.p, axis=0))
+        for k in varied:
+            s = params.specs[k]
+            assert s.domain != "global" and s.control is not None
+            assert s.name not in FIXED[kind]
+    # legacy configurations (written before regional patterns) have none
+    legacy = {k: v for k, v in cfg.as_dict().items() if k != "region_share"}
+    assert GenerateConfig.from_dict(legacy).region_share == 0.0
