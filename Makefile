@@ -197,6 +197,11 @@ test-unity: build ## the Unity package: C# core on mono with NUnit, layer compil
 	@echo "== Unity layer and package"; tests/unity/compile-check && $(PY) tests/unity/package.py check
 bench-unity: build ## managed call overhead of the C# core per frame -> build/bench/unity.json
 	@PY=$(PY) tests/unity/bench $(BUILD)
+# ---- Controls gallery (docs/controls.md): LHM level 3, static, 2 unseen identities x 3 expressions
+.PHONY: controls
+controls: build ## controls gallery: every material control on the physics and the bundle (BUNDLE) -> docs/controls
+	@nice -n 5 $(PY) -m softdeca_train controls --bundle $(BUNDLE) --out docs/controls
+
 # ---- Physics stress suite -------------------------------------------------------------------
 # `make stress`: extreme expressions / identities / materials / gravity, levels 3 and 4, static
 # and dynamic, plus every take in $(RECORDINGS) (every STRESS_TAKE_STRIDE-th frame, 3

@@ -22,6 +22,7 @@ from softdeca_train.data.generate import generate
 from softdeca_train.data.loader import ShardDataset
 from softdeca_train.data.personalise import add_noise, personalise
 from softdeca_train.data.plan import FIXED, make_plan
+from softdeca_train.data.ranges import fixed_outside_profile
 from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.data.shards import iter_shards, verify
 from softdeca_train.landmarks import template_landmarks
@@ -57,12 +58,21 @@ def test_small_dataset_is_complete_and_self_describing(small) -> None:
         # Extreme parameter draws may stop at max_iterations: flagged, not hidden.
         assert a["converged"].dtype == bool
         assert np.all(a["estimated_error"][a["converged"]] <= SMALL.tolerance)
-        # Kind-specific parameters stay at their defaults.
+        # Kind-specific parameters and the ones that are no controls stay at their defaults.
         params = load_parameters()
-        for name in FIXED[kind]:
+        for name in (*FIXED[kind], *fixed_outside_profile(params, SMALL.ranges)):
             k = params.names.index(name)
             assert np.all(a["p"][:, k] == params.defaults()[k])
         params.validate(a["p"])
+        if (
+            kind != "dynamic"
+        ):  # regional patterns: per region, p elsewhere and where none
+            pr = a["p_regions"]
+            assert pr.shape == (len(a["p"]), len(REGIONS), len(params.names))
+            params.validate(pr)
+            patterned = np.any(pr != a["p"][:, None, :], axis=(1, 2))
+            rows_same = np.all(pr == a["p"][:, None, :], axis=(1, 2))
+            assert np.all(patterned | rows_same)
     dyn = _all(out, "dynamic")
     assert dyn["offsets"].shape[1] == SMALL.sequence_length
     # The lead-in leaves the sequence moving: T_{-1} != T_{-2}.
@@ -296,18 +306,20 @@ def test_resuming_with_another_configuration_is_refused(small) -> None:
 def test_parameters_are_sampled_in_the_range_profile(small) -> None:
     from softdeca_train.data.ranges import (
         DEFAULT_PROFILE,
+        FROM_DEFINITION,
         PROFILES,
+        profile_ranges,
         sampling_parameters,
     )
 
     out, _ = small
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["dataset"]["range_profile"] == DEFAULT_PROFILE == "interactive"
+    assert manifest["dataset"]["range_profile"] == DEFAULT_PROFILE == "controls"
     params = sampling_parameters(load_parameters(), DEFAULT_PROFILE)
     for kind in KINDS:
         p = _all(out, kind)["p"]
         params.validate(p)  # inside the narrowed ranges, not only the physics' own
-    lo, hi = PROFILES[DEFAULT_PROFILE]["w_target"]
+    lo, hi = profile_ranges(load_parameters(), DEFAULT_PROFILE)["w_target"]
     k = params.names.index("w_target")
     assert params.specs[k].lo == lo and params.specs[k].hi == hi
     # datasets written before range profiles sampled the physics' ranges
@@ -317,7 +329,7 @@ def test_parameters_are_sampled_in_the_range_profile(small) -> None:
         sampling_parameters(load_parameters(), "nonsense")
     # every profile lies inside the physics' ranges and keeps the physics' defaults sampled
     physics = {s.name: s for s in load_parameters().specs}
-    for profile in PROFILES:
+    for profile in (*PROFILES, *FROM_DEFINITION):
         for s in sampling_parameters(load_parameters(), profile).specs:
             assert physics[s.name].lo <= s.lo <= s.default <= s.hi <= physics[s.name].hi
             assert s.default == physics[s.name].default, (profile, s.name)

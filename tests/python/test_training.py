@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from softdeca_train.data.ranges import DEFAULT_PROFILE, PROFILES
+from softdeca_train.data.ranges import DEFAULT_PROFILE, profile_ranges
 from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.networks import BETA_MAX
+from softdeca_train.parameters import load_parameters
 from softdeca_train.paths import REPO_ROOT
 from softdeca_train.train.bundle import BundleBudget, train_bundle
 from softdeca_train.train.loop import LoopConfig, train
@@ -140,11 +141,15 @@ def test_bundle_pipeline_exports_a_bundle_onnxruntime_agrees_with(
     # the small dataset's sparse test frames may all fail the solver filter: then it says so
     sparse = errors["sparse_other_head_noise"]
     assert sparse["frames"] == 0 or np.isfinite(sparse["mean_mm"])
-    # the networks accept only the ranges the data sampled (the default "interactive" profile)
+    # the networks accept only the ranges the data sampled (the default profile: the control
+    # ranges of plugin/data/parameters.json), and take no parameter that is no control
     w_target = next(p for p in m["parameters"] if p["name"] == "w_target")
     assert w_target["min"] == 1.0
     skull = next(p for p in m["parameters"] if p["name"] == "cranium_scale_x")
-    assert (skull["min"], skull["max"]) == PROFILES[DEFAULT_PROFILE]["cranium_scale_x"]
+    ranges = profile_ranges(load_parameters(), DEFAULT_PROFILE)
+    assert (skull["min"], skull["max"]) == ranges["cranium_scale_x"]
+    names = {p["name"] for p in m["parameters"]}
+    assert names == set(load_parameters().controls().names)
     nets = OnnxNetworks(bundle)
     assert nets.has("softdeca") and nets.has("sparse")
 
