@@ -54,8 +54,8 @@ class Control:
 def global_controls(params: ParameterSet, names: list[str] | None = None) -> list[Control]:
     """One control per parameter of `params` (in its order) that acts on static frames, over
     the range `params` gives it. The gravity azimuth only turns a tilted gravity: it is
-    measured with the tilt at the top of its range, and over half a turn (a full turn ends
-    where it starts)."""
+    measured with the tilt at 90 degrees (or the top of its range, if lower), and over half a
+    turn (a full turn ends where it starts)."""
     out = []
     spec = {s.name: s for s in params.specs}
     for s in params.specs:
@@ -64,7 +64,7 @@ def global_controls(params: ParameterSet, names: list[str] | None = None) -> lis
         fixed: tuple[tuple[str, float], ...] = ()
         lo, hi = s.lo, s.hi
         if s.name == "gravity_azimuth" and "gravity_tilt" in spec:
-            fixed = (("gravity_tilt", spec["gravity_tilt"].hi),)
+            fixed = (("gravity_tilt", min(spec["gravity_tilt"].hi, 90.0)),)
             lo, hi = (lo / 2, hi / 2) if hi - lo >= 360.0 else (lo, hi)
         out.append(Control(s.name, s.name, lo, hi, s.unit, None, fixed))
     return out

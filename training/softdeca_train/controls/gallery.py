@@ -81,8 +81,8 @@ def measure_controls(
 ) -> None:
     """Both ends of every control through the physics and the model (when given); the changes
     go into `acc`, and the first case's shapes are kept for the pictures."""
-    first = not acc.shown
     for c in controls:
+        first = c.name not in acc.shown
         lo, hi = (physics(s) for s in c.ends)
         acc.physics.setdefault(c.name, []).append(hi - lo)
         if first:

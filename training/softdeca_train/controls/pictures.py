@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 from tqdm import tqdm
 
 from softdeca_train.controls.cases import PhysicsCase
@@ -22,7 +23,7 @@ def _fmt(x: float | None, digits: int = 3) -> str:
 def _heat(shape: np.ndarray, tris: np.ndarray, mm: np.ndarray, vmax: float) -> np.ndarray:
     from softdeca_train.render import MeshLayer, RenderSettings, render
 
-    layer = MeshLayer(shape, tris, scalars=mm, clim=(0.0, vmax), scalar_bar="mm")
+    layer = MeshLayer(shape, tris, scalars=mm, clim=(0.0, vmax))
     return render([layer], "three_quarter", settings=RenderSettings(size=SIZE))
 
 
@@ -39,7 +40,11 @@ def control_picture(
     d_model = (
         1e3 * np.linalg.norm(shown["model"] - shown["model_lo"], axis=-1) if has_model else None
     )
-    vmax = max(float(np.percentile(d_phys, 99.5)), 1e-3)
+    # the change on one scale (a region's change fills the colours), the distances to the
+    # physics at the top of the range on another
+    vmax = max(float(np.percentile(d_phys, 99.9)), 1e-3)
+    lin = 1e3 * np.linalg.norm(case.targets - shown["physics"], axis=-1)
+    emax = max(float(np.percentile(lin, 99)), 1e-3)
     images, labels = [], []
     for e in range(len(d_phys)):
         shape = shown["physics"][e]
@@ -49,19 +54,23 @@ def control_picture(
             images.append(_heat(shape, tris, d_model[e], vmax))
             labels.append(f"SoftDECA change, max {d_model[e].max():.2f}")
             err = 1e3 * np.linalg.norm(shown["model"][e] - shape, axis=-1)
-            images.append(_heat(shape, tris, err, vmax))
+            images.append(_heat(shape, tris, err, emax))
             labels.append(f"|SoftDECA - physics|, mean {err.mean():.2f}")
-        lin = 1e3 * np.linalg.norm(case.targets[e] - shape, axis=-1)
-        images.append(_heat(shape, tris, lin, vmax))
-        labels.append(f"|linear - physics|, mean {lin.mean():.2f}")
+        images.append(_heat(shape, tris, lin[e], emax))
+        labels.append(f"|linear - physics|, mean {lin[e].mean():.2f}")
     cols = 4 if d_model is not None else 2
-    footer = f"{c.name}: {c.lo:g} -> {c.hi:g} {c.unit}; colour scale 0-{vmax:.2f} mm"
-    tile(
+    footer = (
+        f"{c.name}: {c.lo:g} -> {c.hi:g} {c.unit} (rows: expressions); inferno colours: change "
+        f"0-{vmax:.2f} mm, distance to the physics at {c.hi:g}: 0-{emax:.2f} mm"
+    )
+    sheet = tile(
         images,
         labels,
-        path,
+        None,
         TileSettings(columns=cols, font_size=13, label_height=20, extra_labels=[footer]),
     )
+    # 256 colours keep a sheet of heat maps a few hundred kB at most (committed to docs/)
+    Image.fromarray(sheet).quantize(256).save(path, optimize=True)
 
 
 def summary_figure(path: Path, entries: list[dict]) -> None:
