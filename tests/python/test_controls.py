@@ -218,3 +218,16 @@ def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:
     # legacy configurations (written before regional patterns) have none
     legacy = {k: v for k, v in cfg.as_dict().items() if k != "region_share"}
     assert GenerateConfig.from_dict(legacy).region_share == 0.0
+
+
+def test_the_report_readme_section_is_replaced_not_repeated(tmp_path) -> None:
+    from softdeca_train.controls.report import SECTION, update_readme
+
+    readme = tmp_path / "README.md"
+    readme.write_text("# Evaluation\n\ntext\n")
+    update_readme(readme, _report())
+    update_readme(readme, _report())
+    text = readme.read_text()
+    assert text.startswith("# Evaluation\n\ntext\n") and text.count(SECTION) == 1
+    assert "median response error 0.800" in text and "target_volume@lips" in text
+    assert "SoftDECA 0.400 mm, linear blendshapes 0.600 mm" in text

@@ -138,10 +138,11 @@ def report_parts(args: argparse.Namespace, bundle: Path) -> tuple[list[dict], di
 
 
 def _run_report(args: argparse.Namespace) -> int:
-    from softdeca_train.controls.report import merge_into_report, validate_report
+    from softdeca_train.controls.report import merge_into_report, update_readme, validate_report
 
     controls, real = report_parts(args, args.bundle)
     doc = merge_into_report(args.report, controls, real)
+    update_readme(Path(args.report).parent / "README.md", doc)
     if "real_takes" in doc:
         validate_report(doc)
         r = doc["real_takes"]

@@ -132,3 +132,51 @@ def merge_into_report(path: Path, controls: list[dict] | None, real: dict | None
         doc["real_takes"] = real
     Path(path).write_text(json.dumps(doc, indent=1) + "\n")
     return doc
+
+
+SECTION = "## Material controls and real takes"
+
+
+def _fmt(x: float | None) -> str:
+    return "–" if x is None else f"{x:.3f}"
+
+
+def readme_section(doc: dict) -> str:
+    """The report README's section on `controls` and `real_takes` (docs/controls.md)."""
+    lines = [SECTION, ""]
+    controls = doc.get("controls") or []
+    if controls:
+        errs = [c["response_error"] for c in controls if c["response_error"] is not None]
+        leaks = [c["leakage"] for c in controls if c["leakage"] is not None]
+        short = [c["name"] for c in controls if c["physics_max_mm"] < 1.0]
+        lines += [
+            f"{len(controls)} controls (docs/controls.md, docs/controls/): median response "
+            f"error {_fmt(float(np.median(errs)) if errs else None)}, median leakage "
+            f"{_fmt(float(np.median(leaks)) if leaks else None)}; moving the physics by less "
+            f"than 1 mm over their range: {', '.join(short) or 'none'}.",
+            "",
+            "| control | region | physics max (mm) | response error | leakage |",
+            "| --- | --- | ---: | ---: | ---: |",
+        ]
+        lines += [
+            f"| {c['name']} | {c['region'] or 'global'} | {_fmt(c['physics_max_mm'])} "
+            f"| {_fmt(c['response_error'])} | {_fmt(c['leakage'])} |"
+            for c in controls
+        ]
+        lines.append("")
+    real = doc.get("real_takes")
+    if real:
+        lines.append(
+            f"Real takes ({real['frames']} frames over {real['identities']} unseen identities, "
+            "default parameters): mean distance to the physics, SoftDECA "
+            f"{real['softdeca_mm']:.3f} mm, linear blendshapes {real['linear_mm']:.3f} mm."
+        )
+    return "\n".join(lines) + "\n"
+
+
+def update_readme(readme: Path, doc: dict) -> None:
+    """Replace (or append) the README's controls section."""
+    text = Path(readme).read_text() if Path(readme).is_file() else ""
+    if SECTION in text:
+        text = text[: text.index(SECTION)]
+    Path(readme).write_text(text.rstrip("\n") + "\n\n" + readme_section(doc))

@@ -127,13 +127,14 @@ def add_evaluate_args(p: argparse.ArgumentParser) -> None:
 
 def run_evaluate(args: argparse.Namespace) -> int:
     from softdeca_train.controls.cli import report_parts
-    from softdeca_train.controls.report import merge_into_report, validate_report
+    from softdeca_train.controls.report import merge_into_report, update_readme, validate_report
     from softdeca_train.train.report import write_report
 
     run = _open_run(args)
     path = write_report(run, Path(args.bundle), Path(args.out), Path(args.bench))
     controls, real = report_parts(args, Path(args.bundle))
     doc = merge_into_report(Path(args.out) / "evaluation.json", controls, real)
+    update_readme(path, doc)
     if real is not None:
         validate_report(doc)
     print(f"report written to {path}")
