@@ -158,7 +158,7 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
     labels = region_labels(template)
     entries = [control_entry(c, acc, labels) for c in controls]
     result = {
-        "config": {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()},
+        "config": {k: _shown_path(v) for k, v in asdict(cfg).items()},
         "identity_seeds": list(IDENTITY_SEEDS[: cfg.identities]),
         "expressions": weights.tolist(),
         "controls": entries,
@@ -169,6 +169,21 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
 
         draw_gallery(cfg.out, controls, acc.shown, cases[0], entries, progress)
     return result
+
+
+def _shown_path(value: object) -> object:
+    """Paths as the report shows them: relative to the repository or the data folder (the
+    gallery is committed: no machine's absolute paths)."""
+    from softdeca_train.paths import data_dir
+
+    if not isinstance(value, Path):
+        return value
+    p = value.resolve()
+    for root, label in ((data_dir().resolve(), "<data>"), (REPO_ROOT.resolve(), "")):
+        if p.is_relative_to(root):
+            rel = str(p.relative_to(root))
+            return f"{label}/{rel}" if label else rel
+    return str(value)
 
 
 def report_entries(result: dict) -> list[dict]:
