@@ -110,6 +110,9 @@ class Dataset:
         unknown = set(parameters or ()) - set(names)
         if unknown:
             raise ValueError(f"unknown parameters {sorted(unknown)}")
+        from softdeca_train.data.regions import region_labels
+
+        self.labels = region_labels(self.template)  # regional patterns -> triangles, vertices
         self.columns = (
             [names.index(n) for n in parameters] if parameters else list(range(len(names)))
         )
