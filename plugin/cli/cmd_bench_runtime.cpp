@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "bench_figures.h"
 #include "command.h"
 #include "json.h"
 #include "options.h"
@@ -25,12 +26,10 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kPaperStaticMs = 7.45, kPaperDynamicMs = 9.87, kPaperFaces = 71358;
 
+// The shared figure (bench_figures.h) with this command's argument order: most figures have no target.
 std::string figure(double value, const std::string& unit, const std::string& how, double target = NAN,
                    const char* better = "lower") {
-  JsonObject o;
-  o.number("value", value).text("unit", unit).raw("target", std::isfinite(target) ? json_number(target) : "null");
-  o.text("better", better).text("how", how);
-  return o.str();
+  return cli::figure(value, unit.c_str(), std::isfinite(target) ? json_number(target) : "null", better, how);
 }
 
 std::string cpu_name() {
@@ -76,12 +75,6 @@ Times median_ms(std::size_t frames, std::size_t warmup, F&& call) {
   return {median(wall), median(cpu)};
 }
 
-double load_average() {
-  std::ifstream in("/proc/loadavg");
-  double l = NAN;
-  in >> l;
-  return l;
-}
 // What every measurement reads: the take, the rigs, the bundle, the frames' SparseSoftDECA input,
 // the output buffers and the description recorded with each figure.
 struct Bench {

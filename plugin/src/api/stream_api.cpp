@@ -4,6 +4,7 @@
 
 #include "api/error.h"
 #include "api/frame_abi.h"
+#include "api/handles.h"
 #include "stream/arkit_names.h"
 #include "stream/receiver.h"
 
@@ -71,14 +72,13 @@ SOFTDECA_API softdeca_status softdeca_receiver_create(const softdeca_receiver_co
     c.format = static_cast<stream::Format>(config->format);
     c.delay = config->jitter_delay;
     c.queue_capacity = config->queue_capacity;
-    auto r = std::make_unique<softdeca_receiver>();
-    r->impl = std::make_unique<stream::Receiver>(c);
-    *out_receiver = r.release();
+    create_handle(out_receiver, "out_receiver",
+                  [&](softdeca_receiver& r) { r.impl = std::make_unique<stream::Receiver>(c); });
   });
 }
 
 SOFTDECA_API void softdeca_receiver_destroy(softdeca_receiver* receiver) {
-  guarded(__func__, [&] { delete receiver; });
+  destroy_handle(__func__, receiver);
 }
 
 SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* receiver, uint32_t* out_port) {
