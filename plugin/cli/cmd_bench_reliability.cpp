@@ -22,20 +22,20 @@
 #include "bench_figures.h"
 #include "command.h"
 #include "json.h"
+#include "live/receiver.h"
 #include "options.h"
 #include "recording/recording_reader.h"
 #include "recording/recording_writer.h"
 #include "stream/frame_sender.h"
 #include "stream/percentile.h"
-#include "stream/receiver.h"
 #include "stream/steady_clock.h"
 
 namespace softdeca::cli {
 namespace {
 using stream::steady_seconds;
 
-stream::ReceiverConfig loopback(stream::Format format) {
-  stream::ReceiverConfig c;
+live::ReceiverConfig loopback(stream::Format format) {
+  live::ReceiverConfig c;
   c.port = 0;
   c.format = format;
   c.queue_capacity = 65536;
@@ -50,7 +50,7 @@ struct Flood {
 
 // `ports` senders, round robin, as fast as the socket takes them, for `seconds`, recording.
 Flood flood_run(const std::string& path, int ports, double seconds) {
-  stream::Receiver r(loopback(stream::Format::ifacialmocap));
+  live::Receiver r(loopback(stream::Format::ifacialmocap));
   recording::Header h;
   h.source = "bench-reliability flood";
   r.start_recording(path, h);
@@ -76,7 +76,7 @@ Flood flood_run(const std::string& path, int ports, double seconds) {
   r.stop_recording();
   done.store(true);
   consumer.join();
-  const stream::ReceiverStats s = r.stats();
+  const live::ReceiverStats s = r.stats();
   out.session_changes = s.session_changes;
   out.delivered = s.delivered;
   out.foreign = s.foreign;
@@ -131,9 +131,9 @@ SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, dou
         std::this_thread::sleep_for(std::chrono::duration<double>(draining_all.load() ? 0.001 : chunk_s));
     }
   });
-  stream::ReceiverConfig c = loopback(stream::Format::softdeca);
+  live::ReceiverConfig c = loopback(stream::Format::softdeca);
   c.source_rate_limit = 0;
-  stream::Receiver r(c);
+  live::Receiver r(c);
   r.start_recording(fifo, recording::Header{});
   stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.port()), stream::Format::softdeca, 3);
   std::vector<double> polls;
@@ -155,7 +155,7 @@ SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, dou
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   SlowDisk out;
-  const stream::ReceiverStats s = r.stats();
+  const live::ReceiverStats s = r.stats();
   out.delivered = s.delivered;
   out.recording_dropped = s.recording_dropped;
   draining_all.store(true);

@@ -16,12 +16,12 @@
 #include "bench_figures.h"
 #include "command.h"
 #include "json.h"
+#include "live/receiver.h"
 #include "options.h"
 #include "recording/recording_reader.h"
 #include "recording/recording_writer.h"
 #include "stream/frame_sender.h"
 #include "stream/percentile.h"
-#include "stream/receiver.h"
 #include "stream/steady_clock.h"
 
 namespace softdeca::cli {
@@ -51,14 +51,14 @@ stream::Frame sample_frame(std::size_t i) {
 }
 
 struct Receiving {
-  stream::Receiver receiver;
+  live::Receiver receiver;
   std::atomic<bool> done{false};
   std::vector<double> latencies;  // send -> available, seconds
   double last_pop = 0;
   std::size_t popped = 0;
   std::thread consumer;
 
-  explicit Receiving(const stream::ReceiverConfig& c) : receiver(c) {
+  explicit Receiving(const live::ReceiverConfig& c) : receiver(c) {
     consumer = std::thread([this] {
       stream::Frame f;
       while (!done.load()) {
@@ -76,8 +76,8 @@ struct Receiving {
   }
 };
 
-stream::ReceiverConfig loopback() {
-  stream::ReceiverConfig c;
+live::ReceiverConfig loopback() {
+  live::ReceiverConfig c;
   c.bind_address = "127.0.0.1";
   c.port = 0;
   c.format = stream::Format::softdeca;
