@@ -179,19 +179,17 @@ int run_bench_reliability(const Args& args) {
             "iFacialMocap flood from many source ports on 127.0.0.1 while recording (session changes,\n"
             "recording growth), the reader on a crafted damaged recording (seconds per MiB), and the\n"
             "consumer's poll while the recording's disk cannot keep up (p99 poll time).");
-  o.option("--out", "FILE", "JSON output", "build/bench/reliability.json")
-      .option("--ports", "N", "source ports of the flood", "200")
+  declare_output_options(o, "reliability", "where the runs write their files");
+  o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
       .option("--resync-mib", "N", "MiB of crafted damage", "16")
-      .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
-      .option("--scratch", "DIR", "where the runs write their files", "build/bench");
+      .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3");
   if (!o.parse(args)) return 0;
-  create_output_folders(o.text("--out"), o.text("--scratch"));
+  const std::string scratch = create_output_folders(o);
   const long ports = o.integer("--ports"), mib = o.integer("--resync-mib");
   const double flood_s = o.number("--flood-seconds"), slow_s = o.number("--slow-seconds");
   if (ports < 2 || ports > 1000 || mib < 1 || mib > 1024 || !(flood_s > 0) || !(slow_s > 0))
     throw UsageError("2 to 1000 ports, 1 to 1024 MiB and positive durations, please");
-  const std::string scratch = o.text("--scratch");
   double load = load_average();
 
   std::fprintf(stderr, "bench-reliability: flood");

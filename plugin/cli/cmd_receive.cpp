@@ -11,6 +11,7 @@
 #include "live/receiver.h"
 #include "options.h"
 #include "recording/recording_format.h"
+#include "stop_limits.h"
 #include "stream/steady_clock.h"
 #include "stream_format_arg.h"
 
@@ -83,10 +84,9 @@ int run_receive(const Args& args) {
       .option("--port", "PORT", "UDP port; 0: any free port (default: the format's, ours 50110)")
       .option("--delay", "SECONDS", "jitter buffer delay", "0.05")
       .option("--out", "FILE", "record delivered frames into FILE (.sdrec)")
-      .option("--subject", "NAME", "subject or take name written into the recording")
-      .option("--frames", "N", "stop after N delivered frames (0: no limit)", "0")
-      .option("--duration", "SECONDS", "stop after this long (0: no limit)", "0")
-      .option("--idle", "SECONDS", "stop this long after the last datagram, once one came (0: never)", "0")
+      .option("--subject", "NAME", "subject or take name written into the recording");
+  StopLimits::declare(o, "delivered frames");
+  o.option("--idle", "SECONDS", "stop this long after the last datagram, once one came (0: never)", "0")
       .option("--stats-json", "FILE", "write the final statistics as JSON")
       .flag("--quiet", "no progress line");
   if (!o.parse(args)) return 0;
@@ -102,8 +102,8 @@ int run_receive(const Args& args) {
   if (port < 0 || port > 65535) throw UsageError("--port must be in [0, 65535]");
   config.port = static_cast<uint16_t>(port);
   config.delay = o.number("--delay");
-  const long max_frames = o.integer("--frames");
-  const double max_duration = o.number("--duration"), idle = o.number("--idle");
+  const StopLimits limits = StopLimits::read(o);
+  const double idle = o.number("--idle");
 
   live::Receiver receiver(config);
   std::printf("listening on %s port %u (%s)\n", config.bind_address.c_str(), receiver.port(),
@@ -138,8 +138,7 @@ int run_receive(const Args& args) {
       progress(s, receiver.frames_recorded(), recording);
       last_progress = now;
     }
-    if ((max_frames > 0 && s.delivered >= static_cast<uint64_t>(max_frames)) ||
-        (max_duration > 0 && now - start >= max_duration) || (idle > 0 && datagrams > 0 && now - last_datagram >= idle))
+    if (limits.reached(double(s.delivered), now - start) || (idle > 0 && datagrams > 0 && now - last_datagram >= idle))
       break;
   }
   receiver.stop();  // flushes the jitter buffer into the recording
