@@ -295,17 +295,16 @@ void measure_storage_error(Bench& bench) {
 int run_bench_runtime(const Args& args) {
   Options o("bench-runtime", "Measure the runtime per frame on the frames of a take (medians), single- and two-threaded,\n"
                              "and write the benchmark JSON (docs/ARCHITECTURE.md, Conventions).");
-  o.option("--bundle", "DIR", "model bundle folder or .tar")
-      .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
-      .option("--take", "FILE", "Live Link Face CSV or recording whose frames drive the measurement")
+  declare_model_inputs(o);
+  o.option("--take", "FILE", "Live Link Face CSV or recording whose frames drive the measurement")
       .option("--frames", "N", "frames measured per figure", "600")
       .option("--warmup", "N", "frames run before measuring", "30")
       .option("--prepares", "N", "prepares measured", "5")
       .option("--out", "FILE", "benchmark JSON", "build/bench/runtime.json")
       .option("--how", "TEXT", "the command line to record in the figures", "softdeca bench-runtime");
   if (!o.parse(args)) return 0;
-  for (const char* req : {"--bundle", "--avatar", "--take"})
-    if (!o.given(req)) throw UsageError(std::string(req) + " is required");
+  require_model_inputs(o);
+  if (!o.given("--take")) throw UsageError("--take is required");
   const Take take = read_take(o.text("--take"), static_cast<std::size_t>(o.integer("--frames")));
   const std::size_t frames = take.weights.size();
   const FaceRig rig = read_rig(o.text("--avatar"));
