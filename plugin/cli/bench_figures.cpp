@@ -12,9 +12,16 @@ std::string figure(double value, const char* unit, const std::string& target, co
       .text("how", how).str();
 }
 
-void create_output_folders(const std::string& out_file, const std::string& scratch) {
-  for (const std::string& dir : {std::filesystem::path(out_file).parent_path().string(), scratch})
+void declare_output_options(Options& o, const std::string& area, const std::string& scratch_help) {
+  o.option("--out", "FILE", "JSON output", "build/bench/" + area + ".json")
+      .option("--scratch", "DIR", scratch_help, "build/bench");
+}
+
+std::string create_output_folders(const Options& o) {
+  const std::string scratch = o.text("--scratch");
+  for (const std::string& dir : {std::filesystem::path(o.text("--out")).parent_path().string(), scratch})
     if (!dir.empty()) std::filesystem::create_directories(dir);
+  return scratch;
 }
 
 double load_average() {

@@ -22,20 +22,20 @@
 #include "bench_figures.h"
 #include "command.h"
 #include "json.h"
+#include "live/receiver.h"
 #include "options.h"
 #include "recording/recording_reader.h"
 #include "recording/recording_writer.h"
 #include "stream/frame_sender.h"
 #include "stream/percentile.h"
-#include "stream/receiver.h"
 #include "stream/steady_clock.h"
 
 namespace softdeca::cli {
 namespace {
 using stream::steady_seconds;
 
-stream::ReceiverConfig loopback(stream::Format format) {
-  stream::ReceiverConfig c;
+live::ReceiverConfig loopback(stream::Format format) {
+  live::ReceiverConfig c;
   c.port = 0;
   c.format = format;
   c.queue_capacity = 65536;
@@ -50,7 +50,7 @@ struct Flood {
 
 // `ports` senders, round robin, as fast as the socket takes them, for `seconds`, recording.
 Flood flood_run(const std::string& path, int ports, double seconds) {
-  stream::Receiver r(loopback(stream::Format::ifacialmocap));
+  live::Receiver r(loopback(stream::Format::ifacialmocap));
   recording::Header h;
   h.source = "bench-reliability flood";
   r.start_recording(path, h);
@@ -76,7 +76,7 @@ Flood flood_run(const std::string& path, int ports, double seconds) {
   r.stop_recording();
   done.store(true);
   consumer.join();
-  const stream::ReceiverStats s = r.stats();
+  const live::ReceiverStats s = r.stats();
   out.session_changes = s.session_changes;
   out.delivered = s.delivered;
   out.foreign = s.foreign;
@@ -131,9 +131,9 @@ SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, dou
         std::this_thread::sleep_for(std::chrono::duration<double>(draining_all.load() ? 0.001 : chunk_s));
     }
   });
-  stream::ReceiverConfig c = loopback(stream::Format::softdeca);
+  live::ReceiverConfig c = loopback(stream::Format::softdeca);
   c.source_rate_limit = 0;
-  stream::Receiver r(c);
+  live::Receiver r(c);
   r.start_recording(fifo, recording::Header{});
   stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.port()), stream::Format::softdeca, 3);
   std::vector<double> polls;
@@ -155,7 +155,7 @@ SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, dou
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   SlowDisk out;
-  const stream::ReceiverStats s = r.stats();
+  const live::ReceiverStats s = r.stats();
   out.delivered = s.delivered;
   out.recording_dropped = s.recording_dropped;
   draining_all.store(true);
@@ -179,19 +179,17 @@ int run_bench_reliability(const Args& args) {
             "iFacialMocap flood from many source ports on 127.0.0.1 while recording (session changes,\n"
             "recording growth), the reader on a crafted damaged recording (seconds per MiB), and the\n"
             "consumer's poll while the recording's disk cannot keep up (p99 poll time).");
-  o.option("--out", "FILE", "JSON output", "build/bench/reliability.json")
-      .option("--ports", "N", "source ports of the flood", "200")
+  declare_output_options(o, "reliability", "where the runs write their files");
+  o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
       .option("--resync-mib", "N", "MiB of crafted damage", "16")
-      .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
-      .option("--scratch", "DIR", "where the runs write their files", "build/bench");
+      .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3");
   if (!o.parse(args)) return 0;
-  create_output_folders(o.text("--out"), o.text("--scratch"));
+  const std::string scratch = create_output_folders(o);
   const long ports = o.integer("--ports"), mib = o.integer("--resync-mib");
   const double flood_s = o.number("--flood-seconds"), slow_s = o.number("--slow-seconds");
   if (ports < 2 || ports > 1000 || mib < 1 || mib > 1024 || !(flood_s > 0) || !(slow_s > 0))
     throw UsageError("2 to 1000 ports, 1 to 1024 MiB and positive durations, please");
-  const std::string scratch = o.text("--scratch");
   double load = load_average();
 
   std::fprintf(stderr, "bench-reliability: flood");

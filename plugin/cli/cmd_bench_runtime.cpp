@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "bench_figures.h"
 #include "command.h"
 #include "json.h"
 #include "options.h"
@@ -25,12 +26,10 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kPaperStaticMs = 7.45, kPaperDynamicMs = 9.87, kPaperFaces = 71358;
 
+// The shared figure (bench_figures.h) with this command's argument order: most figures have no target.
 std::string figure(double value, const std::string& unit, const std::string& how, double target = NAN,
                    const char* better = "lower") {
-  JsonObject o;
-  o.number("value", value).text("unit", unit).raw("target", std::isfinite(target) ? json_number(target) : "null");
-  o.text("better", better).text("how", how);
-  return o.str();
+  return cli::figure(value, unit.c_str(), std::isfinite(target) ? json_number(target) : "null", better, how);
 }
 
 std::string cpu_name() {
@@ -76,12 +75,6 @@ Times median_ms(std::size_t frames, std::size_t warmup, F&& call) {
   return {median(wall), median(cpu)};
 }
 
-double load_average() {
-  std::ifstream in("/proc/loadavg");
-  double l = NAN;
-  in >> l;
-  return l;
-}
 // What every measurement reads: the take, the rigs, the bundle, the frames' SparseSoftDECA input,
 // the output buffers and the description recorded with each figure.
 struct Bench {
@@ -302,17 +295,16 @@ void measure_storage_error(Bench& bench) {
 int run_bench_runtime(const Args& args) {
   Options o("bench-runtime", "Measure the runtime per frame on the frames of a take (medians), single- and two-threaded,\n"
                              "and write the benchmark JSON (docs/ARCHITECTURE.md, Conventions).");
-  o.option("--bundle", "DIR", "model bundle folder or .tar")
-      .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
-      .option("--take", "FILE", "Live Link Face CSV or recording whose frames drive the measurement")
+  declare_model_inputs(o);
+  o.option("--take", "FILE", "Live Link Face CSV or recording whose frames drive the measurement")
       .option("--frames", "N", "frames measured per figure", "600")
       .option("--warmup", "N", "frames run before measuring", "30")
       .option("--prepares", "N", "prepares measured", "5")
       .option("--out", "FILE", "benchmark JSON", "build/bench/runtime.json")
       .option("--how", "TEXT", "the command line to record in the figures", "softdeca bench-runtime");
   if (!o.parse(args)) return 0;
-  for (const char* req : {"--bundle", "--avatar", "--take"})
-    if (!o.given(req)) throw UsageError(std::string(req) + " is required");
+  require_model_inputs(o);
+  if (!o.given("--take")) throw UsageError("--take is required");
   const Take take = read_take(o.text("--take"), static_cast<std::size_t>(o.integer("--frames")));
   const std::size_t frames = take.weights.size();
   const FaceRig rig = read_rig(o.text("--avatar"));

@@ -16,12 +16,12 @@
 #include "bench_figures.h"
 #include "command.h"
 #include "json.h"
+#include "live/receiver.h"
 #include "options.h"
 #include "recording/recording_reader.h"
 #include "recording/recording_writer.h"
 #include "stream/frame_sender.h"
 #include "stream/percentile.h"
-#include "stream/receiver.h"
 #include "stream/steady_clock.h"
 
 namespace softdeca::cli {
@@ -51,14 +51,14 @@ stream::Frame sample_frame(std::size_t i) {
 }
 
 struct Receiving {
-  stream::Receiver receiver;
+  live::Receiver receiver;
   std::atomic<bool> done{false};
   std::vector<double> latencies;  // send -> available, seconds
   double last_pop = 0;
   std::size_t popped = 0;
   std::thread consumer;
 
-  explicit Receiving(const stream::ReceiverConfig& c) : receiver(c) {
+  explicit Receiving(const live::ReceiverConfig& c) : receiver(c) {
     consumer = std::thread([this] {
       stream::Frame f;
       while (!done.load()) {
@@ -76,8 +76,8 @@ struct Receiving {
   }
 };
 
-stream::ReceiverConfig loopback() {
-  stream::ReceiverConfig c;
+live::ReceiverConfig loopback() {
+  live::ReceiverConfig c;
   c.bind_address = "127.0.0.1";
   c.port = 0;
   c.format = stream::Format::softdeca;
@@ -184,15 +184,14 @@ int run_bench_streaming(const Args& args) {
             "as fast as the socket takes them), latency from send to frame available (frames paced),\n"
             "decoder cost, recording write and read rates. Medians over --runs runs; writes the figures\n"
             "as JSON (the benchmark format of docs/ARCHITECTURE.md, Conventions).");
-  o.option("--out", "FILE", "JSON output", "build/bench/streaming.json")
-      .option("--runs", "N", "repetitions of each measurement", "5")
+  declare_output_options(o, "streaming", "where the recording runs write their file");
+  o.option("--runs", "N", "repetitions of each measurement", "5")
       .option("--throughput-frames", "N", "frames blasted per throughput run", "100000")
       .option("--latency-frames", "N", "frames per latency run", "2000")
       .option("--latency-rate", "HZ", "send rate of the latency runs", "1000")
-      .option("--recording-frames", "N", "frames per recording run", "20000")
-      .option("--scratch", "DIR", "where the recording runs write their file", "build/bench");
+      .option("--recording-frames", "N", "frames per recording run", "20000");
   if (!o.parse(args)) return 0;
-  create_output_folders(o.text("--out"), o.text("--scratch"));
+  const std::string scratch = create_output_folders(o);
   const long runs = o.integer("--runs"), tp = o.integer("--throughput-frames"), lat = o.integer("--latency-frames"),
              recf = o.integer("--recording-frames");
   const double lat_rate = o.number("--latency-rate");
@@ -218,7 +217,7 @@ int run_bench_streaming(const Args& args) {
     std::fprintf(stderr, ", decode");
     decode_ns.push_back(decode_run(200000));
     std::fprintf(stderr, ", recording   ");
-    const auto r = recording_run(o.text("--scratch") + "/bench-streaming.sdrec", static_cast<std::size_t>(recf));
+    const auto r = recording_run(scratch + "/bench-streaming.sdrec", static_cast<std::size_t>(recf));
     write_fps.push_back(r.write_fps);
     read_fps.push_back(r.read_fps);
     bytes_per_frame = r.bytes_per_frame;

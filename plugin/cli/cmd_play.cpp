@@ -11,6 +11,7 @@
 #include "options.h"
 #include "recording/player.h"
 #include "recording/recording_reader.h"
+#include "stop_limits.h"
 #include "stream/frame_sender.h"
 #include "stream/steady_clock.h"
 #include "stream_format_arg.h"
@@ -48,10 +49,9 @@ int run_play(const Args& args) {
       .option("--start", "SECONDS", "start this far into the recording", "0")
       .option("--rate", "HZ", "output interpolated frames at this rate instead of the recorded ones")
       .option("--send", "HOST:PORT", "stream over UDP to this numeric address instead of printing")
-      .option("--format", "NAME", "what --send sends: softdeca or livelinkface", "softdeca")
-      .option("--frames", "N", "stop after N frames (0: no limit)", "0")
-      .option("--duration", "SECONDS", "stop after this much wall-clock time (0: no limit)", "0")
-      .flag("--quiet", "print nothing but errors");
+      .option("--format", "NAME", "what --send sends: softdeca or livelinkface", "softdeca");
+  StopLimits::declare(o, "frames");
+  o.flag("--quiet", "print nothing but errors");
   if (!o.parse(args)) return 0;
   recording::Player player(recording::read_recording(o.arg(0)));
   const double speed = o.number("--speed");
@@ -59,8 +59,7 @@ int run_play(const Args& args) {
   player.set_speed(speed);
   player.set_loop(o.on("--loop"));
   player.seek(o.number("--start"));
-  const long max_frames = o.integer("--frames");
-  const double max_duration = o.number("--duration");
+  const StopLimits limits = StopLimits::read(o);
   const double rate = o.given("--rate") ? o.number("--rate") : 0;
   if (o.given("--rate") && !(rate > 0 && rate <= 10000)) throw UsageError("--rate must be in (0, 10000]");
 
@@ -100,10 +99,7 @@ int run_play(const Args& args) {
     }
     ++emitted;
   };
-  const auto done = [&] {
-    return (max_frames > 0 && emitted >= max_frames) ||
-           (max_duration > 0 && stream::steady_seconds() - wall_start >= max_duration);
-  };
+  const auto done = [&] { return limits.reached(double(emitted), stream::steady_seconds() - wall_start); };
 
   if (rate > 0) {
     // Fixed-rate sampling through the player: interpolated frames, speed and looping.

@@ -8,9 +8,10 @@
 
 #include "command.h"
 #include "json.h"
+#include "live/receiver.h"
 #include "options.h"
 #include "recording/recording_format.h"
-#include "stream/receiver.h"
+#include "stop_limits.h"
 #include "stream/steady_clock.h"
 #include "stream_format_arg.h"
 
@@ -21,7 +22,7 @@ namespace {
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_signal(int) { g_interrupted.store(true); }
 
-std::string stats_json(const stream::ReceiverStats& s, std::size_t recorded) {
+std::string stats_json(const live::ReceiverStats& s, std::size_t recorded) {
   JsonObject o;
   const auto u = [&](const char* k, uint64_t v) { o.number(k, static_cast<double>(v)); };
   u("datagrams", s.datagrams);
@@ -56,7 +57,7 @@ std::string stats_json(const stream::ReceiverStats& s, std::size_t recorded) {
   return o.str(true) + "\n";
 }
 
-void progress(const stream::ReceiverStats& s, std::size_t recorded, bool recording) {
+void progress(const live::ReceiverStats& s, std::size_t recorded, bool recording) {
   std::fprintf(stderr,
                "\rframes %llu  %.1f Hz  lost %llu  late %llu  dup %llu  malformed %llu%s%llu   ",
                static_cast<unsigned long long>(s.delivered), s.frame_rate_hz,
@@ -83,15 +84,14 @@ int run_receive(const Args& args) {
       .option("--port", "PORT", "UDP port; 0: any free port (default: the format's, ours 50110)")
       .option("--delay", "SECONDS", "jitter buffer delay", "0.05")
       .option("--out", "FILE", "record delivered frames into FILE (.sdrec)")
-      .option("--subject", "NAME", "subject or take name written into the recording")
-      .option("--frames", "N", "stop after N delivered frames (0: no limit)", "0")
-      .option("--duration", "SECONDS", "stop after this long (0: no limit)", "0")
-      .option("--idle", "SECONDS", "stop this long after the last datagram, once one came (0: never)", "0")
+      .option("--subject", "NAME", "subject or take name written into the recording");
+  StopLimits::declare(o, "delivered frames");
+  o.option("--idle", "SECONDS", "stop this long after the last datagram, once one came (0: never)", "0")
       .option("--stats-json", "FILE", "write the final statistics as JSON")
       .flag("--quiet", "no progress line");
   if (!o.parse(args)) return 0;
 
-  stream::ReceiverConfig config;
+  live::ReceiverConfig config;
   config.format = parse_format(o.text("--format"), true);
   config.listen_network = o.on("--listen");
   config.bind_address = o.given("--bind") ? o.text("--bind") : config.listen_network ? "0.0.0.0" : "127.0.0.1";
@@ -102,10 +102,10 @@ int run_receive(const Args& args) {
   if (port < 0 || port > 65535) throw UsageError("--port must be in [0, 65535]");
   config.port = static_cast<uint16_t>(port);
   config.delay = o.number("--delay");
-  const long max_frames = o.integer("--frames");
-  const double max_duration = o.number("--duration"), idle = o.number("--idle");
+  const StopLimits limits = StopLimits::read(o);
+  const double idle = o.number("--idle");
 
-  stream::Receiver receiver(config);
+  live::Receiver receiver(config);
   std::printf("listening on %s port %u (%s)\n", config.bind_address.c_str(), receiver.port(),
               stream::format_name(config.format));
   std::fflush(stdout);
@@ -129,7 +129,7 @@ int run_receive(const Args& args) {
   while (!g_interrupted.load()) {
     receiver.next(0.05, frame);  // frames are only counted here; recording happens in the receiver
     const double now = stream::steady_seconds();
-    const stream::ReceiverStats s = receiver.stats();
+    const live::ReceiverStats s = receiver.stats();
     if (s.datagrams != datagrams) {
       datagrams = s.datagrams;
       last_datagram = now;
@@ -138,14 +138,13 @@ int run_receive(const Args& args) {
       progress(s, receiver.frames_recorded(), recording);
       last_progress = now;
     }
-    if ((max_frames > 0 && s.delivered >= static_cast<uint64_t>(max_frames)) ||
-        (max_duration > 0 && now - start >= max_duration) || (idle > 0 && datagrams > 0 && now - last_datagram >= idle))
+    if (limits.reached(double(s.delivered), now - start) || (idle > 0 && datagrams > 0 && now - last_datagram >= idle))
       break;
   }
   receiver.stop();  // flushes the jitter buffer into the recording
   const std::size_t recorded = receiver.frames_recorded();
   const std::string error = receiver.stop_recording();
-  const stream::ReceiverStats s = receiver.stats();
+  const live::ReceiverStats s = receiver.stats();
   if (!o.on("--quiet")) {
     progress(s, recorded, recording);
     std::fputc('\n', stderr);

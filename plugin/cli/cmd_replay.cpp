@@ -258,10 +258,9 @@ int run_replay(const Args& args) {
                       "take (as a phone would track it), else the avatar's own. An ICT identity as avatar:\n"
                       "python -m softdeca_train avatar --seed N --out DIR; a contact sheet of the result:\n"
                       "python -m softdeca_train replay-preview --replay OUT.");
-  o.positional("TAKE", "Live Link Face CSV (.csv) or a recording of the streaming format")
-      .option("--bundle", "DIR", "model bundle folder or .tar")
-      .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)")
-      .option("--out", "DIR", "output folder", "out/replay")
+  o.positional("TAKE", "Live Link Face CSV (.csv) or a recording of the streaming format");
+  declare_model_inputs(o);
+  o.option("--out", "DIR", "output folder", "out/replay")
       .option("--models", "LIST", "comma-separated: linear, softdeca, sparse", "linear,softdeca,sparse")
       .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated (value: a number, min, max or default)")
       .option("--localised", "SPEC", "an extra SoftDECA pass with this change 'name=value@x,y,z,r' on top of --set")
@@ -272,8 +271,7 @@ int run_replay(const Args& args) {
       .option("--obj-every", "N", "also write every Nth frame as OBJ (0: none)", "0")
       .flag("--dynamics", "enable the second-order dynamics");
   if (!o.parse(args)) return 0;
-  if (!o.given("--bundle")) throw UsageError("--bundle is required");
-  if (!o.given("--avatar")) throw UsageError("--avatar is required (python -m softdeca_train avatar writes one)");
+  require_model_inputs(o);
   const std::string out = o.text("--out");
   make_directories(out);
   const unsigned threads = static_cast<unsigned>(o.integer("--threads"));

@@ -102,4 +102,14 @@ double percentile(std::vector<double> v, double q) {
   return v[k];
 }
 
+void declare_model_inputs(Options& o) {
+  o.option("--bundle", "DIR", "model bundle folder or .tar")
+      .option("--avatar", "DIR", "avatar folder (neutral.obj, blendshapes/, optional user_face/)");
+}
+
+void require_model_inputs(const Options& o) {
+  if (!o.given("--bundle")) throw UsageError("--bundle is required");
+  if (!o.given("--avatar")) throw UsageError("--avatar is required (python -m softdeca_train avatar writes one)");
+}
+
 }  // namespace softdeca::cli

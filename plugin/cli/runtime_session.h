@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mesh_io.h"
+#include "options.h"
 #include "softdeca/softdeca.h"
 
 namespace softdeca::cli {
@@ -49,6 +50,11 @@ struct FaceRig {  // a neutral mesh and 52 blendshape deltas
 FaceRig read_rig(const std::string& dir, bool optional = false);
 
 bool file_exists(const std::string& path);
+
+// The --bundle and --avatar options of the commands that run the models on an avatar (replay,
+// bench-runtime), and the check after parsing that both were given.
+void declare_model_inputs(Options& o);
+void require_model_inputs(const Options& o);
 void make_directories(const std::string& path);
 double median(std::vector<double> v);
 double percentile(std::vector<double> v, double q);

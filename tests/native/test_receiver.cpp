@@ -13,15 +13,16 @@
 #include <vector>
 
 #include "core/error.h"
+#include "live/receiver.h"
 #include "recording/recording_reader.h"
 #include "stream/frame_sender.h"
 #include "stream/ifacialmocap_packet.h"
 #include "stream/livelinkface_packet.h"
-#include "stream/receiver.h"
 #include "stream/wire_format.h"
 #include "stream_test_support.h"
 
 using namespace softdeca;
+using namespace softdeca::live;
 using namespace softdeca::stream;
 using test::eventually;
 using test::make_frame;

@@ -16,13 +16,14 @@
 #include <vector>
 
 #include "api/error.h"
+#include "live/receiver.h"
 #include "recording/recording_reader.h"
 #include "stream/frame_sender.h"
-#include "stream/receiver.h"
 #include "stream/source_rate_limit.h"
 #include "stream_test_support.h"
 
 using namespace softdeca;
+using namespace softdeca::live;
 using namespace softdeca::stream;
 using test::eventually;
 using test::make_frame;

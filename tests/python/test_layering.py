@@ -1,5 +1,5 @@
-"""The native library's layers: core/ below everything, the C ABI (api/) on top, and nothing
-below api/ including it."""
+"""The native library's layers: core/ below everything, the C ABI (api/) on top, nothing below
+api/ including it, and the streaming areas (stream/, recording/, live/) in one order."""
 
 from __future__ import annotations
 
@@ -39,3 +39,22 @@ def test_core_depends_on_nothing_but_the_public_header() -> None:
             assert inc.startswith("core/") or inc == "softdeca/softdeca.h", (
                 f"{p.name}: {inc}"
             )
+
+
+# The streaming areas in their order, bottom up: frames and wire formats, the recording files
+# built on them, the live receiver that records what it delivers. None includes one above it.
+STREAMING_ORDER = ("stream", "recording", "live")
+
+
+def test_streaming_areas_include_only_downwards() -> None:
+    for below, area in enumerate(STREAMING_ORDER):
+        files = sources(area)
+        assert files, area
+        above = STREAMING_ORDER[below + 1 :]
+        offenders = [
+            f"{p.relative_to(SRC)} includes {inc}"
+            for p in files
+            for inc in local_includes(p)
+            if inc.split("/")[0] in above
+        ]
+        assert offenders == [], f"{area}/ includes an area above it"

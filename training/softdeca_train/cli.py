@@ -14,7 +14,7 @@ from softdeca_train.commands import Command
 
 STAGES = (
     "softdeca_train.template.cli",
-    "softdeca_train.lhm_cli",
+    "softdeca_train.lhm.cli",
     "softdeca_train.landmarks.cli",
     "softdeca_train.sim.cli",
     "softdeca_train.data.cli",

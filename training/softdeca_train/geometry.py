@@ -1,5 +1,5 @@
 """Rigid and similarity alignment of paired 3D points (Umeyama 1991), shared by the landmark
-registration and the reference runtime. (lhm/fit.py still has its own rigid fit of the jaw.)"""
+registration, the reference runtime and the layered head model's jaw fit."""
 
 from __future__ import annotations
 

@@ -9,7 +9,8 @@ public enum LiveLinkFace {
     public static let maxNameBytes = 255
     public static let maxPacketBytes = 2048
 
-    /// The app's 61 values in packet order (Unreal's `EARFaceBlendShape`).
+    /// The app's 61 values in packet order (Unreal's `EARFaceBlendShape`), as in
+    /// plugin/data/face_names.json (a test checks this copy against that file).
     public static let valueNames: [String] = [
         "EyeBlinkLeft", "EyeLookDownLeft", "EyeLookInLeft", "EyeLookOutLeft", "EyeLookUpLeft",
         "EyeSquintLeft", "EyeWideLeft", "EyeBlinkRight", "EyeLookDownRight", "EyeLookInRight",

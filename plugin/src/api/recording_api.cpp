@@ -7,6 +7,7 @@
 
 #include "api/error.h"
 #include "api/frame_abi.h"
+#include "api/handles.h"
 #include "recording/conversions.h"
 #include "recording/player.h"
 #include "recording/recording_reader.h"
@@ -72,10 +73,9 @@ SOFTDECA_API softdeca_status softdeca_recorder_create(const char* path, const so
                                                       softdeca_recorder** out_recorder) {
   return guarded(__func__, [&] {
     require_not_null(path, "path");
-    require_not_null(out_recorder, "out_recorder");
-    auto r = std::make_unique<softdeca_recorder>();
-    r->impl = std::make_unique<recording::RecordingWriter>(path, abi::header_from_abi(header));
-    *out_recorder = r.release();
+    create_handle(out_recorder, "out_recorder", [&](softdeca_recorder& r) {
+      r.impl = std::make_unique<recording::RecordingWriter>(path, abi::header_from_abi(header));
+    });
   });
 }
 
@@ -120,21 +120,20 @@ SOFTDECA_API softdeca_status softdeca_recorder_write_neutral(softdeca_recorder* 
 }
 
 SOFTDECA_API void softdeca_recorder_destroy(softdeca_recorder* recorder) {
-  guarded(__func__, [&] { delete recorder; });
+  destroy_handle(__func__, recorder);
 }
 
 SOFTDECA_API softdeca_status softdeca_player_open(const char* path, softdeca_player** out_player) {
   return guarded(__func__, [&] {
     require_not_null(path, "path");
-    require_not_null(out_player, "out_player");
-    auto p = std::make_unique<softdeca_player>();
-    p->impl = std::make_unique<recording::Player>(recording::read_recording(path));
-    *out_player = p.release();
+    create_handle(out_player, "out_player", [&](softdeca_player& p) {
+      p.impl = std::make_unique<recording::Player>(recording::read_recording(path));
+    });
   });
 }
 
 SOFTDECA_API void softdeca_player_destroy(softdeca_player* player) {
-  guarded(__func__, [&] { delete player; });
+  destroy_handle(__func__, player);
 }
 
 SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player, softdeca_recording_info* out) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "api/error.h"
+#include "api/handles.h"
 #include "runtime/avatar.h"
 #include "runtime/bundle_files.h"
 #include "runtime/model.h"
@@ -69,9 +70,9 @@ SOFTDECA_API softdeca_status softdeca_model_load(const char* path, const softdec
     require_not_null(path, "path");
     require_not_null(out_model, "out_model");
     const auto opts = model_options(options);
-    auto handle = std::make_unique<softdeca_model>();
-    handle->model = Model::load(runtime::BundleFiles::from_path(path), opts);
-    *out_model = handle.release();
+    create_handle(out_model, "out_model", [&](softdeca_model& h) {
+      h.model = Model::load(runtime::BundleFiles::from_path(path), opts);
+    });
   });
 }
 
@@ -82,14 +83,14 @@ SOFTDECA_API softdeca_status softdeca_model_load_memory(const void* data, uint32
     require_not_null(out_model, "out_model");
     require(byte_count > 0, "byte_count is 0");
     const auto opts = model_options(options);
-    auto handle = std::make_unique<softdeca_model>();
-    handle->model = Model::load(runtime::BundleFiles::from_tar(static_cast<const std::uint8_t*>(data), byte_count), opts);
-    *out_model = handle.release();
+    create_handle(out_model, "out_model", [&](softdeca_model& h) {
+      h.model = Model::load(runtime::BundleFiles::from_tar(static_cast<const std::uint8_t*>(data), byte_count), opts);
+    });
   });
 }
 
 SOFTDECA_API void softdeca_model_destroy(softdeca_model* model) {
-  guarded(__func__, [&] { delete model; });
+  destroy_handle(__func__, model);
 }
 
 SOFTDECA_API softdeca_status softdeca_model_get_info(const softdeca_model* model, softdeca_model_info* out_info) {
@@ -229,14 +230,13 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
     d.precision = desc->precision == SOFTDECA_PRECISION_FLOAT  ? runtime::Precision::Float
                   : desc->precision == SOFTDECA_PRECISION_INT8 ? runtime::Precision::Int8
                                                                : runtime::Precision::Half;
-    auto handle = std::make_unique<softdeca_avatar>();
-    handle->avatar = std::make_unique<Avatar>(model->model, d);
-    *out_avatar = handle.release();
+    create_handle(out_avatar, "out_avatar",
+                  [&](softdeca_avatar& h) { h.avatar = std::make_unique<Avatar>(model->model, d); });
   });
 }
 
 SOFTDECA_API void softdeca_avatar_destroy(softdeca_avatar* avatar) {
-  guarded(__func__, [&] { delete avatar; });
+  destroy_handle(__func__, avatar);
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avatar, uint32_t index, double value) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "api/error.h"
+#include "api/handles.h"
 #include "sim/simulator.h"
 
 struct softdeca_sim {
@@ -261,16 +262,16 @@ SOFTDECA_API softdeca_status softdeca_sim_create(const softdeca_sim_mesh* mesh, 
   return guarded(__func__, [&] {
     require_not_null(out_sim, "out_sim");
     require_struct(mesh, "mesh");
-    auto h = std::make_unique<softdeca_sim>();
-    h->sim = std::make_unique<Simulator>(to_mesh(*mesh), to_settings(settings));
-    h->vertices = h->sim->rest_positions();
-    h->skin = embed(h->sim->mesh().skin, h->vertices);
-    *out_sim = h.release();
+    create_handle(out_sim, "out_sim", [&](softdeca_sim& h) {
+      h.sim = std::make_unique<Simulator>(to_mesh(*mesh), to_settings(settings));
+      h.vertices = h.sim->rest_positions();
+      h.skin = embed(h.sim->mesh().skin, h.vertices);
+    });
   });
 }
 
 SOFTDECA_API void softdeca_sim_destroy(softdeca_sim* sim) {
-  guarded(__func__, [&] { delete sim; });
+  destroy_handle(__func__, sim);
 }
 
 SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, uint32_t* out_count) {

@@ -1,24 +1,25 @@
-// Receiver part of the C ABI: thin, checked wrappers over stream::Receiver.
+// Receiver part of the C ABI: thin, checked wrappers over live::Receiver.
 #include <memory>
 #include <string>
 
 #include "api/error.h"
 #include "api/frame_abi.h"
+#include "api/handles.h"
+#include "live/receiver.h"
 #include "stream/arkit_names.h"
-#include "stream/receiver.h"
 
 struct softdeca_receiver {
-  std::unique_ptr<softdeca::stream::Receiver> impl;
+  std::unique_ptr<softdeca::live::Receiver> impl;
 };
 
 namespace {
 using namespace softdeca;
 
-const stream::Receiver& receiver_of(const softdeca_receiver* r) {
+const live::Receiver& receiver_of(const softdeca_receiver* r) {
   require_not_null(r, "receiver");
   return *r->impl;
 }
-stream::Receiver& receiver_of(softdeca_receiver* r) {
+live::Receiver& receiver_of(softdeca_receiver* r) {
   require_not_null(r, "receiver");
   return *r->impl;
 }
@@ -44,7 +45,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_con
     config->port = stream::default_port(stream::Format::softdeca);
     config->queue_capacity = 256;
     config->jitter_delay = 0;
-    const stream::ReceiverConfig defaults;
+    const live::ReceiverConfig defaults;
     config->session_hold = defaults.session_hold;
     config->source_rate_limit = defaults.source_rate_limit;
   });
@@ -61,7 +62,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_create(const softdeca_receiver_co
     require(std::isfinite(config->jitter_delay), "config->jitter_delay is not finite", SOFTDECA_ERROR_NON_FINITE);
     require(std::isfinite(config->session_hold) && std::isfinite(config->source_rate_limit),
             "config->session_hold and source_rate_limit must be finite", SOFTDECA_ERROR_NON_FINITE);
-    stream::ReceiverConfig c;
+    live::ReceiverConfig c;
     c.listen_network = config->listen_network != 0;
     c.bind_address = config->bind_address ? config->bind_address : c.listen_network ? "0.0.0.0" : "127.0.0.1";
     c.follow_newest = config->follow_newest != 0;
@@ -71,14 +72,13 @@ SOFTDECA_API softdeca_status softdeca_receiver_create(const softdeca_receiver_co
     c.format = static_cast<stream::Format>(config->format);
     c.delay = config->jitter_delay;
     c.queue_capacity = config->queue_capacity;
-    auto r = std::make_unique<softdeca_receiver>();
-    r->impl = std::make_unique<stream::Receiver>(c);
-    *out_receiver = r.release();
+    create_handle(out_receiver, "out_receiver",
+                  [&](softdeca_receiver& r) { r.impl = std::make_unique<live::Receiver>(c); });
   });
 }
 
 SOFTDECA_API void softdeca_receiver_destroy(softdeca_receiver* receiver) {
-  guarded(__func__, [&] { delete receiver; });
+  destroy_handle(__func__, receiver);
 }
 
 SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* receiver, uint32_t* out_port) {
@@ -117,7 +117,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
   return guarded(__func__, [&] {
     const auto& r = receiver_of(receiver);
     require_struct(out, "out_stats");
-    const stream::ReceiverStats s = r.stats();
+    const live::ReceiverStats s = r.stats();
     const uint32_t struct_size = out->struct_size;
     *out = softdeca_receiver_stats{};
     out->struct_size = struct_size;

@@ -60,15 +60,10 @@ void add_group(Model& m, std::unique_ptr<ConstraintGroup> g) {
   m.groups.push_back(std::move(g));
 }
 
-Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, StrainLimit strain) {
-  const PhysicalConstants& k = physical_constants();
-  const double pa = k.pascal_per_weight_unit;
-  Model m;
-  m.scaled_rest = scaled_rest(mesh, p);
-  m.pinned = pinned_mask(mesh);
-  const Eigen::Index n = mesh.vertex_count();
+namespace {
 
-  // Projecting groups (their rows come first).
+// The projecting tet groups (their rows come first): soft tissue, muscle, connecting tets.
+void add_tet_groups(Model& m, const SimulationMesh& mesh, const ParameterSet& p, StrainLimit strain, double pa) {
   const Param soft_det = Param::target_volume, soft_eps = Param::max_strain;
   add_group(m, std::make_unique<TetGroup>(
              "soft tissue",
@@ -84,54 +79,59 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
              "connecting", tet_elements(mesh.rest, mesh.connecting_tets, true, m.pinned, p,
                                         Param::w_connect_volume, Param::w_connect_strain, nullptr, nullptr, true),
              strain, pa));
+}
 
+// The skin's membrane strain, on S's triangles embedded in the tets.
+void add_skin_strain(Model& m, const SimulationMesh& mesh, const ParameterSet& p, double pa) {
+  const PhysicalConstants& k = physical_constants();
   const Positions skin_rest = embed(mesh.skin, mesh.rest);
-  {
-    std::vector<TriangleElement> tris;
-    for (Eigen::Index t = 0; t < mesh.skin_triangles.rows(); ++t) {
-      TriangleElement e;
-      for (int c = 0; c < 3; ++c) e.corner[static_cast<std::size_t>(c)] = point_row(mesh.skin, mesh.skin_triangles(t, c));
-      if (all_pinned(m.pinned, e.corner[0]) && all_pinned(m.pinned, e.corner[1]) && all_pinned(m.pinned, e.corner[2]))
-        continue;
-      TriangleStrainGroup::set_rest(e, skin_rest.row(mesh.skin_triangles(t, 0)).transpose(),
-                                    skin_rest.row(mesh.skin_triangles(t, 1)).transpose(),
-                                    skin_rest.row(mesh.skin_triangles(t, 2)).transpose());
-      e.weight = p.at(Param::w_skin_strain, t) * k.skin_thickness_m;
-      tris.push_back(std::move(e));
-    }
-    add_group(m, std::make_unique<TriangleStrainGroup>("skin strain", std::move(tris), pa));
+  std::vector<TriangleElement> tris;
+  for (Eigen::Index t = 0; t < mesh.skin_triangles.rows(); ++t) {
+    TriangleElement e;
+    for (int c = 0; c < 3; ++c) e.corner[static_cast<std::size_t>(c)] = point_row(mesh.skin, mesh.skin_triangles(t, c));
+    if (all_pinned(m.pinned, e.corner[0]) && all_pinned(m.pinned, e.corner[1]) && all_pinned(m.pinned, e.corner[2]))
+      continue;
+    TriangleStrainGroup::set_rest(e, skin_rest.row(mesh.skin_triangles(t, 0)).transpose(),
+                                  skin_rest.row(mesh.skin_triangles(t, 1)).transpose(),
+                                  skin_rest.row(mesh.skin_triangles(t, 2)).transpose());
+    e.weight = p.at(Param::w_skin_strain, t) * k.skin_thickness_m;
+    tris.push_back(std::move(e));
   }
-  {
-    std::vector<TriangleElement> tris;
-    for (Eigen::Index t = 0; t < mesh.skull_triangles.rows(); ++t) {
-      TriangleElement e;
-      bool constant = true;
-      for (int c = 0; c < 3; ++c) {
-        e.corner[static_cast<std::size_t>(c)] = vertex_row(mesh.skull_triangles(t, c));
-        constant = constant && m.pinned[static_cast<std::size_t>(mesh.skull_triangles(t, c))];
-      }
-      if (constant) continue;
-      TriangleStrainGroup::set_rest(e, m.scaled_rest.row(mesh.skull_triangles(t, 0)).transpose(),
-                                    m.scaled_rest.row(mesh.skull_triangles(t, 1)).transpose(),
-                                    m.scaled_rest.row(mesh.skull_triangles(t, 2)).transpose());
-      e.weight = p.at(Param::w_skull_strain, t) * k.skull_shell_thickness_m;
-      tris.push_back(std::move(e));
-    }
-    add_group(m, std::make_unique<TriangleStrainGroup>("skull strain", std::move(tris), pa));
-  }
-  {
-    Eigen::VectorXd w(n);
-    for (Eigen::Index v = 0; v < n; ++v) w[v] = p.at(Param::w_skull_bending, v);
-    std::vector<BendingElement> bend = make_bending_elements(m.scaled_rest, mesh.skull_triangles,
-                                                             k.skull_shell_thickness_m, w);
-    std::vector<BendingElement> kept;
-    for (auto& e : bend)
-      if (!all_pinned(m.pinned, e.laplacian)) kept.push_back(std::move(e));
-    add_group(m, std::make_unique<BendingGroup>(std::move(kept), pa));
-  }
+  add_group(m, std::make_unique<TriangleStrainGroup>("skin strain", std::move(tris), pa));
+}
 
-  // Targets: weight w * area / layer thickness (eq. 14 and 22), divided by gamma when dynamic.
-  m.skin_area = skin_point_areas(mesh);
+// The skull's shell: membrane strain and bending on its triangles, at the scaled rest.
+void add_skull_shell(Model& m, const SimulationMesh& mesh, const ParameterSet& p, double pa) {
+  const PhysicalConstants& k = physical_constants();
+  std::vector<TriangleElement> tris;
+  for (Eigen::Index t = 0; t < mesh.skull_triangles.rows(); ++t) {
+    TriangleElement e;
+    bool constant = true;
+    for (int c = 0; c < 3; ++c) {
+      e.corner[static_cast<std::size_t>(c)] = vertex_row(mesh.skull_triangles(t, c));
+      constant = constant && m.pinned[static_cast<std::size_t>(mesh.skull_triangles(t, c))];
+    }
+    if (constant) continue;
+    TriangleStrainGroup::set_rest(e, m.scaled_rest.row(mesh.skull_triangles(t, 0)).transpose(),
+                                  m.scaled_rest.row(mesh.skull_triangles(t, 1)).transpose(),
+                                  m.scaled_rest.row(mesh.skull_triangles(t, 2)).transpose());
+    e.weight = p.at(Param::w_skull_strain, t) * k.skull_shell_thickness_m;
+    tris.push_back(std::move(e));
+  }
+  add_group(m, std::make_unique<TriangleStrainGroup>("skull strain", std::move(tris), pa));
+
+  Eigen::VectorXd w(mesh.vertex_count());
+  for (Eigen::Index v = 0; v < w.size(); ++v) w[v] = p.at(Param::w_skull_bending, v);
+  std::vector<BendingElement> bend = make_bending_elements(m.scaled_rest, mesh.skull_triangles,
+                                                           k.skull_shell_thickness_m, w);
+  std::vector<BendingElement> kept;
+  for (auto& e : bend)
+    if (!all_pinned(m.pinned, e.laplacian)) kept.push_back(std::move(e));
+  add_group(m, std::make_unique<BendingGroup>(std::move(kept), pa));
+}
+
+// Dynamics' gamma and beta per skin point, and per landmark as its barycentric blend.
+void set_target_dynamics(Model& m, const SimulationMesh& mesh, const ParameterSet& p) {
   const Eigen::Index ns = mesh.skin_count(), nl = mesh.landmark_count();
   m.skin_gamma.resize(ns);
   m.skin_beta.resize(ns);
@@ -146,6 +146,12 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
       m.landmark_gamma[l] += mesh.landmark_weights(l, j) * m.skin_gamma[mesh.landmark_points(l, j)];
       m.landmark_beta[l] += mesh.landmark_weights(l, j) * m.skin_beta[mesh.landmark_points(l, j)];
     }
+}
+
+// Targets: weight w * area / layer thickness (eq. 14 and 22), divided by gamma when dynamic.
+void add_target_groups(Model& m, const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, double pa) {
+  const PhysicalConstants& k = physical_constants();
+  const Eigen::Index ns = mesh.skin_count(), nl = mesh.landmark_count();
   const bool dynamic = mode == TargetMode::kDynamic;
   const Param skin_weight = nl > 0 ? Param::w_regularisation : Param::w_target;
   if (ns > 0) {
@@ -175,16 +181,36 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
     m.landmark_row = m.rows;
     add_group(m, std::make_unique<TargetGroup>("landmarks", std::move(el)));
   }
+}
 
-  // Lumped masses of the tissue tets, for gravity.
-  m.mass = Eigen::VectorXd::Zero(n);
+// Lumped masses of the tissue tets, for gravity.
+Eigen::VectorXd lumped_masses(const SimulationMesh& mesh) {
+  const PhysicalConstants& k = physical_constants();
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh.vertex_count());
   for (const TetIndices* tets : {&mesh.soft_tets, &mesh.muscle_tets})
     for (Eigen::Index t = 0; t < tets->rows(); ++t) {
       const Eigen::Vector3d a = mesh.rest.row((*tets)(t, 0)), b = mesh.rest.row((*tets)(t, 1)),
                             c = mesh.rest.row((*tets)(t, 2)), d = mesh.rest.row((*tets)(t, 3));
       const double vol = std::abs((b - a).dot((c - a).cross(d - a))) / 6.0;
-      for (int j = 0; j < 4; ++j) m.mass[(*tets)(t, j)] += k.tissue_density_kg_m3 * vol / 4.0;
+      for (int j = 0; j < 4; ++j) mass[(*tets)(t, j)] += k.tissue_density_kg_m3 * vol / 4.0;
     }
+  return mass;
+}
+
+}  // namespace
+
+Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, StrainLimit strain) {
+  const double pa = physical_constants().pascal_per_weight_unit;
+  Model m;
+  m.scaled_rest = scaled_rest(mesh, p);
+  m.pinned = pinned_mask(mesh);
+  add_tet_groups(m, mesh, p, strain, pa);  // the projecting groups' rows come first
+  add_skin_strain(m, mesh, p, pa);
+  add_skull_shell(m, mesh, p, pa);
+  m.skin_area = skin_point_areas(mesh);
+  set_target_dynamics(m, mesh, p);
+  add_target_groups(m, mesh, p, mode, pa);
+  m.mass = lumped_masses(mesh);
   return m;
 }
 

@@ -3,23 +3,12 @@
 #include <array>
 #include <cctype>
 
+#include "stream/face_names_table.h"
+
 namespace softdeca::stream {
 namespace {
-constexpr std::array<const char*, kBlendshapeCount> kNames = {
-    "browDownLeft",       "browDownRight",     "browInnerUp",       "browOuterUpLeft",
-    "browOuterUpRight",   "cheekPuff",         "cheekSquintLeft",   "cheekSquintRight",
-    "eyeBlinkLeft",       "eyeBlinkRight",     "eyeLookDownLeft",   "eyeLookDownRight",
-    "eyeLookInLeft",      "eyeLookInRight",    "eyeLookOutLeft",    "eyeLookOutRight",
-    "eyeLookUpLeft",      "eyeLookUpRight",    "eyeSquintLeft",     "eyeSquintRight",
-    "eyeWideLeft",        "eyeWideRight",      "jawForward",        "jawLeft",
-    "jawOpen",            "jawRight",          "mouthClose",        "mouthDimpleLeft",
-    "mouthDimpleRight",   "mouthFrownLeft",    "mouthFrownRight",   "mouthFunnel",
-    "mouthLeft",          "mouthLowerDownLeft", "mouthLowerDownRight", "mouthPressLeft",
-    "mouthPressRight",    "mouthPucker",       "mouthRight",        "mouthRollLower",
-    "mouthRollUpper",     "mouthShrugLower",   "mouthShrugUpper",   "mouthSmileLeft",
-    "mouthSmileRight",    "mouthStretchLeft",  "mouthStretchRight", "mouthUpperUpLeft",
-    "mouthUpperUpRight",  "noseSneerLeft",     "noseSneerRight",    "tongueOut",
-};
+constexpr std::array<const char*, kBlendshapeCount> kNames = SOFTDECA_ARKIT_BLENDSHAPE_NAMES;
+static_assert(SOFTDECA_ARKIT_BLENDSHAPE_COUNT == kBlendshapeCount, "data/face_names.json: 52 ARKit blendshapes");
 
 bool same(std::string_view canonical, std::string_view name, bool ignore_first_case) {
   if (canonical.size() != name.size() || name.empty()) return false;

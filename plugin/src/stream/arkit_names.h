@@ -1,6 +1,7 @@
 // ARKit's 52 blendshape names in the canonical order of every interface (docs/ARCHITECTURE.md, Conventions): the
 // alphabetical order of ARFaceAnchor.BlendShapeLocation, browDownLeft = 0 ... tongueOut = 51.
-// This is the one C++ definition; adapters map their own orders and spellings onto it.
+// The names come from plugin/data/face_names.json (embedded at build time); adapters map their
+// own orders and spellings onto this order.
 #pragma once
 
 #include <cstddef>

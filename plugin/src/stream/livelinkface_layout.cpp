@@ -4,28 +4,13 @@
 #include <array>
 
 #include "stream/arkit_names.h"
+#include "stream/face_names_table.h"
 #include "stream/rotation.h"
 
 namespace softdeca::stream::livelinkface {
 namespace {
-constexpr std::array<const char*, kValueCount> kNames = {
-    "EyeBlinkLeft",     "EyeLookDownLeft",  "EyeLookInLeft",      "EyeLookOutLeft",
-    "EyeLookUpLeft",    "EyeSquintLeft",    "EyeWideLeft",        "EyeBlinkRight",
-    "EyeLookDownRight", "EyeLookInRight",   "EyeLookOutRight",    "EyeLookUpRight",
-    "EyeSquintRight",   "EyeWideRight",     "JawForward",         "JawLeft",
-    "JawRight",         "JawOpen",          "MouthClose",         "MouthFunnel",
-    "MouthPucker",      "MouthLeft",        "MouthRight",         "MouthSmileLeft",
-    "MouthSmileRight",  "MouthFrownLeft",   "MouthFrownRight",    "MouthDimpleLeft",
-    "MouthDimpleRight", "MouthStretchLeft", "MouthStretchRight",  "MouthRollLower",
-    "MouthRollUpper",   "MouthShrugLower",  "MouthShrugUpper",    "MouthPressLeft",
-    "MouthPressRight",  "MouthLowerDownLeft", "MouthLowerDownRight", "MouthUpperUpLeft",
-    "MouthUpperUpRight", "BrowDownLeft",    "BrowDownRight",      "BrowInnerUp",
-    "BrowOuterUpLeft",  "BrowOuterUpRight", "CheekPuff",          "CheekSquintLeft",
-    "CheekSquintRight", "NoseSneerLeft",    "NoseSneerRight",     "TongueOut",
-    "HeadYaw",          "HeadPitch",        "HeadRoll",           "LeftEyeYaw",
-    "LeftEyePitch",     "LeftEyeRoll",      "RightEyeYaw",        "RightEyePitch",
-    "RightEyeRoll",
-};
+constexpr std::array<const char*, kValueCount> kNames = SOFTDECA_LIVELINKFACE_VALUE_NAMES;
+static_assert(SOFTDECA_LIVELINKFACE_VALUE_COUNT == kValueCount, "data/face_names.json: 61 Live Link Face values");
 
 std::array<int, kValueCount> make_canonical() {
   std::array<int, kValueCount> m{};

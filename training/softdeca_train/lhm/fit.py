@@ -21,6 +21,7 @@ from functools import cache
 import numpy as np
 import softdeca_native as native
 
+from softdeca_train.geometry import umeyama
 from softdeca_train.lhm import radial
 from softdeca_train.lhm.model import CRANIUM, JAW, LayeredHeadModel, LhmConfig
 from softdeca_train.lhm.sphere import icosphere, vertex_neighbours, zoom
@@ -166,21 +167,13 @@ def prism_tets(
     return tets.astype(np.int32)
 
 
-def _kabsch(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rigid (R, t) with dst ~ src @ R.T + t."""
-    cs, cd = src.mean(0), dst.mean(0)
-    u, _, vt = np.linalg.svd((src - cs).T @ (dst - cd))
-    d = np.sign(np.linalg.det(vt.T @ u.T))
-    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
-    return r, cd - cs @ r.T
-
-
 def jaw_motion(
     template: Template, head: np.ndarray, expression: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """The jaw's rigid motion between two poses of a head, read from ICT's lower teeth."""
     sl = template.components["teeth_lower"].slice
-    return _kabsch(head[sl], expression[sl])
+    fit = umeyama(head[sl], expression[sl], with_scale=False)
+    return fit.rotation, fit.translation
 
 
 def _bone_labels(template: Template, head: np.ndarray) -> np.ndarray:

@@ -19,20 +19,11 @@ from softdeca_train.models import (
 )
 from softdeca_train.models.synthetic import TEST_PARAMETERS, synthetic_head
 from softdeca_train.runtime.files import write_obj, write_rig
+from softdeca_train.streaming.livelinkface import CSV_ORDER, VALUE_NAMES
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 
-# Live Link Face CSV columns (its own order: eyes, jaw, mouth, brows, cheeks, nose, tongue).
-_LLF_ORDER = (  # noqa: SIM905 - one readable block
-    "EyeBlinkLeft EyeLookDownLeft EyeLookInLeft EyeLookOutLeft EyeLookUpLeft EyeSquintLeft "
-    "EyeWideLeft EyeBlinkRight EyeLookDownRight EyeLookInRight EyeLookOutRight EyeLookUpRight "
-    "EyeSquintRight EyeWideRight JawForward JawRight JawLeft JawOpen MouthClose MouthFunnel "
-    "MouthPucker MouthRight MouthLeft MouthSmileLeft MouthSmileRight MouthFrownLeft "
-    "MouthFrownRight MouthDimpleLeft MouthDimpleRight MouthStretchLeft MouthStretchRight "
-    "MouthRollLower MouthRollUpper MouthShrugLower MouthShrugUpper MouthPressLeft MouthPressRight "
-    "MouthLowerDownLeft MouthLowerDownRight MouthUpperUpLeft MouthUpperUpRight BrowDownLeft "
-    "BrowDownRight BrowInnerUp BrowOuterUpLeft BrowOuterUpRight CheekPuff CheekSquintLeft "
-    "CheekSquintRight NoseSneerLeft NoseSneerRight TongueOut"
-).split()
+# Live Link Face CSV columns: its own order (eyes, jaw, mouth, brows, cheeks, nose, tongue).
+_LLF_ORDER = [VALUE_NAMES[i] for i in CSV_ORDER[:52]]
 
 
 def write_take(path: Path, weights: np.ndarray, face_lost: tuple[int, ...] = ()) -> Path:

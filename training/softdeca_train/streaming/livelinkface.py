@@ -11,13 +11,13 @@ from pathlib import Path
 
 import numpy as np
 
+from softdeca_train.face_names import ARKIT_BLENDSHAPES, LIVELINKFACE_VALUES
 from softdeca_train.streaming.frame import BLENDSHAPE_COUNT, Frame, Pose, Tracking
 from softdeca_train.streaming.protocol import DecodeError, DropReason
 from softdeca_train.streaming.rotations import (
     quaternion_from_yaw_pitch_roll,
     yaw_pitch_roll_from_quaternion,
 )
-from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 
 PORT = 11111
 PACKET_VERSION = 6
@@ -26,20 +26,7 @@ MAX_PACKET_BYTES = 2048
 TIMECODE_RATE = 60.0  # the app's default timecode clock
 
 # The app's 61 values in its packet order (Unreal's EARFaceBlendShape).
-VALUE_NAMES: tuple[str, ...] = (
-    "EyeBlinkLeft", "EyeLookDownLeft", "EyeLookInLeft", "EyeLookOutLeft", "EyeLookUpLeft",
-    "EyeSquintLeft", "EyeWideLeft", "EyeBlinkRight", "EyeLookDownRight", "EyeLookInRight",
-    "EyeLookOutRight", "EyeLookUpRight", "EyeSquintRight", "EyeWideRight", "JawForward",
-    "JawLeft", "JawRight", "JawOpen", "MouthClose", "MouthFunnel", "MouthPucker", "MouthLeft",
-    "MouthRight", "MouthSmileLeft", "MouthSmileRight", "MouthFrownLeft", "MouthFrownRight",
-    "MouthDimpleLeft", "MouthDimpleRight", "MouthStretchLeft", "MouthStretchRight",
-    "MouthRollLower", "MouthRollUpper", "MouthShrugLower", "MouthShrugUpper", "MouthPressLeft",
-    "MouthPressRight", "MouthLowerDownLeft", "MouthLowerDownRight", "MouthUpperUpLeft",
-    "MouthUpperUpRight", "BrowDownLeft", "BrowDownRight", "BrowInnerUp", "BrowOuterUpLeft",
-    "BrowOuterUpRight", "CheekPuff", "CheekSquintLeft", "CheekSquintRight", "NoseSneerLeft",
-    "NoseSneerRight", "TongueOut", "HeadYaw", "HeadPitch", "HeadRoll", "LeftEyeYaw",
-    "LeftEyePitch", "LeftEyeRoll", "RightEyeYaw", "RightEyePitch", "RightEyeRoll",
-)  # fmt: skip
+VALUE_NAMES: tuple[str, ...] = LIVELINKFACE_VALUES
 VALUE_COUNT = len(VALUE_NAMES)
 HEAD_YAW, LEFT_EYE_YAW, RIGHT_EYE_YAW = 52, 55, 58
 # Canonical index of each of the first 52 values.

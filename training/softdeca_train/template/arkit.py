@@ -4,22 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-# Alphabetical order of ARFaceAnchor.BlendShapeLocation names, which is also AR Foundation's
-# ARKitBlendShapeLocation order: every interface of the product uses it.
-ARKIT_BLENDSHAPES: tuple[str, ...] = (
-    "browDownLeft", "browDownRight", "browInnerUp", "browOuterUpLeft", "browOuterUpRight",
-    "cheekPuff", "cheekSquintLeft", "cheekSquintRight", "eyeBlinkLeft", "eyeBlinkRight",
-    "eyeLookDownLeft", "eyeLookDownRight", "eyeLookInLeft", "eyeLookInRight", "eyeLookOutLeft",
-    "eyeLookOutRight", "eyeLookUpLeft", "eyeLookUpRight", "eyeSquintLeft", "eyeSquintRight",
-    "eyeWideLeft", "eyeWideRight", "jawForward", "jawLeft", "jawOpen", "jawRight", "mouthClose",
-    "mouthDimpleLeft", "mouthDimpleRight", "mouthFrownLeft", "mouthFrownRight", "mouthFunnel",
-    "mouthLeft", "mouthLowerDownLeft", "mouthLowerDownRight", "mouthPressLeft",
-    "mouthPressRight", "mouthPucker", "mouthRight", "mouthRollLower", "mouthRollUpper",
-    "mouthShrugLower", "mouthShrugUpper", "mouthSmileLeft", "mouthSmileRight",
-    "mouthStretchLeft", "mouthStretchRight", "mouthUpperUpLeft", "mouthUpperUpRight",
-    "noseSneerLeft", "noseSneerRight", "tongueOut",
-)  # fmt: skip
-assert len(ARKIT_BLENDSHAPES) == 52
+from softdeca_train.face_names import ARKIT_BLENDSHAPES
+
+# The canonical order of every interface of the product (plugin/data/face_names.json).
+__all__ = ["ARKIT_BLENDSHAPES", "arkit_to_ict_matrix"]
 
 
 def arkit_to_ict_matrix(ict_names: list[str], left_suffix: str) -> np.ndarray:

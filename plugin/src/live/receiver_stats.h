@@ -3,7 +3,7 @@
 
 #include <cstdint>
 
-namespace softdeca::stream {
+namespace softdeca::live {
 
 struct ReceiverStats {
   uint64_t datagrams = 0;         // every datagram read from the socket
@@ -38,4 +38,4 @@ struct ReceiverStats {
   double latency_p99_ms = 0;
 };
 
-}  // namespace softdeca::stream
+}  // namespace softdeca::live

@@ -1,11 +1,12 @@
-// The stream receiver: a background thread reads datagrams from a UDP socket, decodes them
-// (datagram_decoder.h), drops and counts what is malformed, duplicated or late, tracks loss
+// The live receiver: a background thread reads datagrams from a UDP socket, decodes them
+// (stream/datagram_decoder.h), drops and counts what is malformed, duplicated or late, tracks loss
 // per sender session, orders frames in a jitter buffer, and hands them out in capture order.
 // It listens on loopback unless told otherwise; the first sender holds the session until it
 // has been quiet for `session_hold` seconds (others are counted and dropped), and every source
 // is rate limited (docs/security.md). Optionally it records every delivered frame through a
-// bounded queue to a writer thread (background_recorder.h): a slow disk drops recorded
-// frames, never stalls the receive thread or a poll.
+// bounded queue to a writer thread (recording/background_recorder.h): a slow disk drops
+// recorded frames, never stalls the receive thread or a poll. It stands above stream/ (its
+// parts) and recording/ (what it records through); neither includes live/.
 #pragma once
 
 #include <atomic>
@@ -20,22 +21,22 @@
 #include <thread>
 #include <vector>
 
+#include "live/receiver_stats.h"
 #include "recording/background_recorder.h"
 #include "stream/datagram_decoder.h"
 #include "stream/jitter_buffer.h"
 #include "stream/neutral_assembler.h"
-#include "stream/receiver_stats.h"
 #include "stream/sequence_tracker.h"
 #include "stream/source_rate_limit.h"
 #include "stream/udp_socket.h"
 
-namespace softdeca::stream {
+namespace softdeca::live {
 
 struct ReceiverConfig {
   std::string bind_address = "127.0.0.1";  // numeric; not loopback only with listen_network
   bool listen_network = false;             // an explicit choice to accept datagrams from other hosts
   uint16_t port = 50110;  // 0: any free port (see Receiver::port)
-  Format format = Format::automatic;
+  stream::Format format = stream::Format::automatic;
   double delay = 0;                  // jitter buffer delay in seconds, [0, 5]; 0: at once
   std::size_t queue_capacity = 256;  // delivered frames kept for next()
   double session_hold = 2.0;         // seconds, (0, 3600]: a quiet sender keeps the session this long
@@ -54,12 +55,12 @@ class Receiver {
 
   uint16_t port() const { return port_; }
   // The oldest delivered frame not yet taken, waiting up to timeout seconds for one.
-  bool next(double timeout, Frame& out);
+  bool next(double timeout, stream::Frame& out);
   // The newest delivered frame (taken or not).
-  bool latest(Frame& out) const;
+  bool latest(stream::Frame& out) const;
   ReceiverStats stats() const;
   // The profile named by the newest frame with landmarks, else the newest profile received.
-  bool profile(wire::Profile& out) const;
+  bool profile(stream::wire::Profile& out) const;
   bool neutral(std::vector<float>& out) const;
   // Asks the current sender (our protocol only) for its neutral mesh; false without a sender.
   bool request_neutral();
@@ -74,17 +75,17 @@ class Receiver {
 
  private:
   void run();
-  void handle(const uint8_t* data, std::size_t size, const Endpoint& from, double now);
-  void count_drop(DropReason reason);
+  void handle(const uint8_t* data, std::size_t size, const stream::Endpoint& from, double now);
+  void count_drop(stream::DropReason reason);
   void start_session(uint32_t session);
-  void on_frame(Frame frame, const Datagram& datagram, double now);
+  void on_frame(stream::Frame frame, const stream::Datagram& datagram, double now);
   void release_due(double now);
-  void deliver(const Frame& frame, double now);
-  bool admit(const Endpoint& from, double now);
-  void send_request(wire::RequestKind what, uint32_t id);
+  void deliver(const stream::Frame& frame, double now);
+  bool admit(const stream::Endpoint& from, double now);
+  void send_request(stream::wire::RequestKind what, uint32_t id);
 
   ReceiverConfig config_;
-  UdpSocket socket_;
+  stream::UdpSocket socket_;
   uint16_t port_ = 0;
   std::atomic<bool> stopping_{false};
   std::thread thread_;
@@ -94,27 +95,27 @@ class Receiver {
   ReceiverStats stats_;
   bool have_session_ = false;
   uint32_t session_ = 0;
-  Format session_format_ = Format::softdeca;
-  SequenceTracker sequence_;
+  stream::Format session_format_ = stream::Format::softdeca;
+  stream::SequenceTracker sequence_;
   uint64_t lost_before_ = 0;      // earlier sessions' losses
   uint64_t expected_before_ = 0;
-  JitterBuffer jitter_;
-  std::array<float, kBlendshapeCount> previous_weights_{};  // for sources that omit weights
-  std::deque<Frame> queue_;
+  stream::JitterBuffer jitter_;
+  std::array<float, stream::kBlendshapeCount> previous_weights_{};  // for sources that omit weights
+  std::deque<stream::Frame> queue_;
   bool have_latest_ = false;
-  Frame latest_;
-  std::map<uint32_t, wire::Profile> profiles_;
+  stream::Frame latest_;
+  std::map<uint32_t, stream::wire::Profile> profiles_;
   uint32_t newest_profile_ = 0;
   uint32_t profile_in_use_ = 0;
-  NeutralAssembler assembler_;
+  stream::NeutralAssembler assembler_;
   std::vector<float> neutral_;
   bool have_sender_ = false;
-  Endpoint sender_;
+  stream::Endpoint sender_;
   uint32_t request_sequence_ = 0;
   double last_profile_request_ = -1e9;
   std::deque<double> delivery_times_;  // recent, for the rate
   std::deque<double> latencies_;       // recent, seconds
-  SourceRateLimit rate_limit_;
+  stream::SourceRateLimit rate_limit_;
   bool have_holder_ = false;  // the sender that holds the session, and when it was last heard
   std::string holder_;
   double holder_heard_ = 0;
@@ -124,4 +125,4 @@ class Receiver {
   uint64_t recording_dropped_before_ = 0;
 };
 
-}  // namespace softdeca::stream
+}  // namespace softdeca::live

@@ -1,4 +1,4 @@
-#include "stream/receiver.h"
+#include "live/receiver.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,22 @@
 #include "stream/percentile.h"
 #include "stream/steady_clock.h"
 
-namespace softdeca::stream {
+namespace softdeca::live {
+// The stream/ parts this receiver puts together.
+using stream::Arrival;
+using stream::crc32;
+using stream::Datagram;
+using stream::DropReason;
+using stream::Endpoint;
+using stream::Format;
+using stream::Frame;
+using stream::JitterBuffer;
+using stream::kBlendshapeCount;
+using stream::percentile;
+using stream::SequenceTracker;
+using stream::steady_seconds;
+namespace wire = stream::wire;
+
 namespace {
 
 constexpr std::size_t kReceiveBuffer = 65536;  // any UDP datagram fits: sizes are exact
@@ -354,4 +369,4 @@ std::size_t Receiver::frames_recorded() const {
   return recorder_ ? recorder_->frames_written() : frames_recorded_;
 }
 
-}  // namespace softdeca::stream
+}  // namespace softdeca::live
