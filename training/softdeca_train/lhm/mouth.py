@@ -15,6 +15,7 @@ the direction sphere are shortened)."""
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,7 +122,7 @@ def _sides(tris: np.ndarray, path: np.ndarray, dirs: np.ndarray, up: np.ndarray)
     inner = np.zeros(len(dirs), bool)
     inner[path[1:-1]] = True
     band = np.flatnonzero(inner[tris].any(axis=1))
-    cut = {tuple(sorted(p)) for p in zip(path[:-1], path[1:], strict=True)}
+    cut = {(min(a, b), max(a, b)) for a, b in itertools.pairwise(path.tolist())}
     by_edge: dict[tuple[int, int], list[int]] = {}
     for f in band:
         a, b, c = (int(x) for x in tris[f])

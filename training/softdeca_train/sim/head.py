@@ -72,7 +72,7 @@ def jaw_skull_vertices(lhm: LayeredHeadModel) -> np.ndarray:
     skin above holds, and inverts the muscle tets. Those vertices stay with the cranium."""
     depth = np.linalg.norm(lhm.skin_wrap - lhm.skull_wrap, axis=1)
     on_bone = depth <= lhm.tissue_depth + JAW_DEPTH_TOLERANCE
-    return ((lhm.skull_labels == JAW) & on_bone) | (lhm.lip_side < 0)
+    return (lhm.skull_labels == JAW) & on_bone
 
 
 def build_head_simulation(
