@@ -23,10 +23,11 @@ import softdeca_native as native
 
 from softdeca_train.lhm import radial
 from softdeca_train.lhm.model import CRANIUM, JAW, LayeredHeadModel, LhmConfig
-from softdeca_train.lhm.mouth import MouthSlit, mouth_line, mouth_slit
+from softdeca_train.lhm.mouth import MouthSlit, mouth_line, mouth_slit, upper_lip_points
 from softdeca_train.lhm.sphere import icosphere, vertex_neighbours, zoom
 from softdeca_train.lhm.tissue_depth import depth_anchors, interpolate_depth
 from softdeca_train.template.model import N_SKIN, Template
+from softdeca_train.template.plausibility import lip_contact_zone
 
 
 @dataclass(frozen=True)
@@ -226,6 +227,18 @@ def _lip_side(slit: MouthSlit) -> np.ndarray:
     return side
 
 
+def _lip_of_points(template: Template, head: np.ndarray, bones: np.ndarray) -> np.ndarray:
+    """Per S vertex, the bone its lip side hangs on: in the lip contact zone, CRANIUM where the
+    upper lip's landmarks are nearer along S than the lower lip's, else JAW; elsewhere the
+    bone ICT's jawOpen moves it with (the mouth socket's roof with the cranium, its floor with
+    the jaw)."""
+    side = bones[:N_SKIN].copy()
+    zone = np.flatnonzero(lip_contact_zone(head, template.landmarks68))
+    above = upper_lip_points(head[:N_SKIN], template.skin_triangles, template.landmarks68, zone)
+    side[zone] = np.where(above, CRANIUM, JAW)
+    return side
+
+
 def _embed_skin_by_side(
     vertices: np.ndarray, soft: np.ndarray, skin: np.ndarray, tri_side: np.ndarray, bone: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -310,7 +323,9 @@ def fit_lhm(
     muscle = np.vstack(tets[cfg.soft_layers :])
 
     bones = _bone_labels(template, head)
-    tet, bary = _embed_skin_by_side(vertices, soft, skin, slit.side, bones[:N_SKIN])
+    tet, bary = _embed_skin_by_side(
+        vertices, soft, skin, slit.side, _lip_of_points(template, head, bones)
+    )
     skull_labels = np.where(
         (rad.owner >= 0) & (bones[np.maximum(rad.owner, 0)] == JAW), JAW, CRANIUM
     )
