@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softdeca_train.lhm.mouth import upper_lip_points
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.template.plausibility import lip_contact_zone
@@ -32,17 +31,20 @@ class LipSets:
 def lip_sets(
     template: Template, head: np.ndarray, radius: float = 0.012, corner_radius: float = 0.008
 ) -> LipSets:
-    """Split the lip contact zone into upper and lower lip: each point goes to the lip whose
-    landmarks are nearer along S (lhm/mouth.py `upper_lip_points`; a split by height fails
-    where the lips are pressed into each other); points within `corner_radius` of the inner
-    mouth corners (ICT landmarks 60 and 64) belong to neither."""
+    """Split the lip contact zone into upper and lower lip by the mouth line: the segment
+    between the inner mouth corners (ICT landmarks 60 and 64), per x; points within
+    `corner_radius` of those corners belong to neither."""
     zone = np.flatnonzero(lip_contact_zone(head, template.landmarks68, radius))
     lm = head[template.landmarks68]
-    above = upper_lip_points(head[:N_SKIN], template.skin_triangles, template.landmarks68, zone)
+    left, right = lm[64], lm[60]
+    t = np.clip((head[zone, 0] - right[0]) / (left[0] - right[0]), 0.0, 1.0)
+    mouth_y = right[1] + t * (left[1] - right[1])
+    # The inner lip contour's midpoint between the upper (62) and lower (66) middles.
+    mouth_y += 0.5 * (lm[62, 1] + lm[66, 1]) - 0.5 * (left[1] + right[1])
     corner = np.linalg.norm(head[zone, None] - lm[None, [60, 64]], axis=2).min(axis=1)
     away = corner > corner_radius
-    upper = zone[away & above]
-    lower = zone[away & ~above]
+    upper = zone[away & (head[zone, 1] >= mouth_y)]
+    lower = zone[away & (head[zone, 1] < mouth_y)]
     tris = template.skin_triangles
 
     def inside(ids: np.ndarray) -> np.ndarray:
