@@ -256,7 +256,11 @@ def _embed_skin_by_side(
         pick = np.flatnonzero(wrong & (bone == b))
         if len(pick) == 0:
             continue
-        allowed = np.flatnonzero(np.tile(tri_side, len(soft) // len(tri_side)) != s)
+        # Candidates near the points only (the nearest-tet search is costly for outside points).
+        lo, hi = skin[pick].min(axis=0) - 0.02, skin[pick].max(axis=0) + 0.02
+        centroid = vertices[soft].mean(axis=1)
+        near = ((centroid > lo) & (centroid < hi)).all(axis=1)
+        allowed = np.flatnonzero((np.tile(tri_side, len(soft) // len(tri_side)) != s) & near)
         t2, b2, _ = native.embed_points(vertices, soft[allowed], skin[pick])
         tet[pick] = allowed[np.asarray(t2)]
         bary[pick] = b2
