@@ -25,10 +25,10 @@ class LhmConfig:
     # Where S's cavities push the muscle wrap deep (behind the oral cavity and the eye
     # sockets), the skull wrap keeps at least this far below it (min_layer_gap stays the hard
     # bound): a muscle layer of min_layer_gap there inverts under the skin's shear.
-    min_muscle_thickness: float = 10.0e-3
+    min_muscle_thickness: float = 16.0e-3
     # Largest radial change of the muscle and skull wraps per unit of arc between neighbouring
     # directions (0: unbounded); steeper steps lean the prisms over into needles and slivers.
-    max_wrap_slope: float = 1.0
+    max_wrap_slope: float = 0.5
     muscle_fraction: float = 0.5  # template muscle wrap depth, as a share of skin-to-skull
     muscle_relative_share: float = 0.1  # paper: 10 % of the relative change is followed
     min_skull_radius: float = 0.02  # the skull wrap keeps this far from the head centre
