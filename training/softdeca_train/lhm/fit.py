@@ -242,9 +242,10 @@ def _lip_of_points(template: Template, head: np.ndarray, bones: np.ndarray) -> n
 def _embed_skin_by_side(
     vertices: np.ndarray, soft: np.ndarray, skin: np.ndarray, tri_side: np.ndarray, bone: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """S's embedding in the soft tets, each lip in its own side of the mouth slit: a point
-    riding the jaw (ICT's jawOpen moves it with the lower teeth) is not embedded in a tet of
-    the upper lip's side, one riding the cranium not in the lower lip's. Next to the slit the
+    """S's embedding in the soft tets, each lip in its own side of the mouth slit: a point of
+    the lower lip's side (`bone` JAW, `_lip_of_points`) is not embedded in a tet of the upper
+    lip's side of the slit (`tri_side` +1), one of the upper lip's not in the lower lip's (-1).
+    Next to the slit the
     radial wall between the sides leans through the lips (the rays come from above and
     behind), so such points are embedded in the nearest tet of their own side, with
     barycentric coordinates outside [0, 1] (exact at rest, affine under deformation)."""
