@@ -83,7 +83,9 @@ def tets_spanning_both_lips(model: LayeredHeadModel, tets: np.ndarray) -> int:
 
 def mouth_quality(model: LayeredHeadModel) -> QualityReport:
     """Element quality of the model, overall and in the mouth region around the slit."""
-    center = model.skin_wrap[-len(model.slit_copy_of) :].mean(axis=0)
+    k = len(model.slit_copy_of)
+    middle = model.n_wrap - k + np.arange(k) if k else model.slit_path  # the slit's inner part
+    center = model.skin_wrap[middle].mean(axis=0)
     mouth = mouth_columns(model.skin_wrap, center, model.n_layers)
     return quality_report(model.vertices, model.soft_tets, model.muscle_tets, mouth)
 

@@ -362,6 +362,7 @@ def fit_lhm(
         tissue_depth=slit.extend(rad.depth),
         lip_side=lip_side,
         slit_copy_of=slit.copy_of.astype(np.int32),
+        slit_path=slit.path.astype(np.int32),
         attachments={
             # Bone each non-skin ICT vertex rides with (teeth, gums, tongue, eyes, ...).
             "bone_of_vertex": bones[N_SKIN:],

@@ -61,9 +61,11 @@ class LayeredHeadModel:
     tissue_depth: np.ndarray  # (n_wrap,) the prior's skin-to-skull depth (normal), metres
     # Mouth slit (lhm/mouth.py): per wrap vertex +1 / -1 in the upper / lower lip's columns
     # next to the slit (0 elsewhere); the last len(slit_copy_of) wrap vertices are the lower
-    # lip's copies of the slit's inner vertices slit_copy_of.
+    # lip's copies of the slit's inner vertices slit_copy_of (none below wrap level 3, where
+    # the mouth is narrower than two wrap edges).
     lip_side: np.ndarray
     slit_copy_of: np.ndarray
+    slit_path: np.ndarray  # wrap vertices along the mouth line, corner to corner
     attachments: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property

@@ -188,7 +188,9 @@ def mouth_slit(
     line_dirs /= np.linalg.norm(line_dirs, axis=1, keepdims=True)
     path = _path_along(dirs, tris, line_dirs)
     if len(path) < 3:
-        raise ValueError("the wrap is too coarse for a mouth slit: raise its level")
+        # The mouth is narrower than two wrap edges (wrap levels below 3): nothing to cut.
+        no_copies = np.zeros(0, np.int64)
+        return MouthSlit(dirs.copy(), tris.copy(), path, no_copies, np.zeros(len(tris), np.int8))
     moved = _snap(dirs, tris, path, line_dirs)
     up = np.cross(line_dirs[-1] - line_dirs[0], line_dirs[len(line_dirs) // 2])
     up /= np.linalg.norm(up)
