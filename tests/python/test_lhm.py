@@ -89,7 +89,8 @@ def test_eyes_are_attached(template_model: LayeredHeadModel) -> None:
 
 def test_resolution_is_a_parameter(template: Template) -> None:
     coarse = fit_lhm(template, None, LhmConfig(level=3, soft_layers=2))
-    assert coarse.n_wrap == 10 * 4**3 + 2
+    # The icosphere's directions plus the mouth slit's copies of its inner vertices.
+    assert coarse.n_wrap == 10 * 4**3 + 2 + len(coarse.slit_copy_of)
     assert coarse.n_layers == 4
     assert len(coarse.soft_tets) == 2 * 3 * 20 * 4**3
     assert (

@@ -9,6 +9,7 @@ import numpy as np
 import softdeca_native as native
 
 from softdeca_train.lhm.model import LayeredHeadModel
+from softdeca_train.lhm.quality import QualityReport, mouth_columns, quality_report
 
 
 @dataclass(frozen=True)
@@ -22,8 +23,14 @@ class LhmReport:
     intersections: dict[str, int]  # pair of surfaces -> intersecting triangle pairs
     winding_skin_min: float  # S vertices w.r.t. the skin wrap: ~1 (inside)
     winding_muscle_max: float  # S vertices w.r.t. the muscle wrap: ~0 (outside)
-    bary_min: float  # S's embedding coordinates (must lie in [0, 1])
+    bary_min: float  # S's embedding coordinates (must lie in [0, 1] but next to the slit)
     bary_max: float
+    # S points embedded in their own lip's side of the mouth slit outside their tet (lhm/fit.py
+    # _embed_skin_by_side), and the farthest of them from it.
+    side_embedded_points: int
+    side_embedded_outside_max_mm: float
+    tets_spanning_both_lips: int  # tets with vertices of both lips' columns (must be 0)
+    quality: dict[str, dict[str, float]]  # lhm/quality.py: overall and in the mouth region
     outside_max_mm: float  # distance of S vertices outside their tet (0 when embedded)
     soft_volume_l: float
     muscle_volume_l: float
@@ -45,7 +52,42 @@ class LhmReport:
             out.append(f"S enters the muscle wrap (winding {self.winding_muscle_max:.3f})")
         if self.bary_min < -bary_tol or self.bary_max > 1 + bary_tol:
             out.append(f"S embedding outside [0, 1]: [{self.bary_min:.3g}, {self.bary_max:.3g}]")
+        if self.side_embedded_outside_max_mm > SIDE_EMBEDDING_MAX_MM:
+            out.append(
+                f"S points {self.side_embedded_outside_max_mm:.3g} mm outside their lip's tets"
+            )
+        if self.tets_spanning_both_lips:
+            out.append(f"{self.tets_spanning_both_lips} tets span both lips")
         return out
+
+
+# S points next to the mouth slit lie at most this far outside the tet of their own lip's side
+# that holds them (measured: 4.6 mm on the template at wrap level 3, 2.0 mm at level 4).
+SIDE_EMBEDDING_MAX_MM = 8.0
+
+
+def closed_wrap_triangles(model: LayeredHeadModel) -> np.ndarray:
+    """The wrap triangles with the mouth slit's copies mapped back to their originals: the
+    closed surface the wraps form at rest (the copies coincide with them there)."""
+    n_orig = model.n_wrap - len(model.slit_copy_of)
+    tris = model.wrap_triangles.astype(np.int64)
+    copies = tris >= n_orig
+    tris[copies] = model.slit_copy_of[tris[copies] - n_orig]
+    return tris.astype(np.int32)
+
+
+def tets_spanning_both_lips(model: LayeredHeadModel, tets: np.ndarray) -> int:
+    side = np.tile(model.lip_side, model.n_layers)[tets]
+    return int(((side > 0).any(axis=1) & (side < 0).any(axis=1)).sum())
+
+
+def mouth_quality(model: LayeredHeadModel) -> QualityReport:
+    """Element quality of the model, overall and in the mouth region around the slit."""
+    k = len(model.slit_copy_of)
+    middle = model.n_wrap - k + np.arange(k) if k else model.slit_path  # the slit's inner part
+    center = model.skin_wrap[middle].mean(axis=0)
+    mouth = mouth_columns(model.skin_wrap, center, model.n_layers)
+    return quality_report(model.vertices, model.soft_tets, model.muscle_tets, mouth)
 
 
 def tet_quality(points: np.ndarray, tets: np.ndarray) -> np.ndarray:
@@ -61,7 +103,7 @@ def tet_quality(points: np.ndarray, tets: np.ndarray) -> np.ndarray:
 def check_lhm(model: LayeredHeadModel, skin: np.ndarray, skin_tris: np.ndarray) -> LhmReport:
     """All invariants of `model` for the skin surface S = (skin, skin_tris)."""
     v = model.vertices
-    tris = model.wrap_triangles.astype(np.int32)
+    tris = closed_wrap_triangles(model)
     wraps = {
         "skin_wrap": model.skin_wrap,
         "muscle_wrap": model.muscle_wrap,
@@ -83,6 +125,14 @@ def check_lhm(model: LayeredHeadModel, skin: np.ndarray, skin_tris: np.ndarray) 
     w_skin = igl.fast_winding_number(wraps["skin_wrap"], tris, skin)
     w_muscle = igl.fast_winding_number(wraps["muscle_wrap"], tris, skin)
     _, _, outside = native.embed_points(v, model.soft_tets, skin)
+    b = model.skin_bary
+    side = (b.min(axis=1) < -1e-9) | (b.max(axis=1) > 1 + 1e-9)
+    own_outside = [0.0]
+    one_tet = np.array([[0, 1, 2, 3]], np.int32)
+    for i in np.flatnonzero(side):
+        corners = v[model.soft_tets[model.skin_tet[i]]]
+        own_outside.append(float(native.embed_points(corners, one_tet, skin[i : i + 1])[2][0]))
+    bary = b[~side]
     d2, _, _ = igl.point_mesh_squared_distance(wraps["skin_wrap"], skin, skin_tris)
     d = np.sqrt(d2)
     # Wrap vertices over the neck opening have no S beneath them: leave them out.
@@ -97,8 +147,12 @@ def check_lhm(model: LayeredHeadModel, skin: np.ndarray, skin_tris: np.ndarray) 
         intersections=inter,
         winding_skin_min=float(w_skin.min()),
         winding_muscle_max=float(w_muscle.max()),
-        bary_min=float(model.skin_bary.min()),
-        bary_max=float(model.skin_bary.max()),
+        bary_min=float(bary.min()),
+        bary_max=float(bary.max()),
+        side_embedded_points=int(side.sum()),
+        side_embedded_outside_max_mm=max(own_outside) * 1e3,
+        tets_spanning_both_lips=tets_spanning_both_lips(model, all_tets),
+        quality=mouth_quality(model).as_dict(),
         outside_max_mm=float(outside.max() * 1e3),
         soft_volume_l=float(native.tet_signed_volumes(v, model.soft_tets).sum() * 1e3),
         muscle_volume_l=float(native.tet_signed_volumes(v, model.muscle_tets).sum() * 1e3),

@@ -24,9 +24,11 @@ import softdeca_native as native
 from softdeca_train.geometry import umeyama
 from softdeca_train.lhm import radial
 from softdeca_train.lhm.model import CRANIUM, JAW, LayeredHeadModel, LhmConfig
+from softdeca_train.lhm.mouth import MouthSlit, mouth_line, mouth_slit, upper_lip_points
 from softdeca_train.lhm.sphere import icosphere, vertex_neighbours, zoom
 from softdeca_train.lhm.tissue_depth import depth_anchors, interpolate_depth
 from softdeca_train.template.model import N_SKIN, Template
+from softdeca_train.template.plausibility import lip_contact_zone
 
 
 @dataclass(frozen=True)
@@ -92,8 +94,10 @@ def _radii(
     center: np.ndarray,
     cfg: LhmConfig,
     layout: SampleLayout,
+    dirs: np.ndarray,
 ) -> _Radii:
-    dirs, tris, nbrs = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
+    """Radii of the wraps' rules along the directions `dirs` (the uncut triangulation)."""
+    _, tris, nbrs = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
     inner_pts = layout.points(skin, skin_tris)
     pts = np.vstack([skin, inner_pts])
     src = np.concatenate([np.arange(len(skin)), np.full(len(inner_pts), -1)])
@@ -133,6 +137,11 @@ def wrap_directions(
     return zoom(dirs, np.asarray(toward), factor), tris, vertex_neighbours(tris, len(dirs))
 
 
+def _slit(skin: np.ndarray, lm68: np.ndarray, center: np.ndarray, cfg: LhmConfig) -> MouthSlit:
+    dirs, tris, _ = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
+    return mouth_slit(dirs, tris, center, mouth_line(skin, lm68))
+
+
 def _template_radii(template: Template, cfg: LhmConfig) -> tuple[_Radii, SampleLayout]:
     """The template's own radii (for the muscle rule) and S's sample layout, once per template
     and configuration."""
@@ -141,7 +150,11 @@ def _template_radii(template: Template, cfg: LhmConfig) -> tuple[_Radii, SampleL
         skin = template.neutral[:N_SKIN]
         layout = surface_sample_layout(skin, template.skin_triangles, cfg.sample_spacing)
         center = head_center(skin, template.landmarks68, cfg.center_offset)
-        radii = _radii(skin, template.skin_triangles, template.landmarks68, center, cfg, layout)
+        slit = _slit(skin, template.landmarks68, center, cfg)
+        radii = _radii(
+            skin, template.skin_triangles, template.landmarks68, center, cfg, layout,
+            slit.directions[: slit.n_original],
+        )  # fmt: skip
         memo[cfg] = (radii, layout)
     return memo[cfg]
 
@@ -197,6 +210,57 @@ def _sphere_fit(points: np.ndarray) -> tuple[np.ndarray, float]:
     return center, float(np.sqrt(sol[3] + center @ center))
 
 
+def _lip_side(slit: MouthSlit) -> np.ndarray:
+    """Per wrap vertex (copies included): +1 in the upper lip's columns next to the slit, -1
+    in the lower lip's, 0 elsewhere and at the mouth corners."""
+    side = np.zeros(len(slit.directions), np.int8)
+    for s in (1, -1):
+        side[np.unique(slit.triangles[slit.side == s])] = s
+    side[slit.path[[0, -1]]] = 0
+    return side
+
+
+def _lip_of_points(template: Template, head: np.ndarray, bones: np.ndarray) -> np.ndarray:
+    """Per S vertex, the bone its lip side hangs on: in the lip contact zone, CRANIUM where the
+    upper lip's landmarks are nearer along S than the lower lip's, else JAW; elsewhere the
+    bone ICT's jawOpen moves it with (the mouth socket's roof with the cranium, its floor with
+    the jaw)."""
+    side = bones[:N_SKIN].copy()
+    zone = np.flatnonzero(lip_contact_zone(head, template.landmarks68))
+    above = upper_lip_points(head[:N_SKIN], template.skin_triangles, template.landmarks68, zone)
+    side[zone] = np.where(above, CRANIUM, JAW)
+    return side
+
+
+def _embed_skin_by_side(
+    vertices: np.ndarray, soft: np.ndarray, skin: np.ndarray, tri_side: np.ndarray, bone: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """S's embedding in the soft tets, each lip in its own side of the mouth slit: a point of
+    the lower lip's side (`bone` JAW, `_lip_of_points`) is not embedded in a tet of the upper
+    lip's side of the slit (`tri_side` +1), one of the upper lip's not in the lower lip's (-1).
+    Next to the slit the
+    radial wall between the sides leans through the lips (the rays come from above and
+    behind), so such points are embedded in the nearest tet of their own side, with
+    barycentric coordinates outside [0, 1] (exact at rest, affine under deformation)."""
+    tet, bary, _ = native.embed_points(vertices, soft, skin)
+    tet = np.asarray(tet, np.int64)
+    side = tri_side[tet % len(tri_side)]
+    wrong = ((side > 0) & (bone == JAW)) | ((side < 0) & (bone == CRANIUM))
+    for s, b in ((1, JAW), (-1, CRANIUM)):
+        pick = np.flatnonzero(wrong & (bone == b))
+        if len(pick) == 0:
+            continue
+        # Candidates near the points only (the nearest-tet search is costly for outside points).
+        lo, hi = skin[pick].min(axis=0) - 0.02, skin[pick].max(axis=0) + 0.02
+        centroid = vertices[soft].mean(axis=1)
+        near = ((centroid > lo) & (centroid < hi)).all(axis=1)
+        allowed = np.flatnonzero((np.tile(tri_side, len(soft) // len(tri_side)) != s) & near)
+        t2, b2, _ = native.embed_points(vertices, soft[allowed], skin[pick])
+        tet[pick] = allowed[np.asarray(t2)]
+        bary[pick] = b2
+    return tet, bary
+
+
 def fit_lhm(
     template: Template, identity: np.ndarray | None = None, config: LhmConfig | None = None
 ) -> LayeredHeadModel:
@@ -206,10 +270,12 @@ def fit_lhm(
         raise ValueError("soft_layers and muscle_layers must be at least 1")
     head = template.identity_neutral(identity)
     skin = head[:N_SKIN]
-    dirs, tris, nbrs = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
+    _, _, nbrs = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
     center = head_center(skin, template.landmarks68, cfg.center_offset)
+    slit = _slit(skin, template.landmarks68, center, cfg)
+    dirs = slit.directions[: slit.n_original]
     tpl, layout = _template_radii(template, cfg)
-    rad = _radii(skin, template.skin_triangles, template.landmarks68, center, cfg, layout)
+    rad = _radii(skin, template.skin_triangles, template.landmarks68, center, cfg, layout, dirs)
 
     # Muscle wrap: template's absolute depth plus a share of the relative change (paper 3.1.2).
     total_t = np.maximum(tpl.skin - tpl.skull_prior, 1e-6)
@@ -222,6 +288,8 @@ def fit_lhm(
     # Smooth the wish, then clamp: min() keeps every bound (nesting, S outside the muscle wrap).
     wish = radial.smooth(rad.skin - depth, nbrs, cfg.inner_smoothing)
     r_muscle = np.minimum(np.minimum(wish, rad.inner), rad.skin - gap)
+    if cfg.max_wrap_slope > 0:
+        r_muscle = radial.limit_slope(r_muscle, dirs, nbrs, cfg.max_wrap_slope)
     # Where S's cavities (mouth, eye sockets) push the muscle wrap below its wish, the skull
     # prior no longer applies (it would lie above the muscle wrap): keep the muscle layer at
     # least min_muscle_thickness thick there instead of min_layer_gap.
@@ -231,25 +299,31 @@ def fit_lhm(
         np.minimum(rad.skull_prior, r_muscle - muscle_gap), nbrs, cfg.inner_smoothing
     )
     r_skull = np.maximum(np.minimum(r_skull, r_muscle - muscle_gap), cfg.min_skull_radius)
+    if cfg.max_wrap_slope > 0:
+        r_skull = radial.limit_slope(r_skull, dirs, nbrs, cfg.max_wrap_slope)
     r_skull = np.minimum(r_skull, r_muscle - gap)
     if np.any(r_skull > r_muscle - gap + 1e-12):
         raise ValueError("the head is too thin for the layers: lower min_skull_radius or gaps")
 
-    # Layers from outside in, with optional intermediate tet layers.
+    # Layers from outside in, with optional intermediate tet layers; the mouth slit's copies
+    # take their original's radius (the lips touch at rest).
     radii = [rad.skin + (r_muscle - rad.skin) * k / cfg.soft_layers for k in range(cfg.soft_layers)]
     radii += [
         r_muscle + (r_skull - r_muscle) * k / cfg.muscle_layers for k in range(cfg.muscle_layers)
     ]
-    radii.append(r_skull)
-    n = len(dirs)
-    vertices = np.vstack([center + r[:, None] * dirs for r in radii])
+    radii = [slit.extend(r) for r in [*radii, r_skull]]
+    all_dirs, tris = slit.directions, slit.triangles
+    n = len(all_dirs)
+    vertices = np.vstack([center + r[:, None] * all_dirs for r in radii])
     ids = [np.arange(k * n, (k + 1) * n) for k in range(len(radii))]
     tets = [prism_tets(ids[k], ids[k + 1], tris, vertices) for k in range(len(radii) - 1)]
     soft = np.vstack(tets[: cfg.soft_layers])
     muscle = np.vstack(tets[cfg.soft_layers :])
 
-    tet, bary, _ = native.embed_points(vertices, soft, skin)
     bones = _bone_labels(template, head)
+    tet, bary = _embed_skin_by_side(
+        vertices, soft, skin, slit.side, _lip_of_points(template, head, bones)
+    )
     skull_labels = np.where(
         (rad.owner >= 0) & (bones[np.maximum(rad.owner, 0)] == JAW), JAW, CRANIUM
     )
@@ -260,13 +334,17 @@ def fit_lhm(
     for _ in range(2):
         share = np.bincount(owner_of, weights=skull_labels[flat], minlength=len(nbrs)) / counts
         skull_labels = np.where(share > 0.5, JAW, np.where(share < 0.5, CRANIUM, skull_labels))
+    lip_side = _lip_side(slit)
+    skull_labels = slit.extend(skull_labels)
+    skull_labels[lip_side > 0] = CRANIUM  # the upper lip hangs on the maxilla
+    skull_labels[lip_side < 0] = JAW  # the lower lip on the mandible
     eyes = [
         _sphere_fit(head[template.components[c].slice]) for c in ("eyeball_left", "eyeball_right")
     ]
     return LayeredHeadModel(
         config=cfg,
         center=center,
-        directions=dirs,
+        directions=all_dirs,
         wrap_triangles=tris,
         vertices=vertices,
         soft_tets=soft,
@@ -274,7 +352,10 @@ def fit_lhm(
         skull_labels=skull_labels.astype(np.int8),
         skin_tet=np.asarray(tet, np.int32),
         skin_bary=bary,
-        tissue_depth=rad.depth,
+        tissue_depth=slit.extend(rad.depth),
+        lip_side=lip_side,
+        slit_copy_of=slit.copy_of.astype(np.int32),
+        slit_path=slit.path.astype(np.int32),
         attachments={
             # Bone each non-skin ICT vertex rides with (teeth, gums, tongue, eyes, ...).
             "bone_of_vertex": bones[N_SKIN:],

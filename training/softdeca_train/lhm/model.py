@@ -24,8 +24,12 @@ class LhmConfig:
     min_layer_gap: float = 2.0e-3  # minimum radial thickness of each tissue layer
     # Where S's cavities push the muscle wrap deep (behind the oral cavity and the eye
     # sockets), the skull wrap keeps at least this far below it (min_layer_gap stays the hard
-    # bound): a muscle layer of min_layer_gap there inverts under the skin's shear.
-    min_muscle_thickness: float = 10.0e-3
+    # bound): a thinner muscle layer there inverts under the skin's shear (2 mm: on every
+    # frame moving the mouth; 10 mm: 3 more failing frames of the stress set than 16 mm).
+    min_muscle_thickness: float = 16.0e-3
+    # Largest radial change of the muscle and skull wraps per unit of arc between neighbouring
+    # directions (0: unbounded); steeper steps lean the prisms over into needles and slivers.
+    max_wrap_slope: float = 0.5
     muscle_fraction: float = 0.5  # template muscle wrap depth, as a share of skin-to-skull
     muscle_relative_share: float = 0.1  # paper: 10 % of the relative change is followed
     min_skull_radius: float = 0.02  # the skull wrap keeps this far from the head centre
@@ -55,6 +59,13 @@ class LayeredHeadModel:
     skin_tet: np.ndarray  # (n_S,) index into soft_tets
     skin_bary: np.ndarray  # (n_S, 4)
     tissue_depth: np.ndarray  # (n_wrap,) the prior's skin-to-skull depth (normal), metres
+    # Mouth slit (lhm/mouth.py): per wrap vertex +1 / -1 in the upper / lower lip's columns
+    # next to the slit (0 elsewhere); the last len(slit_copy_of) wrap vertices are the lower
+    # lip's copies of the slit's inner vertices slit_copy_of (none below wrap level 3, where
+    # the mouth is narrower than two wrap edges).
+    lip_side: np.ndarray
+    slit_copy_of: np.ndarray
+    slit_path: np.ndarray  # wrap vertices along the mouth line, corner to corner
     attachments: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property

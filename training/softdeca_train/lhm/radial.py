@@ -169,3 +169,27 @@ def repair_crossings(
         hit = np.unique(tris[np.array([a for a, _ in pairs])].ravel())
         r[hit] *= factor
     raise RuntimeError("wrap still crosses the surface after repair; raise the wrap level")
+
+
+def limit_slope(
+    r: np.ndarray, dirs: np.ndarray, neighbours: list[np.ndarray], slope: float
+) -> np.ndarray:
+    """The largest radii <= r whose change between neighbouring directions is at most
+    `slope` times the arc between them (|r_i - r_j| <= slope * r_j * angle_ij): a lower
+    envelope, found by relaxing every edge until nothing changes (a shortest-path fixed
+    point). Steep steps in a deep wrap (where S's cavities push it down next to a
+    directions where they do not) make the prisms' side walls lean over and split into
+    needles and slivers; only lowering keeps every "below" bound of the wrap."""
+    counts = np.array([len(n) for n in neighbours])
+    flat = np.concatenate(neighbours)
+    owner = np.repeat(np.arange(len(neighbours)), counts)
+    angle = np.arccos(np.clip(np.einsum("ij,ij->i", dirs[owner], dirs[flat]), -1.0, 1.0))
+    out = r.copy()
+    for _ in range(len(r)):
+        bound = np.full(len(r), np.inf)
+        np.minimum.at(bound, owner, out[flat] * (1.0 + slope * angle))
+        new = np.minimum(out, bound)
+        if np.array_equal(new, out):
+            return out
+        out = new
+    return out
