@@ -41,6 +41,7 @@ struct SurfaceTopology {
 struct CollisionTopology {
   explicit CollisionTopology(const SimulationMesh& mesh);
   std::vector<SurfaceTopology> sets;  // one per mesh.collisions entry
+  Positions rest_skin;                // S at rest: which side of a lip surface a point came from
 };
 
 // Points of every collision set that lie behind their surface by more than `tolerance`.
@@ -48,7 +49,11 @@ struct CollisionTopology {
 // A point counts when its closest surface point lies within the set's max_distance and
 // inside the surface (not on a boundary edge), and the vector to it points against the
 // closest feature's pseudo-normal (face, edge or angle-weighted vertex normal: exact
-// inside/outside for closed surfaces, Baerentzen and Aanaes 2005).
+// inside/outside for closed surfaces, Baerentzen and Aanaes 2005). On a surface of S (an open
+// lip sheet, where the sign of a far point is not defined and a curled lip's normal flips)
+// the point must also have crossed it: at rest it lay on the side the current normal calls
+// outside (no more than 1 mm behind), so a point that was always on the far side of a
+// rolling lip is no contact.
 std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const CollisionTopology& topology,
                                        const Positions& skin, const Positions& vertices, double tolerance);
 // The same, building the topology first.
