@@ -52,7 +52,7 @@ struct CollisionTopology {
 // inside/outside for closed surfaces, Baerentzen and Aanaes 2005). On a surface of S (an open
 // lip sheet, where the sign of a far point is not defined and a curled lip's normal flips)
 // the point must also have crossed it: at rest it lay on the side the current normal calls
-// outside (no more than 1 mm behind), so a point that was always on the far side of a
+// outside (no more than 3 mm behind), so a point that was always on the far side of a
 // rolling lip is no contact.
 std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const CollisionTopology& topology,
                                        const Positions& skin, const Positions& vertices, double tolerance);
