@@ -1,9 +1,9 @@
 // Lip and teeth collisions (paper 3.3.2), resolved after the volumetric solve by a further
 // projective step on the skin surface S itself, as in Komaritzan and Botsch's projective
-// skinning: each penetrating point is tied to the closest point of the surface it went
-// through by a stiff constraint whose target is zero distance, so the two coincide and no gap
-// opens between upper and lower lip; the rest of the lip region follows through strain
-// constraints that keep the shape the volumetric solve produced.
+// skinning: each penetrating point and the closest point of the surface it went through are
+// driven by stiff constraints to a common place (their midpoint; the teeth do not move), so
+// the two coincide and no gap opens between upper and lower lip; the rest of the lip region
+// follows through strain constraints that keep its shape.
 //
 // Why on S and not through the tets: S rides in the outer tet layer, and where the layer is
 // thick (the layered head model closes its wraps over the mouth, so one tet can span both
@@ -82,10 +82,12 @@ struct LipTargets {
   Eigen::VectorXd weight;
 };
 
-// Detect, tie, solve on S, repeat (at most settings.collision_rounds times). Contacts persist
-// across rounds, one per (set, point), moved to the newest closest point. The result is the
-// round with the fewest penetrating points among those that reduce them and move no point
-// farther than twice the deepest initial penetration (+ 1 mm); otherwise the uncorrected skin. With
+// Detect, tie, solve on S, repeat while a point penetrates or a contact's sides are apart (at
+// most settings.collision_rounds times). Contacts persist across rounds, one per (set, point),
+// moved to the newest closest point; their targets are fixed per round (collisions.cpp,
+// contact_rows). The result is the round with the fewest penetrating points among those that
+// reduce them (then the closest contacts) and move no point farther than twice the deepest
+// initial penetration (+ 1 mm); otherwise the uncorrected skin. With
 // `lips`, the collision sets' points first follow their targets on S (strain relative to the
 // targets' shape, the solved skin pinned around the lip region), every frame, and the contacts
 // correct that.
