@@ -146,6 +146,18 @@ TEST_F(SimCAbi, SolvesAndReadsBack) {
   for (size_t i = 0; i < skin_count; ++i)
     if (rest_skin[3 * i + 2] > 0.05f) moved = std::max(moved, static_cast<double>(skin[3 * i + 2] - rest_skin[3 * i + 2]));
   EXPECT_GT(moved, 0.002);
+  // The figures a frame's sanity check reads: the largest distance of S to its target (S's
+  // own, to float precision) and no inverted tet.
+  double largest = 0;
+  for (size_t i = 0; i < skin_count; ++i) {
+    double d2 = 0;
+    for (int c = 0; c < 3; ++c) d2 += std::pow(static_cast<double>(skin[3 * i + c]) - target[3 * i + c], 2);
+    largest = std::max(largest, std::sqrt(d2));
+  }
+  EXPECT_GT(stats.max_target_distance, 0.0);
+  EXPECT_NEAR(stats.max_target_distance, largest, 1e-6);
+  EXPECT_EQ(stats.inverted_elements, 0u);
+  EXPECT_EQ(stats.rejected_collision_rounds, 0u);
 
   // Dynamic steps and a batch through the same handle.
   ASSERT_EQ(softdeca_sim_set_parameter(sim, param("dyn_gamma"), 0.5), SOFTDECA_OK);

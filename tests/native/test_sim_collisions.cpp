@@ -15,9 +15,9 @@ struct Lips {
   std::vector<int32_t> lower, upper;  // skin points of each lip's facing sheet
 };
 
-Lips make_lips(int n = 8) {
+Lips make_lips(int n = 8, double gap = 0.002) {
   Lips l;
-  const double size = 0.03, thick = 0.008, gap = 0.002;
+  const double size = 0.03, thick = 0.008;
   const int per = (n + 1) * (n + 1);
   // Vertex layers: lower bottom, lower top, upper bottom, upper top.
   const double heights[4] = {-gap / 2 - thick, -gap / 2, gap / 2, gap / 2 + thick};
@@ -216,4 +216,43 @@ TEST(SimCollisions, ContactCorrectionsAreBoundedByThePenetrationDepth) {
   EXPECT_EQ(r.stats.rejected_collision_rounds, 0);
   EXPECT_LE(r.stats.max_contact_correction, 2 * deepest + 1e-3);
   EXPECT_LE(max_distance(r.skin, target), 2 * deepest + 1e-3);
+}
+
+TEST(SimCollisions, APointThatNeverCrossedALipSheetIsNoContact) {
+  // Lips 8 mm apart at rest. The lower sheet curls over (turned 180 degrees about X in its
+  // own plane, so its normal points down) and the upper sheet comes down to 3 mm above it:
+  // by the closest feature's normal the upper points are 3 mm "behind" the lower sheet, but
+  // they were 8 mm behind it along that normal at rest too, so they never crossed it.
+  const Lips lips = make_lips(8, 0.008);
+  const Positions rest = embed(lips.mesh.skin, lips.mesh.rest);
+  const auto per = static_cast<Eigen::Index>(lips.lower.size());
+  Positions curled = rest;
+  curled.topRows(per).col(2) *= -1;
+  curled.bottomRows(per).col(1).array() = -0.001;
+  for (const Contact& c : find_penetrations(lips.mesh, curled, lips.mesh.rest, 1e-5)) ADD_FAILURE() << c.point;
+  // Crossing it from the side it was on is a contact: the upper sheet 1 mm below the lower one.
+  Positions crossed = rest;
+  crossed.bottomRows(per).col(1).array() = -0.005;
+  const std::vector<Contact> found = find_penetrations(lips.mesh, crossed, lips.mesh.rest, 1e-5);
+  EXPECT_FALSE(found.empty());
+  for (const Contact& c : found) EXPECT_NEAR(c.depth, 0.001, 1e-9);
+}
+
+TEST(SimCollisions, LipsPushedDeepThroughEachOtherCloseWithBoundedMoves) {
+  // As rolled lips: the sheets pushed up to 5 mm through each other, so ties on both
+  // sides disagree; relative ties once slid whole regions 57 mm on the real head. With fixed
+  // targets no point moves farther than the penetration explains, and the lips close.
+  const Lips lips = make_lips();
+  Simulator sim(lips.mesh);
+  Positions target = squeeze(lips);
+  const auto per = static_cast<Eigen::Index>(lips.lower.size());
+  target.topRows(per).col(1).array() += 0.002;  // the lower sheet farther up through the upper
+  double deepest = 0;
+  for (const Contact& c : find_penetrations(lips.mesh, target, lips.mesh.rest, 1e-5)) deepest = std::max(deepest, c.depth);
+  ASSERT_GT(deepest, 2e-3);
+  const FrameResult r = sim.solve_static(input_with(target));
+  EXPECT_EQ(r.stats.penetrating_after, 0);
+  EXPECT_EQ(r.stats.rejected_collision_rounds, 0);
+  EXPECT_LT(r.stats.max_contact_gap, 1e-5);
+  EXPECT_LE(r.stats.max_contact_correction, 2 * deepest + 1e-3);
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 
 #include "sim/projections.h"
@@ -108,4 +109,27 @@ TEST(SimStrainLimit, NoResponseBelowEpsilon) {
   // With epsilon below 1 a stretched element goes to its rotation (the nearer point).
   const Eigen::Matrix3d C2 = project_strain_limit(F, s, 0.8, StrainLimit::kNearestInSet);
   EXPECT_LT((C2 - R).norm(), 1e-12);
+}
+
+TEST(SimStrainLimit, NoTetProjectionHoldsAnElementInverted) {
+  // An element with one vertex pushed through its opposite face (det F < 0), stretched and
+  // compressed: every tet projection's target has det >= 0, so no energy keeps it inverted.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (const Eigen::Vector3d& sigma : {Eigen::Vector3d(1.2, 1.0, -0.3), Eigen::Vector3d(0.9, 0.8, -0.2),
+                                      Eigen::Vector3d(1.0, 1.0, -1.0), Eigen::Vector3d(1.6, 0.5, -0.4)}) {
+    const Eigen::Matrix3d F = turn * sigma.asDiagonal();
+    const Svd3 s = svd3(F);
+    ASSERT_LT(s.sigma(2), 0);
+    EXPECT_GT(project_rotation(s).determinant(), 0.999);
+    EXPECT_NEAR(project_volume(s, 1.0).determinant(), 1.0, 1e-9);
+    for (const double eps : {0.8, 1.0, 1.05, 2.0}) {
+      const Eigen::Matrix3d P = project_strain_limit(F, s, eps, StrainLimit::kNearestInSet);
+      EXPECT_GE(P.determinant(), -1e-12) << "sigma " << sigma.transpose() << " eps " << eps;
+      // The nearest point of the set: no rotation and no clamped non-inverted point is nearer.
+      EXPECT_LE((P - F).norm(), (project_rotation(s) - F).norm() + 1e-12);
+      Eigen::Vector3d c = s.sigma;
+      for (int i = 0; i < 3; ++i) c(i) = std::clamp(c(i), 0.0, eps);
+      EXPECT_LE((P - F).norm(), (s.U * c.asDiagonal() * s.V.transpose() - F).norm() + 1e-12);
+    }
+  }
 }

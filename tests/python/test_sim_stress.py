@@ -139,21 +139,16 @@ _KNOWN = (
     "needle-shaped muscle / soft tets of the radial LHM invert under strong lip motion "
     "(docs/physics.md, Inverted elements)"
 )
-# Rolled lips (mouthRollLower and mouthRollUpper at 1, seed 1): the linear blend has 355 lip
-# points up to 2.8 mm inside the other lip; every contact round moves points farther than the
-# bound allows and is rejected, and joining the lips to the volumetric result adds one more.
-_ROLLED = (
-    "rolled lips: contact rounds rejected by the correction bound (docs/physics.md)"
-)
 
 
 @pytest.mark.parametrize(
     "reason",
     [
         "exploded",
-        pytest.param(
-            "penetration", marks=pytest.mark.xfail(strict=True, reason=_ROLLED)
-        ),
+        # Rolled lips (mouthRollLower and mouthRollUpper at 1, seed 1): the linear blend has
+        # 355 lip points up to 2.8 mm inside the other lip or the teeth; the contacts resolve
+        # them all (docs/physics.md, Collisions).
+        "penetration",
         pytest.param(
             "inverted_elements", marks=pytest.mark.xfail(strict=True, reason=_KNOWN)
         ),

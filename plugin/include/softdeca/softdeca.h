@@ -470,6 +470,13 @@ typedef struct softdeca_sim_stats {
   double target_rms;        /* RMS distance of S to its (blended) targets (m) */
   double local_seconds, global_seconds, factor_seconds, total_seconds;
   uint32_t penetrating_before, penetrating_after, contacts;
+  /* What a frame's sanity check needs (docs/physics.md, "Sanity bounds"). */
+  uint32_t inverted_elements;       /* soft and muscle tets with volume <= 0 at the end */
+  double max_target_distance;       /* largest distance of a point of S to its (blended) target (m) */
+  uint32_t collision_rounds;        /* contact rounds run */
+  uint32_t rejected_collision_rounds; /* rounds that moved points beyond the penetration depth */
+  double max_contact_gap;           /* largest distance between the two sides of a contact (m) */
+  double max_contact_correction;    /* largest move of a point of S by the contact step (m) */
 } softdeca_sim_stats;
 
 /* One static frame T = phi†(S_t, p). stats may be NULL. On success the result replaces the

@@ -170,6 +170,12 @@ void to_stats(const SolveStats& s, softdeca_sim_stats* out) {
   out->penetrating_before = static_cast<uint32_t>(s.penetrating_before);
   out->penetrating_after = static_cast<uint32_t>(s.penetrating_after);
   out->contacts = static_cast<uint32_t>(s.contacts);
+  out->inverted_elements = static_cast<uint32_t>(s.inverted_elements);
+  out->max_target_distance = s.max_target_distance;
+  out->collision_rounds = static_cast<uint32_t>(s.collision_rounds);
+  out->rejected_collision_rounds = static_cast<uint32_t>(s.rejected_collision_rounds);
+  out->max_contact_gap = s.max_contact_gap;
+  out->max_contact_correction = s.max_contact_correction;
 }
 
 void copy_out(const Positions& p, float* out, std::size_t count, const char* name) {

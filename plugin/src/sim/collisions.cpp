@@ -61,24 +61,40 @@ const Positions& surface_positions(const CollisionSet& set, const Positions& ski
   return set.surface_on_skin ? skin : vertices;
 }
 
-// The contact as a constraint row over S (unknowns of the surface step) and its target: for
-// a surface on S the row is point - surface point with target 0; for a surface on simulated
-// vertices (teeth, fixed in this step) the row is the point and the target the surface point.
-TargetElement contact_element(const SimulationMesh& mesh, const Contact& c, const Positions& vertices, double weight,
-                              Eigen::RowVector3d& target) {
+// The contact's constraint rows over S (unknowns of the surface step), each with a fixed
+// target, appended to `rows` / `targets`. Against a surface on simulated vertices (teeth,
+// fixed in this step) the point's target is its closest surface point. Against a surface on
+// S both sides move halfway: the point to the midpoint of it and its closest surface point,
+// the surface triangle's corners by the same translation (rows weighted by half the
+// barycentric coordinates, below), so the two coincide (no gap, as in projective skinning).
+// Fixed per-vertex targets, not a relative tie "point - surface point = 0" or a barycentric
+// row: a stiff relative tie has no fixed place, and two barycentric rows on one triangle with
+// different targets fix the triangle's slope with a lever (targets 0.1 mm apart at
+// coordinates 0.9 / 0.8 put its corners 1 mm apart), so where ties disagree (rolled lips:
+// each lip inside the other and both inside the teeth) the least-squares solution moved whole
+// regions far (57 mm for penetrations of 2.8 mm). With fixed per-vertex targets every tied
+// point moves toward places within its penetration depth.
+void contact_rows(const SimulationMesh& mesh, const Contact& c, const Positions& skin, const Positions& vertices,
+                  double weight, std::vector<TargetElement>& rows, std::vector<Eigen::RowVector3d>& targets) {
   const CollisionSet& set = mesh.collisions[static_cast<std::size_t>(c.set)];
-  TargetElement e{PointRow{{c.point}, {1.0}}, weight};
-  target.setZero();
+  const Positions& sv = surface_positions(set, skin, vertices);
+  Eigen::RowVector3d q = Eigen::RowVector3d::Zero();
+  for (int k = 0; k < 3; ++k) q += c.bary[k] * sv.row(set.surface(c.triangle, k));
+  const Eigen::RowVector3d meet = set.surface_on_skin ? Eigen::RowVector3d(0.5 * (skin.row(c.point) + q)) : q;
+  rows.push_back({PointRow{{c.point}, {1.0}}, weight});
+  targets.push_back(meet);
+  if (!set.surface_on_skin) return;
+  // Where two sheets press into each other every point is a contact and a corner of the
+  // other side's contacts; with the corners' rows as heavy as the point's the two pulls
+  // balanced short of the surface (alex_rom_3 frame 1400: 2 points left 20-38 um inside after
+  // 30 rounds); at half weight the point's own contact leads and they close.
+  constexpr double kCornerShare = 0.5;
   for (int k = 0; k < 3; ++k) {
     const int32_t v = set.surface(c.triangle, k);
-    if (set.surface_on_skin) {
-      e.point.vertex.push_back(v);
-      e.point.weight.push_back(-c.bary[k]);
-    } else {
-      target += c.bary[k] * vertices.row(v);
-    }
+    if (!(c.bary[k] > 0) || v == c.point) continue;
+    rows.push_back({PointRow{{v}, {1.0}}, kCornerShare * weight * c.bary[k]});
+    targets.push_back(skin.row(v) + meet - q);
   }
-  return e;
 }
 
 double contact_gap(const SimulationMesh& mesh, const Contact& c, const Positions& skin, const Positions& vertices) {
@@ -158,7 +174,7 @@ SurfaceTopology::SurfaceTopology(const TriIndices& tris) {
   }
 }
 
-CollisionTopology::CollisionTopology(const SimulationMesh& mesh) {
+CollisionTopology::CollisionTopology(const SimulationMesh& mesh) : rest_skin(embed(mesh.skin, mesh.rest)) {
   for (const CollisionSet& set : mesh.collisions) sets.emplace_back(set.surface);
 }
 
@@ -207,9 +223,23 @@ bool locate(const SimulationMesh& mesh, const CollisionTopology& topology, std::
   if (best.triangle < 0) return false;
   Vec3 n;
   if (!feature_normal(topology.sets[si], set.surface, sv, best.triangle, best.bary, n) || !(n.norm() > 0)) return false;
-  Vec3 point = Vec3::Zero();
-  for (int k = 0; k < 3; ++k) point += best.bary[k] * sv.row(set.surface(best.triangle, k)).transpose();
-  best.depth = -(q - point).dot(n.normalized());
+  n.normalize();
+  Vec3 point = Vec3::Zero(), rest_point = Vec3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const int32_t v = set.surface(best.triangle, k);
+    point += best.bary[k] * sv.row(v).transpose();
+    if (set.surface_on_skin) rest_point += best.bary[k] * topology.rest_skin.row(v).transpose();
+  }
+  best.depth = -(q - point).dot(n);
+  // A lip sheet is open: behind it by more than the slack already at rest (along today's
+  // normal) means the point never crossed it (a curled lip's normal turned toward it: on
+  // all_mouth_half lower-lip points 6-7 mm below the upper lip, 13 mm "behind" it at rest).
+  // The slack keeps pressed lips, whose closest points lie a few mm apart along the sheet at
+  // rest (press_shrug on the template: 138 of 143 contacts with 3 mm, 36 with 1 mm).
+  constexpr double kRestSideSlack = 3e-3;  // m
+  if (set.surface_on_skin && best.depth > 0 &&
+      (Vec3(topology.rest_skin.row(p).transpose()) - rest_point).dot(n) < -kRestSideSlack)
+    return false;
   out = best;
   return true;
 }
@@ -276,19 +306,17 @@ struct SurfaceProblem {
     const Eigen::Index anchor_row = m.rows;
     add_group(m, std::make_unique<TargetGroup>("lip anchor", anchor));
     std::vector<TargetElement> ties;
-    Positions tie_targets(static_cast<Eigen::Index>(contacts.size()), 3);
-    for (const auto& [key, c] : contacts) {
-      Eigen::RowVector3d target;
-      ties.push_back(contact_element(mesh, c, vertices, pa * settings.collision_weight * skin_area[c.point] /
-                                                            k.target_layer_thickness_m, target));
-      tie_targets.row(static_cast<Eigen::Index>(ties.size()) - 1) = target;
-    }
+    std::vector<Eigen::RowVector3d> tie_targets;
+    for (const auto& [key, c] : contacts)
+      contact_rows(mesh, c, skin, vertices,
+                   pa * settings.collision_weight * skin_area[c.point] / k.target_layer_thickness_m, ties,
+                   tie_targets);
     const Eigen::Index tie_row = m.rows;
     if (!ties.empty()) add_group(m, std::make_unique<TargetGroup>("contacts", std::move(ties)));
     const System sys(m);
     Positions P = Positions::Zero(sys.rows(), 3);
     for (std::size_t i = 0; i < anchor_rows.size(); ++i) P.row(anchor_row + static_cast<Eigen::Index>(i)) = anchor_rows[i];
-    if (tie_targets.rows() > 0) P.middleRows(tie_row, tie_targets.rows()) = tie_targets;
+    for (std::size_t i = 0; i < tie_targets.size(); ++i) P.row(tie_row + static_cast<Eigen::Index>(i)) = tie_targets[i];
     SolverSettings st = settings;
     st.record_energy = false;
     run_projective_dynamics(FrameProblem{&m, &sys, nullptr, nullptr, length}, P, skin, st, pool, stats);
@@ -343,53 +371,39 @@ void slide_contacts(const SimulationMesh& mesh, const CollisionTopology& topolog
 }
 }  // namespace
 
-CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
-                                   const Positions& vertices, const Eigen::VectorXd& skin_area,
-                                   const SolverSettings& settings, ThreadPool* pool, const LipTargets* lips) {
-  const auto t0 = std::chrono::steady_clock::now();
-  CollisionResult r;
-  r.skin = skin;
-  const bool on_surface = lips != nullptr && lips->targets.rows() == skin.rows() && settings.collision_rounds > 0;
-  std::vector<Contact> found;
-  if (!on_surface) {
-    found = find_penetrations(mesh, topology, skin, vertices, settings.penetration_tolerance);
-    r.penetrating_before = static_cast<int>(found.size());
-    if (found.empty() || settings.collision_rounds == 0) {
-      r.penetrating_after = r.penetrating_before;
-      return r;
-    }
-  }
+namespace {
+using ContactMap = std::map<std::pair<int, int32_t>, Contact>;  // one per (set, point)
+
+double largest_gap(const SimulationMesh& mesh, const ContactMap& contacts, const Positions& skin,
+                   const Positions& vertices) {
+  double gap = 0;
+  for (const auto& [key, c] : contacts) gap = std::max(gap, contact_gap(mesh, c, skin, vertices));
+  return gap;
+}
+
+// The rounds of detect, tie, solve from `base` (the uncorrected skin) with its penetrations
+// `found`. A round is kept only when it leaves fewer penetrating points than the best so far
+// (the uncorrected skin to begin with: contacts never add penetrations), or as many (none)
+// with closer contacts, and moves no point farther from the uncorrected skin than twice the
+// deepest penetration found there plus a slack (a tie moves both sides: on two slabs pressed
+// 3 mm into each other points move up to 5.9 mm): a correction the measured depth cannot
+// explain is the contact step injecting energy, and stops the rounds. Rounds go on while a
+// point penetrates or a contact's two sides are farther apart than the tolerance.
+void contact_rounds(const SimulationMesh& mesh, const CollisionTopology& topology, const SurfaceProblem& surface,
+                    const Positions& base, const Positions& vertices, std::vector<Contact> found,
+                    const SolverSettings& settings, CollisionResult& r) {
   constexpr double kCorrectionSlack = 1e-3;  // m, beyond the deepest penetration
-  const SurfaceProblem surface =
-      surface_problem(mesh, skin, vertices, skin_area, settings, pool, on_surface ? lips : nullptr);
-  std::map<std::pair<int, int32_t>, Contact> contacts;  // one per (set, point)
-  // What the contacts correct: the solved skin, or with lip targets the lips on their targets
-  // (joined to the solved skin around them).
-  Positions base = skin;
-  if (on_surface) {
-    SolveStats stats;
-    surface.solve(contacts, r.skin, stats);
-    r.iterations += stats.iterations;
-    base = r.skin;
-    found = find_penetrations(mesh, topology, base, vertices, settings.penetration_tolerance);
-    r.penetrating_before = static_cast<int>(found.size());
-  }
-  // A round is kept only when it leaves fewer penetrating points than the best so far (the
-  // uncorrected skin to begin with: contacts never add penetrations) and moves no point
-  // farther from the uncorrected skin than twice the deepest penetration found there plus a
-  // slack (a tie moves both sides: on two slabs pressed 3 mm into each other points move up
-  // to 5.9 mm): a correction the measured depth cannot explain is the contact step
-  // injecting energy (seen on real snarls as lip points hundreds of millimetres off), and
-  // stops the rounds.
+  const double tol = settings.penetration_tolerance;
   double deepest = 0;
   for (const Contact& c : found) deepest = std::max(deepest, c.depth);
   const double depth_bound = 2 * deepest + kCorrectionSlack;
   Positions best_skin = base;
   std::size_t best_found = found.size();
-  int best_contacts = 0;
-  double best_gap = 0, best_correction = 0;
-  while (!found.empty() && r.rounds < settings.collision_rounds) {
-    slide_contacts(mesh, topology, r.skin, vertices, settings.penetration_tolerance, contacts);
+  double best_gap = INFINITY, gap = 0;
+  ContactMap contacts;
+  r.skin = base;
+  while ((!found.empty() || gap > tol) && r.rounds < settings.collision_rounds) {
+    slide_contacts(mesh, topology, r.skin, vertices, tol, contacts);
     for (const Contact& c : found) contacts[{c.set, c.point}] = c;
     SolveStats stats;
     surface.solve(contacts, r.skin, stats);
@@ -401,21 +415,48 @@ CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTo
       ++r.rejected_rounds;
       break;
     }
-    found = find_penetrations(mesh, topology, r.skin, vertices, settings.penetration_tolerance);
-    if (found.size() < best_found) {
+    found = find_penetrations(mesh, topology, r.skin, vertices, tol);
+    gap = largest_gap(mesh, contacts, r.skin, vertices);
+    if (found.size() < best_found || (found.empty() && best_found == 0 && gap < best_gap)) {
       best_skin = r.skin;
       best_found = found.size();
-      best_contacts = static_cast<int>(contacts.size());
-      best_correction = correction;
-      best_gap = 0;
-      for (const auto& [key, c] : contacts) best_gap = std::max(best_gap, contact_gap(mesh, c, r.skin, vertices));
+      best_gap = gap;
+      r.contacts = static_cast<int>(contacts.size());
+      r.max_correction = correction;
     }
   }
-  r.skin = best_skin;
+  r.skin = std::move(best_skin);
   r.penetrating_after = static_cast<int>(best_found);
-  r.contacts = best_contacts;
-  r.max_contact_gap = best_gap;
-  r.max_correction = best_correction;
+  r.max_contact_gap = std::isfinite(best_gap) ? best_gap : 0.0;
+}
+}  // namespace
+
+CollisionResult resolve_collisions(const SimulationMesh& mesh, const CollisionTopology& topology, const Positions& skin,
+                                   const Positions& vertices, const Eigen::VectorXd& skin_area,
+                                   const SolverSettings& settings, ThreadPool* pool, const LipTargets* lips) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CollisionResult r;
+  r.skin = skin;
+  const bool on_surface = lips != nullptr && lips->targets.rows() == skin.rows() && settings.collision_rounds > 0;
+  std::vector<Contact> found;
+  if (!on_surface) {
+    found = find_penetrations(mesh, topology, skin, vertices, settings.penetration_tolerance);
+    r.penetrating_before = r.penetrating_after = static_cast<int>(found.size());
+    if (found.empty() || settings.collision_rounds == 0) return r;
+  }
+  const SurfaceProblem surface =
+      surface_problem(mesh, skin, vertices, skin_area, settings, pool, on_surface ? lips : nullptr);
+  // What the contacts correct: the solved skin, or with lip targets the lips on their targets
+  // (joined to the solved skin around them).
+  Positions base = skin;
+  if (on_surface) {
+    SolveStats stats;
+    surface.solve({}, base, stats);
+    r.iterations += stats.iterations;
+    found = find_penetrations(mesh, topology, base, vertices, settings.penetration_tolerance);
+    r.penetrating_before = static_cast<int>(found.size());
+  }
+  contact_rounds(mesh, topology, surface, base, vertices, std::move(found), settings, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

@@ -1,9 +1,9 @@
 // Lip and teeth collisions (paper 3.3.2), resolved after the volumetric solve by a further
 // projective step on the skin surface S itself, as in Komaritzan and Botsch's projective
-// skinning: each penetrating point is tied to the closest point of the surface it went
-// through by a stiff constraint whose target is zero distance, so the two coincide and no gap
-// opens between upper and lower lip; the rest of the lip region follows through strain
-// constraints that keep the shape the volumetric solve produced.
+// skinning: each penetrating point and the closest point of the surface it went through are
+// driven by stiff constraints to a common place (their midpoint; the teeth do not move), so
+// the two coincide and no gap opens between upper and lower lip; the rest of the lip region
+// follows through strain constraints that keep its shape.
 //
 // Why on S and not through the tets: S rides in the outer tet layer, and where the layer is
 // thick (the layered head model closes its wraps over the mouth, so one tet can span both
@@ -41,6 +41,7 @@ struct SurfaceTopology {
 struct CollisionTopology {
   explicit CollisionTopology(const SimulationMesh& mesh);
   std::vector<SurfaceTopology> sets;  // one per mesh.collisions entry
+  Positions rest_skin;                // S at rest: which side of a lip surface a point came from
 };
 
 // Points of every collision set that lie behind their surface by more than `tolerance`.
@@ -48,7 +49,11 @@ struct CollisionTopology {
 // A point counts when its closest surface point lies within the set's max_distance and
 // inside the surface (not on a boundary edge), and the vector to it points against the
 // closest feature's pseudo-normal (face, edge or angle-weighted vertex normal: exact
-// inside/outside for closed surfaces, Baerentzen and Aanaes 2005).
+// inside/outside for closed surfaces, Baerentzen and Aanaes 2005). On a surface of S (an open
+// lip sheet, where the sign of a far point is not defined and a curled lip's normal flips)
+// the point must also have crossed it: at rest it lay on the side the current normal calls
+// outside (no more than 3 mm behind), so a point that was always on the far side of a
+// rolling lip is no contact.
 std::vector<Contact> find_penetrations(const SimulationMesh& mesh, const CollisionTopology& topology,
                                        const Positions& skin, const Positions& vertices, double tolerance);
 // The same, building the topology first.
@@ -77,10 +82,12 @@ struct LipTargets {
   Eigen::VectorXd weight;
 };
 
-// Detect, tie, solve on S, repeat (at most settings.collision_rounds times). Contacts persist
-// across rounds, one per (set, point), moved to the newest closest point. The result is the
-// round with the fewest penetrating points among those that reduce them and move no point
-// farther than twice the deepest initial penetration (+ 1 mm); otherwise the uncorrected skin. With
+// Detect, tie, solve on S, repeat while a point penetrates or a contact's sides are apart (at
+// most settings.collision_rounds times). Contacts persist across rounds, one per (set, point),
+// moved to the newest closest point; their targets are fixed per round (collisions.cpp,
+// contact_rows). The result is the round with the fewest penetrating points among those that
+// reduce them (then the closest contacts) and move no point farther than twice the deepest
+// initial penetration (+ 1 mm); otherwise the uncorrected skin. With
 // `lips`, the collision sets' points first follow their targets on S (strain relative to the
 // targets' shape, the solved skin pinned around the lip region), every frame, and the contacts
 // correct that.

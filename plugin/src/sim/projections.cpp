@@ -1,6 +1,7 @@
 #include "sim/projections.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 namespace softdeca::sim {
@@ -55,15 +56,18 @@ Eigen::Matrix3d project_volume(const Svd3& svd, double target) {
 
 Eigen::Matrix3d project_strain_limit(const Eigen::Matrix3d& F, const Svd3& svd, double eps,
                                      StrainLimit mode) {
-  if (svd.sigma(0) <= eps) return F;  // below the limit: no strain response (eq. 10)
+  // The rotation-variant SVD shows an inverted element as sigma(2) < 0.
+  const bool inverted = svd.sigma(2) < 0;
+  if (svd.sigma(0) <= eps && !inverted) return F;  // below the limit: no strain response (eq. 10)
   const Eigen::Matrix3d R = project_rotation(svd);
-  if (mode == StrainLimit::kPaperRotation) return R;
-  // Closest point of SO(3) ∪ {sigma_max <= eps}: compare the two candidates' distances.
+  if (mode == StrainLimit::kPaperRotation) return svd.sigma(0) > eps ? R : F;
+  // Closest point of SO(3) ∪ {sigma_max <= eps, det >= 0}: compare the two candidates'
+  // distances. The second set excludes inverted elements (its projection clamps the signed
+  // singular values to [0, eps]), so no candidate holds an element inverted.
   double to_rotation = 0, to_clamp = 0;
   Eigen::Vector3d clamped;
   for (int i = 0; i < 3; ++i) {
-    const double a = std::abs(svd.sigma(i));
-    clamped(i) = std::copysign(std::min(a, eps), svd.sigma(i));
+    clamped(i) = std::clamp(svd.sigma(i), 0.0, eps);
     // Distance to the rotation: sigma against +1 (rotation-variant SVD keeps the sign).
     to_rotation += (svd.sigma(i) - 1) * (svd.sigma(i) - 1);
     to_clamp += (svd.sigma(i) - clamped(i)) * (svd.sigma(i) - clamped(i));

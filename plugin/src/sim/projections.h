@@ -10,9 +10,10 @@ namespace softdeca::sim {
 
 // How strain limiting (eq. 10) projects an element whose largest singular value exceeds eps.
 enum class StrainLimit {
-  // Closest point of the set SO(3) ∪ {sigma_max <= eps}: no response below eps; above eps the
-  // nearer of the rotation and the singular values clamped to eps. A true projection, so the
-  // PD energy decreases monotonically and a fixed point exists for every weight (default).
+  // Closest point of the set SO(3) ∪ {sigma_max <= eps, det >= 0}: no response below eps; above
+  // eps, or for an inverted element, the nearer of the rotation and the signed singular values
+  // clamped to [0, eps]. A true projection, so the PD energy decreases monotonically and a
+  // fixed point exists for every weight (default); no target of it is inverted.
   kNearestInSet,
   // The paper's literal rule: the rotation R whenever sigma_max > eps. Not a projection onto a
   // fixed set: can raise the energy when elements cross eps and can cycle between "on" and
@@ -26,7 +27,8 @@ Eigen::Vector3d project_volume_sigma(const Eigen::Vector3d& sigma, double target
 // Closest F' with det F' = target (eq. B.1's set, target sampled in [0.5, 1.5]).
 Eigen::Matrix3d project_volume(const Svd3& svd, double target);
 
-// Strain-limiting projection; returns F itself where sigma_max <= eps (no strain response).
+// Strain-limiting projection; returns F itself where sigma_max <= eps and F is not inverted
+// (no strain response).
 Eigen::Matrix3d project_strain_limit(const Eigen::Matrix3d& F, const Svd3& svd, double eps,
                                      StrainLimit mode);
 
