@@ -50,6 +50,7 @@ class Behaviour:
     corrupt: set[str] = field(default_factory=set)
     requests: list[tuple[str, str | None]] = field(default_factory=list)
     sent: int = 0
+    lock: threading.Lock = field(default_factory=threading.Lock)
 
 
 class Server:
@@ -86,8 +87,11 @@ class Server:
                 if cut is not None:  # announce everything, send part, hang up
                     payload = payload[:cut]
                     self.close_connection = True
+                # Counted before writing: the client may have read it all and moved on
+                # before this thread runs again.
+                with behaviour.lock:
+                    behaviour.sent += len(payload)
                 self.wfile.write(payload)
-                behaviour.sent += len(payload)
 
             def log_message(self, *args: object) -> None:
                 pass
