@@ -19,25 +19,17 @@
 #include "stream/ifacialmocap_packet.h"
 #include "stream/livelinkface_packet.h"
 #include "stream/wire_format.h"
+#include "receiver_test_support.h"
 #include "stream_test_support.h"
 
 using namespace softdeca;
 using namespace softdeca::live;
 using namespace softdeca::stream;
 using test::eventually;
+using test::loopback;
 using test::make_frame;
 
 namespace {
-
-ReceiverConfig loopback(Format format = Format::softdeca, double delay = 0.3) {
-  ReceiverConfig c;
-  c.bind_address = "127.0.0.1";
-  c.port = 0;
-  c.format = format;
-  c.delay = delay;
-  c.queue_capacity = 4096;
-  return c;
-}
 
 std::vector<Frame> take_all(Receiver& r) {
   std::vector<Frame> out;
@@ -57,7 +49,7 @@ wire::Profile sample_profile() {
 }  // namespace
 
 TEST(Receiver, ExactStatisticsUnderLossReorderingAndDuplication) {
-  Receiver r(loopback());
+  Receiver r(loopback(Format::softdeca, 0.3));
   FrameSender s(make_endpoint("127.0.0.1", r.port()), Format::softdeca, 42);
   const std::set<uint32_t> dropped = {20, 50, 51, 120};
   const std::set<uint32_t> doubled = {30, 90};
@@ -244,14 +236,14 @@ TEST(Receiver, RecordsWhatItDelivers) {
 }
 
 TEST(Receiver, RefusesBadConfigurationsAndTakenPorts) {
-  ReceiverConfig c = loopback();
+  ReceiverConfig c = loopback(Format::softdeca, 0.3);
   c.delay = -1;
   EXPECT_THROW(Receiver{c}, Error);
-  c = loopback();
+  c = loopback(Format::softdeca, 0.3);
   c.bind_address = "not-an-address";
   EXPECT_THROW(Receiver{c}, Error);
-  Receiver first(loopback());
-  c = loopback();
+  Receiver first(loopback(Format::softdeca, 0.3));
+  c = loopback(Format::softdeca, 0.3);
   c.port = first.port();
   EXPECT_THROW(Receiver{c}, Error);
 }

@@ -15,28 +15,22 @@
 #include <thread>
 #include <vector>
 
-#include "api/error.h"
+#include "core/error.h"
 #include "live/receiver.h"
 #include "recording/recording_reader.h"
 #include "stream/frame_sender.h"
 #include "stream/source_rate_limit.h"
+#include "receiver_test_support.h"
 #include "stream_test_support.h"
 
 using namespace softdeca;
 using namespace softdeca::live;
 using namespace softdeca::stream;
 using test::eventually;
+using test::loopback;
 using test::make_frame;
 
 namespace {
-
-ReceiverConfig loopback(Format format = Format::softdeca) {
-  ReceiverConfig c;
-  c.port = 0;
-  c.format = format;
-  c.queue_capacity = 4096;
-  return c;
-}
 
 std::size_t drain(Receiver& r) {
   std::size_t n = 0;
