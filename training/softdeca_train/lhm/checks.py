@@ -26,7 +26,7 @@ class LhmReport:
     bary_min: float  # S's embedding coordinates (must lie in [0, 1] but next to the slit)
     bary_max: float
     # S points embedded in their own lip's side of the mouth slit outside their tet (lhm/fit.py
-    # _embed_skin_by_side), and the farthest of them from it.
+    # embed_skin_by_side), and the farthest of them from it.
     side_embedded_points: int
     side_embedded_outside_max_mm: float
     tets_spanning_both_lips: int  # tets with vertices of both lips' columns (must be 0)
@@ -88,6 +88,27 @@ def mouth_quality(model: LayeredHeadModel) -> QualityReport:
     center = model.skin_wrap[middle].mean(axis=0)
     mouth = mouth_columns(model.skin_wrap, center, model.n_layers)
     return quality_report(model.vertices, model.soft_tets, model.muscle_tets, mouth)
+
+
+def conforming_quality(model: LayeredHeadModel) -> QualityReport:
+    """Element quality of the conforming fill of `model` (lhm/conforming.py), overall and in
+    the mouth region (vertices within the region's radius of the slit's middle)."""
+    from softdeca_train.lhm.conforming import conforming_mesh
+    from softdeca_train.lhm.quality import MOUTH_REGION_RADIUS
+
+    cfg = model.config
+    tm = conforming_mesh(model, cfg.tet_edge_length, cfg.tet_envelope, cfg.slit_gap)
+    k = len(model.slit_copy_of)
+    middle = model.n_wrap - k + np.arange(k) if k else model.slit_path
+    center = model.skin_wrap[middle].mean(axis=0)
+    # the mouth's columns: directions from the head centre within the region's radius of the
+    # slit's middle on the skin wrap (as for the prisms, from the skin to the skull)
+    axis = center - model.center
+    r = np.linalg.norm(axis)
+    d = tm.vertices - model.center
+    cos = d @ axis / np.maximum(np.linalg.norm(d, axis=1) * r, 1e-12)
+    mouth = cos > np.cos(np.arctan(MOUTH_REGION_RADIUS / r))
+    return quality_report(tm.vertices, tm.soft_tets, tm.muscle_tets, mouth)
 
 
 def tet_quality(points: np.ndarray, tets: np.ndarray) -> np.ndarray:

@@ -30,6 +30,12 @@ def _lhm_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--level", type=int, default=4, help="wrap resolution: icosphere level (4)")
     p.add_argument("--soft-layers", type=int, default=1, help="tet layers skin..muscle (1)")
     p.add_argument("--muscle-layers", type=int, default=1, help="tet layers muscle..skull (1)")
+    p.add_argument(
+        "--tet-mesh",
+        choices=("conforming", "prisms"),
+        default="conforming",
+        help="the simulation's tets: the conforming fill (default) or the wraps' prisms",
+    )
     p.add_argument("--out", default="out/lhm", help="output folder (out/lhm)")
 
 
@@ -45,18 +51,26 @@ def _lhm_run(args: argparse.Namespace) -> int:
     t = Template.load(args.ict)
     h = None if args.seed is None else t.sample_identity(args.seed)
     cfg = LhmConfig(
-        level=args.level, soft_layers=args.soft_layers, muscle_layers=args.muscle_layers
+        level=args.level,
+        soft_layers=args.soft_layers,
+        muscle_layers=args.muscle_layers,
+        tet_mesh=args.tet_mesh,
     )
     model = fit_lhm(t, h, cfg)
-    report = check_lhm(model, t.identity_neutral(h)[:N_SKIN], t.skin_triangles)
+    checked = check_lhm(model, t.identity_neutral(h)[:N_SKIN], t.skin_triangles)
+    report = checked.as_dict()
+    if cfg.tet_mesh == "conforming":
+        from softdeca_train.lhm.checks import conforming_quality
+
+        report["conforming_quality"] = conforming_quality(model).as_dict()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     name = "template" if args.seed is None else f"seed{args.seed}"
     model.save(out / f"lhm_{name}.npz")
-    (out / f"lhm_{name}_report.json").write_text(json.dumps(report.as_dict(), indent=2) + "\n")
+    (out / f"lhm_{name}_report.json").write_text(json.dumps(report, indent=2) + "\n")
     render_layers(t, model, out / f"lhm_{name}.png", head=t.identity_neutral(h))
-    print(json.dumps(report.as_dict(), indent=2))
-    problems = report.failures()
+    print(json.dumps(report, indent=2))
+    problems = checked.failures()
     print("valid" if not problems else "INVALID: " + "; ".join(problems))
     print(f"wrote {out}/lhm_{name}.npz, .png and _report.json")
     return 0 if not problems else 1

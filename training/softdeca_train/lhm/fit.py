@@ -189,7 +189,7 @@ def jaw_motion(
     return fit.rotation, fit.translation
 
 
-def _bone_labels(template: Template, head: np.ndarray) -> np.ndarray:
+def bone_labels(template: Template, head: np.ndarray) -> np.ndarray:
     """Per ICT vertex: JAW where jawOpen moves it like the lower teeth do, else CRANIUM."""
     i = template.expression_names.index("jawOpen")
     opened = head + template.expression_deltas[i]
@@ -220,7 +220,7 @@ def _lip_side(slit: MouthSlit) -> np.ndarray:
     return side
 
 
-def _lip_of_points(template: Template, head: np.ndarray, bones: np.ndarray) -> np.ndarray:
+def lip_of_points(template: Template, head: np.ndarray, bones: np.ndarray) -> np.ndarray:
     """Per S vertex, the bone its lip side hangs on: in the lip contact zone, CRANIUM where the
     upper lip's landmarks are nearer along S than the lower lip's, else JAW; elsewhere the
     bone ICT's jawOpen moves it with (the mouth socket's roof with the cranium, its floor with
@@ -232,11 +232,11 @@ def _lip_of_points(template: Template, head: np.ndarray, bones: np.ndarray) -> n
     return side
 
 
-def _embed_skin_by_side(
-    vertices: np.ndarray, soft: np.ndarray, skin: np.ndarray, tri_side: np.ndarray, bone: np.ndarray
+def embed_skin_by_side(
+    vertices: np.ndarray, soft: np.ndarray, skin: np.ndarray, tet_side: np.ndarray, bone: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """S's embedding in the soft tets, each lip in its own side of the mouth slit: a point of
-    the lower lip's side (`bone` JAW, `_lip_of_points`) is not embedded in a tet of the upper
+    the lower lip's side (`bone` JAW, `lip_of_points`) is not embedded in a tet of the upper
     lip's side of the slit (`tri_side` +1), one of the upper lip's not in the lower lip's (-1).
     Next to the slit the
     radial wall between the sides leans through the lips (the rays come from above and
@@ -244,7 +244,7 @@ def _embed_skin_by_side(
     barycentric coordinates outside [0, 1] (exact at rest, affine under deformation)."""
     tet, bary, _ = native.embed_points(vertices, soft, skin)
     tet = np.asarray(tet, np.int64)
-    side = tri_side[tet % len(tri_side)]
+    side = tet_side[tet]
     wrong = ((side > 0) & (bone == JAW)) | ((side < 0) & (bone == CRANIUM))
     for s, b in ((1, JAW), (-1, CRANIUM)):
         pick = np.flatnonzero(wrong & (bone == b))
@@ -254,7 +254,7 @@ def _embed_skin_by_side(
         lo, hi = skin[pick].min(axis=0) - 0.02, skin[pick].max(axis=0) + 0.02
         centroid = vertices[soft].mean(axis=1)
         near = ((centroid > lo) & (centroid < hi)).all(axis=1)
-        allowed = np.flatnonzero((np.tile(tri_side, len(soft) // len(tri_side)) != s) & near)
+        allowed = np.flatnonzero((tet_side != s) & near)
         t2, b2, _ = native.embed_points(vertices, soft[allowed], skin[pick])
         tet[pick] = allowed[np.asarray(t2)]
         bary[pick] = b2
@@ -320,9 +320,10 @@ def fit_lhm(
     soft = np.vstack(tets[: cfg.soft_layers])
     muscle = np.vstack(tets[cfg.soft_layers :])
 
-    bones = _bone_labels(template, head)
-    tet, bary = _embed_skin_by_side(
-        vertices, soft, skin, slit.side, _lip_of_points(template, head, bones)
+    bones = bone_labels(template, head)
+    tet_side = np.tile(slit.side, len(soft) // len(slit.side))
+    tet, bary = embed_skin_by_side(
+        vertices, soft, skin, tet_side, lip_of_points(template, head, bones)
     )
     skull_labels = np.where(
         (rad.owner >= 0) & (bones[np.maximum(rad.owner, 0)] == JAW), JAW, CRANIUM

@@ -30,6 +30,14 @@ class LhmConfig:
     # Largest radial change of the muscle and skull wraps per unit of arc between neighbouring
     # directions (0: unbounded); steeper steps lean the prisms over into needles and slivers.
     max_wrap_slope: float = 0.5
+    # The simulation's tets: "conforming" fills the wraps with well-shaped tets
+    # (lhm/conforming.py, fTetWild), "prisms" uses the wraps' own prism tets.
+    tet_mesh: str = "conforming"
+    tet_edge_length: float = 0.03  # target tet edge, share of the head's bounding box diagonal
+    tet_envelope: float = 5.0e-4  # largest boundary deviation, share of that diagonal
+    # The mouth slit opened this wide (vertically, metres) for the conforming mesh: at 1.5 mm
+    # fTetWild joined the two sides in 120 vertices up to 4 mm from the mouth corners.
+    slit_gap: float = 4.0e-3
     muscle_fraction: float = 0.5  # template muscle wrap depth, as a share of skin-to-skull
     muscle_relative_share: float = 0.1  # paper: 10 % of the relative change is followed
     min_skull_radius: float = 0.02  # the skull wrap keeps this far from the head centre

@@ -78,7 +78,7 @@ def from_template(template: object | None = None) -> TemplateDefinition:
     bone labels of the layered head model (JAW where jawOpen moves a vertex like the teeth)."""
     from softdeca_train.landmarks import template_landmarks
     from softdeca_train.landmarks.definition import load_definition
-    from softdeca_train.lhm.fit import _bone_labels
+    from softdeca_train.lhm.fit import bone_labels
     from softdeca_train.lhm.model import JAW as LHM_JAW
     from softdeca_train.template import Template
     from softdeca_train.template.model import N_SKIN
@@ -86,7 +86,7 @@ def from_template(template: object | None = None) -> TemplateDefinition:
     t = template if isinstance(template, Template) else Template.load()
     definition = load_definition()
     lms = template_landmarks(t)
-    bones = _bone_labels(t, t.neutral)
+    bones = bone_labels(t, t.neutral)
     return TemplateDefinition(
         name="ict-facekit-s",
         head_vertices=t.n_vertices,

@@ -9,7 +9,8 @@ import numpy as np
 import softdeca_native as native
 
 from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
-from softdeca_train.lhm.fit import jaw_motion
+from softdeca_train.lhm.conforming import conforming_mesh
+from softdeca_train.lhm.fit import bone_labels, embed_skin_by_side, jaw_motion, lip_of_points
 from softdeca_train.lhm.model import JAW
 from softdeca_train.sim.lips import LipSets, lip_sets
 from softdeca_train.template import Template
@@ -75,6 +76,56 @@ def jaw_skull_vertices(lhm: LayeredHeadModel) -> np.ndarray:
     return (lhm.skull_labels == JAW) & on_bone
 
 
+@dataclass(frozen=True)
+class _Tissue:
+    """The simulated tissue of a head: vertices, tets, bones, S's embedding in the soft tets."""
+
+    vertices: np.ndarray
+    soft_tets: np.ndarray
+    muscle_tets: np.ndarray
+    skull_triangles: np.ndarray  # over vertices; empty when every skull vertex is pinned
+    cranium: np.ndarray
+    jaw: np.ndarray
+    skin_tet: np.ndarray
+    skin_bary: np.ndarray
+
+
+def _tissue(template: Template, head: np.ndarray, lhm: LayeredHeadModel) -> _Tissue:
+    """The LHM's own prism tets, or its conforming fill (LhmConfig.tet_mesh)."""
+    cfg = lhm.config
+    on_jaw = jaw_skull_vertices(lhm)
+    if cfg.tet_mesh == "prisms":
+        skull_ids = (lhm.n_layers - 1) * lhm.n_wrap + np.arange(lhm.n_wrap)
+        return _Tissue(
+            lhm.vertices,
+            lhm.soft_tets,
+            lhm.muscle_tets,
+            (lhm.wrap_triangles + (lhm.n_layers - 1) * lhm.n_wrap).astype(np.int32),
+            skull_ids[~on_jaw],
+            skull_ids[on_jaw],
+            lhm.skin_tet,
+            lhm.skin_bary,
+        )
+    if cfg.tet_mesh != "conforming":
+        raise ValueError(f"unknown tet_mesh {cfg.tet_mesh!r}: 'conforming' or 'prisms'")
+    tm = conforming_mesh(lhm, cfg.tet_edge_length, cfg.tet_envelope, cfg.slit_gap)
+    bone_jaw = on_jaw[tm.bone_wrap_vertex]
+    lip_bone = lip_of_points(template, head, bone_labels(template, head))
+    skin_tet, skin_bary = embed_skin_by_side(
+        tm.vertices, tm.soft_tets, head[:N_SKIN].astype(np.float64), tm.soft_side, lip_bone
+    )
+    return _Tissue(
+        tm.vertices,
+        tm.soft_tets,
+        tm.muscle_tets,
+        np.zeros((0, 3), np.int32),
+        tm.bone_vertices[~bone_jaw],
+        tm.bone_vertices[bone_jaw],
+        np.asarray(skin_tet, np.int32),
+        skin_bary,
+    )
+
+
 def build_head_simulation(
     template: Template,
     identity: np.ndarray | None = None,
@@ -85,19 +136,17 @@ def build_head_simulation(
     the sparse variant (SurfaceLandmarks.triangle / .bary)."""
     head = template.identity_neutral(identity)
     lhm = fit_lhm(template, identity, config)
-    n_lhm = len(lhm.vertices)
+    tissue = _tissue(template, head, lhm)
+    n_lhm = len(tissue.vertices)
     up = template.components["teeth_upper"]
     lo = template.components["teeth_lower"]
     teeth_upper = n_lhm + np.arange(up.stop - up.start)
     teeth_lower = teeth_upper[-1] + 1 + np.arange(lo.stop - lo.start)
-    rest = np.vstack([lhm.vertices, head[up.slice], head[lo.slice]])
-    skull = lhm.wrap_triangles + (lhm.n_layers - 1) * lhm.n_wrap
-    skull_ids = (lhm.n_layers - 1) * lhm.n_wrap + np.arange(lhm.n_wrap)
-    on_jaw = jaw_skull_vertices(lhm)
-    cranium = np.concatenate([skull_ids[~on_jaw], teeth_upper])
-    jaw = np.concatenate([skull_ids[on_jaw], teeth_lower])
+    rest = np.vstack([tissue.vertices, head[up.slice], head[lo.slice]])
+    cranium = np.concatenate([tissue.cranium, teeth_upper])
+    jaw = np.concatenate([tissue.jaw, teeth_lower])
     skin_vertices, skin_weights = native.skin_embedding_from_tets(
-        lhm.soft_tets, lhm.skin_tet.tolist(), lhm.skin_bary
+        tissue.soft_tets, tissue.skin_tet.tolist(), tissue.skin_bary
     )
     lips = lip_sets(template, head)
     zone = lips.zone.astype(np.int32)
@@ -126,10 +175,10 @@ def build_head_simulation(
         lm_weights = np.asarray(bary, dtype=np.float64)
     mesh = native.SimulationMesh(
         rest=rest,
-        soft_tets=lhm.soft_tets,
-        muscle_tets=lhm.muscle_tets,
+        soft_tets=tissue.soft_tets,
+        muscle_tets=tissue.muscle_tets,
         connecting_tets=np.zeros((0, 4), np.int32),
-        skull_triangles=skull.astype(np.int32),
+        skull_triangles=tissue.skull_triangles,
         cranium_vertices=cranium.astype(np.int32).tolist(),
         jaw_vertices=jaw.astype(np.int32).tolist(),
         skin_vertices=skin_vertices,

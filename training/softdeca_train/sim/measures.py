@@ -27,29 +27,38 @@ class SoftVolume:
         self.tets = hs.mesh.soft_tets
         rest = hs.mesh.rest
         self.rest_volume = float(native.tet_signed_volumes(rest, self.tets).sum())
-        n_free = hs.lhm.config.soft_layers * hs.lhm.n_wrap  # layers above the muscle wrap
+        # The refit moves the vertices of the soft tissue alone (not shared with the muscle
+        # tets, not on a bone): the skin wrap's, for the LHM's prisms.
+        free = np.zeros(len(rest), bool)
+        free[np.unique(self.tets)] = True
+        free[np.unique(hs.mesh.muscle_tets)] = False
+        free[hs.mesh.cranium_vertices] = False
+        free[hs.mesh.jaw_vertices] = False
+        self.free_ids = np.flatnonzero(free)
+        self.fixed_ids = np.flatnonzero(~free)
         rows = np.repeat(np.arange(len(hs.mesh.skin_vertices)), 4)
         cols = hs.mesh.skin_vertices.ravel()
         embed = sp.csr_matrix(
             (hs.mesh.skin_weights.ravel(), (rows, cols)), shape=(len(rows) // 4, len(rest))
         )
-        self.free = embed[:, :n_free].tocsc()
-        self.fixed = embed[:, n_free:].tocsr()
-        self.n_free = n_free
+        self.free = embed[:, self.free_ids].tocsc()
+        self.fixed = embed[:, self.fixed_ids].tocsr()
         normal = (self.free.T @ self.free).tocsc()
         self.ridge = 1e-6 * float(normal.diagonal().mean())
-        self.solve = spla.factorized((normal + self.ridge * sp.identity(n_free)).tocsc())
+        self.solve = spla.factorized(
+            (normal + self.ridge * sp.identity(len(self.free_ids))).tocsc()
+        )
 
     def change_percent(self, vertices: np.ndarray) -> float:
         v = float(native.tet_signed_volumes(np.asarray(vertices, np.float64), self.tets).sum())
         return 100.0 * (v / self.rest_volume - 1.0)
 
     def linear_vertices(self, skin_target: np.ndarray, simulated: np.ndarray) -> np.ndarray:
-        """`simulated` with the layers above the muscle wrap refitted to the skin target."""
+        """`simulated` with the soft tissue's own vertices refitted to the skin target."""
         x = np.asarray(simulated, np.float64).copy()
-        rhs = np.asarray(skin_target, np.float64) - self.fixed @ x[self.n_free :]
-        b = self.free.T @ rhs + self.ridge * x[: self.n_free]
-        x[: self.n_free] = np.column_stack([self.solve(b[:, k]) for k in range(3)])
+        rhs = np.asarray(skin_target, np.float64) - self.fixed @ x[self.fixed_ids]
+        b = self.free.T @ rhs + self.ridge * x[self.free_ids]
+        x[self.free_ids] = np.column_stack([self.solve(b[:, k]) for k in range(3)])
         return x
 
 

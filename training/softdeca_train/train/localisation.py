@@ -67,8 +67,8 @@ def _physics(run: Run, batch: Batch, change: LocalChange | None) -> np.ndarray:
     for k, name in enumerate(names):
         sim.set_parameter(name, float(batch.p[0, k]))
     if change is not None:
-        tets = hs.lhm.soft_tets
-        centroids = hs.lhm.vertices[tets].mean(axis=1)
+        tets = hs.mesh.soft_tets
+        centroids = hs.mesh.rest[tets].mean(axis=1)
         field = np.full(len(tets), float(batch.p[0, names.index(change.name)]))
         field[_inside(centroids, change)] = change.value
         sim.set_parameter_field(change.name, field)

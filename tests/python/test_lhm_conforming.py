@@ -1,0 +1,151 @@
+"""The conforming tet mesh of the layered head model (lhm/conforming.py; docs/physics.md,
+"The conforming tet mesh"): element quality, the slot between the lips, the bones, S's
+embedding by lip side, and the physics on an open mouth."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import softdeca_native as native
+from softdeca_train.lhm import LhmConfig
+from softdeca_train.lhm.conforming import (
+    boundary_faces,
+    conforming_mesh,
+    slotted_vertices,
+)
+from softdeca_train.lhm.fit import bone_labels, lip_of_points
+from softdeca_train.lhm.model import JAW
+from softdeca_train.lhm.quality import aspect_ratios, dihedral_angles
+from softdeca_train.sim.expressions import weights_of
+from softdeca_train.sim.head import HeadSimulation, build_head_simulation
+from softdeca_train.sim.measures import SoftVolume
+from softdeca_train.sim.sanity import check_frame
+from softdeca_train.template import Template
+from softdeca_train.template.model import N_SKIN
+
+CONFIG = LhmConfig(level=3, tet_mesh="conforming")
+
+
+@pytest.fixture(scope="module")
+def head(template: Template) -> HeadSimulation:
+    return build_head_simulation(template, None, CONFIG)
+
+
+def test_every_tet_is_well_shaped(head: HeadSimulation) -> None:
+    rest = np.asarray(head.mesh.rest)
+    for tets in (np.asarray(head.mesh.soft_tets), np.asarray(head.mesh.muscle_tets)):
+        assert (native.tet_signed_volumes(rest, tets) > 0).all()
+        # measured on the template: smallest dihedral angle 9.2 (soft) / 18.0 (muscle)
+        # degrees, largest aspect ratio 9.1 / 5.7 (the LHM's prisms: 0.5 / 7.2 degrees, 137 /
+        # 8.8); fTetWild's meshes vary a little from run to run
+        assert dihedral_angles(rest, tets).min() > 5.0
+        assert aspect_ratios(rest, tets).max() < 15.0
+
+
+def test_the_slot_separates_the_lips_sides(head: HeadSimulation) -> None:
+    """No soft tet of the upper lip's side shares a vertex with one of the lower lip's, away
+    from the mouth corners (where the slot closes)."""
+    lhm = head.lhm
+    model_slot = slotted_vertices(lhm, CONFIG.slit_gap)
+    k = len(lhm.slit_copy_of)
+    assert k >= 2
+    # the slot is open: originals and copies apart by the gap in every layer
+    n_orig = lhm.n_wrap - k
+    gap = model_slot[lhm.slit_copy_of, 1] - model_slot[n_orig + np.arange(k), 1]
+    assert np.allclose(gap, CONFIG.slit_gap)
+    tm = conforming_mesh(
+        lhm, CONFIG.tet_edge_length, CONFIG.tet_envelope, CONFIG.slit_gap
+    )
+    soft, side, rest = tm.soft_tets, tm.soft_side, tm.vertices
+    up = np.unique(soft[side > 0])
+    lo = np.unique(soft[side < 0])
+    shared = np.intersect1d(up, lo)
+    # the slot closes along the corner columns (skin wrap to skull wrap at the slit's ends)
+    d = np.full(len(shared), np.inf)
+    for e in lhm.slit_path[[0, -1]]:
+        a, b = lhm.skin_wrap[e], lhm.skull_wrap[e]
+        t = np.clip((rest[shared] - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+        d = np.minimum(
+            d, np.linalg.norm(rest[shared] - (a + t[:, None] * (b - a)), axis=1)
+        )
+    far = d > 1e-3
+    assert len(up) > 0 and len(lo) > 0
+    assert not far.any(), f"{int(far.sum())} vertices shared by both lips' tets"
+
+
+def test_the_surface_is_closed_and_the_bones_hold_the_deep_layer(
+    head: HeadSimulation,
+) -> None:
+    m = head.mesh
+    tets = np.vstack([np.asarray(m.soft_tets), np.asarray(m.muscle_tets)])
+    faces = boundary_faces(tets)
+    # every boundary edge is shared by exactly two boundary faces: a closed surface
+    edges = np.sort(
+        np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1
+    )
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    assert (counts == 2).all()
+    n_tissue = int(tets.max()) + 1
+    bones = np.concatenate([m.cranium_vertices, m.jaw_vertices])
+    on_bone = bones[bones < n_tissue]
+    assert len(on_bone) > 500
+    # the upper lip's deep layer is on the cranium (the maxilla)
+    tm = conforming_mesh(
+        head.lhm, CONFIG.tet_edge_length, CONFIG.tet_envelope, CONFIG.slit_gap
+    )
+    upper = tm.bone_vertices[head.lhm.lip_side[tm.bone_wrap_vertex] > 0]
+    assert len(upper) > 0 and np.isin(upper, m.cranium_vertices).all()
+    # bone vertices lie on the skull wrap, never on the skin side
+    d = np.linalg.norm(
+        np.asarray(m.rest)[on_bone] - head.head[:N_SKIN].mean(axis=0), axis=1
+    )
+    assert d.max() < 0.2
+
+
+def test_each_lip_is_embedded_on_its_own_side(
+    head: HeadSimulation, template: Template
+) -> None:
+    lhm = head.lhm
+    tm = conforming_mesh(
+        lhm, CONFIG.tet_edge_length, CONFIG.tet_envelope, CONFIG.slit_gap
+    )
+    lip = lip_of_points(template, head.head, bone_labels(template, head.head))
+    sv = np.asarray(head.mesh.skin_vertices)
+    # the soft tet of each S point: the one whose 4 vertices it is embedded on
+    key = {tuple(sorted(t)): i for i, t in enumerate(tm.soft_tets.tolist())}
+    tet = np.array([key[tuple(sorted(r))] for r in sv.tolist()])
+    side = tm.soft_side[tet]
+    assert not ((side > 0) & (lip == JAW)).any()
+    assert not ((side < 0) & (lip != JAW)).any()
+    # S is reproduced exactly at rest
+    w = np.asarray(head.mesh.skin_weights)
+    rest = np.asarray(head.mesh.rest)
+    s = np.einsum("nk,nkd->nd", w, rest[sv])
+    assert np.abs(s - head.head[:N_SKIN]).max() < 1e-6
+
+
+def test_an_open_jaw_keeps_the_mouth_open_without_exploding(
+    head: HeadSimulation,
+) -> None:
+    sim = head.simulator(threads=1)
+    w = weights_of({"jawOpen": 1.0})
+    blended = head.blend(w[None])[0]
+    jaw = head.jaw_transforms(blended[None])[0]
+    target = blended[:N_SKIN].astype(np.float64)
+    vertices, skin, stats = sim.solve_static(target, jaw=jaw)
+    check = check_frame(head, SoftVolume(head), target, skin, vertices, stats)
+    assert check.converged
+    assert check.opening_linear_mm > 20
+    assert 0.9 <= check.open_ratio <= 1.1
+    assert "exploded" not in check.failures()
+    assert check.penetrating_physics <= check.penetrating_linear
+
+
+def test_the_mesh_is_cached(template: Template, head: HeadSimulation) -> None:
+    again = build_head_simulation(template, None, dataclasses.replace(CONFIG))
+    assert np.array_equal(np.asarray(again.mesh.rest), np.asarray(head.mesh.rest))
+    assert np.array_equal(
+        np.asarray(again.mesh.soft_tets), np.asarray(head.mesh.soft_tets)
+    )
