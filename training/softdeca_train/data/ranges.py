@@ -41,16 +41,16 @@ PROFILES: dict[str, dict[str, tuple[float, float]]] = {
     "appendix-a": {},
     "plausible": {"w_target": (1.0, 100.0), "w_regularisation": (0.1, 10.0)},
     "interactive": {
-        "w_soft_volume": _decade(10.0),
+        "w_soft_volume": _decade(30.0),
         "w_soft_strain": _decade(1.0),
-        "w_muscle_volume": _decade(10.0),
+        "w_muscle_volume": _decade(30.0),
         "w_muscle_strain": _decade(1.0),
         "w_skin_strain": _decade(1.0),
         "w_skull_strain": (10.0, 100.0),  # the default is the physics' maximum
         "w_skull_bending": (10.0, 100.0),
         "w_connect_volume": _decade(10.0),
         "w_connect_strain": _decade(10.0),
-        "w_target": _decade(10.0),
+        "w_target": _decade(1.0),
         "w_regularisation": (0.1, 1.0),  # below 0.1 the skin hangs off S (plausible)
         "w_landmark": _decade(10.0),
         "target_volume": _TEN_PERCENT,
