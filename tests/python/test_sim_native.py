@@ -51,7 +51,8 @@ def test_static_batch_and_sequence(head: sn.SimulationMesh) -> None:
     assert all(s["converged"] for s in stats)
     assert np.abs(skins[1] - skins[2]).max() < 1e-5
     front = int(np.argmax(rest[:, 2]))
-    assert skins[1][front, 2] - rest[front, 2] > 0.003  # follows the push
+    # follows the push (4 mm there): 3.0 mm of it at the defaults, the tissue taking the rest
+    assert skins[1][front, 2] - rest[front, 2] > 0.002
     sim.set_parameter("dyn_gamma", 0.5)
     sim.set_parameter("dyn_beta", 0.6)
     seq, _, _ = sim.solve_sequence(np.stack([rest] + [push] * 12))
@@ -102,8 +103,9 @@ def test_hand_built_mesh_and_errors(head: sn.SimulationMesh) -> None:
 
 
 def test_batch_takes_per_frame_jaw_transforms(head: sn.SimulationMesh) -> None:
-    """solve_static_batch(jaw=(F, 4, 4)) gives what solve_static gives frame by frame."""
-    sim = sn.Simulator(head, threads=2)
+    """solve_static_batch(jaw=(F, 4, 4)) gives what solve_static gives frame by frame (both
+    converged tightly: they start from different guesses)."""
+    sim = sn.Simulator(head, threads=2, tolerance=1e-9, max_iterations=5000)
     rest = head.embed_skin(head.rest)
     jaws = np.stack([np.eye(4)] * 3)
     for k, angle in enumerate((0.0, 0.05, 0.1)):

@@ -41,9 +41,9 @@ PROFILES: dict[str, dict[str, tuple[float, float]]] = {
     "appendix-a": {},
     "plausible": {"w_target": (1.0, 100.0), "w_regularisation": (0.1, 10.0)},
     "interactive": {
-        "w_soft_volume": _decade(30.0),
+        "w_soft_volume": (3.0, 100.0),  # a decade below the default, up to the physics' top
         "w_soft_strain": _decade(1.0),
-        "w_muscle_volume": _decade(30.0),
+        "w_muscle_volume": (3.0, 100.0),
         "w_muscle_strain": _decade(1.0),
         "w_skin_strain": _decade(1.0),
         "w_skull_strain": (10.0, 100.0),  # the default is the physics' maximum
