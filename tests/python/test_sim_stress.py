@@ -132,14 +132,11 @@ def _failures(frames: list, reason: str) -> list[str]:
     ]
 
 
-# Known failures, measured and kept visible (strict: the test fails once they are fixed, so
-# the mark must go): `mouthClose` at 1 alone (the lips pressed through each other over a closed
-# jaw, a shape meant to be combined with jawOpen) inverts a few soft tets at the lips on the
-# template and seed 1; the other 106 frames hold every bound (docs/physics.md, Known limits).
-_KNOWN = (
-    "mouthClose alone at 1 inverts a few soft tets at the lips "
-    "(docs/physics.md, Inverted elements and the target / volume balance)"
-)
+# Known failures, measured and kept visible: `mouthClose` at 1 alone (the lips pressed through
+# each other over a closed jaw, a shape meant to be combined with jawOpen) inverts a few soft
+# tets at the lips on the template and seed 1 (docs/physics.md, Known limits). They are left
+# out of the inverted-element bound by name, and reported; every other frame must hold it.
+_KNOWN_INVERTED = ("mouthClose=1",)
 
 
 @pytest.mark.parametrize(
@@ -150,16 +147,22 @@ _KNOWN = (
         # 355 lip points up to 2.8 mm inside the other lip or the teeth; the contacts resolve
         # them all (docs/physics.md, Collisions).
         "penetration",
-        pytest.param(
-            "inverted_elements", marks=pytest.mark.xfail(strict=True, reason=_KNOWN)
-        ),
+        "inverted_elements",
         "volume",
     ],
 )
 def test_reduced_suite_holds_the_bounds(reduced: list, reason: str) -> None:
-    bad = _failures(reduced, reason)
+    frames = reduced
+    if reason == "inverted_elements":
+        known = [f for f in reduced if f.label in _KNOWN_INVERTED]
+        assert len(known) == 2  # the template's and seed 1's, both judged
+        frames = [f for f in reduced if f.label not in _KNOWN_INVERTED]
+        still = _failures(known, reason)
+        if still:
+            print(f"known, still failing '{reason}':", *still, sep="\n")
+    bad = _failures(frames, reason)
     assert not bad, (
-        f"{len(bad)} of {len(reduced)} frames fail '{reason}':\n" + "\n".join(bad[:10])
+        f"{len(bad)} of {len(frames)} frames fail '{reason}':\n" + "\n".join(bad[:10])
     )
 
 
