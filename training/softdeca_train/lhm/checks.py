@@ -81,11 +81,16 @@ def tets_spanning_both_lips(model: LayeredHeadModel, tets: np.ndarray) -> int:
     return int(((side > 0).any(axis=1) & (side < 0).any(axis=1)).sum())
 
 
+def _slit_middle(model: LayeredHeadModel) -> np.ndarray:
+    """Middle of the slit's inner part on the skin wrap: the mouth region's centre."""
+    k = len(model.slit_copy_of)
+    middle = model.n_wrap - k + np.arange(k) if k else model.slit_path
+    return model.skin_wrap[middle].mean(axis=0)
+
+
 def mouth_quality(model: LayeredHeadModel) -> QualityReport:
     """Element quality of the model, overall and in the mouth region around the slit."""
-    k = len(model.slit_copy_of)
-    middle = model.n_wrap - k + np.arange(k) if k else model.slit_path  # the slit's inner part
-    center = model.skin_wrap[middle].mean(axis=0)
+    center = _slit_middle(model)
     mouth = mouth_columns(model.skin_wrap, center, model.n_layers)
     return quality_report(model.vertices, model.soft_tets, model.muscle_tets, mouth)
 
@@ -98,9 +103,7 @@ def conforming_quality(model: LayeredHeadModel) -> QualityReport:
 
     cfg = model.config
     tm = conforming_mesh(model, cfg.tet_edge_length, cfg.tet_envelope, cfg.slit_gap)
-    k = len(model.slit_copy_of)
-    middle = model.n_wrap - k + np.arange(k) if k else model.slit_path
-    center = model.skin_wrap[middle].mean(axis=0)
+    center = _slit_middle(model)
     # the mouth's columns: directions from the head centre within the region's radius of the
     # slit's middle on the skin wrap (as for the prisms, from the skin to the skull)
     axis = center - model.center

@@ -237,7 +237,8 @@ def embed_skin_by_side(
 ) -> tuple[np.ndarray, np.ndarray]:
     """S's embedding in the soft tets, each lip in its own side of the mouth slit: a point of
     the lower lip's side (`bone` JAW, `lip_of_points`) is not embedded in a tet of the upper
-    lip's side of the slit (`tri_side` +1), one of the upper lip's not in the lower lip's (-1).
+    lip's side of the slit (`tet_side` +1, per soft tet), one of the upper lip's not in the
+    lower lip's (-1).
     Next to the slit the
     radial wall between the sides leans through the lips (the rays come from above and
     behind), so such points are embedded in the nearest tet of their own side, with
@@ -321,10 +322,9 @@ def fit_lhm(
     muscle = np.vstack(tets[cfg.soft_layers :])
 
     bones = bone_labels(template, head)
+    lip_bone = lip_of_points(template, head, bones)
     tet_side = np.tile(slit.side, len(soft) // len(slit.side))
-    tet, bary = embed_skin_by_side(
-        vertices, soft, skin, tet_side, lip_of_points(template, head, bones)
-    )
+    tet, bary = embed_skin_by_side(vertices, soft, skin, tet_side, lip_bone)
     skull_labels = np.where(
         (rad.owner >= 0) & (bones[np.maximum(rad.owner, 0)] == JAW), JAW, CRANIUM
     )
@@ -360,6 +360,9 @@ def fit_lhm(
         attachments={
             # Bone each non-skin ICT vertex rides with (teeth, gums, tongue, eyes, ...).
             "bone_of_vertex": bones[N_SKIN:],
+            # Per S vertex, the bone its lip side hangs on (lip_of_points): how any tet mesh
+            # of this model embeds S by side.
+            "skin_lip_bone": lip_bone,
             "eye_centers": np.array([e[0] for e in eyes]),
             "eye_radii": np.array([e[1] for e in eyes]),
         },

@@ -10,7 +10,7 @@ import softdeca_native as native
 
 from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
 from softdeca_train.lhm.conforming import conforming_mesh
-from softdeca_train.lhm.fit import bone_labels, embed_skin_by_side, jaw_motion, lip_of_points
+from softdeca_train.lhm.fit import embed_skin_by_side, jaw_motion
 from softdeca_train.lhm.model import JAW
 from softdeca_train.sim.lips import LipSets, lip_sets
 from softdeca_train.template import Template
@@ -90,7 +90,7 @@ class _Tissue:
     skin_bary: np.ndarray
 
 
-def _tissue(template: Template, head: np.ndarray, lhm: LayeredHeadModel) -> _Tissue:
+def _tissue(head: np.ndarray, lhm: LayeredHeadModel) -> _Tissue:
     """The LHM's own prism tets, or its conforming fill (LhmConfig.tet_mesh)."""
     cfg = lhm.config
     on_jaw = jaw_skull_vertices(lhm)
@@ -110,9 +110,12 @@ def _tissue(template: Template, head: np.ndarray, lhm: LayeredHeadModel) -> _Tis
         raise ValueError(f"unknown tet_mesh {cfg.tet_mesh!r}: 'conforming' or 'prisms'")
     tm = conforming_mesh(lhm, cfg.tet_edge_length, cfg.tet_envelope, cfg.slit_gap)
     bone_jaw = on_jaw[tm.bone_wrap_vertex]
-    lip_bone = lip_of_points(template, head, bone_labels(template, head))
     skin_tet, skin_bary = embed_skin_by_side(
-        tm.vertices, tm.soft_tets, head[:N_SKIN].astype(np.float64), tm.soft_side, lip_bone
+        tm.vertices,
+        tm.soft_tets,
+        head[:N_SKIN].astype(np.float64),
+        tm.soft_side,
+        lhm.attachments["skin_lip_bone"],
     )
     return _Tissue(
         tm.vertices,
@@ -136,7 +139,7 @@ def build_head_simulation(
     the sparse variant (SurfaceLandmarks.triangle / .bary)."""
     head = template.identity_neutral(identity)
     lhm = fit_lhm(template, identity, config)
-    tissue = _tissue(template, head, lhm)
+    tissue = _tissue(head, lhm)
     n_lhm = len(tissue.vertices)
     up = template.components["teeth_upper"]
     lo = template.components["teeth_lower"]
