@@ -15,10 +15,11 @@ slit between the lips) and fills it with well-shaped tets instead:
 4. the mesh's vertices on the skull wrap are the bone's (pinned), each with the skull wrap
    vertex nearest to it (its bone label).
 
-fTetWild takes 15-40 s per head at wrap level 3 (about 90 s at level 4) and is not bitwise
-reproducible from run to run (the same input gave 3972 and 4104 vertices): meshes are cached on
-disk under the cache folder (`tetmesh/`), keyed by the input surface and the settings, so a head
-keeps one mesh once made (data generation, tests and evaluation on one machine agree)."""
+fTetWild's fill takes 14-21 s at wrap level 3 (a head build about 35 s, 90 s at level 4) and
+is not bitwise reproducible from run to run (the same input gave 3972 and 4104 vertices):
+meshes are cached on disk under the cache folder (`tetmesh/`), keyed by the input surface and
+the settings, so a head keeps one mesh once made (data generation, tests and evaluation on one
+machine agree)."""
 
 from __future__ import annotations
 

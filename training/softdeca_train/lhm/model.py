@@ -36,7 +36,7 @@ class LhmConfig:
     tet_edge_length: float = 0.03  # target tet edge, share of the head's bounding box diagonal
     tet_envelope: float = 5.0e-4  # largest boundary deviation, share of that diagonal
     # The mouth slit opened this wide (vertically, metres) for the conforming mesh: at 1.5 mm
-    # fTetWild joined the two sides in 120 vertices up to 4 mm from the mouth corners.
+    # fTetWild joined the two sides in 140 vertices up to 4.4 mm from the mouth corners' columns.
     slit_gap: float = 4.0e-3
     muscle_fraction: float = 0.5  # template muscle wrap depth, as a share of skin-to-skull
     muscle_relative_share: float = 0.1  # paper: 10 % of the relative change is followed
