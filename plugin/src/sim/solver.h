@@ -13,7 +13,7 @@
 namespace softdeca::sim {
 
 struct SolverSettings {
-  int max_iterations = 300;
+  int max_iterations = 800;
   // Converged when the estimated RMS distance of the free vertices to the fixed point,
   // residual / (1 - contraction), falls below tolerance * the rest bounding-box diagonal
   // (the residual is the RMS move of one plain PD step; the contraction is measured by plain

@@ -51,7 +51,7 @@ class PhysicsCase:
     weights: np.ndarray  # (E, 52)
     level: int = 3
     tolerance: float = 1e-4
-    max_iterations: int = 200
+    max_iterations: int = 800
 
     @cached_property
     def head(self):  # -> HeadSimulation

@@ -3,7 +3,12 @@
 Real takes are the best source of realistic co-activation but leave parts of the 52-D cube
 empty. The sampler keeps the co-activation (a Gaussian over logit-weights fitted to the real
 frames, so correlated shapes move together) and adds coverage (each draw, with probability
-`sweep_share`, sweeps one or two random weights uniformly over [0, 1])."""
+`sweep_share`, sweeps one or two random weights uniformly over [0, 1]).
+
+One rule of the rig holds in every draw: `mouthClose` never exceeds `jawOpen`. The shape
+closes the lips against an open jaw; past the jaw's opening it drives the lips through each
+other (two generated frames had the upper lip's middle 10.4 and 5.1 mm below the lower's).
+Real takes keep it: of 15,333 recorded frames 3 exceed it, by at most 0.058."""
 
 from __future__ import annotations
 
@@ -11,7 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
+
 EPS = 1e-3
+MOUTH_CLOSE, JAW_OPEN = ARKIT_BLENDSHAPES.index("mouthClose"), ARKIT_BLENDSHAPES.index("jawOpen")
 
 
 def _logit(w: np.ndarray) -> np.ndarray:
@@ -42,4 +50,5 @@ class CoverageSampler:
             k = rng.choice(len(self.mean), size=rng.integers(1, 3), replace=False)
             w[i, k] = rng.random(len(k))
         w[w < 0.01] = 0.0  # real takes are sparse: keep near-zero weights at zero
+        w[:, MOUTH_CLOSE] = np.minimum(w[:, MOUTH_CLOSE], w[:, JAW_OPEN])
         return w.astype(np.float32)

@@ -17,8 +17,9 @@ parameter sets (ridge linear in p made the test error worse; SoftDECA stayed wit
 correction, docs/training.md).
 
 `controls` (the default) samples every control over its control range, the one list in
-plugin/data/parameters.json (`control`: the range a user moves it in, measured to move the
-physics by at least 1 mm where it acts, docs/controls.md) and keeps the parameters that are
+plugin/data/parameters.json (`control`: the range a user moves it in; docs/controls.md says
+how far each moves the physics and why a range ends where it does: within it every sampled
+frame passes the physics' sanity bounds, docs/physics.md) and keeps the parameters that are
 no controls (they act on nothing in the head model) at their defaults."""
 
 from __future__ import annotations

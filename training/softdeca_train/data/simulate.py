@@ -126,22 +126,28 @@ def _set_parameters(sim: native.Simulator, names: list[str], p: np.ndarray) -> N
         sim.set_parameter(name, float(value))
 
 
-def _set_regional(head: _Head, g: GroupSpec, names: list[str]) -> np.ndarray:
+def _set_regional(head: _Head, g: GroupSpec, names: list[str]) -> tuple[np.ndarray, float]:
     """The group's regional pattern on the simulator (fields over the parameters' element
-    domains); returns the pattern stored with the instances (p in every region without one)."""
+    domains). Returns the pattern stored with the instances (p in every region without one)
+    and the soft tissue's requested volume: target_volume's rest-volume-weighted mean over
+    the soft tets (p's value without a pattern)."""
     from softdeca_train.data.regions import REGIONS, region_labels, regional_field
 
+    tv = names.index("target_volume")
     if g.p_regions is None:
-        return np.repeat(g.p[None], len(REGIONS), axis=0)
+        return np.repeat(g.p[None], len(REGIONS), axis=0), float(g.p[tv])
     labels = region_labels(head.ctx.template)
     domains = {s.name: s.domain for s in load_parameters().specs}
     skin = head.hs.head[:N_SKIN]
+    requested = float(g.p[tv])
     for k, name in enumerate(names):
         column = g.p_regions[:, k]
         if np.any(column != g.p[k]):
             field = regional_field(column, labels, head.sim.mesh, skin, domains[name])
             head.sim.set_parameter_field(name, field)
-    return g.p_regions
+            if k == tv:
+                requested = head.volume.mean_over_tets(field)
+    return g.p_regions, requested
 
 
 def _stats(stats: list[dict]) -> dict[str, np.ndarray]:
@@ -167,7 +173,7 @@ class _Head:
 def _static_group(head: _Head, g: GroupSpec, sparse: bool, names: list[str]) -> None:
     ctx, hs, sim, cfg, out, volume = (head.ctx, head.hs, head.sim, head.cfg, head.out, head.volume)
     _set_parameters(sim, names, g.p)
-    p_regions = _set_regional(head, g, names)
+    p_regions, requested_volume = _set_regional(head, g, names)
     w = g.frames.weights
     targets = ctx.blend.targets(hs.head[:N_SKIN], w)
     jaws = hs.jaw_transforms(hs.blend(w))
@@ -195,7 +201,7 @@ def _static_group(head: _Head, g: GroupSpec, sparse: bool, names: list[str]) -> 
     ]
     skins, stats = [s[1] for s in solved], [s[2] for s in solved]
     out.add(
-        failures=out.judge(hs, volume, targets, solved, sim.get_parameter("target_volume")),
+        failures=out.judge(hs, volume, targets, solved, requested_volume),
         param_id=np.full(n, g.param_id, np.int32),
         p=np.repeat(g.p[None], n, axis=0),
         p_regions=np.repeat(p_regions[None], n, axis=0),

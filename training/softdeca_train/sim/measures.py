@@ -26,7 +26,8 @@ class SoftVolume:
     def __init__(self, hs: HeadSimulation) -> None:
         self.tets = hs.mesh.soft_tets
         rest = hs.mesh.rest
-        self.rest_volume = float(native.tet_signed_volumes(rest, self.tets).sum())
+        self._rest_volumes = np.asarray(native.tet_signed_volumes(rest, self.tets))
+        self.rest_volume = float(self._rest_volumes.sum())
         # The refit moves the vertices of the soft tissue alone (not shared with the muscle
         # tets, not on a bone): the skin wrap's, for the LHM's prisms.
         free = np.zeros(len(rest), bool)
@@ -48,6 +49,12 @@ class SoftVolume:
         self.solve = spla.factorized(
             (normal + self.ridge * sp.identity(len(self.free_ids))).tocsc()
         )
+
+    def mean_over_tets(self, field: np.ndarray) -> float:
+        """The rest-volume-weighted mean of a per-soft-tet field (e.g. a regional
+        target_volume: the soft tissue's requested volume, relative to rest)."""
+        rest = self._rest_volumes
+        return float((rest * np.asarray(field, np.float64)).sum() / rest.sum())
 
     def change_percent(self, vertices: np.ndarray) -> float:
         v = float(native.tet_signed_volumes(np.asarray(vertices, np.float64), self.tets).sum())

@@ -28,7 +28,11 @@ from softdeca_train.template.model import N_SKIN
 
 EXTREME_SIGMA = 2.5
 EXTREME_MODES = 10  # the identity modes set to ±EXTREME_SIGMA (the leading ones)
-# Material weights put at the ends of their ranges together ("soft" / "stiff").
+# The material controls put at the ends of their control ranges together (the ranges a user
+# moves them in and data generation samples, plugin/data/parameters.json): "soft" is every
+# tissue weight at the bottom with the targets' weight at the top (the targets' strongest
+# pull on the weakest tissue), "stiff" the other way round; "thin" and "full" the soft
+# tissue's requested volume and strain limit at their bottom and top.
 MATERIAL_WEIGHTS = (
     "w_soft_volume",
     "w_soft_strain",
@@ -36,6 +40,7 @@ MATERIAL_WEIGHTS = (
     "w_muscle_strain",
     "w_skin_strain",
 )
+TISSUE_SHAPE = ("target_volume", "max_strain")
 # Gravity 2 g: (tilt, azimuth) in degrees from -Y (down) - forward (+Z, face down), sideways, up.
 GRAVITY_DIRECTIONS = {
     "down": (0.0, 0.0),
@@ -87,10 +92,14 @@ def identity_coefficients(template: Template, label: str) -> np.ndarray | None:
 
 
 def material_ends() -> dict[str, dict[str, float]]:
-    specs = {s.name: s for s in load_parameters().specs}
+    ranges = {s.name: s.control for s in load_parameters().specs if s.control is not None}
+    lo = {n: ranges[n][0] for n in (*MATERIAL_WEIGHTS, "w_target", *TISSUE_SHAPE)}
+    hi = {n: ranges[n][1] for n in (*MATERIAL_WEIGHTS, "w_target", *TISSUE_SHAPE)}
     return {
-        "soft": {n: specs[n].lo for n in MATERIAL_WEIGHTS},
-        "stiff": {n: specs[n].hi for n in MATERIAL_WEIGHTS},
+        "soft": {**{n: lo[n] for n in MATERIAL_WEIGHTS}, "w_target": hi["w_target"]},
+        "stiff": {**{n: hi[n] for n in MATERIAL_WEIGHTS}, "w_target": lo["w_target"]},
+        "thin": {n: lo[n] for n in TISSUE_SHAPE},
+        "full": {n: hi[n] for n in TISSUE_SHAPE},
     }
 
 
