@@ -187,6 +187,7 @@ def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:
     from softdeca_train.data.expressions import expression_sources, load_takes
     from softdeca_train.data.plan import FIXED, make_plan
     from softdeca_train.data.ranges import sampling_parameters
+    from softdeca_train.data.regions import REGIONAL_DOMAINS
     from softdeca_train.paths import default_takes_path
 
     cfg = GenerateConfig(static=24, dynamic=0, sparse=8, region_share=0.5, seed=3)
@@ -213,7 +214,7 @@ def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:
         varied = np.flatnonzero(np.any(g.p_regions != g.p, axis=0))
         for k in varied:
             s = params.specs[k]
-            assert s.domain != "global" and s.control is not None
+            assert s.domain in REGIONAL_DOMAINS and s.control is not None
             assert s.name not in FIXED[kind]
     # legacy configurations (written before regional patterns) have none
     legacy = {k: v for k, v in cfg.as_dict().items() if k != "region_share"}

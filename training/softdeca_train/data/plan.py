@@ -93,18 +93,18 @@ def regional_pattern(
     share: float,
 ) -> np.ndarray | None:
     """With probability `share`, a regional pattern over p: each localisable parameter (one
-    the physics defines per element) that is not fixed gets, with probability 1/2, its own
-    value in every region of the face a control can set (drawn from its range like p), the
-    others keep p's value everywhere. None: p everywhere."""
+    the physics defines per element of a place on S, REGIONAL_DOMAINS) that is not fixed
+    gets, with probability 1/2, its own value in every region of the face a control can set
+    (drawn from its range like p), the others keep p's value everywhere. None: p everywhere."""
     from softdeca_train.controls.definitions import CONTROL_REGIONS
-    from softdeca_train.data.regions import REGIONS
+    from softdeca_train.data.regions import REGIONAL_DOMAINS, REGIONS
 
     if rng.random() >= share:
         return None
     pattern = np.repeat(p[None], len(REGIONS), axis=0)
     rows = [REGIONS.index(r) for r in CONTROL_REGIONS]
     for k, s in enumerate(params.specs):
-        if s.domain == "global" or s.name in fixed or rng.random() < 0.5:
+        if s.domain not in REGIONAL_DOMAINS or s.name in fixed or rng.random() < 0.5:
             continue
         pattern[rows, k] = np.clip(s.sample(rng, len(rows)), s.lo, s.hi)
     return pattern

@@ -24,6 +24,11 @@ REGIONS = (
 )
 
 
+# Parameter domains whose elements have a region (element_regions); a landmark's weight
+# (w_landmark) belongs to a tracked point, not to a place on S, and takes no regional value.
+REGIONAL_DOMAINS = ("soft_tet", "muscle_tet", "skin_triangle", "skin_point")
+
+
 def _near(points: np.ndarray, centres: np.ndarray, radius: float) -> np.ndarray:
     d = np.linalg.norm(points[:, None, :] - centres[None, :, :], axis=2)
     return d.min(axis=1) < radius
