@@ -92,6 +92,12 @@ def test_tile_lays_out_labelled_grid(tmp_path):
     assert (tmp_path / "t.png").is_file()
     with pytest.raises(ValueError, match="labels"):
         R.tile([a, b], ["only one"])
+    # A label wider than its cell wraps onto more lines: the label band grows, nothing
+    # overlaps the next cell.
+    long = "linear blendshapes - scream - expressions, h+2.5σ, level 3"
+    wrapped = R.tile([a, b], [long, "b"], None, R.TileSettings(columns=2, padding=5))
+    single = R.tile([a, b], ["a", "b"], None, R.TileSettings(columns=2, padding=5))
+    assert wrapped.shape[0] > single.shape[0] and wrapped.shape[1] == single.shape[1]
 
 
 def test_bad_input_gives_clear_errors():

@@ -318,10 +318,29 @@ class TileSettings:
 
 
 def _font(size: int) -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
+    # DejaVu Sans (shipped with matplotlib) has the Greek labels use (σ of the identities);
+    # Pillow's own default font draws them as boxes.
+    try:
+        from matplotlib import font_manager
+
+        return ImageFont.truetype(font_manager.findfont("DejaVu Sans"), size)
+    except (ImportError, OSError, ValueError):
+        pass
     try:
         return ImageFont.load_default(size=size)
     except TypeError:  # Pillow < 10.1 has no sized default font
         return ImageFont.load_default()
+
+
+def _wrap(text: str, font: ImageFont.ImageFont | ImageFont.FreeTypeFont, width: float) -> str:
+    """`text` broken at spaces into lines no wider than `width` pixels where it can be."""
+    lines: list[str] = []
+    for word in text.split(" "):
+        if lines and font.getlength(f"{lines[-1]} {word}") <= width:
+            lines[-1] = f"{lines[-1]} {word}"
+        else:
+            lines.append(word)
+    return "\n".join(lines)
 
 
 def tile(
@@ -347,20 +366,24 @@ def tile(
     cols = settings.columns or len(imgs)
     rows = -(-len(imgs) // cols)
     cell_w = max(i.shape[1] for i in imgs)
-    cell_h = max(i.shape[0] for i in imgs) + settings.label_height
+    font = _font(settings.font_size)
+    # Labels wider than their cell wrap onto more lines (they overlapped the next cell).
+    labels = [_wrap(label, font, cell_w - 8) for label in labels]
+    line_h = settings.font_size + 4
+    label_h = settings.label_height + line_h * max(t.count("\n") for t in labels)
+    cell_h = max(i.shape[0] for i in imgs) + label_h
     pad = settings.padding
     footer = len(settings.extra_labels) * (settings.font_size + 6)
     width = cols * cell_w + (cols + 1) * pad
     height = rows * cell_h + (rows + 1) * pad + footer
     canvas = Image.new("RGB", (width, height), settings.background)
     draw = ImageDraw.Draw(canvas)
-    font = _font(settings.font_size)
     for k, (img, label) in enumerate(zip(imgs, labels, strict=True)):
         r, c = divmod(k, cols)
         x = pad + c * (cell_w + pad)
         y = pad + r * (cell_h + pad)
-        draw.text((x + 4, y + 4), label, fill=settings.label_color, font=font)
-        canvas.paste(Image.fromarray(img), (x, y + settings.label_height))
+        draw.multiline_text((x + 4, y + 4), label, fill=settings.label_color, font=font, spacing=4)
+        canvas.paste(Image.fromarray(img), (x, y + label_h))
     y = rows * cell_h + (rows + 1) * pad
     for line in settings.extra_labels:
         draw.text((pad + 4, y), line, fill=settings.label_color, font=font)
