@@ -212,6 +212,8 @@ TEST(SimStatic, LandmarksDriveTheSparseVariant) {
     for (int j = 0; j < 3; ++j) lmk.row(l) += mesh.landmark_weights(l, j) * skin.row(mesh.landmark_points(l, j));
   }
   in.landmark_targets = bump(lmk, 0.005);
+  sim.parameters().set("w_landmark", 10);
+  sim.parameters().set("w_regularisation", 0.1);
   const FrameResult r = sim.solve_static(in);
   EXPECT_TRUE(r.stats.converged);
   Positions reached(lmk.rows(), 3);

@@ -20,6 +20,7 @@ from softdeca_train.data.config import KINDS, TEST, TRAIN, GenerateConfig
 from softdeca_train.data.expressions import Draws, ExpressionSource
 from softdeca_train.data.ranges import fixed_outside_profile
 from softdeca_train.parameters import ParameterSet
+from softdeca_train.sim.dynamics import MAX_PEAK_GAIN, peak_gain
 
 KIND_CODE = {k: i for i, k in enumerate(KINDS)}
 # Parameters that do not act in a kind keep their defaults there (paper 4.2.1: static
@@ -74,10 +75,15 @@ class ShardSpec:
 def sample_parameters(
     params: ParameterSet, kind: str, rng: np.random.Generator, fixed: tuple[str, ...] = ()
 ) -> np.ndarray:
-    """One parameter vector; the kind's FIXED entries and `fixed` at their defaults."""
-    p = params.sample(rng)
+    """One parameter vector; the kind's FIXED entries and `fixed` at their defaults. The
+    dynamics pair (gamma, beta) is drawn again until eq. 9 amplifies no motion by more than
+    MAX_PEAK_GAIN (sim/dynamics.py: past it the tissue resonates)."""
+    lo, hi = [s.lo for s in params.specs], [s.hi for s in params.specs]
     # exp(log(hi)) may round past hi: keep every value inside its range exactly.
-    p = np.clip(p, [s.lo for s in params.specs], [s.hi for s in params.specs])
+    p = np.clip(params.sample(rng), lo, hi)
+    g, b = params.names.index("dyn_gamma"), params.names.index("dyn_beta")
+    while peak_gain(p[g], p[b]) > MAX_PEAK_GAIN:
+        p[[g, b]] = np.clip(params.sample(rng), lo, hi)[[g, b]]
     defaults = params.defaults()
     for name in (*FIXED[kind], *fixed):
         k = params.names.index(name)

@@ -53,7 +53,7 @@ PROFILES: dict[str, dict[str, tuple[float, float]]] = {
         "w_connect_strain": _decade(10.0),
         "w_target": _decade(1.0),
         "w_regularisation": (0.1, 1.0),  # below 0.1 the skin hangs off S (plausible)
-        "w_landmark": _decade(10.0),
+        "w_landmark": _decade(0.3),
         "target_volume": _TEN_PERCENT,
         "max_strain": _TEN_PERCENT,
         "gravity_strength": (1.0, 1.2),

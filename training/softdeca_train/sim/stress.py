@@ -18,6 +18,7 @@ from tqdm import tqdm
 
 from softdeca_train.lhm import LhmConfig
 from softdeca_train.parameters import load_parameters
+from softdeca_train.sim.dynamics import LinearDynamics
 from softdeca_train.sim.expressions import all_expressions, combinations
 from softdeca_train.sim.head import HeadSimulation, build_head_simulation
 from softdeca_train.sim.measures import SoftVolume
@@ -169,6 +170,9 @@ def _severity(c: FrameCheck) -> float:
 
 
 def _frames(sim: Any, hs: HeadSimulation, case: StressCase) -> Iterator[tuple[int, Any]]:
+    """Per frame (linear blend, jaw, the S a frame is judged against, the solve's result):
+    a dynamic run is judged against the linear blend under the same dynamics."""
+    linear = LinearDynamics()
     if case.dynamic:
         sim.reset_dynamics()
     for i, (_, w) in enumerate(case.frames):
@@ -177,6 +181,9 @@ def _frames(sim: Any, hs: HeadSimulation, case: StressCase) -> Iterator[tuple[in
         target = blended[:N_SKIN].astype(np.float64)
         solve = sim.step_dynamic if case.dynamic else sim.solve_static
         vertices, skin, st = solve(target, jaw=jaw)
+        if case.dynamic:
+            gamma, beta = sim.get_parameter("dyn_gamma"), sim.get_parameter("dyn_beta")
+            target = linear.step(target, gamma, beta)
         yield i, (blended, jaw, target, vertices, skin, st)
 
 
