@@ -353,3 +353,37 @@ def test_offset_structure_splits_shared_and_expression_parts(small) -> None:
         assert o.test_linear_in_p_mm is not None and np.isfinite(o.test_linear_in_p_mm)
     # nothing passes a filter nothing meets
     assert offset_structure(out, "static", params, max_error=-1.0) is None
+
+
+def test_evaluation_reads_every_test_frame_and_training_counts_what_it_leaves_out(
+    small, template, tmp_path
+) -> None:
+    import shutil
+
+    from softdeca_train.train.batches import EVERY_FRAME, Dataset
+
+    out, _ = small
+    copy = tmp_path / "ds"
+    shutil.copytree(out, copy)
+    ds = Dataset(copy, template)
+    # Mark one test frame as a solve far above the tolerance.
+    shard = copy / ds.shards("static", "test")[0]
+    with np.load(shard) as z:
+        a = {k: z[k] for k in z.files}
+    a["estimated_error"] = np.array(a["estimated_error"], copy=True)
+    a["estimated_error"][0] = 1.0
+    np.savez(shard, **a)
+    n_test = int((_all(copy, "static")["split"] == TEST).sum())
+
+    def frames(max_error: float | None) -> int:
+        return sum(
+            len(b.weights) for b in ds.batches("static", "test", None, 8, max_error)
+        )
+
+    assert frames(EVERY_FRAME) == n_test
+    assert frames(None) == n_test - 1
+    assert ds.left_out("static", "test") == {
+        "kept": n_test - 1,
+        "left_out": 1,
+        "max_error": 3 * SMALL.tolerance,
+    }

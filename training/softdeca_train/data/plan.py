@@ -82,7 +82,8 @@ def sample_parameters(
     # exp(log(hi)) may round past hi: keep every value inside its range exactly.
     p = np.clip(params.sample(rng), lo, hi)
     g, b = params.names.index("dyn_gamma"), params.names.index("dyn_beta")
-    while peak_gain(p[g], p[b]) > MAX_PEAK_GAIN:
+    dynamics_fixed = {"dyn_gamma", "dyn_beta"} <= {*FIXED[kind], *fixed}
+    while not dynamics_fixed and peak_gain(p[g], p[b]) > MAX_PEAK_GAIN:
         p[[g, b]] = np.clip(params.sample(rng), lo, hi)[[g, b]]
     defaults = params.defaults()
     for name in (*FIXED[kind], *fixed):
