@@ -136,3 +136,23 @@ TEST(SimDynamics, PerPointCoefficientsLocaliseTheDynamics) {
   EXPECT_GT(lag_slow, 0.5);
   EXPECT_LT(lag_fast, lag_slow);
 }
+
+TEST(SimDynamics, ContactsAreInelastic) {
+  // Three points: one hit a contact while moving into it (-Y, shifted back +Y), one was
+  // shifted while already moving away, one was not touched.
+  Positions previous(3, 3), skin(3, 3), shift = Positions::Zero(3, 3);
+  previous << 0, 0.010, 0, 1, 0, 0, 2, 0, 0;
+  skin << 0.002, 0.006, 0, 1, 0.003, 0, 2.001, 0.002, 0;  // after the contact step
+  shift.row(0) << 0, 0.002, 0;  // before it: (0.002, 0.004, 0), 6 mm down, 2 mm across
+  shift.row(1) << 0, 0.001, 0;  // before it: (1, 0.002, 0), already moving up
+  const Positions out = inelastic_previous(skin, shift, previous);
+  // Velocity into the contact is gone, the sliding part is kept, the place is the corrected one.
+  const Eigen::RowVector3d v0 = skin.row(0) - out.row(0);
+  EXPECT_NEAR(v0.x(), 0.002, 1e-15);
+  EXPECT_NEAR(v0.y(), 0.0, 1e-15);
+  // Moving away: the velocity before the contact is kept (the shift does not add to it).
+  const Eigen::RowVector3d v1 = skin.row(1) - out.row(1);
+  EXPECT_NEAR(v1.y(), 0.002, 1e-15);
+  // Untouched: T_{t-1} as it was.
+  EXPECT_EQ(out.row(2), previous.row(2));
+}

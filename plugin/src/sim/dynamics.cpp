@@ -24,4 +24,18 @@ double dynamics_spectral_radius(double gamma, double beta) {
   return std::max(std::abs(a + disc), std::abs(a - disc));
 }
 
+Positions inelastic_previous(const Positions& skin, const Positions& shift, const Positions& previous) {
+  Positions out = previous;
+  for (Eigen::Index i = 0; i < skin.rows(); ++i) {
+    const double length = shift.row(i).norm();
+    if (length == 0) continue;
+    const Eigen::RowVector3d n = shift.row(i) / length;
+    Eigen::RowVector3d v = skin.row(i) - shift.row(i) - previous.row(i);  // before the contact
+    const double into = v.dot(n);
+    if (into < 0) v -= into * n;
+    out.row(i) = skin.row(i) - v;
+  }
+  return out;
+}
+
 }  // namespace softdeca::sim

@@ -27,4 +27,11 @@ Positions blend_targets(const Positions& S, const Positions& T1, const Positions
 // Characteristic roots' largest modulus of the recursion for one (gamma, beta).
 double dynamics_spectral_radius(double gamma, double beta);
 
+// T_{t-1} for the next frame's blend after the contact step moved skin points by `shift`
+// (T_t = skin includes it): contacts are inelastic. A moved point keeps its corrected place,
+// and its velocity T_t - T_{t-1} loses the part that ran into the contact (along the shift),
+// so the momentum term neither carries the correction on nor pushes the point back in;
+// velocity away from the contact is kept. Unmoved points keep `previous`.
+Positions inelastic_previous(const Positions& skin, const Positions& shift, const Positions& previous);
+
 }  // namespace softdeca::sim

@@ -132,6 +132,7 @@ FrameResult Simulator::solve_frame(const Prepared& prep, const FrameInput& in, c
     }
     CollisionResult c = resolve_collisions(mesh_, collision_topology_, r.skin, x, prep.model.skin_area, settings_, pool,
                                            lips.targets.rows() ? &lips : nullptr);
+    r.contact_shift = c.skin - r.skin;
     r.skin = std::move(c.skin);
     r.stats.penetrating_before = c.penetrating_before;
     r.stats.penetrating_after = c.penetrating_after;
@@ -196,7 +197,9 @@ FrameResult Simulator::dynamic_step(const Prepared& stat, const Prepared& dyn, c
   if (mesh_.landmark_count() > 0)
     lmk_target = blend_targets(in.landmark_targets, h.landmark1, h.landmark2, m.landmark_gamma, m.landmark_beta);
   FrameResult r = solve_frame(dyn, in, skin_target, lmk_target, in.warm_start.rows() ? in.warm_start : h.vertices, pool);
-  h.skin2 = std::move(h.skin1);
+  // Contacts are inelastic: their corrections do not enter the momentum (sim/dynamics.h).
+  h.skin2 = r.contact_shift.rows() == r.skin.rows() ? inelastic_previous(r.skin, r.contact_shift, h.skin1)
+                                                    : std::move(h.skin1);
   h.skin1 = r.skin;
   if (mesh_.landmark_count() > 0) {
     h.landmark2 = std::move(h.landmark1);

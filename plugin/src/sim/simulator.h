@@ -32,6 +32,7 @@ struct FrameResult {
   Positions vertices;  // all simulated vertices
   Positions skin;      // S, through its embedding
   SolveStats stats;
+  Positions contact_shift;  // per skin point, what the contact step moved it (empty: no contacts)
 };
 
 class Simulator {
