@@ -212,10 +212,10 @@ STRESS_TAKE_STRIDE ?= 10
 .PHONY: stress bench-stress
 stress: build ## the physics stress suite judged by the sanity bounds -> out/stress (report, contact sheet)
 	@nice -n 5 $(PY) -m softdeca_train stress --ict "$(SOFTDECA_ICT)" --recordings "$(RECORDINGS)" \
-	  --take-stride $(STRESS_TAKE_STRIDE) --out $(OUT)/stress
+	  --take-stride $(STRESS_TAKE_STRIDE) --workers $(JOBS) --out $(OUT)/stress
 bench-stress: build ## the stress suite's figures -> build/bench/physics_stress.json
 	@nice -n 5 $(PY) -m softdeca_train stress --ict "$(SOFTDECA_ICT)" --recordings "$(RECORDINGS)" \
-	  --take-stride $(STRESS_TAKE_STRIDE) --out build/stress --bench-out build/bench --quiet
+	  --take-stride $(STRESS_TAKE_STRIDE) --workers $(JOBS) --out build/stress --bench-out build/bench --quiet
 
 # ---- Native binaries per platform and the Unity package tarball (docs/platforms.md) -----------
 # Linux x86_64 is build/release. Windows x64 is cross-built here with MinGW-w64 in build/windows;

@@ -3,6 +3,7 @@ library, a reduced suite (LHM level 3, two identities) and the snarl frame that 
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -14,7 +15,13 @@ from softdeca_train.sim.expressions import (
     single_shapes,
 )
 from softdeca_train.sim.sanity import BOUNDS, FrameCheck, bench_figures, failure_counts
-from softdeca_train.sim.stress import StressCase, StressPlan, build_cases, run_stress
+from softdeca_train.sim.stress import (
+    StressCase,
+    StressPlan,
+    build_cases,
+    run_stress,
+    run_stress_parallel,
+)
 from softdeca_train.template import Template
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 
@@ -213,3 +220,20 @@ def test_jaw_and_skin_motion_do_not_invert_the_muscle_layer(
     )
     (frame,) = run_stress(template, [case], keep_worst=0, progress=False).frames
     assert frame.check.inverted_elements <= most, frame.check.as_dict()
+
+
+def test_the_suite_on_several_processes_gives_what_one_process_gives(
+    template: Template,
+) -> None:
+    frames = list(combinations().items())[:2]
+    cases = [StressCase("tiny", who, LEVEL, frames) for who in IDENTITIES]
+    one = run_stress(template, cases, keep_worst=3, progress=False)
+    two = run_stress_parallel(None, cases, keep_worst=3, workers=2, progress=False)
+    # as JSON: a closed mouth's ratio is NaN, which equals nothing
+    assert [json.dumps(f.as_dict()) for f in two.frames] == [
+        json.dumps(f.as_dict()) for f in one.frames
+    ]
+    assert [w.title for w in two.worst] == [w.title for w in one.worst]
+    assert [w.score for w in two.worst] == sorted(
+        (w.score for w in two.worst), reverse=True
+    )

@@ -155,6 +155,7 @@ class WorstFrame:
     neutral: np.ndarray
     linear: np.ndarray
     physics: np.ndarray
+    score: float = 0.0  # _severity: the contact sheet shows the highest first
 
 
 @dataclass
@@ -233,7 +234,7 @@ def run_stress(
                     f"{check.max_displacement_mm:.1f} mm"
                 )
                 physics = hs.whole_head(skin, blended, jaw).astype(np.float32)
-                worst = WorstFrame(title, hs.head, blended.astype(np.float32), physics)
+                worst = WorstFrame(title, hs.head, blended.astype(np.float32), physics, score)
                 item = (score, len(out.frames), worst)
                 if len(heap) < keep_worst:
                     heapq.heappush(heap, item)
@@ -241,6 +242,56 @@ def run_stress(
                     heapq.heapreplace(heap, item)
     bar.close()
     out.worst = [w for _, _, w in sorted(heap, key=lambda t: -t[0])]
+    out.seconds = time.perf_counter() - t0
+    return out
+
+
+def _case_groups(cases: list[StressCase]) -> list[list[StressCase]]:
+    """The cases of one head simulation (identity, level) together, in the given order."""
+    groups: dict[tuple[str, int], list[StressCase]] = {}
+    for c in cases:
+        groups.setdefault((c.identity, c.level), []).append(c)
+    return list(groups.values())
+
+
+def _run_group(
+    ict: str | None, cases: list[StressCase], keep_worst: int, settings: dict[str, Any]
+) -> StressResult:
+    return run_stress(Template.load(ict), cases, keep_worst, False, **settings)
+
+
+def run_stress_parallel(
+    ict: str | None,
+    cases: list[StressCase],
+    keep_worst: int = 6,
+    workers: int = 2,
+    progress: bool = True,
+    **settings: Any,
+) -> StressResult:
+    """run_stress over `workers` processes, one head simulation (identity, level) per task,
+    the largest first; the frames come back in the order run_stress gives them."""
+    import multiprocessing
+    import time
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    t0 = time.perf_counter()
+    groups = _case_groups(cases)
+    size = [sum(len(c.frames) for c in g) for g in groups]
+    results: list[StressResult | None] = [None] * len(groups)
+    bar = tqdm(total=sum(size), desc="stress", unit="frame", disable=not progress)
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(workers, mp_context=ctx) as pool:
+        order = sorted(range(len(groups)), key=lambda k: -size[k])
+        jobs = {pool.submit(_run_group, ict, groups[k], keep_worst, settings): k for k in order}
+        for job in as_completed(jobs):
+            k = jobs[job]
+            results[k] = job.result()
+            bar.update(size[k])
+    bar.close()
+    out = StressResult()
+    done = [r for r in results if r is not None]
+    out.frames = [f for r in done for f in r.frames]
+    out.worst = sorted((w for r in done for w in r.worst), key=lambda w: -w.score)[:keep_worst]
     out.seconds = time.perf_counter() - t0
     return out
 

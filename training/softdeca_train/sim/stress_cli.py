@@ -43,6 +43,12 @@ def add_stress_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--keep-worst", type=int, default=6, help="rows of the contact sheet (6)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help="processes, one head simulation (identity, level) each at a time (1)",
+    )
+    p.add_argument(
         "--ict",
         default=None,
         help="ICT-FaceKit checkout, FaceXModel folder or archive (default: $SOFTDECA_ICT)",
@@ -52,11 +58,17 @@ def add_stress_args(p: argparse.ArgumentParser) -> None:
 def run_stress_cli(args: argparse.Namespace) -> int:
     from softdeca_train.bench import figure, report_area
     from softdeca_train.sim.run import failure_line
-    from softdeca_train.sim.stress import StressPlan, build_cases, run_stress, write_report
+    from softdeca_train.sim.stress import (
+        StressPlan,
+        build_cases,
+        run_stress,
+        run_stress_parallel,
+        write_report,
+    )
     from softdeca_train.template import Template
 
-    if args.level < 1 or args.fine_level < 0 or args.take_stride < 1:
-        raise ValueError("need --level >= 1, --fine-level >= 0, --take-stride >= 1")
+    if args.level < 1 or args.fine_level < 0 or args.take_stride < 1 or args.workers < 1:
+        raise ValueError("need --level >= 1, --fine-level >= 0, --take-stride >= 1, --workers >= 1")
     takes: tuple[Path, ...] = ()
     if args.recordings:
         folder = Path(args.recordings)
@@ -83,7 +95,12 @@ def run_stress_cli(args: argparse.Namespace) -> int:
         flush=True,
     )
     settings = {"collision_rounds": 0} if args.no_collisions else {}
-    result = run_stress(template, cases, args.keep_worst, not args.quiet, **settings)
+    if args.workers > 1:
+        result = run_stress_parallel(
+            args.ict, cases, args.keep_worst, args.workers, not args.quiet, **settings
+        )
+    else:
+        result = run_stress(template, cases, args.keep_worst, not args.quiet, **settings)
     command = "python -m softdeca_train stress " + shlex.join(sys.argv[2:])
     summary = write_report(Path(args.out), result, template, command)
     s = summary["all"]
