@@ -372,6 +372,10 @@ def test_evaluation_reads_every_test_frame_and_training_counts_what_it_leaves_ou
         a = {k: z[k] for k in z.files}
     a["estimated_error"] = np.array(a["estimated_error"], copy=True)
     a["estimated_error"][0] = 1.0
+    # and another as failing a sanity bound (bit 0: exploded)
+    a["failures"] = np.array(a["failures"], copy=True)
+    a["failures"][:] = 0
+    a["failures"][1] = 1
     np.savez(shard, **a)
     n_test = int((_all(copy, "static")["split"] == TEST).sum())
 
@@ -381,9 +385,10 @@ def test_evaluation_reads_every_test_frame_and_training_counts_what_it_leaves_ou
         )
 
     assert frames(EVERY_FRAME) == n_test
-    assert frames(None) == n_test - 1
+    assert frames(None) == n_test - 2
     assert ds.left_out("static", "test") == {
-        "kept": n_test - 1,
+        "kept": n_test - 2,
         "left_out": 1,
+        "failed_bounds": 1,
         "max_error": 3 * SMALL.tolerance,
     }

@@ -26,6 +26,20 @@ from softdeca_train.template.model import N_SKIN
 EVERY_FRAME = math.inf
 
 
+def training_mask(arrays: dict[str, np.ndarray], limit: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per instance of one shard: (solver error within `limit`, passes the sanity bounds).
+    A sequence counts as failing if any of its frames does. With `limit` EVERY_FRAME both are
+    all true: the evaluation judges every frame, failed ones included."""
+    n = len(arrays["instance_id"])
+    if limit == EVERY_FRAME:
+        ones = np.ones(n, bool)
+        return ones, ones
+    solved = (arrays["estimated_error"].reshape(n, -1) <= limit).all(axis=1)
+    failures = arrays.get("failures")  # datasets made before the sanity bounds lack it
+    sane = np.ones(n, bool) if failures is None else (failures.reshape(n, -1) == 0).all(axis=1)
+    return solved, sane
+
+
 @dataclass
 class Batch:
     """One group of frames. Shapes: B frames (static/sparse) or L sequence frames (dynamic);
@@ -134,18 +148,19 @@ class Dataset:
         ]
 
     def left_out(self, kind: str, split: str, max_error: float | None = None) -> dict[str, int]:
-        """Instances of one kind and split that `batches` yields (`kept`) and leaves out for
-        their solver error (`left_out`, same limit as `batches`): reported, never silent."""
+        """Instances of one kind and split that `batches` yields (`kept`), leaves out for
+        their solver error (`left_out`, same limit as `batches`) and, of the others, for a
+        failed sanity bound (`failed_bounds`, sim/sanity.py): reported, never silent."""
         limit = 3 * self.tolerance if max_error is None else max_error
-        kept = left = 0
+        kept = left = failed = 0
         for f in self.shards(kind, split):
             with np.load(self.folder / f) as z:
-                err = z["estimated_error"]
-            n = len(err) if err.ndim else 1
-            ok = (err.reshape(n, -1) <= limit).all(axis=1)
-            kept += int(ok.sum())
-            left += int((~ok).sum())
-        return {"kept": kept, "left_out": left, "max_error": limit}  # type: ignore[dict-item]
+                arrays = {k: z[k] for k in ("instance_id", "estimated_error", "failures") if k in z}
+            solved, sane = training_mask(arrays, limit)
+            kept += int((solved & sane).sum())
+            left += int((~solved).sum())
+            failed += int((solved & ~sane).sum())
+        return {"kept": kept, "left_out": left, "failed_bounds": failed, "max_error": limit}  # type: ignore[dict-item]
 
     def batches(
         self,
@@ -156,7 +171,8 @@ class Dataset:
         max_error: float | None = None,
     ) -> Iterator[Batch]:
         """Every batch of one pass (shuffled with `rng`, in order without). Frames whose
-        solver error exceeds `max_error` (default 3x the dataset's tolerance) are left out."""
+        solver error exceeds `max_error` (default 3x the dataset's tolerance) or that fail a
+        sanity bound are left out; EVERY_FRAME keeps all (`left_out` counts them)."""
         limit = 3 * self.tolerance if max_error is None else max_error
         files = self.shards(kind, split)
         if rng is not None:
@@ -164,8 +180,8 @@ class Dataset:
         for f in files:
             with np.load(self.folder / f) as z:
                 a = {k: z[k] for k in z.files if k != "meta"}
-            n = len(a["instance_id"])
-            ok = (a["estimated_error"].reshape(n, -1) <= limit).all(axis=1)
+            solved, sane = training_mask(a, limit)
+            ok = solved & sane
             groups = [np.flatnonzero(ok & (a["param_id"] == g)) for g in np.unique(a["param_id"])]
             if rng is not None:
                 groups = [groups[k] for k in rng.permutation(len(groups))]

@@ -216,7 +216,8 @@ def write_report(
     assert isinstance(sd, SoftDeca)
     local = localisation_figure(run, sd, out / "localisation.png")
     # Frames training leaves out because the volumetric solver's estimated error is above 3x
-    # the dataset's tolerance; the evaluation reads every test frame.
+    # the dataset's tolerance or the frame fails a sanity bound; the evaluation reads every
+    # test frame.
     left_out = {
         f"{kind}/train": run.data.left_out(kind, "train")
         for kind in ("static", "sparse", "dynamic")
@@ -236,14 +237,18 @@ def write_report(
 
 
 def _left_out_line(left: dict[str, dict[str, int]]) -> str:
-    """Frames training leaves out for the volumetric solver's error (evaluation: none)."""
+    """Frames training leaves out for the volumetric solver's error or a failed sanity bound
+    (evaluation: none)."""
     if not left:
         return "Frames left out for the solver's estimated error: not counted."
-    parts = [f"{k} {v['left_out']} of {v['kept'] + v['left_out']}" for k, v in left.items()]
+    total = lambda v: v["kept"] + v["left_out"] + v.get("failed_bounds", 0)  # noqa: E731
+    parts = [f"{k} {v['left_out']} of {total(v)}" for k, v in left.items()]
+    failed = [f"{k} {v.get('failed_bounds', 0)}" for k, v in left.items()]
     return (
         "The evaluation reads every test frame. Frames left out of training because the "
         "volumetric solver's estimated error exceeds 3x the dataset's tolerance: "
-        f"{', '.join(parts)}."
+        f"{', '.join(parts)}; because they fail a sanity bound (docs/physics.md): "
+        f"{', '.join(failed)}."
     )
 
 
