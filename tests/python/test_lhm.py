@@ -89,8 +89,9 @@ def test_eyes_are_attached(template_model: LayeredHeadModel) -> None:
 
 def test_resolution_is_a_parameter(template: Template) -> None:
     coarse = fit_lhm(template, None, LhmConfig(level=3, soft_layers=2))
-    # The icosphere's directions plus the mouth slit's copies of its inner vertices.
-    assert coarse.n_wrap == 10 * 4**3 + 2 + len(coarse.slit_copy_of)
+    # The icosphere's directions plus the slits' copies of their inner vertices (mouth, eyes).
+    copies = len(coarse.slit_copy_of) + len(coarse.eye_copy_of)
+    assert coarse.n_wrap == 10 * 4**3 + 2 + copies and len(coarse.eye_copy_of) >= 2
     assert coarse.n_layers == 4
     assert len(coarse.soft_tets) == 2 * 3 * 20 * 4**3
     assert (

@@ -178,13 +178,13 @@ def test_the_default_resolution_has_a_slit_too(template: Template) -> None:
 
 
 def test_a_mouth_narrower_than_two_wrap_edges_gets_no_slit() -> None:
-    from softdeca_train.lhm.mouth import mouth_slit
+    from softdeca_train.lhm.mouth import slit_along
     from softdeca_train.lhm.sphere import icosphere
 
     dirs, tris = icosphere(2)
     narrow = np.array([[-0.01, 0.0, 1.0], [0.0, 0.0, 1.0], [0.01, 0.0, 1.0]])
-    slit = mouth_slit(dirs, tris, np.zeros(3), narrow)
+    slit = slit_along(dirs, tris, np.zeros(3), narrow)
     assert len(slit.copy_of) == 0 and np.array_equal(slit.triangles, tris)
     wide = np.array([[-0.5, 0.0, 1.0], [0.0, 0.0, 1.0], [0.5, 0.0, 1.0]])
-    cut = mouth_slit(dirs, tris, np.zeros(3), wide)
+    cut = slit_along(dirs, tris, np.zeros(3), wide)
     assert len(cut.copy_of) >= 1 and (cut.side != 0).any()

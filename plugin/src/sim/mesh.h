@@ -46,7 +46,8 @@ struct Bone {
 struct CollisionSet {
   std::string name;
   std::vector<int32_t> points;  // skin point indices
-  TriIndices surface;           // over skin points, or over simulated vertices (teeth)
+  TriIndices surface;           // over skin points, or over simulated vertices (teeth); empty: the
+                                // points are only placed on their targets (the surface step)
   bool surface_on_skin = true;
   double max_distance = 0.01;  // metres: farther closest points are not this contact
 };

@@ -67,13 +67,9 @@ SIDE_EMBEDDING_MAX_MM = 8.0
 
 
 def closed_wrap_triangles(model: LayeredHeadModel) -> np.ndarray:
-    """The wrap triangles with the mouth slit's copies mapped back to their originals: the
-    closed surface the wraps form at rest (the copies coincide with them there)."""
-    n_orig = model.n_wrap - len(model.slit_copy_of)
-    tris = model.wrap_triangles.astype(np.int64)
-    copies = tris >= n_orig
-    tris[copies] = model.slit_copy_of[tris[copies] - n_orig]
-    return tris.astype(np.int32)
+    """The wrap triangles with the slits' copies mapped back to their originals: the closed
+    surface the wraps form at rest (the copies coincide with them there)."""
+    return model.copy_of()[model.wrap_triangles].astype(np.int32)
 
 
 def tets_spanning_both_lips(model: LayeredHeadModel, tets: np.ndarray) -> int:
@@ -83,8 +79,7 @@ def tets_spanning_both_lips(model: LayeredHeadModel, tets: np.ndarray) -> int:
 
 def _slit_middle(model: LayeredHeadModel) -> np.ndarray:
     """Middle of the slit's inner part on the skin wrap: the mouth region's centre."""
-    k = len(model.slit_copy_of)
-    middle = model.n_wrap - k + np.arange(k) if k else model.slit_path
+    middle = model.mouth_copies if len(model.slit_copy_of) else model.slit_path
     return model.skin_wrap[middle].mean(axis=0)
 
 

@@ -47,6 +47,7 @@ class TetMesh:
     soft_tets: np.ndarray  # (T_s, 4), positive volume
     muscle_tets: np.ndarray  # (T_m, 4), positive volume
     soft_side: np.ndarray  # (T_s,) +1 upper lip's side of the slit, -1 lower lip's, 0 elsewhere
+    soft_lid_side: np.ndarray  # (T_s,) the same for the eye slits: +1 upper lid's, -1 lower
     bone_vertices: np.ndarray  # vertices on the skull wrap (pinned to a bone)
     bone_wrap_vertex: np.ndarray  # the skull wrap vertex nearest to each of them
 
@@ -62,22 +63,20 @@ def boundary_faces(tets: np.ndarray) -> np.ndarray:
 
 
 def slotted_vertices(model: LayeredHeadModel, gap: float) -> np.ndarray:
-    """The LHM's vertices with the mouth slit opened: in every layer the slit's inner vertices
-    (upper lip) move up and their copies (lower lip) down by gap / 2."""
+    """The LHM's vertices with the slits opened: in every layer each slit's inner vertices
+    (upper lip, upper lid) move up and their copies (lower lip, lower lid) down by gap / 2."""
     v = model.vertices.copy()
-    k = len(model.slit_copy_of)
-    if k == 0:
-        return v
-    n_orig = model.n_wrap - k
+    originals = np.concatenate([model.eye_copy_of, model.slit_copy_of])
+    copies = np.concatenate([model.eye_copies, model.mouth_copies])
     for layer in range(model.n_layers):
         base = layer * model.n_wrap
-        v[base + model.slit_copy_of, 1] += 0.5 * gap
-        v[base + n_orig + np.arange(k), 1] -= 0.5 * gap
+        v[base + originals, 1] += 0.5 * gap
+        v[base + copies, 1] -= 0.5 * gap
     return v
 
 
-def _triangle_side(model: LayeredHeadModel) -> np.ndarray:
-    s = model.lip_side[model.wrap_triangles]
+def _triangle_side(model: LayeredHeadModel, vertex_side: np.ndarray) -> np.ndarray:
+    s = vertex_side[model.wrap_triangles]
     return np.where((s > 0).any(axis=1), 1, np.where((s < 0).any(axis=1), -1, 0)).astype(np.int8)
 
 
@@ -157,7 +156,9 @@ def conforming_mesh(
     soft = tets[~muscle]
     # Lip side: the side of the LHM prism (slotted) that holds the soft tet's centroid.
     prism, _, _ = native.embed_points(slotted, model.soft_tets, centroids[~muscle])
-    side = _triangle_side(model)[np.asarray(prism) % len(model.wrap_triangles)]
+    triangle = np.asarray(prism) % len(model.wrap_triangles)
+    side = _triangle_side(model, model.lip_side)[triangle]
+    lid_side = _triangle_side(model, model.eye_side)[triangle]
 
     skull = slotted[(model.n_layers - 1) * model.n_wrap :]
     d2, _, _ = igl.point_mesh_squared_distance(v, skull, model.wrap_triangles.astype(np.int64))
@@ -171,6 +172,7 @@ def conforming_mesh(
         soft_tets=soft.astype(np.int32),
         muscle_tets=tets[muscle].astype(np.int32),
         soft_side=side.astype(np.int8),
+        soft_lid_side=lid_side.astype(np.int8),
         bone_vertices=bone.astype(np.int32),
         bone_wrap_vertex=np.asarray(nearest, np.int32),
     )

@@ -23,8 +23,9 @@ import softdeca_native as native
 
 from softdeca_train.geometry import umeyama
 from softdeca_train.lhm import radial
+from softdeca_train.lhm.eyes import EYES, fissure_line, lid_side_of_points
 from softdeca_train.lhm.model import CRANIUM, JAW, LayeredHeadModel, LhmConfig
-from softdeca_train.lhm.mouth import MouthSlit, mouth_line, mouth_slit, upper_lip_points
+from softdeca_train.lhm.mouth import Slit, mouth_line, slit_along, upper_lip_points
 from softdeca_train.lhm.sphere import icosphere, vertex_neighbours, zoom
 from softdeca_train.lhm.tissue_depth import depth_anchors, interpolate_depth
 from softdeca_train.template.model import N_SKIN, Template
@@ -137,9 +138,50 @@ def wrap_directions(
     return zoom(dirs, np.asarray(toward), factor), tris, vertex_neighbours(tris, len(dirs))
 
 
-def _slit(skin: np.ndarray, lm68: np.ndarray, center: np.ndarray, cfg: LhmConfig) -> MouthSlit:
+@dataclass(frozen=True)
+class _Cuts:
+    """The wraps' slits: each eye's fissure cut first, then the mouth's on their result, so
+    the wrap vertices are the originals, the eyes' copies, then the mouth's (the last
+    len(mouth.copy_of), as LayeredHeadModel documents). Cuts keep the triangles' order."""
+
+    eyes: list[Slit]
+    mouth: Slit
+
+    @property
+    def directions(self) -> np.ndarray:
+        return self.mouth.directions
+
+    @property
+    def triangles(self) -> np.ndarray:
+        return self.mouth.triangles
+
+    @property
+    def eye_copy_of(self) -> np.ndarray:
+        return np.concatenate([e.copy_of for e in self.eyes]).astype(np.int64)
+
+    @property
+    def n_original(self) -> int:
+        return len(self.directions) - len(self.mouth.copy_of) - len(self.eye_copy_of)
+
+    @property
+    def eye_triangle_side(self) -> np.ndarray:
+        """Per wrap triangle: +1 / -1 on an upper / lower lid's side of its eye's slit."""
+        return np.sum([e.side for e in self.eyes], axis=0).astype(np.int8)
+
+    def extend(self, per_vertex: np.ndarray) -> np.ndarray:
+        """A per-original-vertex array with the copies' values appended."""
+        copies = np.concatenate([self.eye_copy_of, self.mouth.copy_of])
+        return np.concatenate([per_vertex, per_vertex[copies]])
+
+
+def _slit(skin: np.ndarray, lm68: np.ndarray, center: np.ndarray, cfg: LhmConfig) -> _Cuts:
     dirs, tris, _ = wrap_directions(cfg.level, cfg.zoom_toward, cfg.zoom_factor)
-    return mouth_slit(dirs, tris, center, mouth_line(skin, lm68))
+    eyes = []
+    for eye in EYES:
+        cut = slit_along(dirs, tris, center, fissure_line(skin, lm68, eye))
+        eyes.append(cut)
+        dirs, tris = cut.directions, cut.triangles
+    return _Cuts(eyes, slit_along(dirs, tris, center, mouth_line(skin, lm68)))
 
 
 def _template_radii(template: Template, cfg: LhmConfig) -> tuple[_Radii, SampleLayout]:
@@ -210,13 +252,13 @@ def _sphere_fit(points: np.ndarray) -> tuple[np.ndarray, float]:
     return center, float(np.sqrt(sol[3] + center @ center))
 
 
-def _lip_side(slit: MouthSlit) -> np.ndarray:
-    """Per wrap vertex (copies included): +1 in the upper lip's columns next to the slit, -1
-    in the lower lip's, 0 elsewhere and at the mouth corners."""
-    side = np.zeros(len(slit.directions), np.int8)
+def _vertex_side(tris: np.ndarray, tri_side: np.ndarray, n: int, ends: np.ndarray) -> np.ndarray:
+    """Per wrap vertex (copies included): +1 in the upper side's columns next to a slit, -1 in
+    the lower's, 0 elsewhere and at the slits' ends (`ends`), where they close."""
+    side = np.zeros(n, np.int8)
     for s in (1, -1):
-        side[np.unique(slit.triangles[slit.side == s])] = s
-    side[slit.path[[0, -1]]] = 0
+        side[np.unique(tris[tri_side == s])] = s
+    side[ends] = 0
     return side
 
 
@@ -233,32 +275,44 @@ def lip_of_points(template: Template, head: np.ndarray, bones: np.ndarray) -> np
 
 
 def embed_skin_by_side(
-    vertices: np.ndarray, soft: np.ndarray, skin: np.ndarray, tet_side: np.ndarray, bone: np.ndarray
+    vertices: np.ndarray,
+    soft: np.ndarray,
+    skin: np.ndarray,
+    tet_side: np.ndarray,
+    bone: np.ndarray,
+    tet_lid_side: np.ndarray,
+    lid_side: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """S's embedding in the soft tets, each lip in its own side of the mouth slit: a point of
-    the lower lip's side (`bone` JAW, `lip_of_points`) is not embedded in a tet of the upper
-    lip's side of the slit (`tet_side` +1, per soft tet), one of the upper lip's not in the
-    lower lip's (-1).
-    Next to the slit the
-    radial wall between the sides leans through the lips (the rays come from above and
-    behind), so such points are embedded in the nearest tet of their own side, with
-    barycentric coordinates outside [0, 1] (exact at rest, affine under deformation)."""
+    """S's embedding in the soft tets, each lip and each lid in its own side of its slit: a
+    point of the lower lip's side (`bone` JAW, `lip_of_points`) is not embedded in a tet of
+    the upper lip's side of the mouth slit (`tet_side` +1, per soft tet), one of the upper
+    lip's not in the lower lip's (-1); likewise a point of an upper or lower lid (`lid_side`
+    +1 / -1, lhm/eyes.py) is not embedded in a tet of the other lid's side (`tet_lid_side`).
+    Next to a slit the radial wall between the sides leans through the lips (the rays come
+    from above and behind), so such points are embedded in the nearest tet of their own side,
+    with barycentric coordinates outside [0, 1] (exact at rest, affine under deformation)."""
     tet, bary, _ = native.embed_points(vertices, soft, skin)
     tet = np.asarray(tet, np.int64)
-    side = tet_side[tet]
-    wrong = ((side > 0) & (bone == JAW)) | ((side < 0) & (bone == CRANIUM))
-    for s, b in ((1, JAW), (-1, CRANIUM)):
-        pick = np.flatnonzero(wrong & (bone == b))
-        if len(pick) == 0:
-            continue
-        # Candidates near the points only (the nearest-tet search is costly for outside points).
-        lo, hi = skin[pick].min(axis=0) - 0.02, skin[pick].max(axis=0) + 0.02
-        centroid = vertices[soft].mean(axis=1)
-        near = ((centroid > lo) & (centroid < hi)).all(axis=1)
-        allowed = np.flatnonzero((tet_side != s) & near)
-        t2, b2, _ = native.embed_points(vertices, soft[allowed], skin[pick])
-        tet[pick] = allowed[np.asarray(t2)]
-        bary[pick] = b2
+    lip_of_point = np.where(bone == JAW, -1, 1)
+
+    def clash(t_lip: np.ndarray, t_lid: np.ndarray, p_lip: np.ndarray, p_lid: np.ndarray):
+        return ((t_lip != 0) & (t_lip != p_lip)) | ((t_lid != 0) & (p_lid != 0) & (t_lid != p_lid))
+
+    wrong = clash(tet_side[tet], tet_lid_side[tet], lip_of_point, lid_side)
+    centroid = vertices[soft].mean(axis=1)
+    for p_lip in (1, -1):
+        for p_lid in (1, 0, -1):
+            pick = np.flatnonzero(wrong & (lip_of_point == p_lip) & (lid_side == p_lid))
+            if len(pick) == 0:
+                continue
+            # Candidates near the points only (the nearest-tet search is costly for outside
+            # points).
+            lo, hi = skin[pick].min(axis=0) - 0.02, skin[pick].max(axis=0) + 0.02
+            near = ((centroid > lo) & (centroid < hi)).all(axis=1)
+            allowed = np.flatnonzero(~clash(tet_side, tet_lid_side, p_lip, p_lid) & near)
+            t2, b2, _ = native.embed_points(vertices, soft[allowed], skin[pick])
+            tet[pick] = allowed[np.asarray(t2)]
+            bary[pick] = b2
     return tet, bary
 
 
@@ -323,8 +377,13 @@ def fit_lhm(
 
     bones = bone_labels(template, head)
     lip_bone = lip_of_points(template, head, bones)
-    tet_side = np.tile(slit.side, len(soft) // len(slit.side))
-    tet, bary = embed_skin_by_side(vertices, soft, skin, tet_side, lip_bone)
+    lid_side = lid_side_of_points(skin, template.landmarks68)
+    layers = len(soft) // len(tris)
+    tet, bary = embed_skin_by_side(
+        vertices, soft, skin,
+        np.tile(slit.mouth.side, layers), lip_bone,
+        np.tile(slit.eye_triangle_side, layers), lid_side,
+    )  # fmt: skip
     skull_labels = np.where(
         (rad.owner >= 0) & (bones[np.maximum(rad.owner, 0)] == JAW), JAW, CRANIUM
     )
@@ -335,7 +394,9 @@ def fit_lhm(
     for _ in range(2):
         share = np.bincount(owner_of, weights=skull_labels[flat], minlength=len(nbrs)) / counts
         skull_labels = np.where(share > 0.5, JAW, np.where(share < 0.5, CRANIUM, skull_labels))
-    lip_side = _lip_side(slit)
+    lip_side = _vertex_side(tris, slit.mouth.side, n, slit.mouth.path[[0, -1]])
+    eye_ends = np.concatenate([e.path[[0, -1]] for e in slit.eyes])
+    eye_side = _vertex_side(tris, slit.eye_triangle_side, n, eye_ends)
     skull_labels = slit.extend(skull_labels)
     skull_labels[lip_side > 0] = CRANIUM  # the upper lip hangs on the maxilla
     skull_labels[lip_side < 0] = JAW  # the lower lip on the mandible
@@ -355,14 +416,18 @@ def fit_lhm(
         skin_bary=bary,
         tissue_depth=slit.extend(rad.depth),
         lip_side=lip_side,
-        slit_copy_of=slit.copy_of.astype(np.int32),
-        slit_path=slit.path.astype(np.int32),
+        slit_copy_of=slit.mouth.copy_of.astype(np.int32),
+        slit_path=slit.mouth.path.astype(np.int32),
+        eye_side=eye_side,
+        eye_copy_of=slit.eye_copy_of.astype(np.int32),
         attachments={
             # Bone each non-skin ICT vertex rides with (teeth, gums, tongue, eyes, ...).
             "bone_of_vertex": bones[N_SKIN:],
             # Per S vertex, the bone its lip side hangs on (lip_of_points): how any tet mesh
             # of this model embeds S by side.
             "skin_lip_bone": lip_bone,
+            # Per S vertex, its lid's side of the eye slits (+1 upper, -1 lower, 0 neither).
+            "skin_lid_side": lid_side,
             "eye_centers": np.array([e[0] for e in eyes]),
             "eye_radii": np.array([e[1] for e in eyes]),
         },

@@ -74,11 +74,35 @@ class LayeredHeadModel:
     lip_side: np.ndarray
     slit_copy_of: np.ndarray
     slit_path: np.ndarray  # wrap vertices along the mouth line, corner to corner
+    # Eye slits (lhm/eyes.py), the same per eye: eye_side +1 / -1 in an upper / lower lid's
+    # columns; the len(eye_copy_of) wrap vertices before the mouth's copies are the lower
+    # lids' copies of eye_copy_of.
+    eye_side: np.ndarray
+    eye_copy_of: np.ndarray
     attachments: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def n_wrap(self) -> int:
         return len(self.directions)
+
+    @property
+    def n_original(self) -> int:
+        """Wrap vertices that are not a slit's copy."""
+        return self.n_wrap - len(self.slit_copy_of) - len(self.eye_copy_of)
+
+    @property
+    def eye_copies(self) -> np.ndarray:
+        """Wrap vertex ids of the eye slits' copies (twins of eye_copy_of)."""
+        return self.n_original + np.arange(len(self.eye_copy_of))
+
+    @property
+    def mouth_copies(self) -> np.ndarray:
+        """Wrap vertex ids of the mouth slit's copies (twins of slit_copy_of)."""
+        return self.n_wrap - len(self.slit_copy_of) + np.arange(len(self.slit_copy_of))
+
+    def copy_of(self) -> np.ndarray:
+        """Per wrap vertex, its original (itself for originals)."""
+        return np.concatenate([np.arange(self.n_original), self.eye_copy_of, self.slit_copy_of])
 
     @property
     def n_layers(self) -> int:

@@ -1,4 +1,5 @@
-"""The mouth in the layered head model: a slit through every wrap along the mouth line.
+"""The mouth in the layered head model: a slit through every wrap along the mouth line (the
+same cut separates the eyelids, lhm/eyes.py).
 
 The wraps are radial graphs over one triangulation of directions, so a slit is a path of wrap
 edges whose inner vertices are doubled: the triangles above the path keep the original
@@ -60,7 +61,7 @@ def upper_lip_points(
     return to_upper[points] < to_lower[points]
 
 
-def _closest_on_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
+def closest_on_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
     """Closest point of the polyline `line` to each of `points` (all 3D)."""
     a, b = line[:-1], line[1:]
     ab = b - a
@@ -71,14 +72,14 @@ def _closest_on_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class MouthSlit:
+class Slit:
     """The slit of a wrap triangulation with `n` directions."""
 
     directions: np.ndarray  # (n + k, 3): the moved directions, then the k copies'
     triangles: np.ndarray  # (F, 3) the cut triangulation
-    path: np.ndarray  # wrap vertices along the mouth line, corner to corner (original ids)
+    path: np.ndarray  # wrap vertices along the line, end to end (original ids)
     copy_of: np.ndarray  # (k,) original vertex of each copy (the path's inner vertices)
-    side: np.ndarray  # (F,) +1: the upper lip's side of the slit, -1: the lower's, 0: neither
+    side: np.ndarray  # (F,) +1: the upper side of the slit (upper lip, lid), -1: the lower's
 
     @property
     def n_original(self) -> int:
@@ -101,7 +102,7 @@ def _path_along(dirs: np.ndarray, tris: np.ndarray, line_dirs: np.ndarray) -> np
     arc = np.arccos(np.clip(np.einsum("ij,ij->i", dirs[e[:, 0]], dirs[e[:, 1]]), -1, 1))
     mid = dirs[e].mean(axis=1)
     mid /= np.linalg.norm(mid, axis=1, keepdims=True)
-    off = np.linalg.norm(_closest_on_polyline(mid, line_dirs) - mid, axis=1) / arc.mean()
+    off = np.linalg.norm(closest_on_polyline(mid, line_dirs) - mid, axis=1) / arc.mean()
     w = arc * (1.0 + 25.0 * off**2)
     n = len(dirs)
     graph = coo_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), (n, n))
@@ -111,7 +112,7 @@ def _path_along(dirs: np.ndarray, tris: np.ndarray, line_dirs: np.ndarray) -> np
     path = [stop]
     while path[-1] != start:
         if pred[path[-1]] < 0:
-            raise ValueError("the mouth corners are not connected on the wrap triangulation")
+            raise ValueError("the slit's ends are not connected on the wrap triangulation")
         path.append(int(pred[path[-1]]))
     return np.array(path[::-1])
 
@@ -126,7 +127,7 @@ def _snap(
 ) -> np.ndarray:
     """Move the path's directions onto the line (ends onto its ends), shortening any move that
     would fold a direction triangle (orientation kept at least half of what it was)."""
-    target = _closest_on_polyline(dirs[path], line_dirs)
+    target = closest_on_polyline(dirs[path], line_dirs)
     target[0], target[-1] = line_dirs[0], line_dirs[-1]
     target /= np.linalg.norm(target, axis=1, keepdims=True)
     before = _orientation(dirs, tris)
@@ -170,7 +171,7 @@ def _sides(tris: np.ndarray, path: np.ndarray, dirs: np.ndarray, up: np.ndarray)
                         stack.append(g)
         comps += 1
     if comps != 2:
-        raise ValueError(f"the mouth path splits its neighbourhood into {comps} parts, not 2")
+        raise ValueError(f"the slit's path splits its neighbourhood into {comps} parts, not 2")
     comp = np.array([label[f] for f in band.tolist()])
     height = dirs[tris[band]].mean(axis=1) @ up
     upper = 0 if height[comp == 0].mean() > height[comp == 1].mean() else 1
@@ -179,18 +180,16 @@ def _sides(tris: np.ndarray, path: np.ndarray, dirs: np.ndarray, up: np.ndarray)
     return side
 
 
-def mouth_slit(
-    dirs: np.ndarray, tris: np.ndarray, center: np.ndarray, line: np.ndarray
-) -> MouthSlit:
-    """Cut the wrap triangulation (directions `dirs` from `center`) along the mouth line
-    `line` (3D points on S, corner to corner)."""
+def slit_along(dirs: np.ndarray, tris: np.ndarray, center: np.ndarray, line: np.ndarray) -> Slit:
+    """Cut the wrap triangulation (directions `dirs` from `center`) along `line` (3D points
+    on S, corner to corner: the mouth line, an eye's fissure)."""
     line_dirs = line - center
     line_dirs /= np.linalg.norm(line_dirs, axis=1, keepdims=True)
     path = _path_along(dirs, tris, line_dirs)
     if len(path) < 3:
-        # The mouth is narrower than two wrap edges (wrap levels below 3): nothing to cut.
+        # The line is shorter than two wrap edges (coarse wrap levels): nothing to cut.
         no_copies = np.zeros(0, np.int64)
-        return MouthSlit(dirs.copy(), tris.copy(), path, no_copies, np.zeros(len(tris), np.int8))
+        return Slit(dirs.copy(), tris.copy(), path, no_copies, np.zeros(len(tris), np.int8))
     moved = _snap(dirs, tris, path, line_dirs)
     up = np.cross(line_dirs[-1] - line_dirs[0], line_dirs[len(line_dirs) // 2])
     up /= np.linalg.norm(up)
@@ -204,4 +203,4 @@ def mouth_slit(
     lower = side < 0
     swap = lower[:, None] & (new_id[tris] >= 0)
     cut[swap] = new_id[tris[swap]]
-    return MouthSlit(np.vstack([moved, moved[copy_of]]), cut.astype(np.int32), path, copy_of, side)
+    return Slit(np.vstack([moved, moved[copy_of]]), cut.astype(np.int32), path, copy_of, side)

@@ -1,5 +1,6 @@
-"""A head's simulation: layered head model + teeth as bone vertices + lip/teeth collision
-sets → the native SimulationMesh and Simulator; ARKit frames → skin targets and jaw motion."""
+"""A head's simulation: layered head model + teeth as bone vertices + lip, lid and teeth
+collision sets → the native SimulationMesh and Simulator; ARKit frames → skin targets and jaw
+motion."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
 from softdeca_train.lhm.conforming import conforming_mesh
 from softdeca_train.lhm.fit import embed_skin_by_side, jaw_motion
 from softdeca_train.lhm.model import JAW
+from softdeca_train.sim.lids import LidSets, lid_sets
 from softdeca_train.sim.lips import LipSets, lip_sets
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
@@ -35,6 +37,7 @@ class HeadSimulation:
     teeth_upper: np.ndarray  # simulated vertex ids of the upper teeth (ICT order)
     teeth_lower: np.ndarray
     lips: LipSets
+    lids: LidSets
 
     def simulator(self, **settings: object) -> native.Simulator:
         return native.Simulator(self.mesh, **settings)
@@ -116,6 +119,8 @@ def _tissue(head: np.ndarray, lhm: LayeredHeadModel) -> _Tissue:
         head[:N_SKIN].astype(np.float64),
         tm.soft_side,
         lhm.attachments["skin_lip_bone"],
+        tm.soft_lid_side,
+        lhm.attachments["skin_lid_side"],
     )
     return _Tissue(
         tm.vertices,
@@ -171,6 +176,11 @@ def build_head_simulation(
             surface_on_skin=False,
         ),
     ]
+    # The eyelids: placed on their targets like the lips, with no surface to stay out of
+    # (sim/lids.py says why no lid contacts).
+    lids = lid_sets(template, head)
+    eyelids = np.concatenate([lids.upper, lids.lower]).tolist()
+    collisions.append(native.CollisionSet("eyelids", eyelids, np.zeros((0, 3), np.int32)))
     lm_points = lm_weights = None
     if landmarks is not None:
         tri, bary = landmarks
@@ -191,4 +201,4 @@ def build_head_simulation(
         landmark_weights=lm_weights,
         collisions=collisions,
     )
-    return HeadSimulation(template, identity, head, lhm, mesh, teeth_upper, teeth_lower, lips)
+    return HeadSimulation(template, identity, head, lhm, mesh, teeth_upper, teeth_lower, lips, lids)

@@ -1,0 +1,54 @@
+"""The eyelids' points of S (lhm/eyes.py has the slits between the lids). They form a
+collision set with no surface: like every collision set's points they are placed on their
+targets after the volumetric solve (docs/physics.md, Collisions), and there is nothing for
+them to stay out of. The lids are thin flaps moved by their own muscles, far thinner than the
+tets under them: with the eye slits the volumetric solve alone left a full blink's lids 4.0 mm
+(level 3) and 3.1 mm (level 4) apart where the linear blend closes them to 0.4 mm.
+
+No lid-against-lid contacts: on real blinks the lids press over a large area (alex_rom_3
+frame 800, `eyeBlink` 0.94 with `eyeSquint` 0.64: 198 lid points 10-40 µm inside the other
+lid), and the contact rounds took 30 rounds and 4 s there, against 1.3 s for the whole frame
+without them, still leaving 13 points 40 µm inside. Where the linear blend drives the upper lid
+past the lower one (`eyeBlink` with `eyeLookDown`) it passes in front of it, as in the linear
+blend.
+
+Each lid's points lie on the face or its eye socket within `reach` of the eye's fissure line;
+points within `corner_radius` of the eye corners belong to neither lid (the lids are one
+surface there; they follow the volumetric solve)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdeca_train.lhm.eyes import EYES, fissure_line, lid_side_of_points
+from softdeca_train.lhm.mouth import closest_on_polyline
+from softdeca_train.template import Template
+from softdeca_train.template.model import N_SKIN
+
+
+@dataclass(frozen=True)
+class LidSets:
+    upper: np.ndarray  # skin vertex indices of the upper lids (both eyes)
+    lower: np.ndarray
+
+
+def lid_sets(
+    template: Template, head: np.ndarray, reach: float = 0.008, corner_radius: float = 0.004
+) -> LidSets:
+    skin = head[:N_SKIN]
+    lm68 = template.landmarks68
+    candidates = np.concatenate([
+        np.arange(template.components[c].slice.start, template.components[c].slice.stop)
+        for c in ("face", "eye_socket_left", "eye_socket_right")
+    ])  # fmt: skip
+    side = lid_side_of_points(skin, lm68)
+    chosen = np.zeros(N_SKIN, bool)
+    for eye in EYES:
+        line = fissure_line(skin, lm68, eye)
+        p = skin[candidates]
+        near = np.linalg.norm(p - closest_on_polyline(p, line), axis=1) < reach
+        corners = np.linalg.norm(p[:, None] - line[None, [0, -1]], axis=2).min(axis=1)
+        chosen[candidates[near & (corners > corner_radius)]] = True
+    return LidSets(np.flatnonzero(chosen & (side > 0)), np.flatnonzero(chosen & (side < 0)))
