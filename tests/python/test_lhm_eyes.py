@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from softdeca_train.lhm import LhmConfig
+from softdeca_train.lhm.checks import check_lhm
 from softdeca_train.lhm.conforming import conforming_mesh
 from softdeca_train.lhm.eyes import EYES, fissure_line, lid_side_of_points
 from softdeca_train.sim.expressions import weights_of
@@ -59,6 +60,8 @@ def test_each_eye_has_a_slit_whose_copies_coincide_at_rest(
         assert not ((side > 0).any(axis=1) & (side < 0).any(axis=1)).any()
     assert not np.isin(m.eye_copy_of, m.slit_copy_of).any()
     assert (m.lip_side[m.eye_copies] == 0).all()
+    report = check_lhm(m, head.head[:N_SKIN], head.template.skin_triangles)
+    assert report.tets_spanning_both_lids == 0 and report.failures() == []
 
 
 def test_each_lids_points_are_embedded_on_its_own_side(

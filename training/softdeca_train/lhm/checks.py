@@ -30,6 +30,7 @@ class LhmReport:
     side_embedded_points: int
     side_embedded_outside_max_mm: float
     tets_spanning_both_lips: int  # tets with vertices of both lips' columns (must be 0)
+    tets_spanning_both_lids: int  # the same for an eye's two lids (must be 0)
     quality: dict[str, dict[str, float]]  # lhm/quality.py: overall and in the mouth region
     outside_max_mm: float  # distance of S vertices outside their tet (0 when embedded)
     soft_volume_l: float
@@ -58,6 +59,8 @@ class LhmReport:
             )
         if self.tets_spanning_both_lips:
             out.append(f"{self.tets_spanning_both_lips} tets span both lips")
+        if self.tets_spanning_both_lids:
+            out.append(f"{self.tets_spanning_both_lids} tets span both lids of an eye")
         return out
 
 
@@ -72,8 +75,13 @@ def closed_wrap_triangles(model: LayeredHeadModel) -> np.ndarray:
     return model.copy_of()[model.wrap_triangles].astype(np.int32)
 
 
-def tets_spanning_both_lips(model: LayeredHeadModel, tets: np.ndarray) -> int:
-    side = np.tile(model.lip_side, model.n_layers)[tets]
+def tets_spanning_both_lips(
+    model: LayeredHeadModel, tets: np.ndarray, vertex_side: np.ndarray | None = None
+) -> int:
+    """Tets with vertices on both sides of a slit (`vertex_side`: the wraps' lip_side, or
+    eye_side for the lids)."""
+    side = model.lip_side if vertex_side is None else vertex_side
+    side = np.tile(side, model.n_layers)[tets]
     return int(((side > 0).any(axis=1) & (side < 0).any(axis=1)).sum())
 
 
@@ -171,6 +179,7 @@ def check_lhm(model: LayeredHeadModel, skin: np.ndarray, skin_tris: np.ndarray) 
         side_embedded_points=int(side.sum()),
         side_embedded_outside_max_mm=max(own_outside) * 1e3,
         tets_spanning_both_lips=tets_spanning_both_lips(model, all_tets),
+        tets_spanning_both_lids=tets_spanning_both_lips(model, all_tets, model.eye_side),
         quality=mouth_quality(model).as_dict(),
         outside_max_mm=float(outside.max() * 1e3),
         soft_volume_l=float(native.tet_signed_volumes(v, model.soft_tets).sum() * 1e3),
