@@ -64,9 +64,9 @@ struct CollisionResult {
   Positions skin;  // S after resolution
   int penetrating_before = 0, penetrating_after = 0, contacts = 0, rounds = 0, iterations = 0;
   double max_contact_gap = 0;  // largest distance between the two sides of a contact (m)
-  double max_correction = 0;   // largest move of a skin point by the kept round (m)
-  // Rounds stopped because they moved a point farther than the deepest penetration explains,
-  // and the largest move any round made (m).
+  double max_correction = 0;   // largest move of a contact's points by the kept round (m)
+  // Rounds stopped because they moved a contact's points farther than the deepest
+  // penetration explains, and the largest such move any round made (m).
   int rejected_rounds = 0;
   double largest_round_correction = 0;
   double seconds = 0;
@@ -86,8 +86,9 @@ struct LipTargets {
 // most settings.collision_rounds times). Contacts persist across rounds, one per (set, point),
 // moved to the newest closest point; their targets are fixed per round (collisions.cpp,
 // contact_rows). The result is the round with the fewest penetrating points among those that
-// reduce them (then the closest contacts) and move no point farther than twice the deepest
-// initial penetration (+ 1 mm); otherwise the uncorrected skin. With
+// reduce them (then the closest contacts) and move no contact's point (nor, on a surface over
+// S, its triangle's corners) farther than twice the deepest initial penetration (+ 1 mm);
+// otherwise the uncorrected skin. With
 // `lips`, the collision sets' points first follow their targets on S (strain relative to the
 // targets' shape, the solved skin pinned around the lip region), every frame, and the contacts
 // correct that.
