@@ -342,6 +342,9 @@ void bind_simulator(nb::module_& m) {
           nb::arg("jaw") = nb::none(), nb::arg("warm_start") = nb::none(),
           "The next dynamic frame (eq. 9) -> (vertices, skin, stats).")
       .def("reset_dynamics", &Simulator::reset_dynamics)
+      .def("dynamic_target", &Simulator::dynamic_skin_target, nb::arg("skin_targets"),
+           "The blended target (eq. 9) the next step_dynamic solves toward for these skin targets "
+           "(the targets themselves before the first frame); changes nothing.")
       .def(
           "solve_static_batch", &solve_many<&Simulator::solve_static_batch>,
           nb::arg("skin_targets"), nb::arg("landmark_targets") = nb::none(), nb::arg("jaw") = nb::none(),

@@ -3,6 +3,7 @@
 
 #include <random>
 
+#include "core/error.h"
 #include "sim/dynamics.h"
 #include "sim_test_support.h"
 
@@ -135,6 +136,34 @@ TEST(SimDynamics, PerPointCoefficientsLocaliseTheDynamics) {
   }
   EXPECT_GT(lag_slow, 0.5);
   EXPECT_LT(lag_fast, lag_slow);
+}
+
+TEST(SimDynamics, DynamicTargetIsTheBlendTheNextStepSolvesToward) {
+  const SimulationMesh mesh = small_head();
+  Simulator sim(mesh);
+  const Positions skin = rest_skin(mesh);
+  Eigen::VectorXd gamma(mesh.skin_count());
+  for (Eigen::Index i = 0; i < gamma.size(); ++i) gamma[i] = skin(i, 0) > 0 ? 0.9 : 0.2;
+  sim.parameters().set_field("dyn_gamma", gamma);
+  sim.parameters().set("dyn_beta", 0.3);
+  const Positions pose = bump(skin, 0.01);
+  // Before the first frame a step is static: its target is the input itself.
+  EXPECT_EQ(max_distance(sim.dynamic_skin_target(pose), pose), 0.0);
+  const Positions t1 = sim.step_dynamic(input_with(skin)).skin;
+  const Positions t2 = sim.step_dynamic(input_with(pose)).skin;
+  // After two frames: gamma S + 2 alpha T_{t-1} - beta T_{t-2}, point by point.
+  const Positions expected = blend_targets(pose, t2, t1, gamma, Eigen::VectorXd::Constant(gamma.size(), 0.3));
+  const Positions target = sim.dynamic_skin_target(pose);
+  EXPECT_LT(max_distance(target, expected), 1e-12);
+  EXPECT_GT(max_distance(target, pose), 1e-4);  // the slow points lag
+  // Asking changes nothing: the next step is the one it would have been.
+  Simulator twin(mesh);
+  twin.parameters().set_field("dyn_gamma", gamma);
+  twin.parameters().set("dyn_beta", 0.3);
+  twin.step_dynamic(input_with(skin));
+  twin.step_dynamic(input_with(pose));
+  EXPECT_LT(max_distance(sim.step_dynamic(input_with(pose)).skin, twin.step_dynamic(input_with(pose)).skin), 1e-12);
+  EXPECT_THROW(sim.dynamic_skin_target(Positions(2, 3)), softdeca::Error);
 }
 
 TEST(SimDynamics, ContactsAreInelastic) {

@@ -60,6 +60,22 @@ def test_static_batch_and_sequence(head: sn.SimulationMesh) -> None:
     assert moved.max() > 1.05 * moved[-1]  # overshoot, then back toward the static pose
 
 
+def test_dynamic_target_is_what_the_next_step_solves_toward(head: sn.SimulationMesh) -> None:
+    """The reference a dynamic frame is judged against: gamma S + 2 alpha T1 - beta T2."""
+    sim = sn.Simulator(head, threads=1)
+    sim.set_parameter("dyn_gamma", 0.3)
+    sim.set_parameter("dyn_beta", 0.2)
+    rest = head.embed_skin(head.rest)
+    push = rest + np.array([0.0, 0.0, 0.003])
+    np.testing.assert_array_equal(sim.dynamic_target(push), push)  # first frame: static
+    _, t1, _ = sim.step_dynamic(rest)
+    _, t2, _ = sim.step_dynamic(push)
+    expected = 0.3 * push + (1 - 0.3 + 0.2) * t2 - 0.2 * t1
+    np.testing.assert_allclose(sim.dynamic_target(push), expected, atol=1e-12)
+    with pytest.raises(ValueError):
+        sim.dynamic_target(push[:5])
+
+
 def test_hand_built_mesh_and_errors(head: sn.SimulationMesh) -> None:
     mesh = sn.SimulationMesh(
         rest=head.rest,

@@ -210,6 +210,13 @@ FrameResult Simulator::dynamic_step(const Prepared& stat, const Prepared& dyn, c
   return r;
 }
 
+Positions Simulator::dynamic_skin_target(const Positions& skin_targets) {
+  check_positions(skin_targets, mesh_.skin_count(), "skin_targets");
+  if (history_.frames == 0) return skin_targets;
+  const Model& m = prepare(TargetMode::kDynamic).model;
+  return blend_targets(skin_targets, history_.skin1, history_.skin2, m.skin_gamma, m.skin_beta);
+}
+
 FrameResult Simulator::step_dynamic(const FrameInput& in) {
   check(in);
   Prepared& stat = prepare(TargetMode::kStatic);

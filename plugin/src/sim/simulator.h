@@ -56,6 +56,10 @@ class Simulator {
   // returns the static solution and seeds T_{t-1} = T_{t-2} with it.
   FrameResult step_dynamic(const FrameInput& input);
   void reset_dynamics() { history_ = DynamicsHistory{}; }
+  // The skin's blended target of eq. 9 that the next step_dynamic would solve toward for these
+  // skin targets (the targets themselves before the first frame): the S its physics is asked
+  // to reach, so the reference a dynamic frame is judged against. Changes nothing.
+  Positions dynamic_skin_target(const Positions& skin_targets);
   const DynamicsHistory& dynamics_history() const { return history_; }
   // reset_dynamics() then step_dynamic() over the frames.
   std::vector<FrameResult> solve_sequence(const std::vector<FrameInput>& frames);

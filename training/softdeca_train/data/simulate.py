@@ -18,7 +18,6 @@ from softdeca_train.landmarks import SurfaceLandmarks, template_landmarks
 from softdeca_train.lhm import LhmConfig
 from softdeca_train.parameters import load_parameters
 from softdeca_train.sim import HeadSimulation, build_head_simulation
-from softdeca_train.sim.dynamics import LinearDynamics
 from softdeca_train.sim.measures import SoftVolume
 from softdeca_train.sim.sanity import REASONS, check_frame
 from softdeca_train.template import Template
@@ -233,14 +232,12 @@ def _dynamic_group(head: _Head, g: GroupSpec, names: list[str]) -> None:
     _set_parameters(sim, names, fixed)
     sim.reset_dynamics()
     solved = []
-    linear = LinearDynamics()  # the reference the frames are judged against
-    reference = []
+    reference = []  # each step's blended target: what its frame is judged against
     for f in range(len(w)):
         if f == lead:  # the sampled dynamics take over, with the lead-in's velocity
             _set_parameters(sim, names, g.p)
+        reference.append(sim.dynamic_target(targets[f]))
         solved.append(sim.step_dynamic(targets[f], jaw=jaws[f]))
-        gamma, beta = sim.get_parameter("dyn_gamma"), sim.get_parameter("dyn_beta")
-        reference.append(linear.step(targets[f], gamma, beta))
     skins, stats = [s[1] for s in solved], [s[2] for s in solved]
     offsets = out.offsets(np.stack(skins), targets)
     failures = out.judge(

@@ -1,6 +1,5 @@
 """The second-order dynamics of eq. 9 seen as a filter on the target sequence: how much it can
-amplify motion (which (gamma, beta) pairs are plausible tissue), and the linear blend carried
-through the same recursion (what a dynamic frame is judged against).
+amplify motion, so which (gamma, beta) pairs are plausible tissue.
 
 Eq. 9 blends the target gamma S_t + 2 alpha T_{t-1} - beta T_{t-2} with 2 alpha = 1 - gamma +
 beta, so a constant S is kept (gain 1 at rest). Its frequency response is
@@ -24,23 +23,3 @@ def peak_gain(gamma: float, beta: float) -> float:
     z = np.exp(-1j * _FREQUENCIES)
     h = gamma / np.abs(1.0 - (1.0 - gamma + beta) * z + beta * z * z)
     return float(h.max())
-
-
-class LinearDynamics:
-    """The linear blend through eq. 9's recursion, D_t = gamma S_t + 2 alpha D_{t-1} - beta
-    D_{t-2}, starting at rest on the first frame (D_0 = S_0, as the physics solves its first
-    frame statically). A dynamic frame's lag and overshoot are what its controls ask for; the
-    physics is judged against D_t, the linear blendshapes under the same dynamics."""
-
-    def __init__(self) -> None:
-        self._d1: np.ndarray | None = None
-        self._d2: np.ndarray | None = None
-
-    def step(self, target: np.ndarray, gamma: float, beta: float) -> np.ndarray:
-        target = np.asarray(target, np.float64)
-        if self._d1 is None or self._d2 is None:
-            self._d1 = self._d2 = target
-            return target
-        d = gamma * target + (1.0 - gamma + beta) * self._d1 - beta * self._d2
-        self._d2, self._d1 = self._d1, d
-        return d

@@ -12,7 +12,6 @@ import numpy as np
 import softdeca_native as native
 from tqdm import tqdm
 
-from softdeca_train.sim.dynamics import LinearDynamics
 from softdeca_train.sim.head import HeadSimulation
 from softdeca_train.sim.measures import SoftVolume, mean_distance_mm
 from softdeca_train.sim.sanity import FrameCheck, check_frame, failure_counts
@@ -62,21 +61,18 @@ def simulate_frames(
     volume = SoftVolume(hs)
     out = SimulatedTake()
     start = time.perf_counter()
-    linear = LinearDynamics()  # a dynamic frame is judged against the linear blend under eq. 9
     if dynamic:
         sim.reset_dynamics()
     for w in tqdm(weights, desc="simulate", unit="frame", disable=not progress):
         blended = hs.blend(w[None])[0]
         jaw = hs.jaw_transforms(blended[None])[0]
         target = blended[:N_SKIN].astype(np.float64)
+        # a dynamic frame is judged against its step's blended target (eq. 9)
+        judged = sim.dynamic_target(target) if dynamic else target
         solve = sim.step_dynamic if dynamic else sim.solve_static
         vertices, skin, st = solve(target, jaw=jaw)
         out.linear.append(blended.astype(np.float32))
         out.physics.append(hs.whole_head(skin, blended, jaw).astype(np.float32))
-        judged = target
-        if dynamic:
-            gamma, beta = sim.get_parameter("dyn_gamma"), sim.get_parameter("dyn_beta")
-            judged = linear.step(target, gamma, beta)
         check = check_frame(
             hs, volume, judged, skin, vertices, st, sim.get_parameter("target_volume")
         )

@@ -18,7 +18,6 @@ from tqdm import tqdm
 
 from softdeca_train.lhm import LhmConfig
 from softdeca_train.parameters import load_parameters
-from softdeca_train.sim.dynamics import LinearDynamics
 from softdeca_train.sim.expressions import all_expressions, combinations
 from softdeca_train.sim.head import HeadSimulation, build_head_simulation
 from softdeca_train.sim.measures import SoftVolume
@@ -172,8 +171,7 @@ def _severity(c: FrameCheck) -> float:
 
 def _frames(sim: Any, hs: HeadSimulation, case: StressCase) -> Iterator[tuple[int, Any]]:
     """Per frame (linear blend, jaw, the S a frame is judged against, the solve's result):
-    a dynamic run is judged against the linear blend under the same dynamics."""
-    linear = LinearDynamics()
+    a dynamic frame is judged against its step's blended target (eq. 9)."""
     if case.dynamic:
         sim.reset_dynamics()
     for i, (_, w) in enumerate(case.frames):
@@ -181,11 +179,9 @@ def _frames(sim: Any, hs: HeadSimulation, case: StressCase) -> Iterator[tuple[in
         jaw = hs.jaw_transforms(blended[None])[0]
         target = blended[:N_SKIN].astype(np.float64)
         solve = sim.step_dynamic if case.dynamic else sim.solve_static
+        judged = sim.dynamic_target(target) if case.dynamic else target
         vertices, skin, st = solve(target, jaw=jaw)
-        if case.dynamic:
-            gamma, beta = sim.get_parameter("dyn_gamma"), sim.get_parameter("dyn_beta")
-            target = linear.step(target, gamma, beta)
-        yield i, (blended, jaw, target, vertices, skin, st)
+        yield i, (blended, jaw, judged, vertices, skin, st)
 
 
 def run_stress(
