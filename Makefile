@@ -89,12 +89,13 @@ demo: demo-bundle build ## template, layers, identities, landmarks, then a real 
 	@$(PY) -m softdeca_train avatar --ict "$(SOFTDECA_ICT)" --seed $(DEMO_SEED) --out $(OUT)/demo/replay/avatar
 	@$(BUILD)/plugin/cli/softdeca replay $(DEMO_TAKE) --bundle $(BUNDLE) --avatar $(OUT)/demo/replay/avatar \
 	  --start $(DEMO_START) --frames $(DEMO_FRAMES) --dynamics --localised "$(DEMO_LOCALISED)" --out $(OUT)/demo/replay
-	@$(PY) -m softdeca_train replay-preview --replay $(OUT)/demo/replay
+	@$(PY) -m softdeca_train replay-preview --replay $(OUT)/demo/replay --physics-seed $(DEMO_SEED) --ict "$(SOFTDECA_ICT)"
 	@echo "demo replay ($(BUNDLE), identity seed $(DEMO_SEED), $(DEMO_FRAMES) frames of $(notdir $(DEMO_TAKE))):"
 	@echo "  mesh sequence: $(OUT)/demo/replay/{linear,softdeca,sparse,softdeca_localised}.pc2 over $(OUT)/demo/replay/neutral.obj"
 	@echo "                 (PC2 point caches: Blender Mesh Cache modifier; docs/runtime.md)"
 	@echo "  preview:       $(OUT)/demo/replay/preview.png"
 	@echo "  timings:       $(OUT)/demo/replay/replay.json"
+	@echo "  lip openings:  $(OUT)/demo/replay/preview.json (linear, physics and the models on the shown frames)"
 
 bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
 	@mkdir -p build/bench

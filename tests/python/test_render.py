@@ -100,6 +100,14 @@ def test_tile_lays_out_labelled_grid(tmp_path):
     assert wrapped.shape[0] > single.shape[0] and wrapped.shape[1] == single.shape[1]
 
 
+def test_labels_keep_their_own_line_breaks_when_wrapped(tmp_path):
+    font = R._font(14)
+    wrapped = R._wrap("SoftDECA, frame 409\nred: 0.5 mm from linear blendshapes", font, 150)
+    assert wrapped.startswith("SoftDECA, frame 409\nred:")
+    assert all(font.getlength(line) <= 150 for line in wrapped.split("\n"))
+    R.tile([np.zeros((8, 8, 3), np.uint8)], ["a\nb c"], tmp_path / "t.png")
+
+
 def test_bad_input_gives_clear_errors():
     with pytest.raises(ValueError, match="triangle index"):
         R.render([R.MeshLayer(OCTA_V, OCTA_F + 10)], settings=SMALL)

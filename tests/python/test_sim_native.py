@@ -60,7 +60,9 @@ def test_static_batch_and_sequence(head: sn.SimulationMesh) -> None:
     assert moved.max() > 1.05 * moved[-1]  # overshoot, then back toward the static pose
 
 
-def test_dynamic_target_is_what_the_next_step_solves_toward(head: sn.SimulationMesh) -> None:
+def test_dynamic_target_is_what_the_next_step_solves_toward(
+    head: sn.SimulationMesh,
+) -> None:
     """The reference a dynamic frame is judged against: gamma S + 2 alpha T1 - beta T2."""
     sim = sn.Simulator(head, threads=1)
     sim.set_parameter("dyn_gamma", 0.3)

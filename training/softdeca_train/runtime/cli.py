@@ -78,12 +78,23 @@ def _avatar_run(args: argparse.Namespace) -> int:
 def _replay_preview_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--replay", required=True, help="output folder of `softdeca replay`")
     p.add_argument("--frames", type=int, default=4, help="rows of the contact sheet (4)")
+    p.add_argument(
+        "--physics-seed",
+        type=int,
+        default=None,
+        help="add the physics on the shown frames for the ICT identity of this seed (the "
+        "avatar's), with the take's widest-open mouth among them (about a minute)",
+    )
+    p.add_argument(
+        "--ict", default=None, help="ICT-FaceKit (default: $SOFTDECA_ICT or the data folder's)"
+    )
 
 
 def _replay_preview_run(args: argparse.Namespace) -> int:
     from softdeca_train.runtime.preview import render_preview
 
-    print(f"wrote {render_preview(args.replay, args.frames)}")
+    out = render_preview(args.replay, args.frames, physics_seed=args.physics_seed, ict=args.ict)
+    print(f"wrote {out}")
     return 0
 
 

@@ -1,6 +1,7 @@
 """The contact sheet of a replay: chosen frames (rows) of every model the replay wrote (columns:
-linear blendshapes, SoftDECA, SparseSoftDECA, SoftDECA with the localised change), rendered
-with render.py, framed on the face.
+linear blendshapes, SoftDECA, SparseSoftDECA, SoftDECA with the localised change), and, when
+asked, the physics φ† itself on those frames (preview_physics.py), rendered with render.py,
+framed on the face.
 
 A correction of a few millimetres is invisible in a shaded render, so the models' columns are
 coloured by how far each vertex lies from the linear blendshapes of the same frame, and the
@@ -22,6 +23,7 @@ from softdeca_train.runtime.files import read_obj, read_pc2
 
 LABELS = {
     "linear": "linear blendshapes",
+    "physics": "physics (static)",
     "softdeca": "SoftDECA",
     "softdeca_localised": "SoftDECA, localised change",
     "sparse": "SparseSoftDECA (landmarks)",
@@ -48,13 +50,36 @@ def face_focus(neutral: np.ndarray) -> Focus:
     return Focus(tuple(float(x) for x in lo), tuple(float(x) for x in hi))
 
 
-def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
+def _with_physics(
+    caches: dict[str, np.ndarray], chosen: list[int], column: np.ndarray
+) -> dict[str, np.ndarray]:
+    """The physics column after the linear one; only the chosen frames are filled."""
+    physics = np.zeros_like(caches["linear"])
+    physics[chosen] = column
+    out = {"linear": caches["linear"], "physics": physics}
+    return out | {k: v for k, v in caches.items() if k != "linear"}
+
+
+def render_preview(
+    replay: Path,
+    frames: int = 4,
+    size: int = 360,
+    physics_seed: int | None = None,
+    ict: str | None = None,
+) -> Path:
+    """`physics_seed`: simulate the shown frames for the ICT identity the avatar was made
+    from, and show the take's widest-open mouth among them (preview.json: lip openings)."""
     replay = Path(replay)
     summary = json.loads((replay / "replay.json").read_text())
     neutral, triangles = read_obj(replay / "neutral.obj")
     caches = {name: read_pc2(Path(path)) for name, path in summary["point_caches"].items()}
     chosen = pick_frames(caches, neutral, frames)
     first = int(summary.get("first_frame", 0))
+    physics_notes: list[str] = []
+    if physics_seed is not None:
+        caches, chosen, physics_notes = _add_physics(
+            replay, summary, caches, chosen, first, physics_seed, ict
+        )
     focus = face_focus(neutral)
     settings = RenderSettings(size=(size, size), margin=1.15)
 
@@ -62,7 +87,12 @@ def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
         return np.linalg.norm(caches[a][f] - caches[b][f], axis=1) * 1e3
 
     # Colour scales per column: the 99.5th percentile over the shown frames.
-    ref = {"softdeca": "linear", "sparse": "linear", "softdeca_localised": "softdeca"}
+    ref = {
+        "physics": "linear",
+        "softdeca": "linear",
+        "sparse": "linear",
+        "softdeca_localised": "softdeca",
+    }
     ref = {k: v for k, v in ref.items() if k in caches and v in caches}
     scale = {
         k: float(np.percentile(np.concatenate([distance_mm(k, v, f) for f in chosen]), 99.5))
@@ -104,6 +134,7 @@ def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
         else "",
         "median ms/frame: "
         + ", ".join(f"{LABELS.get(k, k)} {v['median_ms']:.2f}" for k, v in timing.items()),
+        *physics_notes,
     ]
     out = replay / "preview.png"
     tile(
@@ -118,3 +149,56 @@ def render_preview(replay: Path, frames: int = 4, size: int = 360) -> Path:
         ),
     )
     return out
+
+
+def _add_physics(
+    replay: Path,
+    summary: dict,
+    caches: dict[str, np.ndarray],
+    chosen: list[int],
+    first: int,
+    seed: int,
+    ict: str | None,
+) -> tuple[dict[str, np.ndarray], list[int], list[str]]:
+    """The physics column, the widest-open mouth among the rows (it replaces the row of its
+    segment), preview.json with every column's lip opening, and the sheet's notes."""
+    from softdeca_train.runtime.preview_physics import (
+        lip_openings_mm,
+        simulate_column,
+        widest_open_frame,
+    )
+    from softdeca_train.template import Template
+
+    template = Template.load(ict)
+    lin = caches["linear"]
+    wide = widest_open_frame(lin, template)
+    segment = int(np.searchsorted(np.linspace(0, len(lin), len(chosen) + 1), wide, "right")) - 1
+    chosen = sorted({*chosen[:segment], wide, *chosen[segment + 1 :]})
+    column = simulate_column(Path(summary["take"]), first, chosen, lin, template, seed)
+    caches = _with_physics(caches, chosen, column.heads)
+    openings = {
+        name: [round(float(x), 3) for x in lip_openings_mm(c[chosen], template)]
+        for name, c in caches.items()
+    }
+    (replay / "preview.json").write_text(
+        json.dumps(
+            {
+                "frames": [first + f for f in chosen],
+                "widest_open_frame": first + wide,
+                "identity_seed": seed,
+                "lip_opening_mm": openings,
+                "physics_failures": column.failures,
+                "physics_seconds": round(column.seconds, 1),
+            },
+            indent=1,
+        )
+    )
+    row = chosen.index(wide)
+    failing = sum(bool(f) for f in column.failures)
+    notes = [
+        f"physics: the simulation, static, LHM level 3, default parameters, collisions on, "
+        f"ICT identity seed {seed}; {failing} of {len(chosen)} shown frames fail a sanity bound",
+        f"lip opening at frame {first + wide} (the take's widest-open mouth): "
+        + ", ".join(f"{LABELS.get(k, k)} {v[row]:.1f} mm" for k, v in openings.items()),
+    ]
+    return caches, chosen, notes
