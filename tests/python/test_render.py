@@ -102,7 +102,9 @@ def test_tile_lays_out_labelled_grid(tmp_path):
 
 def test_labels_keep_their_own_line_breaks_when_wrapped(tmp_path):
     font = R._font(14)
-    wrapped = R._wrap("SoftDECA, frame 409\nred: 0.5 mm from linear blendshapes", font, 150)
+    wrapped = R._wrap(
+        "SoftDECA, frame 409\nred: 0.5 mm from linear blendshapes", font, 150
+    )
     assert wrapped.startswith("SoftDECA, frame 409\nred:")
     assert all(font.getlength(line) <= 150 for line in wrapped.split("\n"))
     R.tile([np.zeros((8, 8, 3), np.uint8)], ["a\nb c"], tmp_path / "t.png")

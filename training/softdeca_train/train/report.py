@@ -362,19 +362,30 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
 def _where_the_error_is(e: dict) -> list[str]:
     """How much of the error depends on the expression at all, and the generalisation gap."""
     nc, orc = e.get("no-correction"), e.get("group-offset-oracle")
-    if nc is None or orc is None or orc.get("mean_mm") is None:
+    if nc is None:
         return []
-    share = 1 - orc["mean_mm"] / nc["mean_mm"]
+    if orc is None or orc.get("mean_mm") is None:
+        reference = (
+            "Every (identity, p) group of the test split has one frame, so the part of the "
+            "correction shared by a group's frames (S_t plus their mean T - S_t) is not "
+            "measured here."
+        )
+    else:
+        share = 1 - orc["mean_mm"] / nc["mean_mm"]
+        reference = (
+            "Reference (uses the physics, not a model): S_t plus the mean of T - S_t over "
+            "the frames of the same (identity, p) group, the part of the correction that "
+            f"does not depend on the expression, known exactly: {_row(orc)} mm. So "
+            f"{100 * share:.0f} % of the no-correction error is an offset shared by the "
+            "frames of a group, which depends on p and h alone; a model has to learn it "
+            "from the training parameter sets (data/offset_structure.py measures the same "
+            "split on a whole dataset)."
+        )
     lines = [
         "",
         "### Where the error is",
         "",
-        "Reference (uses the physics, not a model): S_t plus the mean of T - S_t over the "
-        "frames of the same (identity, p) group, the part of the correction that does not "
-        f"depend on the expression, known exactly: {_row(orc)} mm. So {100 * share:.0f} % of "
-        "the no-correction error is an offset shared by the frames of a group, which depends "
-        "on p and h alone; a model has to learn it from the training parameter sets "
-        "(data/offset_structure.py measures the same split on a whole dataset).",
+        reference,
         "",
         "| model | training frames (mm) | test frames (mm) |",
         "| --- | ---: | ---: |",
