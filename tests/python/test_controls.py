@@ -19,7 +19,11 @@ from softdeca_train.controls.definitions import (
 )
 from softdeca_train.controls.gallery import Collected, control_entry, measure_controls
 from softdeca_train.controls.metrics import control_response, leakage, response_error
-from softdeca_train.controls.report import validate_report
+from softdeca_train.controls.report import (
+    kept_real_takes,
+    merge_into_report,
+    validate_report,
+)
 from softdeca_train.data.regions import REGIONS
 from softdeca_train.parameters import load_parameters
 
@@ -180,6 +184,16 @@ def test_the_report_schema() -> None:
 def test_the_committed_report_follows_the_schema() -> None:
     doc = json.loads((REPO / "docs" / "evaluation" / "evaluation.json").read_text())
     validate_report(doc)
+
+
+def test_a_rerun_without_real_takes_keeps_the_reports(tmp_path) -> None:
+    report = tmp_path / "evaluation.json"
+    assert kept_real_takes(report) is None
+    real = {"frames": 4, "identities": 1, "softdeca_mm": 0.2, "linear_mm": 0.3}
+    report.write_text(json.dumps({"errors": {}, "real_takes": real}))
+    kept = kept_real_takes(report)
+    report.write_text(json.dumps({"errors": {}}))  # the rerun writes its report afresh
+    assert merge_into_report(report, None, kept)["real_takes"] == real
 
 
 def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:

@@ -123,6 +123,13 @@ def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
     }
 
 
+def kept_real_takes(path: Path) -> dict | None:
+    """The `real_takes` a report already has (None: no report, or none in it): what a rerun
+    that does not measure them keeps."""
+    path = Path(path)
+    return json.loads(path.read_text()).get("real_takes") if path.is_file() else None
+
+
 def merge_into_report(path: Path, controls: list[dict] | None, real: dict | None) -> dict:
     """Add (or replace) `controls` and `real_takes` in an existing report, keeping the rest."""
     doc = json.loads(Path(path).read_text())

@@ -127,13 +127,22 @@ def add_evaluate_args(p: argparse.ArgumentParser) -> None:
 
 def run_evaluate(args: argparse.Namespace) -> int:
     from softdeca_train.controls.cli import report_parts
-    from softdeca_train.controls.report import merge_into_report, update_readme, validate_report
+    from softdeca_train.controls.report import (
+        kept_real_takes,
+        merge_into_report,
+        update_readme,
+        validate_report,
+    )
     from softdeca_train.train.report import write_report
 
     run = _open_run(args)
+    report = Path(args.out) / "evaluation.json"
+    # --no-real-takes keeps the figures the report had (write_report starts it afresh)
+    kept = kept_real_takes(report)
     path = write_report(run, Path(args.bundle), Path(args.out), Path(args.bench))
     controls, real = report_parts(args, Path(args.bundle))
-    doc = merge_into_report(Path(args.out) / "evaluation.json", controls, real)
+    real = real if real is not None else kept
+    doc = merge_into_report(report, controls, real)
     update_readme(path, doc)
     if real is not None:
         validate_report(doc)
