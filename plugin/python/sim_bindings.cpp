@@ -43,6 +43,8 @@ nb::dict stats_dict(const SolveStats& s) {
   d["target_rms"] = s.target_rms;
   d["max_target_distance"] = s.max_target_distance;
   d["inverted_elements"] = s.inverted_elements;
+  d["inversion_rounds"] = s.inversion_rounds;
+  d["stiffened_elements"] = s.stiffened_elements;
   d["local_seconds"] = s.local_seconds;
   d["global_seconds"] = s.global_seconds;
   d["factor_seconds"] = s.factor_seconds;
@@ -297,7 +299,7 @@ void bind_simulator(nb::module_& m) {
           "__init__",
           [](Simulator* s, const SimulationMesh& mesh, int max_iterations, double tolerance, int anderson_window,
              int threads, bool paper_strain_rule, int collision_rounds, double collision_weight,
-             double penetration_tolerance, bool lips_follow_targets) {
+             double penetration_tolerance, bool lips_follow_targets, int inversion_rounds) {
             SolverSettings st;
             st.max_iterations = max_iterations;
             st.tolerance = tolerance;
@@ -308,6 +310,7 @@ void bind_simulator(nb::module_& m) {
             st.collision_weight = collision_weight;
             st.penetration_tolerance = penetration_tolerance;
             st.lips_follow_targets = lips_follow_targets;
+            st.inversion_rounds = inversion_rounds;
             new (s) Simulator(mesh, st);
           },
           nb::arg("mesh"), nb::arg("max_iterations") = SolverSettings{}.max_iterations,
@@ -316,7 +319,8 @@ void bind_simulator(nb::module_& m) {
           nb::arg("collision_rounds") = SolverSettings{}.collision_rounds,
           nb::arg("collision_weight") = SolverSettings{}.collision_weight,
           nb::arg("penetration_tolerance") = SolverSettings{}.penetration_tolerance,
-          nb::arg("lips_follow_targets") = SolverSettings{}.lips_follow_targets)
+          nb::arg("lips_follow_targets") = SolverSettings{}.lips_follow_targets,
+          nb::arg("inversion_rounds") = SolverSettings{}.inversion_rounds)
       .def("set_parameter", [](Simulator& s, const std::string& name, double v) { s.parameters().set(name, v); },
            nb::arg("name"), nb::arg("value"), "Sets a parameter everywhere (ValueError when out of range).")
       .def("get_parameter", [](const Simulator& s, const std::string& name) {

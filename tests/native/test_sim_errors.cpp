@@ -109,4 +109,10 @@ TEST(SimErrors, BadSettingsAreRefused) {
   s = SolverSettings{};
   s.max_iterations = 0;
   expect_error([&] { Simulator sim(mesh, s); }, SOFTDECA_ERROR_INVALID_ARGUMENT, "max_iterations");
+  s = SolverSettings{};
+  s.inversion_rounds = 11;
+  expect_error([&] { Simulator sim(mesh, s); }, SOFTDECA_ERROR_INVALID_ARGUMENT, "inversion_rounds");
+  s = SolverSettings{};
+  s.inversion_stiffening = 1.0;
+  expect_error([&] { Simulator sim(mesh, s); }, SOFTDECA_ERROR_INVALID_ARGUMENT, "inversion_stiffening");
 }

@@ -32,7 +32,7 @@ bool all_pinned(const std::vector<char>& pinned, const PointRow& r) {
 std::vector<TetElement> tet_elements(const Positions& rest, const TetIndices& tets, bool reorient,
                                      const std::vector<char>& pinned, const ParameterSet& p, Param w_volume,
                                      Param w_strain, const Param* target_det, const Param* max_strain,
-                                     bool strain_limited) {
+                                     bool strain_limited, const Eigen::VectorXd* stiffening) {
   std::vector<TetElement> all = TetGroup::make_elements(rest, tets, reorient), kept;
   kept.reserve(all.size());
   for (std::size_t i = 0; i < all.size(); ++i) {
@@ -41,8 +41,9 @@ std::vector<TetElement> tet_elements(const Positions& rest, const TetIndices& te
     for (int32_t v : e.v) constant = constant && pinned[static_cast<std::size_t>(v)];
     if (constant) continue;
     const auto idx = static_cast<Eigen::Index>(i);
-    e.w_volume = p.at(w_volume, idx);
-    e.w_strain = p.at(w_strain, idx);
+    const double k = stiffening && stiffening->size() == tets.rows() ? (*stiffening)[idx] : 1.0;
+    e.w_volume = k * p.at(w_volume, idx);
+    e.w_strain = k * p.at(w_strain, idx);
     e.target_det = target_det ? p.at(*target_det, idx) : 1.0;
     e.max_strain = !strain_limited ? -INFINITY : max_strain ? p.at(*max_strain, idx) : p.global(Param::max_strain);
     kept.push_back(e);
@@ -63,21 +64,25 @@ void add_group(Model& m, std::unique_ptr<ConstraintGroup> g) {
 namespace {
 
 // The projecting tet groups (their rows come first): soft tissue, muscle, connecting tets.
-void add_tet_groups(Model& m, const SimulationMesh& mesh, const ParameterSet& p, StrainLimit strain, double pa) {
+void add_tet_groups(Model& m, const SimulationMesh& mesh, const ParameterSet& p, StrainLimit strain, double pa,
+                    const TetStiffening* stiffening) {
   const Param soft_det = Param::target_volume, soft_eps = Param::max_strain;
   add_group(m, std::make_unique<TetGroup>(
              "soft tissue",
              tet_elements(mesh.rest, mesh.soft_tets, false, m.pinned, p, Param::w_soft_volume,
-                          Param::w_soft_strain, &soft_det, &soft_eps, true),
+                          Param::w_soft_strain, &soft_det, &soft_eps, true,
+                          stiffening ? &stiffening->soft : nullptr),
              strain, pa));
   add_group(m, std::make_unique<TetGroup>(
              "muscle", tet_elements(mesh.rest, mesh.muscle_tets, false, m.pinned, p, Param::w_muscle_volume,
-                                    Param::w_muscle_strain, nullptr, nullptr, false),
+                                    Param::w_muscle_strain, nullptr, nullptr, false,
+                                    stiffening ? &stiffening->muscle : nullptr),
              strain, pa));
   // Connecting tets keep their unscaled rest: a scaled skull pushes the tissue it holds.
   add_group(m, std::make_unique<TetGroup>(
              "connecting", tet_elements(mesh.rest, mesh.connecting_tets, true, m.pinned, p,
-                                        Param::w_connect_volume, Param::w_connect_strain, nullptr, nullptr, true),
+                                        Param::w_connect_volume, Param::w_connect_strain, nullptr, nullptr, true,
+                                        nullptr),
              strain, pa));
 }
 
@@ -199,12 +204,13 @@ Eigen::VectorXd lumped_masses(const SimulationMesh& mesh) {
 
 }  // namespace
 
-Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, StrainLimit strain) {
+Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, StrainLimit strain,
+                  const TetStiffening* stiffening) {
   const double pa = physical_constants().pascal_per_weight_unit;
   Model m;
   m.scaled_rest = scaled_rest(mesh, p);
   m.pinned = pinned_mask(mesh);
-  add_tet_groups(m, mesh, p, strain, pa);  // the projecting groups' rows come first
+  add_tet_groups(m, mesh, p, strain, pa, stiffening);  // the projecting groups' rows come first
   add_skin_strain(m, mesh, p, pa);
   add_skull_shell(m, mesh, p, pa);
   m.skin_area = skin_point_areas(mesh);

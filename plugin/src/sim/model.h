@@ -35,7 +35,14 @@ struct Model {
   std::vector<PointRow> landmark_rows;  // landmark l as a combination of simulated vertices
 };
 
-Model build_model(const SimulationMesh& mesh, const ParameterSet& params, TargetMode mode, StrainLimit strain);
+// Per-tet multipliers of the volume and strain weights (soft tissue, muscle; empty: 1), beyond
+// the parameters' own ranges: the solver's stiffening of elements a solve left inverted.
+struct TetStiffening {
+  Eigen::VectorXd soft, muscle;
+};
+
+Model build_model(const SimulationMesh& mesh, const ParameterSet& params, TargetMode mode, StrainLimit strain,
+                  const TetStiffening* stiffening = nullptr);
 
 // Appends a group's rows (projecting groups must come before constant ones); empty groups are
 // skipped.

@@ -23,14 +23,28 @@ void check_positions(const Positions& p, Eigen::Index rows, const char* what) {
 
 // Tets whose signed volume is not positive: the projections bring an inverted element back,
 // so one left at the end of a solve is a failed frame, reported rather than hidden.
+bool is_inverted(const TetIndices& tets, Eigen::Index t, const Positions& x) {
+  const Eigen::Vector3d a = x.row(tets(t, 0)).transpose();
+  const Eigen::Vector3d e1 = x.row(tets(t, 1)).transpose() - a, e2 = x.row(tets(t, 2)).transpose() - a,
+                        e3 = x.row(tets(t, 3)).transpose() - a;
+  return e1.dot(e2.cross(e3)) <= 0;
+}
+
 int inverted_tets(const TetIndices& tets, const Positions& x) {
   int n = 0;
-  for (Eigen::Index t = 0; t < tets.rows(); ++t) {
-    const Eigen::Vector3d a = x.row(tets(t, 0)).transpose();
-    const Eigen::Vector3d e1 = x.row(tets(t, 1)).transpose() - a, e2 = x.row(tets(t, 2)).transpose() - a,
-                          e3 = x.row(tets(t, 3)).transpose() - a;
-    n += e1.dot(e2.cross(e3)) <= 0 ? 1 : 0;
-  }
+  for (Eigen::Index t = 0; t < tets.rows(); ++t) n += is_inverted(tets, t, x) ? 1 : 0;
+  return n;
+}
+
+// Multiplies the stiffening of every inverted tet by `factor`; returns how many there were.
+int stiffen(const TetIndices& tets, const Positions& x, double factor, Eigen::VectorXd& k) {
+  if (k.size() != tets.rows()) k = Eigen::VectorXd::Ones(tets.rows());
+  int n = 0;
+  for (Eigen::Index t = 0; t < tets.rows(); ++t)
+    if (is_inverted(tets, t, x)) {
+      k[t] *= factor;
+      ++n;
+    }
   return n;
 }
 
@@ -90,6 +104,7 @@ Simulator::Prepared& Simulator::prepare(TargetMode mode) {
   Prepared& p = prepared_[i];
   if (has_prepared_[i] && p.revision == params_.revision()) return p;
   const bool refactor = !has_prepared_[i] || p.matrix_revision != params_.matrix_revision() || !p.system;
+  p.mode = mode;
   p.model = build_model(mesh_, params_, mode, settings_.strain_limit);
   p.force = gravity_forces(p.model, params_);
   if (refactor) {
@@ -119,8 +134,10 @@ FrameResult Simulator::solve_frame(const Prepared& prep, const FrameInput& in, c
   Positions P = Positions::Zero(prep.system->rows(), 3);
   fill_rows(P, prep.model.skin_row, skin_targets);
   fill_rows(P, prep.model.landmark_row, landmark_targets);
+  const Positions P0 = P;
   FrameProblem problem{&prep.model, prep.system.get(), nullptr, &prep.force, length_scale_};
   run_projective_dynamics(problem, P, x, settings_, pool, r.stats);
+  stiffen_inverted(prep, P0, x, pool, r.stats);
 
   r.skin = embed(mesh_.skin, x);
   // Collisions: a further projective step on S, until no point penetrates (3.3.2).
@@ -152,6 +169,33 @@ FrameResult Simulator::solve_frame(const Prepared& prep, const FrameInput& in, c
   r.vertices = std::move(x);
   r.stats.total_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r;
+}
+
+void Simulator::stiffen_inverted(const Prepared& prep, const Positions& P0, Positions& x, ThreadPool* pool,
+                                 SolveStats& stats) const {
+  TetStiffening k;
+  for (int round = 0; round < settings_.inversion_rounds; ++round) {
+    const int n = stiffen(mesh_.soft_tets, x, settings_.inversion_stiffening, k.soft) +
+                  stiffen(mesh_.muscle_tets, x, settings_.inversion_stiffening, k.muscle);
+    if (n == 0) return;
+    const auto t0 = Clock::now();
+    const Model model = build_model(mesh_, params_, prep.mode, settings_.strain_limit, &k);
+    const System system(model);
+    stats.factor_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+    Positions P = P0;
+    SolveStats s;
+    const FrameProblem problem{&model, &system, nullptr, &prep.force, length_scale_};
+    run_projective_dynamics(problem, P, x, settings_, pool, s);
+    stats.iterations += s.iterations;
+    stats.converged = s.converged;
+    stats.estimated_error = s.estimated_error;
+    stats.relative_step = s.relative_step;
+    stats.contraction = s.contraction;
+    stats.local_seconds += s.local_seconds;
+    stats.global_seconds += s.global_seconds;
+    stats.inversion_rounds = round + 1;
+    stats.stiffened_elements += n;
+  }
 }
 
 FrameResult Simulator::solve_static(const FrameInput& in) {

@@ -74,6 +74,7 @@ class Simulator {
 
  private:
   struct Prepared {
+    TargetMode mode = TargetMode::kStatic;
     Model model;
     std::unique_ptr<System> system;
     Positions force;
@@ -84,6 +85,9 @@ class Simulator {
   void check(const FrameInput& input) const;
   FrameResult solve_frame(const Prepared& prep, const FrameInput& input, const Positions& skin_targets,
                           const Positions& landmark_targets, Positions start, ThreadPool* pool) const;
+  // Re-solves with the inverted tets stiffened (SolverSettings::inversion_rounds).
+  void stiffen_inverted(const Prepared& prep, const Positions& P0, Positions& x, ThreadPool* pool,
+                        SolveStats& stats) const;
   FrameResult dynamic_step(const Prepared& stat, const Prepared& dyn, const FrameInput& input,
                            DynamicsHistory& history, ThreadPool* pool) const;
 

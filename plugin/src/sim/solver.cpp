@@ -82,6 +82,9 @@ void validate(const SolverSettings& s) {
   require(s.collision_rounds >= 0 && s.collision_rounds <= 100, "collision_rounds must be in [0, 100]");
   require(std::isfinite(s.penetration_tolerance) && s.penetration_tolerance >= 0,
           "penetration_tolerance must be non-negative");
+  require(s.inversion_rounds >= 0 && s.inversion_rounds <= 10, "inversion_rounds must be in [0, 10]");
+  require(std::isfinite(s.inversion_stiffening) && s.inversion_stiffening > 1 && s.inversion_stiffening <= 1e3,
+          "inversion_stiffening must be in (1, 1000]");
 }
 
 void run_projective_dynamics(const FrameProblem& pr, Positions& P, Positions& x, const SolverSettings& s,

@@ -35,6 +35,15 @@ struct SolverSettings {
   // every frame, with the target term's weights (collisions.h, LipTargets); false: the lips
   // keep the volumetric result and only penetrations are corrected.
   bool lips_follow_targets = true;
+  // Elements a solve leaves inverted: projective dynamics' quadratic energies have no barrier
+  // at zero volume, so where skin targets pull harder than a small tet's volume term resists
+  // (its weight scales with its volume, the targets' with their area) a tet can stay flipped.
+  // Real tissue stiffens without bound as it is crushed; the solver approximates that by
+  // multiplying the inverted tets' volume and strain weights by `inversion_stiffening` and
+  // continuing from the result, at most `inversion_rounds` times (0: off). Counted in
+  // SolveStats::inversion_rounds; tets still inverted after the last round are reported.
+  int inversion_rounds = 4;
+  double inversion_stiffening = 10.0;
 };
 
 // Throws Error when a setting is out of range.
@@ -52,6 +61,8 @@ struct SolveStats {
   double target_rms = 0;     // RMS distance of the skin points to their (blended) targets (m)
   double max_target_distance = 0;  // largest distance of a skin point to its (blended) target (m)
   int inverted_elements = 0;       // soft and muscle tets with volume <= 0 at the end of the solve
+  int inversion_rounds = 0;        // re-solves with inverted tets stiffened (SolverSettings)
+  int stiffened_elements = 0;      // tets stiffened over those rounds
   double local_seconds = 0, global_seconds = 0, factor_seconds = 0, total_seconds = 0;
   // Collisions: penetrating points before and after resolution, contacts used, rounds.
   int penetrating_before = 0, penetrating_after = 0, contacts = 0, collision_rounds = 0;

@@ -10,7 +10,9 @@ bounds"). A frame is compared with the linear blend S_t it was simulated from:
 - mouth opening: where the linear blend's lips are more than `open_mm` apart (inner middle of
   the upper lip to that of the lower lip, ICT landmarks 62 and 66; negative where the upper
   lip's middle is below the lower lip's: crossed lips, an interpenetration that the
-  penetration bound judges, not an open mouth), physics / linear opening outside `open_ratio`;
+  penetration bound judges, not an open mouth), physics / linear opening outside `open_ratio`,
+  beyond what a contact correction explains (as for `exploded`: a lip the linear blend pushes
+  into the teeth must come out of them, and the opening changes by up to that depth);
 - inverted elements: any soft or muscle tet with volume <= 0 at the end of the solve;
 - volume: the soft tissue's volume change farther from the requested one (`target_volume`,
   its rest-volume-weighted mean where it varies by region) than the linear blend's (refit,
@@ -89,9 +91,10 @@ class FrameCheck:
             out.append("exploded")
         if self.penetrating_physics > self.penetrating_linear:
             out.append("penetration")
-        r = self.open_ratio
-        if not math.isnan(r) and not bounds.open_ratio[0] <= r <= bounds.open_ratio[1]:
-            out.append("mouth_open_ratio")
+        if not math.isnan(self.open_ratio):
+            lo, hi = (k * self.opening_linear_mm for k in bounds.open_ratio)
+            if not lo - self.explained_mm <= self.opening_physics_mm <= hi + self.explained_mm:
+                out.append("mouth_open_ratio")
         if self.inverted_elements > 0:
             out.append("inverted_elements")
         req = self.volume_requested_percent
