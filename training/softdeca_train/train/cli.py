@@ -1,5 +1,6 @@
 """Command lines of the training: `train-bundle` (every bundle network, then the bundle),
-`train-model` (one model of the registry, e.g. a baseline), `evaluate` (the report)."""
+`train-model` (one model of the registry, e.g. a baseline), `evaluate` (the report),
+`linear-baseline` (closed-form linear fits of the data)."""
 
 from __future__ import annotations
 
@@ -150,6 +151,45 @@ def run_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def add_linear_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.train.linear_baseline import DEFAULT_SETS, GROUPS
+
+    p.add_argument("--dataset", required=True, help="generated dataset folder")
+    p.add_argument(
+        "--features",
+        nargs="+",
+        default=list(DEFAULT_SETS),
+        help="feature sets, each a string of group letters ("
+        + "; ".join(f"{k}: {v}" for k, v in GROUPS.items())
+        + f"); default {' '.join(DEFAULT_SETS)}",
+    )
+    p.add_argument(
+        "--ridge", type=float, default=1e-3, help="ridge strength relative to A^T A (1e-3)"
+    )
+    p.add_argument("--out", help="also write the figures as JSON here")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+
+
+def run_linear(args: argparse.Namespace) -> int:
+    import json
+
+    from softdeca_train.train.linear_baseline import (
+        LinearBaselineConfig,
+        format_table,
+        parse_sets,
+        run_linear_baselines,
+    )
+
+    cfg = LinearBaselineConfig(feature_sets=parse_sets(args.features), ridge=args.ridge)
+    result = run_linear_baselines(args.dataset, cfg, progress=not args.no_progress)
+    print(format_table(result))
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps(result, indent=1) + "\n")
+        print(f"wrote {args.out}")
+    return 0
+
+
 COMMANDS = [
     Command(
         "train-bundle",
@@ -170,5 +210,13 @@ COMMANDS = [
         "error heat maps) and build/bench/models.json.",
         add_evaluate_args,
         run_evaluate,
+    ),
+    Command(
+        "linear-baseline",
+        "Closed-form ridge regressions of a dataset's static offsets T - S on the model inputs "
+        "(w, p, gravity load, h), fitted on the train split, measured on every test frame: "
+        "what the inputs explain linearly.",
+        add_linear_args,
+        run_linear,
     ),
 ]

@@ -1,0 +1,142 @@
+"""The closed-form linear baselines: the features, the ridge fit, and a planted dataset whose
+offsets are linear in w and p, which the `wp` fit must recover and the `w` fit must not."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from softdeca_train.parameters import load_parameters
+from softdeca_train.train.linear_baseline import (
+    LinearBaselineConfig,
+    ParameterScaling,
+    features,
+    fit_ridge,
+    format_table,
+    run_linear_baselines,
+)
+
+VERTICES = (
+    20  # a small stand-in for S: the fit does not care how many vertices there are
+)
+
+
+def _ranges() -> list[dict]:
+    return [
+        {"name": s.name, "lo": s.lo, "hi": s.hi, "default": s.default, "scale": s.scale}
+        for s in load_parameters().specs
+    ]
+
+
+def _scaling() -> ParameterScaling:
+    return ParameterScaling.of({"dataset": {"parameters": _ranges()}})
+
+
+def test_parameters_normalise_to_their_ranges() -> None:
+    sc = _scaling()
+    specs = load_parameters().specs
+    lo = np.array([s.lo for s in specs])
+    hi = np.array([s.hi for s in specs])
+    assert np.allclose(sc.normalise(lo), 0.0) and np.allclose(sc.normalise(hi), 1.0)
+    k = next(i for i, s in enumerate(specs) if s.scale == "log")
+    mid = lo.copy()
+    mid[k] = np.sqrt(lo[k] * hi[k])  # the geometric middle of a log-scaled range
+    assert sc.normalise(mid)[k] == pytest.approx(0.5)
+
+
+def test_gravity_load_is_zero_at_the_capture_load() -> None:
+    sc = _scaling()
+    names = load_parameters().names
+    p = np.array([s.default for s in load_parameters().specs])
+    assert np.allclose(
+        sc.gravity_load(p), 0.0
+    )  # 1 g straight down: what the neutral carries
+    p[names.index("gravity_strength")] = 2.0
+    assert np.allclose(sc.gravity_load(p), [0.0, -1.0, 0.0])
+    p[names.index("gravity_strength")] = 1.0
+    p[names.index("gravity_tilt")] = 180.0  # upside down
+    assert np.allclose(sc.gravity_load(p), [0.0, 2.0, 0.0])
+
+
+def test_unknown_feature_letters_are_refused() -> None:
+    sc = _scaling()
+    with pytest.raises(ValueError, match="feature set"):
+        features("wx", np.zeros((1, 52)), sc.lo[None], np.zeros((1, 3)), sc)
+
+
+def test_ridge_recovers_a_planted_linear_map() -> None:
+    rng = np.random.default_rng(0)
+    a = np.concatenate([np.ones((200, 1)), rng.normal(size=(200, 5))], axis=1)
+    x = rng.normal(size=(6, 12))
+    y = a @ x + 1e-6 * rng.normal(size=(200, 12))
+    est = fit_ridge(a.T @ a, a.T @ y, 1e-9)
+    assert np.abs(est - x).max() < 1e-5
+    # a strong ridge shrinks the coefficients toward zero
+    assert np.abs(fit_ridge(a.T @ a, a.T @ y, 100.0)).max() < 0.1 * np.abs(x).max()
+
+
+def _planted_dataset(folder: Path, rng: np.random.Generator) -> None:
+    """Static shards whose offsets are A_w w + A_p p_hat: linear in w and in p normalised."""
+    specs = load_parameters().specs
+    sc = _scaling()
+    a_w = 1e-3 * rng.normal(size=(52, VERTICES * 3))
+    a_p = 1e-3 * rng.normal(size=(len(specs), VERTICES * 3))
+    lo = np.array([s.lo for s in specs])
+    hi = np.array([s.hi for s in specs])
+    shards = []
+    for index, split in enumerate((0, 0, 0, 0, 1)):
+        n = 40
+        w = rng.uniform(0, 1, size=(n, 52)).astype(np.float32)
+        p = lo + (hi - lo) * rng.uniform(size=(n, len(specs)))
+        log = np.array([s.scale == "log" for s in specs])
+        p[:, log] = np.exp(
+            np.log(lo[log])
+            + (np.log(hi[log]) - np.log(lo[log])) * rng.uniform(size=(n, log.sum()))
+        )
+        off = w @ a_w + sc.normalise(p) @ a_p
+        name = f"shard-static-{index:05d}.npz"
+        np.savez(
+            folder / name,
+            instance_id=np.arange(n) + 100 * index,
+            split=np.full(n, split, np.int8),
+            failures=np.zeros(n, np.uint8),
+            estimated_error=np.zeros(n, np.float32),
+            weights=w,
+            p=p,
+            h=rng.normal(size=(n, 4)).astype(np.float32),
+            offsets=off.reshape(n, VERTICES, 3).astype(np.float16),
+        )
+        shards.append({"file": name, "kind": "static", "split": split})
+    manifest = {
+        "header": {"config": {"tolerance": 1e-4}},
+        "dataset": {"parameters": _ranges()},
+        "shards": shards,
+    }
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+
+
+def test_a_planted_dataset_is_explained_by_w_and_p_together(tmp_path: Path) -> None:
+    _planted_dataset(tmp_path, np.random.default_rng(1))
+    cfg = LinearBaselineConfig(feature_sets=("w", "p", "wp"), ridge=1e-9)
+    result = run_linear_baselines(tmp_path, cfg, progress=False)
+    rows = {r["feature_set"]: r for r in result["rows"]}
+    none = result["no_correction_test_mm"]
+    assert result["train_frames"] == 160 and result["test_frames"] == 40
+    # float16 offsets limit the fit: about 1e-3 of the offsets' size
+    assert rows["wp"]["test_mm"] < 0.01 * none
+    assert rows["w"]["test_mm"] > 0.2 * none and rows["p"]["test_mm"] > 0.2 * none
+    assert rows["wp"]["columns"] == 1 + 52 + len(load_parameters().names)
+    assert "| wp |" in format_table(result)
+
+
+def test_a_dataset_without_test_frames_is_an_error(tmp_path: Path) -> None:
+    _planted_dataset(tmp_path, np.random.default_rng(2))
+    m = json.loads((tmp_path / "manifest.json").read_text())
+    m["shards"] = [s for s in m["shards"] if s["split"] == 0]
+    (tmp_path / "manifest.json").write_text(json.dumps(m))
+    with pytest.raises(ValueError, match="no static test frame"):
+        run_linear_baselines(
+            tmp_path, LinearBaselineConfig(feature_sets=("w",)), progress=False
+        )
