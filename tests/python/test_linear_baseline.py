@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from softdeca_train.data.config import GenerateConfig
+from softdeca_train.data.ranges import sampling_parameters
 from softdeca_train.parameters import load_parameters
 from softdeca_train.train.linear_baseline import (
     LinearBaselineConfig,
@@ -23,10 +25,17 @@ VERTICES = (
 )
 
 
+def _header() -> dict:
+    return {
+        "config": GenerateConfig().as_dict()
+    }  # the default range profile, `controls`
+
+
 def _ranges() -> list[dict]:
+    """What a manifest records: the ranges its profile sampled."""
+    params = sampling_parameters(load_parameters(), GenerateConfig().ranges)
     return [
-        {"name": s.name, "lo": s.lo, "hi": s.hi, "default": s.default, "scale": s.scale}
-        for s in load_parameters().specs
+        {"name": s.name, "lo": s.lo, "hi": s.hi, "scale": s.scale} for s in params.specs
     ]
 
 
@@ -34,9 +43,12 @@ def _scaling() -> ParameterScaling:
     return ParameterScaling.of({"dataset": {"parameters": _ranges()}})
 
 
-def test_parameters_normalise_to_their_ranges() -> None:
+def test_parameters_normalise_to_the_dataset_ranges() -> None:
     sc = _scaling()
-    specs = load_parameters().specs
+    specs = sc.params.specs
+    # the dataset's ranges are the control ranges where a parameter is a control
+    controls = {s.name: s.control for s in load_parameters().specs if s.control}
+    assert all((s.lo, s.hi) == controls[s.name] for s in specs if s.name in controls)
     lo = np.array([s.lo for s in specs])
     hi = np.array([s.hi for s in specs])
     assert np.allclose(sc.normalise(lo), 0.0) and np.allclose(sc.normalise(hi), 1.0)
@@ -63,7 +75,9 @@ def test_gravity_load_is_zero_at_the_capture_load() -> None:
 def test_unknown_feature_letters_are_refused() -> None:
     sc = _scaling()
     with pytest.raises(ValueError, match="feature set"):
-        features("wx", np.zeros((1, 52)), sc.lo[None], np.zeros((1, 3)), sc)
+        features(
+            "wx", np.zeros((1, 52)), sc.params.defaults()[None], np.zeros((1, 3)), sc
+        )
 
 
 def test_ridge_recovers_a_planted_linear_map() -> None:
@@ -79,8 +93,8 @@ def test_ridge_recovers_a_planted_linear_map() -> None:
 
 def _planted_dataset(folder: Path, rng: np.random.Generator) -> None:
     """Static shards whose offsets are A_w w + A_p p_hat: linear in w and in p normalised."""
-    specs = load_parameters().specs
     sc = _scaling()
+    specs = sc.params.specs
     a_w = 1e-3 * rng.normal(size=(52, VERTICES * 3))
     a_p = 1e-3 * rng.normal(size=(len(specs), VERTICES * 3))
     lo = np.array([s.lo for s in specs])
@@ -110,7 +124,7 @@ def _planted_dataset(folder: Path, rng: np.random.Generator) -> None:
         )
         shards.append({"file": name, "kind": "static", "split": split})
     manifest = {
-        "header": {"config": {"tolerance": 1e-4}},
+        "header": _header(),
         "dataset": {"parameters": _ranges()},
         "shards": shards,
     }

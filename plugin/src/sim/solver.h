@@ -55,8 +55,11 @@ struct SolveStats {
   double relative_step = 0;    // last plain PD step's RMS move / bounding-box diagonal
   double contraction = 0;      // measured contraction of a plain step (slowest mode)
   double estimated_error = 0;  // relative_step / (1 - contraction)
-  double energy = 0;         // PD energy (J) at the last evaluated iterate
-  std::vector<double> energy_history;  // per accepted iterate, when recorded
+  // PD energy (J) at the last evaluated iterate, and per accepted iterate when recorded: of
+  // the material's own weights, so of the solve before any stiffening round (whose stiffened
+  // energy is another function; iterations and convergence include the rounds).
+  double energy = 0;
+  std::vector<double> energy_history;
   int anderson_rejections = 0;
   double target_rms = 0;     // RMS distance of the skin points to their (blended) targets (m)
   double max_target_distance = 0;  // largest distance of a skin point to its (blended) target (m)

@@ -17,14 +17,14 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterator, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from softdeca_train.data.shards import iter_shards
-from softdeca_train.parameters import load_parameters
+from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.train.batches import EVERY_FRAME, training_mask
 
 # Feature groups by letter: a feature set is a string of them ("wpg": w, p and gravity).
@@ -50,31 +50,32 @@ class LinearBaselineConfig:
 
 @dataclass(frozen=True)
 class ParameterScaling:
-    """p -> [0, 1] over the dataset's sampling ranges (log-scaled parameters in log)."""
+    """p -> [0, 1] over the dataset's sampling ranges (ParameterSet.normalise: log-scaled
+    parameters in log), and the gravity load p's strength and angles make."""
 
-    lo: np.ndarray
-    hi: np.ndarray
-    log: np.ndarray
+    params: ParameterSet
     gravity: tuple[int, int, int]  # columns of strength, tilt, azimuth
 
     @classmethod
     def of(cls, manifest: dict) -> ParameterScaling:
-        names = load_parameters().names
-        ranges = {q["name"]: q for q in manifest["dataset"]["parameters"]}
-        lo = np.array([ranges[n]["lo"] for n in names], float)
-        hi = np.array([ranges[n]["hi"] for n in names], float)
-        log = np.array([ranges[n].get("scale") == "log" for n in names])
+        """The ranges the manifest recorded as sampled (the definition may have changed)."""
+        sampled = {q["name"]: q for q in manifest["dataset"]["parameters"]}
+        params = ParameterSet(
+            tuple(
+                replace(s, lo=sampled[s.name]["lo"], hi=sampled[s.name]["hi"])
+                for s in load_parameters().specs
+            )
+        )
+        names = params.names
         g = tuple(names.index(n) for n in ("gravity_strength", "gravity_tilt", "gravity_azimuth"))
-        return cls(lo, hi, log, g)  # type: ignore[arg-type]
+        return cls(params, g)  # type: ignore[arg-type]
 
     def normalise(self, p: np.ndarray) -> np.ndarray:
-        lo, hi, x = self.lo.copy(), self.hi.copy(), np.asarray(p, float).copy()
-        lo[self.log], hi[self.log] = np.log(lo[self.log]), np.log(hi[self.log])
-        x[..., self.log] = np.log(x[..., self.log])
-        span = np.where(hi > lo, hi - lo, 1.0)
-        return (x - lo) / span
+        return self.params.normalise(np.asarray(p, float))
 
     def gravity_load(self, p: np.ndarray) -> np.ndarray:
+        """s d - d0 (in g): zero at the capture's load, 1 g along -Y (plugin/src/sim/model.cpp,
+        gravity_forces)."""
         s, t, a = (np.asarray(p, float)[..., i] for i in self.gravity)
         t, a = np.radians(t), np.radians(a)
         d = np.stack([np.sin(t) * np.cos(a), -np.cos(t), np.sin(t) * np.sin(a)], -1)
@@ -149,7 +150,7 @@ def run_linear_baselines(
     limit = cfg.error_limit * float(manifest["header"]["config"]["tolerance"])
     sets = tuple(dict.fromkeys(cfg.feature_sets))
     for s in sets:
-        features(s, np.zeros((1, 52)), scaling.lo[None], np.zeros((1, 1)), scaling)
+        features(s, np.zeros((1, 52)), scaling.params.defaults()[None], np.zeros((1, 1)), scaling)
     n_train_shards = sum(
         1 for s in manifest["shards"] if s["kind"] == "static" and s.get("split", 0) == 0
     )
