@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softdeca_train.sim.sanity import LOWER_LIP_MIDDLE, UPPER_LIP_MIDDLE
+from softdeca_train.sim import sanity
 from softdeca_train.template import Template
 
 # Linear blends of the replay and of the simulation must agree to this (m): the avatar was
@@ -29,10 +29,8 @@ class PhysicsColumn:
 
 
 def lip_openings_mm(heads: np.ndarray, template: Template) -> np.ndarray:
-    """(F, V, 3) heads in template order -> (F,) inner-lip-middle distances in mm."""
-    lm = template.landmarks68
-    d = heads[:, lm[UPPER_LIP_MIDDLE]] - heads[:, lm[LOWER_LIP_MIDDLE]]
-    return 1e3 * np.linalg.norm(d, axis=1)
+    """(F, V, 3) heads in template order -> (F,) signed inner-lip-middle distances in mm."""
+    return sanity.lip_openings_mm(template.landmarks68, heads)
 
 
 def widest_open_frame(linear: np.ndarray, template: Template) -> int:

@@ -119,12 +119,18 @@ def _penetrations(hs: HeadSimulation, skin: np.ndarray, vertices: np.ndarray) ->
     return out
 
 
+def lip_openings_mm(landmarks68: np.ndarray, heads: np.ndarray) -> np.ndarray:
+    """(..., V, 3) skins or heads in template order -> (...) inner upper-lip middle to inner
+    lower-lip middle (mm); negative where the upper lip's middle lies below the lower lip's
+    (+Y is up in the head's frame): crossed lips, not an open mouth."""
+    heads = np.asarray(heads)
+    d = heads[..., landmarks68[UPPER_LIP_MIDDLE], :] - heads[..., landmarks68[LOWER_LIP_MIDDLE], :]
+    return 1e3 * np.linalg.norm(d, axis=-1) * np.where(d[..., 1] >= 0.0, 1.0, -1.0)
+
+
 def lip_opening_mm(hs: HeadSimulation, skin: np.ndarray) -> float:
-    """Inner upper-lip middle to inner lower-lip middle (mm); negative where the upper lip's
-    middle lies below the lower lip's (+Y is up in the head's frame)."""
-    lm = hs.template.landmarks68
-    d = skin[lm[UPPER_LIP_MIDDLE]] - skin[lm[LOWER_LIP_MIDDLE]]
-    return 1e3 * float(np.linalg.norm(d)) * (1.0 if d[1] >= 0.0 else -1.0)
+    """One frame's lip opening (lip_openings_mm)."""
+    return float(lip_openings_mm(hs.template.landmarks68, skin))
 
 
 def check_frame(
