@@ -153,16 +153,6 @@ def _failures(frames: list, reason: str) -> list[str]:
     ]
 
 
-# Known failures, measured and kept visible: `mouthClose` at 1 alone (the lips pressed 40 mm
-# through each other over a closed jaw, a shape meant to be combined with jawOpen) inverts soft
-# tets at the lips. The solver's stiffening rounds bring some back, how many depends on the
-# tet mesh fTetWild made for the head (not reproducible from run to run): on the template, 28
-# inverted tets without the rounds, 9 after the default 4 on one mesh and none on another
-# (docs/physics.md, Known limits). Left out of the inverted-element bound by name and
-# reported; every other frame must hold it.
-_KNOWN_INVERTED = ("mouthClose=1",)
-
-
 @pytest.mark.parametrize(
     "reason",
     [
@@ -171,22 +161,17 @@ _KNOWN_INVERTED = ("mouthClose=1",)
         # 355 lip points up to 2.8 mm inside the other lip or the teeth; the contacts resolve
         # them all (docs/physics.md, Collisions).
         "penetration",
+        # mouthClose at 1 alone (the lips pressed 40 mm through each other over a closed jaw)
+        # inverts 28 lip tets of the template without the solver's stiffening rounds, none
+        # with them on the head's (reproducible) tet mesh (docs/physics.md, Known limits).
         "inverted_elements",
         "volume",
     ],
 )
 def test_reduced_suite_holds_the_bounds(reduced: list, reason: str) -> None:
-    frames = reduced
-    if reason == "inverted_elements":
-        known = [f for f in reduced if f.label in _KNOWN_INVERTED]
-        assert len(known) == 2  # the template's and seed 1's, both judged
-        frames = [f for f in reduced if f.label not in _KNOWN_INVERTED]
-        still = _failures(known, reason)
-        if still:
-            print(f"known, still failing '{reason}':", *still, sep="\n")
-    bad = _failures(frames, reason)
+    bad = _failures(reduced, reason)
     assert not bad, (
-        f"{len(bad)} of {len(frames)} frames fail '{reason}':\n" + "\n".join(bad[:10])
+        f"{len(bad)} of {len(reduced)} frames fail '{reason}':\n" + "\n".join(bad[:10])
     )
 
 

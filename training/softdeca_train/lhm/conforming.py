@@ -15,19 +15,16 @@ slit between the lips) and fills it with well-shaped tets instead:
 4. the mesh's vertices on the skull wrap are the bone's (pinned), each with the skull wrap
    vertex nearest to it (its bone label).
 
-fTetWild's fill takes 14-21 s at wrap level 3 (a head build about 35 s, 90 s at level 4) and
-is not bitwise reproducible from run to run (the same input gave 3972 and 4104 vertices):
-meshes are cached on disk under the cache folder (`tetmesh/`), keyed by the input surface and
-the settings, so a head keeps one mesh once made (data generation, tests and evaluation on one
-machine agree)."""
+fTetWild's fill takes 14-21 s at wrap level 3 (a head build about 35 s, 90 s at level 4). It
+seeds itself from std::random_device (the same input gave 5,000 to 5,600 vertices from run to
+run), so it runs in a process of its own with those seeds fixed (lhm/tetfill.py): a head's mesh
+depends on its input surface and the settings only, on every machine. Meshes are cached on
+disk under the cache folder (`tetmesh/`), keyed by both."""
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
-import tempfile
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,6 +35,7 @@ from scipy.spatial import cKDTree
 
 from softdeca_train.lhm.checks import closed_wrap_triangles
 from softdeca_train.lhm.model import LayeredHeadModel
+from softdeca_train.lhm.tetfill import run_fill
 from softdeca_train.paths import cache_dir
 
 
@@ -85,14 +83,8 @@ def _winding_inside(surface: np.ndarray, tris: np.ndarray, points: np.ndarray) -
     return np.asarray(w) > 0.5
 
 
-@contextlib.contextmanager
-def _working_directory(path: str) -> Iterator[None]:
-    before = os.getcwd()
-    os.chdir(path)
-    try:
-        yield
-    finally:
-        os.chdir(before)
+# Part of the cache key: meshes made before the fill's seeds were fixed are not reused.
+FILL_VERSION = "fixed-seed-1"
 
 
 def _cache_key(surface: np.ndarray, faces: np.ndarray, settings: tuple[float, ...]) -> str:
@@ -100,6 +92,7 @@ def _cache_key(surface: np.ndarray, faces: np.ndarray, settings: tuple[float, ..
     h.update(np.ascontiguousarray(surface, np.float64).tobytes())
     h.update(np.ascontiguousarray(faces, np.int64).tobytes())
     h.update(repr(settings).encode())
+    h.update(FILL_VERSION.encode())
     return h.hexdigest()[:20]
 
 
@@ -112,20 +105,7 @@ def fill(
     if path.exists():
         with np.load(path) as z:
             return z["vertices"], z["tets"]
-    import pytetwild
-
-    # fTetWild writes a scratch file into the working directory: give it a folder of its own.
-    with tempfile.TemporaryDirectory() as scratch, _working_directory(scratch):
-        v, t = pytetwild.tetrahedralize(
-            surface.astype(np.float64),
-            faces.astype(np.int32),
-            edge_length_fac=edge_length,
-            epsilon=envelope,
-            num_threads=1,
-            quiet=True,
-        )
-    v = np.asarray(v, np.float64)
-    t = np.asarray(t, np.int32)
+    v, t = run_fill(surface.astype(np.float64), faces.astype(np.int32), edge_length, envelope)
     vol = native.tet_signed_volumes(v, t)
     t[vol < 0] = t[vol < 0][:, [0, 2, 1, 3]]
     path.parent.mkdir(parents=True, exist_ok=True)
