@@ -13,6 +13,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +38,14 @@ def run_fill(
     surface: np.ndarray, faces: np.ndarray, edge_length: float, envelope: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """fTetWild's tets inside `surface` (as fTetWild orients them), from a child process."""
-    env = dict(os.environ, LD_PRELOAD=str(seed_library()))
+    env = dict(os.environ)
+    if sys.platform.startswith("linux"):
+        env["LD_PRELOAD"] = str(seed_library())
+    else:  # the preload interposes GNU libstdc++'s random_device: Linux builds only
+        warnings.warn(
+            "the tet fill's seeds are fixed on Linux only: meshes made here are not reproducible",
+            stacklevel=2,
+        )
     env["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).parents[2]), *sys.path])
     # fTetWild writes a scratch file into the working directory: give it a folder of its own.
     with tempfile.TemporaryDirectory() as scratch:
