@@ -166,6 +166,12 @@ def add_linear_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--ridge", type=float, default=1e-3, help="ridge strength relative to A^T A (1e-3)"
     )
+    p.add_argument(
+        "--local",
+        action="store_true",
+        help="also the per-element fits (per vertex; per face through deformation transfer) "
+        "and DT's floor, on each element's own (regional) parameters; needs the template data",
+    )
     p.add_argument("--out", help="also write the figures as JSON here")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
 
@@ -183,6 +189,18 @@ def run_linear(args: argparse.Namespace) -> int:
     cfg = LinearBaselineConfig(feature_sets=parse_sets(args.features), ridge=args.ridge)
     result = run_linear_baselines(args.dataset, cfg, progress=not args.no_progress)
     print(format_table(result))
+    if args.local:
+        from softdeca_train.train.local_fit import (
+            LocalFitConfig,
+            format_local_table,
+            run_local_fits,
+        )
+
+        local = run_local_fits(
+            args.dataset, LocalFitConfig(ridge=args.ridge), progress=not args.no_progress
+        )
+        print(format_local_table(local))
+        result["local"] = local
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps(result, indent=1) + "\n")
@@ -215,7 +233,8 @@ COMMANDS = [
         "linear-baseline",
         "Closed-form ridge regressions of a dataset's static offsets T - S on the model inputs "
         "(w, p, gravity load, h), fitted on the train split, measured on every test frame: "
-        "what the inputs explain linearly.",
+        "what the inputs explain linearly; with --local also per-element fits and the floor "
+        "of deformation transfer.",
         add_linear_args,
         run_linear,
     ),
