@@ -92,14 +92,31 @@ def mlp(sizes: Sequence[int], out_scale: float = 1.0) -> nn.Sequential:
 
 
 class WeightEncoder(nn.Module):
-    """f_w: blendshape weights -> latent code z (per frame)."""
+    """f_w: blendshape weights -> latent code z (per frame). Options: `linear_skip` adds a
+    linear map of w to the MLP's output (the part of the correction linear in w starts there
+    in closed form); `constant_slot` makes the last entry of z a constant 1, so the
+    hypernetwork's entry for it is a correction that does not depend on w (p's own)."""
 
-    def __init__(self, n_weights: int, sizes: NetworkSizes) -> None:
+    def __init__(
+        self,
+        n_weights: int,
+        sizes: NetworkSizes,
+        linear_skip: bool = False,
+        constant_slot: bool = False,
+    ) -> None:
         super().__init__()
-        self.net = mlp([n_weights, *sizes.f_w_hidden, sizes.latent])
+        self.constant_slot = constant_slot
+        free = sizes.latent - 1 if constant_slot else sizes.latent
+        self.net = mlp([n_weights, *sizes.f_w_hidden, free])
+        self.skip = nn.Linear(n_weights, free, bias=False) if linear_skip else None
 
     def forward(self, weights: torch.Tensor) -> torch.Tensor:
-        return self.net(weights)
+        z = self.net(weights)
+        if self.skip is not None:
+            z = z + self.skip(weights)
+        if self.constant_slot:
+            z = torch.cat([z, torch.ones_like(z[:, :1])], dim=1)
+        return z
 
 
 class LandmarkEncoder(nn.Module):
@@ -145,6 +162,46 @@ class ElementMLP(nn.Module):
         return self.rest(x)
 
 
+# The gravity load of a parameter vector: s d - d0 in g, d the direction of the strength s,
+# tilt and azimuth (degrees), d0 the capture's own load (1 g along -Y); the simulator's
+# gravity_forces and linear_baseline.ParameterScaling.gravity_load use the same.
+GRAVITY_COLUMNS = ("gravity_strength", "gravity_tilt", "gravity_azimuth")
+
+
+class LocalLinear(nn.Module):
+    """Per element, an affine map of the element's own parameters: [1, p_i, g_i] (p_i
+    normalised, g_i its gravity load) times a table (n, 1 + P + 3, k). A region's control
+    then changes the output in that region only."""
+
+    def __init__(self, n_elements: int, specs: Sequence[ParameterSpec], k: int) -> None:
+        super().__init__()
+        names = [s.name for s in specs]
+        self.normalise = Normalise(specs)
+        self.gravity = (
+            [names.index(c) for c in GRAVITY_COLUMNS]
+            if all(c in names for c in GRAVITY_COLUMNS)
+            else None
+        )
+        self.table = nn.Parameter(torch.zeros(n_elements, 1 + len(specs) + 3, k))
+
+    def features(self, parameters: torch.Tensor) -> torch.Tensor:
+        """(n, P) raw -> (n, 1 + P + 3)."""
+        ones = torch.ones_like(parameters[:, :1])
+        if self.gravity is None:
+            load = torch.zeros_like(parameters[:, :3])
+        else:
+            s, tilt, azimuth = (parameters[:, i] for i in self.gravity)
+            t, a = torch.deg2rad(tilt), torch.deg2rad(azimuth)
+            d = torch.stack(
+                [torch.sin(t) * torch.cos(a), -torch.cos(t), torch.sin(t) * torch.sin(a)], 1
+            )
+            load = s[:, None] * d + torch.tensor([0.0, 1.0, 0.0], dtype=d.dtype)
+        return torch.cat([ones, self.normalise(parameters), load], dim=1)
+
+    def forward(self, parameters: torch.Tensor) -> torch.Tensor:
+        return torch.einsum("nd,ndk->nk", self.features(parameters), self.table)
+
+
 class HyperNetwork(nn.Module):
     """f_ph (k = 9: a 3x3 deformation-gradient block per face and latent) or f_ph_v (k = 3: a
     vertex offset per latent). Output [n, latent, k]. `unit` is a fixed factor on the output
@@ -163,6 +220,7 @@ class HyperNetwork(nn.Module):
         out_scale: float,
         unit: float = 1.0,
         base: bool = False,
+        local_linear: bool = False,
     ) -> None:
         super().__init__()
         self.latent, self.k, self.unit = sizes.latent, k, unit
@@ -170,11 +228,17 @@ class HyperNetwork(nn.Module):
         self.body = ElementMLP(
             n_elements, specs, sizes, sizes.hyper_hidden, sizes.latent * k, out_scale / unit
         )
+        # With a constant last entry of z (WeightEncoder.constant_slot): that entry's tensor
+        # gains an affine map of each element's own parameters.
+        self.local = LocalLinear(n_elements, specs, k) if local_linear else None
 
     def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:
         out = self.body(parameters, identity).reshape(-1, self.latent, self.k)
         if self.base is not None:
             out = out + self.base
+        if self.local is not None:
+            last = out[:, -1:] + self.local(parameters)[:, None]
+            out = torch.cat([out[:, :-1], last], dim=1)
         return out * self.unit if self.unit != 1.0 else out
 
 

@@ -23,6 +23,7 @@ from softdeca_train.train.models import (
     LatentDynamics,
     NoCorrection,
     SoftDeca,
+    SoftDecaHybrid,
     SoftDecaVertex,
     SparseSoftDeca,
     Trainable,
@@ -178,6 +179,18 @@ def frame_function(model: Trainable, batch: Batch) -> Callable[[], object]:
             return deformation_transfer(one.dt, one.S, dg)
 
         return softdeca
+    if isinstance(model, SoftDecaHybrid):
+        faces = model.f_ph(batch.face_parameters(model.n_faces), batch.h)
+        vertices = model.f_ph_v(batch.vertex_parameters(model.n_vertices), batch.h)
+
+        def hybrid() -> object:
+            z = model.f_w(one.weights)
+            dg = torch.einsum("bk,fkn->bfn", z, faces).reshape(1, -1, 3, 3)
+            return deformation_transfer(one.dt, one.S, dg) + torch.einsum(
+                "bk,vkn->bvn", z, vertices
+            )
+
+        return hybrid
     if isinstance(model, SoftDecaVertex):
         hyper = model.f_ph_v(expand(batch.p, model.n_vertices), batch.h)
         return lambda: one.S + torch.einsum("bk,vkn->bvn", model.f_w(one.weights), hyper)

@@ -184,6 +184,88 @@ class SoftDeca(Trainable):
         return deformation_transfer(batch.dt, batch.S, self.deformation_gradients(batch))
 
 
+class SoftDecaHybrid(Trainable):
+    """SoftDECA with a vertex stage: X = DT(S_t, I + z(w) . L(p, h)) + z(w) . L_v(p, h).
+
+    DT alone cannot reach the physics: fed the physics' own face gradients it stays 0.19 mm
+    from T where S_t is 0.41 mm off (`linear-baseline --local`, docs/training.md), because its
+    pull toward S_t holds back the smooth, low-frequency part of the correction (the sag).
+    The vertex stage carries that part. z has a linear path in w and a constant last entry
+    whose L_v tensor is an affine map of each vertex's own parameters, so the model starts at
+    the per-vertex ridge fit (`init_from_dataset`, closed form) and a region's control acts in
+    its region."""
+
+    hypernetworks = ("f_ph", "f_ph_v")
+    hyper_lr = HYPER_LR_SOFTDECA
+
+    def __init__(self, d: TemplateDefinition, specs: Sequence[ParameterSpec], sizes: NetworkSizes):
+        super().__init__()
+        self.f_w = WeightEncoder(len(d.blendshapes), sizes, linear_skip=True, constant_slot=True)
+        self.f_ph = HyperNetwork(d.n_faces, specs, sizes, 9, 1e-4, base=True)
+        self.f_ph_v = HyperNetwork(
+            d.skin_vertices, specs, sizes, 3, 1e-5, unit=CM, base=True, local_linear=True
+        )
+        self.n_faces, self.n_vertices = d.n_faces, d.skin_vertices
+        self.n_weights = len(d.blendshapes)
+
+    def vertex_features(self, weights: torch.Tensor, p_vertices: torch.Tensor) -> torch.Tensor:
+        """(V, B, 52 + 1 + P + 3): [w, local features of each vertex] (the vertex stage's
+        linear inputs, in the networks' own normalisation)."""
+        assert self.f_ph_v.local is not None
+        own = self.f_ph_v.local.features(p_vertices).double()  # (V, 1 + P + 3)
+        b, v = len(weights), len(own)
+        return torch.cat(
+            [weights.double()[None].expand(v, b, -1), own[:, None].expand(v, b, -1)], dim=2
+        )
+
+    @torch.no_grad()
+    def init_from_dataset(self, data: object, progress: bool = True, ridge: float = 1e-3) -> None:
+        """Start at the per-vertex ridge fit of T - S_t on [w, 1, p_v, g_v] over the kept
+        train frames: its w part (rank latent - 1, by SVD) in f_w's linear path and L_v's
+        base, its constant and parameter parts in L_v's local map; every MLP's output and the
+        DT stage start at zero."""
+        from tqdm import tqdm
+
+        from softdeca_train.train.local_fit import LocalRidge
+
+        fit: LocalRidge | None = None
+        bar = tqdm(desc="vertex stage fit", unit="frame", disable=not progress)
+        for b in data.batches("static", "train"):  # type: ignore[attr-defined]
+            x = self.vertex_features(b.weights, b.vertex_parameters(self.n_vertices))
+            fit = fit or LocalRidge(self.n_vertices, x.shape[-1], 3)
+            fit.add(x, (b.T - b.S).transpose(0, 1) / CM)
+            bar.update(b.frames)
+        bar.close()
+        if fit is None:
+            raise ValueError("no static train frame to start the vertex stage from")
+        coef = fit.solve(ridge)  # (V, 52 + 1 + P + 3, 3), centimetres
+        nw, v = self.n_weights, self.n_vertices
+        a = coef[:, :nw].permute(0, 2, 1).reshape(v * 3, nw)  # w part, (V * 3, 52)
+        u, sv, vt = torch.linalg.svd(a, full_matrices=False)
+        r = min(self.f_ph_v.latent - 1, len(sv))
+        hyper, enc = self.f_ph_v, self.f_w
+        assert hyper.base is not None and hyper.local is not None and enc.skip is not None
+        base = torch.zeros_like(hyper.base)
+        base[:, :r] = (u[:, :r] * sv[:r]).reshape(v, 3, r).permute(0, 2, 1).float()
+        hyper.base.copy_(base)
+        hyper.local.table.copy_(coef[:, nw:].float())
+        enc.skip.weight.zero_()
+        enc.skip.weight[:r] = vt[:r].float()
+        # The MLPs' output layers at zero (f_w's, both hypernetworks' bodies; the DT stage's
+        # base table is zero too): the model starts exactly at the fit and they train from it.
+        for last in (enc.net[-1], self.f_ph.body.rest[-1][-1], hyper.body.rest[-1][-1]):
+            assert isinstance(last, nn.Linear)
+            last.weight.zero_()
+            last.bias.zero_()
+
+    def predict(self, batch: Batch) -> torch.Tensor:
+        z = self.f_w(batch.weights)  # (B, latent), last entry 1
+        hyper = self.f_ph(batch.face_parameters(self.n_faces), batch.h)  # (F, latent, 9)
+        g = torch.einsum("bk,fkn->bfn", z, hyper).reshape(len(z), self.n_faces, 3, 3)
+        vertex = self.f_ph_v(batch.vertex_parameters(self.n_vertices), batch.h)  # (V, latent, 3)
+        return deformation_transfer(batch.dt, batch.S, g) + torch.einsum("bk,vkn->bvn", z, vertex)
+
+
 class SoftDecaVertex(Trainable):
     """The vertex-position variant (Table 1): X = S_t + z(w) . L_v(p, h), no DT."""
 

@@ -55,6 +55,11 @@ MODELS: dict[str, Entry] = {
             lambda d, s, z, b: m.SoftDeca(d, s, z),
         ),
         Entry(
+            "softdeca-hybrid",
+            "SoftDECA + a vertex stage started at the per-vertex ridge fit",
+            lambda d, s, z, b: m.SoftDecaHybrid(d, s, z),
+        ),
+        Entry(
             "softdeca-dynamics",
             "SoftDECA's per-vertex dynamics (eq. 21)",
             lambda d, s, z, b: m.Dynamics(b, d.skin_vertices, s, z),  # type: ignore[arg-type]

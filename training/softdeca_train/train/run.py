@@ -113,7 +113,9 @@ class Run:
             raise ValueError(f"unknown model {name!r}; known: {', '.join(MODELS)}")
         model = self.build(name)
         fresh = not self.checkpoint(name).is_file()
-        if fresh and type(model).init_from_data is not Trainable.init_from_data:
+        if fresh and hasattr(model, "init_from_dataset"):  # closed-form start over all data
+            model.init_from_dataset(self.data, progress=progress)
+        elif fresh and type(model).init_from_data is not Trainable.init_from_data:
             rng = np.random.default_rng(cfg.seed)
             sample = list(itertools.islice(self.data.batches(model.kind, "train", rng), 48))
             model.init_from_data(sample)

@@ -1,0 +1,79 @@
+"""SoftDECA with a vertex stage (train/models.py SoftDecaHybrid): the constant slot of z, the
+per-vertex local map of the parameters, and the closed-form start at the per-vertex ridge
+fit, checked against an independent fit on the small generated dataset."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import torch
+from softdeca_train.models.networks import TEST_SIZES, LocalLinear, WeightEncoder
+from softdeca_train.train.linear_baseline import ParameterScaling
+from softdeca_train.train.models import CM, SoftDecaHybrid
+from softdeca_train.train.run import Run, RunConfig
+
+
+def test_the_constant_slot_is_one_and_the_skip_is_linear() -> None:
+    enc = WeightEncoder(52, TEST_SIZES, linear_skip=True, constant_slot=True)
+    w = torch.rand(4, 52)
+    z = enc(w)
+    assert z.shape == (4, TEST_SIZES.latent)
+    assert torch.equal(z[:, -1], torch.ones(4))
+    with torch.no_grad():
+        enc.net[-1].weight.zero_()
+        enc.net[-1].bias.zero_()
+    assert torch.allclose(enc(2 * w)[:, :-1], 2 * enc(w)[:, :-1])
+
+
+def test_local_features_carry_the_gravity_load_of_the_baselines(small) -> None:
+    folder, _ = small
+    run = Run(folder / "run-local", RunConfig(str(folder), "test", seed=3))
+    local = LocalLinear(3, run.specs, 3)
+    names = [s.name for s in run.specs]
+    p = np.tile(np.array([s.default for s in run.specs], np.float32), (3, 1))
+    p[1, names.index("gravity_strength")] = 2.0
+    p[2, names.index("gravity_tilt")] = 30.0
+    x = local.features(torch.from_numpy(p)).numpy()
+    assert x.shape == (3, 1 + len(names) + 3) and (x[:, 0] == 1).all()
+    scaling = ParameterScaling.of(run.data.manifest)
+    cols = [scaling.params.names.index(n) for n in names]
+    full = np.tile(scaling.params.defaults(), (3, 1))
+    full[:, cols] = p
+    assert np.allclose(x[:, -3:], scaling.gravity_load(full), atol=1e-6)
+
+
+def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
+    folder, _ = small
+    run = Run(folder / "run-hybrid", RunConfig(str(folder), "test", seed=3))
+    # latent 53: the w part keeps its full rank 52, so the start is the fit itself
+    model = SoftDecaHybrid(run.definition, run.specs, replace(run.sizes, latent=53))
+    ridge = 1e-3
+    model.init_from_dataset(run.data, progress=False, ridge=ridge)
+    batches = list(run.data.batches("static", "train"))
+    picked = np.arange(0, model.n_vertices, 997)  # an independent fit on a few vertices
+    xs, ys = [], []
+    for b in batches:
+        x = model.vertex_features(b.weights, b.vertex_parameters(model.n_vertices))
+        xs.append(x[picked].numpy())
+        ys.append(((b.T - b.S).transpose(0, 1)[picked] / CM).double().numpy())
+    x, y = (
+        np.concatenate(xs, axis=1),
+        np.concatenate(ys, axis=1),
+    )  # (n, frames, d), (n, frames, 3)
+    with torch.no_grad():
+        for b in batches[:2]:
+            got = (model.predict(b) - b.S)[:, picked].numpy()
+            xb = model.vertex_features(b.weights, b.vertex_parameters(model.n_vertices))
+            for j, vtx in enumerate(picked):
+                gram = x[j].T @ x[j]
+                lam = ridge * np.trace(gram) / len(gram)
+                coef = np.linalg.solve(gram + lam * np.eye(len(gram)), x[j].T @ y[j])
+                want = CM * (xb[vtx].numpy() @ coef)  # (B, 3) metres
+                assert np.abs(got[:, j] - want).max() < 2e-6, vtx
+    # and it is a correction: closer to T than S_t on the train frames
+    with torch.no_grad():
+        b = batches[0]
+        assert (model.predict(b) - b.T).norm(dim=-1).mean() < (b.S - b.T).norm(
+            dim=-1
+        ).mean()
