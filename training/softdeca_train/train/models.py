@@ -229,7 +229,8 @@ class SoftDecaHybrid(Trainable):
         from softdeca_train.train.local_fit import LocalRidge
 
         fit: LocalRidge | None = None
-        bar = tqdm(desc="vertex stage fit", unit="frame", disable=not progress)
+        kept = data.left_out("static", "train")["kept"]  # type: ignore[attr-defined]
+        bar = tqdm(total=kept, desc="vertex stage fit", unit="frame", disable=not progress)
         for b in data.batches("static", "train"):  # type: ignore[attr-defined]
             x = self.vertex_features(b.weights, b.vertex_parameters(self.n_vertices))
             fit = fit or LocalRidge(self.n_vertices, x.shape[-1], 3)
