@@ -187,8 +187,8 @@ class SoftDeca(Trainable):
 class SoftDecaHybrid(Trainable):
     """SoftDECA with a vertex stage: X = DT(S_t, I + z(w) . L(p, h)) + z(w) . L_v(p, h).
 
-    DT alone cannot reach the physics: fed the physics' own face gradients it stays 0.19 mm
-    from T where S_t is 0.41 mm off (`linear-baseline --local`, docs/training.md), because its
+    DT alone cannot reach the physics: fed the physics' own face gradients it stays 0.187 mm
+    from T where S_t is 0.398 mm off (`linear-baseline --local`, docs/training.md), because its
     pull toward S_t holds back the smooth, low-frequency part of the correction (the sag).
     The vertex stage carries that part. z has a linear path in w and a constant last entry
     whose L_v tensor is an affine map of each vertex's own parameters, so the model starts at
