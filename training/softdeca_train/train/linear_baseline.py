@@ -24,6 +24,7 @@ import numpy as np
 from tqdm import tqdm
 
 from softdeca_train.data.shards import iter_shards
+from softdeca_train.models.networks import GRAVITY_COLUMNS
 from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.train.batches import EVERY_FRAME, training_mask
 
@@ -67,7 +68,7 @@ class ParameterScaling:
             )
         )
         names = params.names
-        g = tuple(names.index(n) for n in ("gravity_strength", "gravity_tilt", "gravity_azimuth"))
+        g = tuple(names.index(n) for n in GRAVITY_COLUMNS)
         return cls(params, g)  # type: ignore[arg-type]
 
     def normalise(self, p: np.ndarray) -> np.ndarray:

@@ -5,6 +5,7 @@ static model, and the Table 1 baselines. Errors are per-vertex Euclidean distanc
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -25,7 +26,7 @@ from softdeca_train.models.networks import (
 )
 from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.topology import TemplateDefinition
-from softdeca_train.train.batches import Batch
+from softdeca_train.train.batches import Batch, Dataset
 
 EPS = 1e-12
 CM = 0.01  # vertex offsets are learned in centimetres (HyperNetwork.unit)
@@ -47,7 +48,15 @@ class Trainable(nn.Module):
     kind = "static"
 
     def init_from_data(self, batches: Sequence[Batch]) -> None:
-        """Data-driven initialisation before the first step (default: none)."""
+        """Data-driven initialisation from a sample of batches (default: none)."""
+
+    def init_from_dataset(
+        self, data: Dataset, rng: np.random.Generator, progress: bool = True
+    ) -> None:
+        """Initialisation before the first step: by default `init_from_data` on 48 shuffled
+        train batches; a model with a closed-form start over all the data overrides it."""
+        if type(self).init_from_data is not Trainable.init_from_data:
+            self.init_from_data(list(itertools.islice(data.batches(self.kind, "train", rng), 48)))
 
     # The per-element hypernetworks (attribute names) and their learning-rate factor. Adam
     # moves every weight by about the learning rate per step whatever its gradient, so a
@@ -219,7 +228,13 @@ class SoftDecaHybrid(Trainable):
         )
 
     @torch.no_grad()
-    def init_from_dataset(self, data: object, progress: bool = True, ridge: float = 1e-3) -> None:
+    def init_from_dataset(
+        self,
+        data: Dataset,
+        rng: np.random.Generator | None = None,
+        progress: bool = True,
+        ridge: float = 1e-3,
+    ) -> None:
         """Start at the per-vertex ridge fit of T - S_t on [w, 1, p_v, g_v] over the kept
         train frames: its w part (rank latent - 1, by SVD) in f_w's linear path and L_v's
         base, its constant and parameter parts in L_v's local map; every MLP's output and the
@@ -229,9 +244,9 @@ class SoftDecaHybrid(Trainable):
         from softdeca_train.train.local_fit import LocalRidge
 
         fit: LocalRidge | None = None
-        kept = data.left_out("static", "train")["kept"]  # type: ignore[attr-defined]
+        kept = data.left_out("static", "train")["kept"]
         bar = tqdm(total=kept, desc="vertex stage fit", unit="frame", disable=not progress)
-        for b in data.batches("static", "train"):  # type: ignore[attr-defined]
+        for b in data.batches("static", "train"):
             x = self.vertex_features(b.weights, b.vertex_parameters(self.n_vertices))
             fit = fit or LocalRidge(self.n_vertices, x.shape[-1], 3)
             fit.add(x, (b.T - b.S).transpose(0, 1) / CM)

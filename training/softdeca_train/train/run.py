@@ -4,7 +4,6 @@ resumes from its checkpoint, so `train-bundle` can be killed and rerun at any po
 
 from __future__ import annotations
 
-import itertools
 import json
 from dataclasses import asdict, dataclass, field, replace
 from functools import cached_property
@@ -113,12 +112,8 @@ class Run:
             raise ValueError(f"unknown model {name!r}; known: {', '.join(MODELS)}")
         model = self.build(name)
         fresh = not self.checkpoint(name).is_file()
-        if fresh and hasattr(model, "init_from_dataset"):  # closed-form start over all data
-            model.init_from_dataset(self.data, progress=progress)
-        elif fresh and type(model).init_from_data is not Trainable.init_from_data:
-            rng = np.random.default_rng(cfg.seed)
-            sample = list(itertools.islice(self.data.batches(model.kind, "train", rng), 48))
-            model.init_from_data(sample)
+        if fresh:
+            model.init_from_dataset(self.data, np.random.default_rng(cfg.seed), progress)
         summary = train(model, self.data, cfg, self.folder, name, progress)
         summary["config"] = asdict(cfg)
         (self.folder / f"{name}.summary.json").write_text(json.dumps(summary, indent=1) + "\n")
