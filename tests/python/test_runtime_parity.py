@@ -32,7 +32,9 @@ BOUND_MM = {"float": 1e-4, "half": 1e-3, "int8": 0.02}
 def setup(tmp_path_factory):
     head = synthetic_head()
     specs = load_parameter_specs(TEST_PARAMETERS)
-    nets = build_random(head.definition, specs, TEST_SIZES, seed=7)
+    # with SoftDECA's vertex stage (format version 2); the template-topology test below and
+    # the contract tests run bundles without one
+    nets = build_random(head.definition, specs, TEST_SIZES, seed=7, vertex_stage=True)
     folder = tmp_path_factory.mktemp("parity") / "bundle"
     export_bundle(folder, head.definition, nets, BundleInfo(True, "parity"))
     return head, nets, NativeModel(folder)
@@ -149,6 +151,45 @@ def test_sparse_static_dynamic_and_retargeted(setup, precision, localise):
     print(f"\nSparse {precision} localised={localise}: {worst} mm")
     for key, v in worst.items():
         assert v < BOUND_MM[precision], key
+
+
+def test_the_vertex_stage_counts(setup):
+    """The runtime adds SoftDECA's vertex stage: without it the reference lands far from the
+    native output, and a localised parameter moves the result through the stage's own table."""
+    head, nets, _ = setup
+    assert nets.softdeca is not None and nets.softdeca.f_ph_v is not None
+    ref, nat = pair(setup, "float")
+    without = ReferenceAvatar(
+        TorchNetworks(as_stored(replace_stage(nets, None))),
+        head.definition,
+        head.neutral,
+        head.head_triangles,
+        head.blendshapes,
+    )
+    without.prepare()
+    w = frames(1, 9)[0]
+    x, _ = nat.evaluate_weights(w)
+    assert err_mm(x, ref.evaluate_weights(w)[0]) < BOUND_MM["float"]
+    assert err_mm(x, without.evaluate_weights(w)[0]) > 0.1
+    # one vertex's own parameter: the stage's affine table moves that vertex
+    nv = head.definition.skin_vertices
+    values = np.full(nv, 1.0)
+    values[nv // 2] = 1.4
+    nat.set_parameter_vertices("target_volume", values)
+    ref.params.set_vertices("target_volume", values)
+    nat.prepare()
+    ref.prepare()
+    x2, _ = nat.evaluate_weights(w)
+    assert err_mm(x2, ref.evaluate_weights(w)[0]) < BOUND_MM["float"]
+    assert err_mm(x2[nv // 2], x[nv // 2]) > 1e-3
+
+
+def replace_stage(nets, stage):
+    import copy
+
+    out = copy.deepcopy(nets)
+    out.softdeca.f_ph_v = stage
+    return out
 
 
 def test_linear_blendshapes_are_exact(setup):

@@ -50,7 +50,9 @@ def _train_error(run: Run, model: torch.nn.Module) -> float:
     return float(np.mean(errs))
 
 
-@pytest.mark.parametrize("name", ["softdeca", "sparse", "mlp-equal-time", "face-mlp"])
+@pytest.mark.parametrize(
+    "name", ["softdeca", "softdeca-dt", "sparse", "mlp-equal-time", "face-mlp"]
+)
 def test_static_models_learn(run: Run, name: str) -> None:
     before = _train_error(run, run.build(name))
     run.train(name, LoopConfig(steps=40, lr=3e-3, lr_end=1e-3, seed=1), progress=False)
@@ -81,7 +83,7 @@ def test_hypernetwork_learning_rate_factor_reaches_the_optimiser(
 ) -> None:
     """LoopConfig.hyper_lr overrides the model's factor for its hypernetworks only: at 0,
     f_ph stays as initialised while f_w trains."""
-    model = run.build("softdeca")
+    model = run.build("softdeca-dt")
     before = {k: v.clone() for k, v in model.state_dict().items()}
     train(
         model,
@@ -95,6 +97,11 @@ def test_hypernetwork_learning_rate_factor_reaches_the_optimiser(
     moved = {k for k in before if not torch.equal(before[k], after[k])}
     assert moved and all(k.startswith("f_w.") for k in moved), sorted(moved)
     assert model.lr_scales() == {"f_ph.": model.hyper_lr}
+    # the model with a vertex stage: its fitted linear path in f_w moves at the same factor
+    hybrid = run.build("softdeca")
+    f = hybrid.hyper_lr
+    assert hybrid.lr_scales() == {"f_w.skip.": f, "f_ph.": f, "f_ph_v.": f}
+    assert hybrid.lr_scales(0.5)["f_w.skip."] == 0.5
 
 
 def test_a_step_can_average_several_groups(run: Run, tmp_path) -> None:

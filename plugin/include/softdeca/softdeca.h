@@ -117,8 +117,9 @@ SOFTDECA_API const char* softdeca_status_name(softdeca_status status);
 typedef struct softdeca_model softdeca_model;
 typedef struct softdeca_avatar softdeca_avatar;
 
-/* The bundle format version this library reads (manifest "format_version"). */
-#define SOFTDECA_BUNDLE_FORMAT_VERSION 1
+/* The newest bundle format version this library reads (manifest "format_version"); it reads
+ * every version from 1 up to it. Version 2 adds SoftDECA's optional vertex stage. */
+#define SOFTDECA_BUNDLE_FORMAT_VERSION 2
 
 typedef struct softdeca_model_options {
   uint32_t struct_size;            /* sizeof(softdeca_model_options) */

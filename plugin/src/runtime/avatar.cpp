@@ -33,8 +33,18 @@ bool all_finite(const float* v, std::size_t n) {
 }
 }  // namespace
 
+// A hypernetwork's L(p, h) for n elements of the given width, checked and stored.
+HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
+                                 const std::vector<float>& identity, std::size_t n, std::size_t width) const {
+  std::vector<float> l(n * static_cast<std::size_t>(m_.latent) * width);
+  net.run({parameters.data(), identity.data()}, {l.data()}, 1);
+  if (!all_finite(l.data(), l.size()))
+    throw Error(SOFTDECA_ERROR_FORMAT, net.spec().key + " produced non-finite values for these parameters");
+  return HyperTensor(l.data(), n, m_.latent, static_cast<int>(width), precision_);
+}
+
 std::size_t Preparation::bytes() const {
-  return face_l.bytes() + vertex_l.bytes() + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4;
+  return face_l.bytes() + vertex_l.bytes() + softdeca_vertex_l.bytes() + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4;
 }
 
 class Avatar::FrameGuard {
@@ -170,7 +180,6 @@ void Avatar::prepare() {
   prep->dt = dt_;
   prep->identity = identity;
   const auto n0 = Clock::now();
-  const std::size_t latent = static_cast<std::size_t>(m_.latent);
   for (const int model : {kSoftDeca, kSparse}) {
     const bool sparse = model == kSparse;
     if (!model_->has(sparse)) continue;
@@ -178,14 +187,15 @@ void Avatar::prepare() {
     const OnnxNetwork& hyper = *model_->hyper(sparse);
     const auto& cols = hyper.spec().parameter_columns;
     const std::size_t n = sparse ? vs_ : nf_, width = sparse ? 3 : 9;
-    std::vector<float> p(n * cols.size()), l(n * latent * width);
+    std::vector<float> p(n * cols.size());
     if (sparse) params->vertex_matrix(cols, p.data());
     else params->face_matrix(cols, p.data());
-    hyper.run({p.data(), identity.data()}, {l.data()}, 1);
-    if (!all_finite(l.data(), l.size()))
-      throw Error(SOFTDECA_ERROR_FORMAT, hyper.spec().key + " produced non-finite values for these parameters");
-    HyperTensor tensor(l.data(), n, m_.latent, static_cast<int>(width), precision_);
-    (sparse ? prep->vertex_l : prep->face_l) = std::move(tensor);
+    (sparse ? prep->vertex_l : prep->face_l) = hyper_tensor(hyper, p, identity, n, width);
+    if (const OnnxNetwork* stage = sparse ? nullptr : model_->softdeca_vertex_stage()) {
+      std::vector<float> pv(vs_ * stage->spec().parameter_columns.size());
+      params->vertex_matrix(stage->spec().parameter_columns, pv.data());
+      prep->softdeca_vertex_l = hyper_tensor(*stage, pv, identity, vs_, 3);
+    }
     // Dynamics coefficients per skin vertex.
     const OnnxNetwork& dyn = *model_->dynamics(sparse);
     const auto& dcols = dyn.spec().parameter_columns;
@@ -268,7 +278,17 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
     if (phase == 1) solve(0, worker_.parts());  // the serial top part: on this thread, no hand-off
     else worker_.run(solve);
   }
-  st.solve_ms = ms(t2, Clock::now());
+  auto t3 = Clock::now();
+  st.solve_ms = ms(t2, t3);
+  if (prep.softdeca_vertex_l.empty()) return;
+  // The vertex stage on top of DT's result, in place: static_ += z . L_v.
+  const std::size_t vblocks = prep.softdeca_vertex_l.blocks();
+  auto stage = [&](std::size_t part, std::size_t parts) {
+    vertex_offsets(prep.softdeca_vertex_l, z_.data(), static_.data(), vblocks * part / parts,
+                   vblocks * (part + 1) / parts, static_.data());
+  };
+  worker_.run(stage);
+  st.hyper_ms += ms(t3, Clock::now());
 }
 
 void Avatar::write_rigid_non_skin(const float* skin, float* head) const {

@@ -62,6 +62,7 @@ struct Preparation {
   std::shared_ptr<const DeformationTransfer> dt;
   std::vector<float> identity;
   HyperTensor face_l, vertex_l;       // SoftDECA: [F][latent][9]; sparse: [Vs][latent][3]
+  HyperTensor softdeca_vertex_l;      // SoftDECA's vertex stage, [Vs][latent][3] (empty: none)
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   std::size_t bytes() const;
 };
@@ -99,6 +100,8 @@ class Avatar {
  private:
   class FrameGuard;
   std::shared_ptr<const Preparation> current() const;
+  HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
+                           const std::vector<float>& identity, std::size_t n, std::size_t width) const;
   void check_output(const Output& out) const;
   void read_weights(const float* weights, std::size_t count);
   const float* select_landmarks(const float* points, std::size_t count, const char* what) const;

@@ -94,7 +94,7 @@ NetworkSpec expected_network(const Manifest& m, const std::string& key, int p) {
   } else if (key == "sparse.f_l") {
     n.inputs = {{"landmark_offsets", {-1, 3 * static_cast<std::int64_t>(m.landmarks.size())}}};
     n.outputs = {{"z", {-1, L}}};
-  } else if (key == "sparse.f_ph_v") {
+  } else if (key == "sparse.f_ph_v" || key == "softdeca.f_ph_v") {
     n.inputs = per_vertex;
     n.outputs = {{"L", {V, L, 3}}};
   } else if (key == "softdeca.f_dyn" || key == "sparse.f_dyn") {
@@ -117,9 +117,9 @@ void parse_header(const Json& doc, Manifest& m) {
                                  : std::string("?");
   check(format == kBundleFormat, "not a SoftDECA model bundle (format '" + format + "', expected '" + kBundleFormat + "')");
   m.format_version = static_cast<int>(doc.at("format_version", "manifest").integer("format_version"));
-  if (m.format_version != kBundleFormatVersion)
-    fail("bundle format version " + std::to_string(m.format_version) + " is not supported; this runtime reads version " +
-         std::to_string(kBundleFormatVersion));
+  if (m.format_version < kBundleFormatVersionMin || m.format_version > kBundleFormatVersion)
+    fail("bundle format version " + std::to_string(m.format_version) + " is not supported; this runtime reads versions " +
+         std::to_string(kBundleFormatVersionMin) + " to " + std::to_string(kBundleFormatVersion));
   m.untrained = doc.at("untrained", "manifest").boolean("untrained");
   if (doc.has("description") && doc.at("description", "manifest").is_string())
     m.description = doc.at("description", "manifest").string("description");
@@ -268,11 +268,15 @@ NetworkSpec parse_network(const Json& j, const char* key, const Manifest& m) {
 
 void parse_networks(const Json& doc, Manifest& m) {
   const Json& nets = doc.at("networks", "manifest");
-  for (const char* key : {"identity_encoder", "softdeca.f_w", "softdeca.f_ph", "softdeca.f_dyn", "sparse.f_l",
-                          "sparse.f_ph_v", "sparse.f_dyn"}) {
+  for (const char* key : {"identity_encoder", "softdeca.f_w", "softdeca.f_ph", "softdeca.f_dyn", "softdeca.f_ph_v",
+                          "sparse.f_l", "sparse.f_ph_v", "sparse.f_dyn"}) {
     if (nets.has(key)) m.networks[key] = parse_network(nets.at(key, "networks"), key, m);
   }
   check(m.networks.count("identity_encoder") > 0, "networks.identity_encoder is required");
+  // SoftDECA's optional vertex stage (X = DT(S_t, I + z.L) + z.L_v) belongs to its model.
+  m.has_softdeca_vertex_stage = m.networks.count("softdeca.f_ph_v") > 0;
+  check(!m.has_softdeca_vertex_stage || m.format_version >= 2,
+        "softdeca.f_ph_v (SoftDECA's vertex stage) needs bundle format version 2");
   const auto count = [&](std::initializer_list<const char*> keys) {
     int c = 0;
     for (const char* k : keys) c += static_cast<int>(m.networks.count(k));
@@ -284,6 +288,8 @@ void parse_networks(const Json& doc, Manifest& m) {
   check(sp == 0 || sp == 3, "the SparseSoftDECA model needs sparse.f_l, sparse.f_ph_v and sparse.f_dyn");
   m.has_softdeca = sd == 3;
   m.has_sparse = sp == 3;
+  check(!m.has_softdeca_vertex_stage || m.has_softdeca,
+        "softdeca.f_ph_v (SoftDECA's vertex stage) needs the SoftDECA model (softdeca.f_w, softdeca.f_ph, softdeca.f_dyn)");
   check(m.has_softdeca || m.has_sparse, "the bundle holds neither model");
 }
 }  // namespace

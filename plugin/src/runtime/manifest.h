@@ -11,7 +11,8 @@
 
 namespace softdeca::runtime {
 
-constexpr int kBundleFormatVersion = 1;
+// Versions this runtime reads: 1, and 2 (which adds SoftDECA's optional vertex stage).
+constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 2;
 constexpr const char* kBundleFormat = "softdeca-bundle";
 constexpr const char* kDtFormulation = "cotangent-poisson-1";
 // The 52 ARKit shapes in canonical order: names from the one definition, stream/arkit_names.h.
@@ -60,6 +61,7 @@ struct Manifest {
   double beta_max = 0, gamma_min = 0, gamma_max = 0;
   std::map<std::string, NetworkSpec> networks;
   bool has_softdeca = false, has_sparse = false;
+  bool has_softdeca_vertex_stage = false;  // softdeca.f_ph_v present (format version 2)
 
   const NetworkSpec& network(const std::string& key) const;
   int find_parameter(const std::string& name) const;  // -1 when absent

@@ -13,8 +13,9 @@ namespace softdeca::runtime {
 namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, message); }
 
-const char* const kNetworkKeys[] = {"identity_encoder", "softdeca.f_w", "softdeca.f_ph", "softdeca.f_dyn",
-                                    "sparse.f_l",       "sparse.f_ph_v", "sparse.f_dyn"};
+// The order of Model::networks_ (the accessors in model.h index it).
+const char* const kNetworkKeys[] = {"identity_encoder", "softdeca.f_w",  "softdeca.f_ph", "softdeca.f_dyn",
+                                    "sparse.f_l",       "sparse.f_ph_v", "sparse.f_dyn",  "softdeca.f_ph_v"};
 
 std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
 

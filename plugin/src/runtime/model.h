@@ -49,6 +49,8 @@ class Model {
   const OnnxNetwork* hyper(bool sparse) const { return networks_.at(sparse ? 5 : 2).get(); }
   const OnnxNetwork* dynamics(bool sparse) const { return networks_.at(sparse ? 6 : 3).get(); }
   bool has(bool sparse) const { return sparse ? manifest_.has_sparse : manifest_.has_softdeca; }
+  // SoftDECA's vertex stage L_v(p, h) (per skin vertex, like the sparse model's), or null.
+  const OnnxNetwork* softdeca_vertex_stage() const { return networks_.at(7).get(); }
 
  private:
   Model() = default;

@@ -29,16 +29,20 @@ from softdeca_train.models.reference import Model
 from softdeca_train.models.topology import LandmarkSet, TemplateDefinition
 
 FORMAT = "softdeca-bundle"
-FORMAT_VERSION = 1
+# Version 2 adds SoftDECA's optional vertex stage (softdeca.f_ph_v); a bundle without one is
+# written as version 1, so runtimes that read only version 1 still run it.
+FORMAT_VERSION = 2
+FORMAT_VERSIONS = (1, 2)
 OPSET = 17
 MANIFEST = "manifest.json"
 SKIN_TRIANGLES_FILE = "skin_triangles.i32"
 NON_SKIN_BONES_FILE = "non_skin_bones.u8"
 # The per-element tables (one row per face or vertex: HyperNetwork.base, the positional
-# encodings) are stored as float16 and cast back to float32 inside the graph. They are most of a
-# bundle (SoftDECA's base table alone is 28,068 x 32 x 9), and the runtime keeps the per-avatar
-# tensors in half precision anyway (docs/bundle.md). Encoders and MLP weights stay float32.
-HALF_TABLES = ("base", "positional")
+# encodings, LocalLinear.table) are stored as float16 and cast back to float32 inside the
+# graph. They are most of a bundle (SoftDECA's base table alone is 28,068 x 32 x 9), and the
+# runtime keeps the per-avatar tensors in half precision anyway (docs/bundle.md). Encoders
+# and MLP weights stay float32.
+HALF_TABLES = ("base", "positional", "table")
 
 
 def _is_half_table(name: str) -> bool:
@@ -88,6 +92,12 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
             "parameter_columns": cols,
         }
         specs["softdeca.f_dyn"] = dict(dynamics)
+        if nets.softdeca.f_ph_v is not None:
+            specs["softdeca.f_ph_v"] = {
+                "inputs": per_vertex,
+                "outputs": [_tensor("L", [v, lat, 3])],
+                "parameter_columns": cols,
+            }
     if nets.sparse is not None:
         specs["sparse.f_l"] = {
             "inputs": [_tensor("landmark_offsets", ["batch", 3 * k])],
@@ -107,7 +117,7 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
 def _modules(nets: BundleNetworks) -> dict[str, nn.Module]:
     out: dict[str, nn.Module] = {"identity_encoder": nets.identity_encoder}
     if nets.softdeca is not None:
-        out |= {f"softdeca.{k}": m for k, m in vars(nets.softdeca).items()}
+        out |= {f"softdeca.{k}": m for k, m in vars(nets.softdeca).items() if m is not None}
     if nets.sparse is not None:
         out |= {f"sparse.{k}": m for k, m in vars(nets.sparse).items()}
     return out
@@ -237,7 +247,7 @@ def export_bundle(
     lm = definition.landmarks
     manifest: dict[str, Any] = {
         "format": FORMAT,
-        "format_version": FORMAT_VERSION,
+        "format_version": 2 if "softdeca.f_ph_v" in specs else 1,
         "untrained": info.untrained,
         "description": info.description,
         "units": "metre",
@@ -337,9 +347,10 @@ def pack_bundle(folder: str | Path) -> bytes:
 
 def read_manifest(folder: str | Path) -> dict[str, Any]:
     m = json.loads((Path(folder) / MANIFEST).read_text())
-    if m.get("format") != FORMAT or m.get("format_version") != FORMAT_VERSION:
+    if m.get("format") != FORMAT or m.get("format_version") not in FORMAT_VERSIONS:
         raise ValueError(
-            f"{folder}: not a {FORMAT} version {FORMAT_VERSION} bundle "
+            f"{folder}: not a {FORMAT} bundle of version "
+            f"{' or '.join(map(str, FORMAT_VERSIONS))} "
             f"({m.get('format')!r} version {m.get('format_version')!r})"
         )
     return m
@@ -417,6 +428,12 @@ class OnnxNetworks:
     def f_ph_v(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray:
         p = self._columns("sparse.f_ph_v", parameters)
         return self._run("sparse.f_ph_v", parameters=p, identity=identity[None])[0]
+
+    def vertex_stage(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray | None:
+        if "softdeca.f_ph_v" not in self.sessions:
+            return None
+        p = self._columns("softdeca.f_ph_v", parameters)
+        return self._run("softdeca.f_ph_v", parameters=p, identity=identity[None])[0]
 
     def f_dyn(
         self, model: Model, parameters: np.ndarray, identity: np.ndarray

@@ -191,7 +191,8 @@ class LocalLinear(nn.Module):
             load = torch.zeros_like(parameters[:, :3])
         else:
             s, tilt, azimuth = (parameters[:, i] for i in self.gravity)
-            t, a = torch.deg2rad(tilt), torch.deg2rad(azimuth)
+            # degrees by a constant factor: ONNX opset 17 has no deg2rad
+            t, a = tilt * (np.pi / 180.0), azimuth * (np.pi / 180.0)
             d = torch.stack(
                 [torch.sin(t) * torch.cos(a), -torch.cos(t), torch.sin(t) * torch.sin(a)], 1
             )
@@ -303,6 +304,8 @@ class SoftDecaNetworks:
     f_w: WeightEncoder
     f_ph: HyperNetwork
     f_dyn: DynamicsNetwork
+    # the optional vertex stage: X = DT(S_t, I + z . L) + z . L_v (bundle format version 2)
+    f_ph_v: HyperNetwork | None = None
 
 
 @dataclass
@@ -326,7 +329,7 @@ class BundleNetworks:
         out: list[nn.Module] = [self.identity_encoder]
         for m in (self.softdeca, self.sparse):
             if m is not None:
-                out += list(vars(m).values())
+                out += [n for n in vars(m).values() if n is not None]
         return out
 
     def eval(self) -> BundleNetworks:
@@ -344,10 +347,12 @@ def build_random(
     sparse: bool = True,
     dg_scale: float = 0.02,
     offset_scale: float = 1e-3,
+    vertex_stage: bool = False,
 ) -> BundleNetworks:
     """Random-weight networks (untrained). `dg_scale` sets the size of the deformation-gradient
     corrections (G - I) and `offset_scale` that of the vertex offsets (metres), so that an
-    untrained bundle stays close to its input instead of producing noise."""
+    untrained bundle stays close to its input instead of producing noise. `vertex_stage` adds
+    SoftDECA's vertex stage (with its per-vertex affine table, random too)."""
     torch.manual_seed(seed)
     specs = tuple(specs)
     nf, nv = definition.n_faces, definition.skin_vertices
@@ -357,6 +362,9 @@ def build_random(
             f_w=WeightEncoder(len(definition.blendshapes), sizes),
             f_ph=HyperNetwork(nf, specs, sizes, 9, dg_scale),
             f_dyn=DynamicsNetwork(nv, specs, sizes),
+            f_ph_v=HyperNetwork(nv, specs, sizes, 3, offset_scale, local_linear=True)
+            if vertex_stage
+            else None,
         )
     if sparse:
         sp = SparseNetworks(
@@ -364,5 +372,8 @@ def build_random(
             f_ph_v=HyperNetwork(nv, specs, sizes, 3, offset_scale),
             f_dyn=DynamicsNetwork(nv, specs, sizes, gamma0=0.6, beta0=0.25),
         )
+    if sd is not None and sd.f_ph_v is not None and sd.f_ph_v.local is not None:
+        with torch.no_grad():  # the affine table starts at zero in training; random here
+            sd.f_ph_v.local.table.normal_(0.0, offset_scale)
     enc = IdentityEncoder(nv, sizes, seed)
     return BundleNetworks(sizes, specs, enc, sd, sp).eval()

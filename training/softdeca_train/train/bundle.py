@@ -1,5 +1,6 @@
 """`train-bundle`: every network a bundle holds, trained stage by stage in one run folder
-(identity encoder, SoftDECA, its dynamics, SparseSoftDECA, its dynamics), measured on the
+(identity encoder, SoftDECA with its vertex stage, its dynamics, SparseSoftDECA, its
+dynamics), measured on the
 dataset's test split, and exported as a model bundle (docs/bundle.md) whose manifest records
 the data, the command, the budgets and the measured errors. Killed at any point, the same
 command resumes: finished stages are kept, the running one continues from its checkpoint."""
@@ -18,7 +19,7 @@ from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, Spa
 from softdeca_train.train.evaluate import test_errors
 from softdeca_train.train.identity import IdentityConfig
 from softdeca_train.train.loop import LoopConfig
-from softdeca_train.train.models import Dynamics, SoftDeca, SparseSoftDeca
+from softdeca_train.train.models import Dynamics, SoftDecaHybrid, SparseSoftDeca
 from softdeca_train.train.registry import BUNDLE_STAGES
 from softdeca_train.train.run import Run
 
@@ -79,13 +80,13 @@ def train_bundle(
     errors["identity_encoder"] = identity_info["errors"]
     sd, sd_dyn = models["softdeca"], models["softdeca-dynamics"]
     sp, sp_dyn = models["sparse"], models["sparse-dynamics"]
-    assert isinstance(sd, SoftDeca) and isinstance(sp, SparseSoftDeca)
+    assert isinstance(sd, SoftDecaHybrid) and isinstance(sp, SparseSoftDeca)
     assert isinstance(sd_dyn, Dynamics) and isinstance(sp_dyn, Dynamics)
     nets = BundleNetworks(
         sizes=run.sizes,
         specs=run.specs,
         identity_encoder=enc,
-        softdeca=SoftDecaNetworks(sd.f_w, sd.f_ph, sd_dyn.f_dyn),
+        softdeca=SoftDecaNetworks(sd.f_w, sd.f_ph, sd_dyn.f_dyn, sd.f_ph_v),
         sparse=SparseNetworks(sp.f_l, sp.f_ph_v, sp_dyn.f_dyn),
     ).eval()
     manifest = run.data.manifest

@@ -132,7 +132,7 @@ def test_errors(
             jobs += [(f"{name}_{w}", m, w) for w in SPARSE_INPUTS]
         elif isinstance(m, (Dynamics, LatentDynamics)):
             jobs.append((name, m, None))
-            if isinstance(m.static, SoftDeca):  # the static model on the same sequences
+            if isinstance(m.static, (SoftDeca, SoftDecaHybrid)):  # the static model alone
                 jobs.append((f"{name}_without", _AsDynamic(m.static), None))
         else:
             jobs.append((f"{name}_static", m, None))

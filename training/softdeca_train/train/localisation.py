@@ -1,7 +1,8 @@
 """The localisation figure of the evaluation (paper eq. 20): one parameter changed inside a
-ball on the face, applied at inference to SoftDECA (a per-face parameter map into f_ph) and
-to the physics (the same value on the soft-tissue tets whose centroid lies in the ball), on a
-test identity and expression; both shown as the displacement the change causes."""
+ball on the face, applied at inference to SoftDECA (per-face and per-vertex parameter maps
+into its hypernetworks) and to the physics (the same value on the soft-tissue tets whose
+centroid lies in the ball), on a test identity and expression; both shown as the
+displacement the change causes."""
 
 from __future__ import annotations
 
@@ -11,11 +12,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.render import MeshLayer, RenderSettings, render, tile
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.batches import Batch
-from softdeca_train.train.models import SoftDeca
+from softdeca_train.train.models import Trainable
 from softdeca_train.train.run import Run
 
 
@@ -42,11 +42,19 @@ def _inside(points: np.ndarray, change: LocalChange) -> np.ndarray:
 
 
 @torch.no_grad()
-def _softdeca(model: SoftDeca, batch: Batch, p_faces: torch.Tensor) -> torch.Tensor:
-    hyper = model.f_ph(p_faces, batch.h)
-    z = model.f_w(batch.weights[:1])
-    dg = torch.einsum("bk,fkn->bfn", z, hyper).reshape(1, model.n_faces, 3, 3)
-    return deformation_transfer(batch.dt, batch.S[:1], dg)[0]
+def _first_frame(
+    model: Trainable, batch: Batch, p_faces: torch.Tensor, p_vertices: torch.Tensor
+) -> torch.Tensor:
+    """The model's output for the batch's first frame under a per-element parameter map."""
+    one = replace(
+        batch,
+        weights=batch.weights[:1],
+        S=batch.S[:1],
+        T=batch.T[:1],
+        p_faces=p_faces,
+        p_vertices=p_vertices,
+    )
+    return model.predict(one)[0]
 
 
 def _physics(run: Run, batch: Batch, change: LocalChange | None) -> np.ndarray:
@@ -79,7 +87,7 @@ def _physics(run: Run, batch: Batch, change: LocalChange | None) -> np.ndarray:
 
 
 def localisation_figure(
-    run: Run, model: SoftDeca, path: Path, change: LocalChange | None = None
+    run: Run, model: Trainable, path: Path, change: LocalChange | None = None
 ) -> dict:
     """Render the figure; returns what it measured (mm)."""
     change = change or LocalChange()
@@ -92,10 +100,13 @@ def localisation_figure(
     neutral = batch.neutral.double().numpy()
     tris = run.template.skin_triangles
     inside = _inside(neutral[tris].mean(axis=1), change)
-    p_faces = batch.p.expand(model.n_faces, -1).clone()
-    x0 = _softdeca(model, batch, p_faces).numpy()
+    inside_v = _inside(neutral, change)
+    p_faces = batch.p.expand(len(tris), -1).clone()
+    p_vertices = batch.p.expand(len(neutral), -1).clone()
+    x0 = _first_frame(model, batch, p_faces, p_vertices).numpy()
     p_faces[torch.from_numpy(inside), k] = change.value
-    x1 = _softdeca(model, batch, p_faces).numpy()
+    p_vertices[torch.from_numpy(inside_v), k] = change.value
+    x1 = _first_frame(model, batch, p_faces, p_vertices).numpy()
     t0, t1 = _physics(run, batch, None), _physics(run, batch, change)
     d_model = 1e3 * np.linalg.norm(x1 - x0, axis=1)
     d_phys = 1e3 * np.linalg.norm(t1 - t0, axis=1)

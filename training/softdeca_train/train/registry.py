@@ -51,13 +51,14 @@ MODELS: dict[str, Entry] = {
     for e in (
         Entry(
             "softdeca",
-            "SoftDECA: deformation gradients + DT",
-            lambda d, s, z, b: m.SoftDeca(d, s, z),
+            "SoftDECA: deformation gradients + DT, plus a vertex stage started at the "
+            "per-vertex ridge fit (the bundle's model)",
+            lambda d, s, z, b: m.SoftDecaHybrid(d, s, z),
         ),
         Entry(
-            "softdeca-hybrid",
-            "SoftDECA + a vertex stage started at the per-vertex ridge fit",
-            lambda d, s, z, b: m.SoftDecaHybrid(d, s, z),
+            "softdeca-dt",
+            "SoftDECA as the paper has it: deformation gradients + DT only",
+            lambda d, s, z, b: m.SoftDeca(d, s, z),
         ),
         Entry(
             "softdeca-dynamics",
