@@ -97,11 +97,6 @@ def test_hypernetwork_learning_rate_factor_reaches_the_optimiser(
     moved = {k for k in before if not torch.equal(before[k], after[k])}
     assert moved and all(k.startswith("f_w.") for k in moved), sorted(moved)
     assert model.lr_scales() == {"f_ph.": model.hyper_lr}
-    # the model with a vertex stage: its fitted linear path in f_w moves at the same factor
-    hybrid = run.build("softdeca")
-    f = hybrid.hyper_lr
-    assert hybrid.lr_scales() == {"f_w.skip.": f, "f_ph.": f, "f_ph_v.": f}
-    assert hybrid.lr_scales(0.5)["f_w.skip."] == 0.5
 
 
 def test_a_step_can_average_several_groups(run: Run, tmp_path) -> None:
