@@ -6,6 +6,7 @@ end to end and its ONNX files agree with torch; the committed bundle loads in on
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -97,6 +98,15 @@ def test_hypernetwork_learning_rate_factor_reaches_the_optimiser(
     moved = {k for k in before if not torch.equal(before[k], after[k])}
     assert moved and all(k.startswith("f_w.") for k in moved), sorted(moved)
     assert model.lr_scales() == {"f_ph.": model.hyper_lr}
+
+
+def test_a_checkpoint_of_another_architecture_is_refused_clearly(run: Run) -> None:
+    if not run.finished("softdeca-dt"):
+        run.train("softdeca-dt", LoopConfig(steps=2, seed=1), progress=False)
+    other = Run(run.folder.parent / "other-arch", run.config)
+    shutil.copy(run.checkpoint("softdeca-dt"), other.checkpoint("softdeca"))
+    with pytest.raises(ValueError, match="another version"):
+        other.load("softdeca")
 
 
 def test_a_step_can_average_several_groups(run: Run, tmp_path) -> None:

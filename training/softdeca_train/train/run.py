@@ -104,7 +104,14 @@ class Run:
         if not path.is_file():
             raise FileNotFoundError(f"{name} is not trained in {self.folder} (no {path.name})")
         model = self.build(name)
-        model.load_state_dict(torch.load(path, weights_only=False)["model"])
+        try:
+            model.load_state_dict(torch.load(path, weights_only=False)["model"])
+        except RuntimeError as e:  # a checkpoint of another architecture under this name
+            raise ValueError(
+                f"{path} does not hold the current {name} model ({MODELS[name].description}); "
+                f"it was trained with another version of it: train {name} again in a new "
+                f"run folder. ({str(e).splitlines()[0]})"
+            ) from e
         return model.eval()
 
     def train(self, name: str, cfg: LoopConfig, progress: bool = True) -> dict:
