@@ -263,9 +263,12 @@ class SoftDecaHybrid(Trainable):
         # their second moment, the truncation of A R loses least of E |A w|^2; a plain SVD of A
         # keeps modes of shapes that are rarely used (start 0.211 mm against the full fit's
         # 0.200 on softdeca-l3-c3's test split at latent 32).
-        chol = torch.linalg.cholesky(
-            moment / fit.frames + 1e-6 * torch.eye(nw, dtype=torch.float64)
-        )
+        # The moment is regularised relative to its own scale: weights the data (nearly) never
+        # moves would otherwise get R^-1 in the thousands, and with them codes z in the
+        # thousands for inputs that do move them (float32 then rounds f_w's output at 1e-4).
+        moment = moment / fit.frames
+        ridge_w = 1e-2 * float(torch.trace(moment)) / nw + 1e-12
+        chol = torch.linalg.cholesky(moment + ridge_w * torch.eye(nw, dtype=torch.float64))
         u, sv, vt = torch.linalg.svd(a @ chol, full_matrices=False)
         vt = torch.linalg.solve_triangular(chol.T, vt.T, upper=True).T  # rows: (V^T R^-1)
         r = min(self.f_ph_v.latent - 1, len(sv))
