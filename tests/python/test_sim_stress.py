@@ -62,6 +62,15 @@ def test_bounds_name_each_failure() -> None:
     assert _check(**rolled, opening_physics_mm=15.3).failures() == ["mouth_open_ratio"]
     assert _check(**rolled, opening_physics_mm=9.0).failures() == []
     assert _check(**rolled, opening_physics_mm=8.9).failures() == ["mouth_open_ratio"]
+    # The bench's ratio is the judged one: the explained part off, the rest counted.
+    assert _check(**rolled, opening_physics_mm=13.5).judged_open_ratio == 1.0
+    assert _check(**rolled, opening_physics_mm=15.3).judged_open_ratio == pytest.approx(
+        (12.1 + 1.3) / 12.1
+    )
+    assert _check(**rolled, opening_physics_mm=9.0).judged_open_ratio == pytest.approx(
+        (12.1 - 1.2) / 12.1
+    )
+    assert _check(opening_physics_mm=10.5).judged_open_ratio == pytest.approx(1.05)
     # A closed linear mouth has no ratio to keep.
     closed = _check(opening_linear_mm=BOUNDS.open_mm, opening_physics_mm=0.1)
     assert math.isnan(closed.open_ratio) and closed.failures() == []
@@ -93,6 +102,10 @@ def test_bounds_name_each_failure() -> None:
         and fig["stress_exploded_frames"] == 0
     )
     assert fig["mouth_open_ratio_min"] == fig["mouth_open_ratio_max"] == 1.0
+    # A rolled lip out of the teeth: 1.16 plain, 1.0 as judged; both are reported.
+    fig = bench_figures([_check(**rolled, opening_physics_mm=14.0)])
+    assert fig["mouth_open_ratio_max"] == 1.0
+    assert fig["mouth_open_raw_ratio_max"] == pytest.approx(14.0 / 12.1)
 
 
 def test_expression_library() -> None:

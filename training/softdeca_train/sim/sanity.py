@@ -85,6 +85,18 @@ class FrameCheck:
             return math.nan
         return self.opening_physics_mm / self.opening_linear_mm
 
+    @property
+    def judged_open_ratio(self) -> float:
+        """The ratio the mouth-opening bound judges: the physics' opening with the part a contact
+        correction explains taken off (at most the linear blend's deepest lip penetration, as
+        in `failures`). A lip the linear blend sinks into the teeth must come out of them,
+        which changes the opening by up to that depth; only the change beyond it counts."""
+        if math.isnan(self.open_ratio):
+            return math.nan
+        excess = self.opening_physics_mm - self.opening_linear_mm
+        beyond = math.copysign(max(abs(excess) - self.explained_mm, 0.0), excess)
+        return (self.opening_linear_mm + beyond) / self.opening_linear_mm
+
     def failures(self, bounds: SanityBounds = BOUNDS) -> list[str]:
         out = []
         if self.max_displacement_mm > bounds.exploded_mm + self.explained_mm:
@@ -92,8 +104,8 @@ class FrameCheck:
         if self.penetrating_physics > self.penetrating_linear:
             out.append("penetration")
         if not math.isnan(self.open_ratio):
-            lo, hi = (k * self.opening_linear_mm for k in bounds.open_ratio)
-            if not lo - self.explained_mm <= self.opening_physics_mm <= hi + self.explained_mm:
+            lo, hi = bounds.open_ratio
+            if not lo <= self.judged_open_ratio <= hi:
                 out.append("mouth_open_ratio")
         if self.inverted_elements > 0:
             out.append("inverted_elements")
@@ -107,7 +119,11 @@ class FrameCheck:
         return out
 
     def as_dict(self) -> dict[str, object]:
-        return asdict(self) | {"open_ratio": self.open_ratio, "failures": self.failures()}
+        return asdict(self) | {
+            "open_ratio": self.open_ratio,
+            "judged_open_ratio": self.judged_open_ratio,
+            "failures": self.failures(),
+        }
 
 
 def _penetrations(hs: HeadSimulation, skin: np.ndarray, vertices: np.ndarray) -> dict[int, float]:
@@ -175,8 +191,10 @@ def failure_counts(checks: list[FrameCheck]) -> dict[str, int]:
 
 
 def bench_figures(checks: list[FrameCheck]) -> dict[str, float | int]:
-    """The stress figures of `make bench` over a set of frames."""
-    ratios = [c.open_ratio for c in checks if not math.isnan(c.open_ratio)]
+    """The stress figures of `make bench` over a set of frames: the opening ratio as the bound
+    judges it (judged_open_ratio) and, beside it, the plain physics / linear ratio."""
+    ratios = [c.judged_open_ratio for c in checks if not math.isnan(c.open_ratio)]
+    raw = [c.open_ratio for c in checks if not math.isnan(c.open_ratio)]
     return {
         "stress_frames": len(checks),
         "stress_exploded_frames": sum("exploded" in c.failures() for c in checks),
@@ -184,6 +202,8 @@ def bench_figures(checks: list[FrameCheck]) -> dict[str, float | int]:
         "mouth_open_frames": len(ratios),
         "mouth_open_ratio_min": min(ratios, default=math.nan),
         "mouth_open_ratio_max": max(ratios, default=math.nan),
+        "mouth_open_raw_ratio_min": min(raw, default=math.nan),
+        "mouth_open_raw_ratio_max": max(raw, default=math.nan),
         "stress_failed_frames": sum(bool(c.failures()) for c in checks),
         "max_displacement_mm": max((c.max_displacement_mm for c in checks), default=0.0),
     }

@@ -120,6 +120,12 @@ def run_stress_cli(args: argparse.Namespace) -> int:
                 s["mouth_open_ratio_min"], "ratio", how, 0.9, "higher"
             ),
             "physics.mouth_open_ratio_max": figure(s["mouth_open_ratio_max"], "ratio", how, 1.1),
+            "physics.mouth_open_raw_ratio_min": figure(
+                s["mouth_open_raw_ratio_min"], "ratio", how + " (plain physics / linear)"
+            ),
+            "physics.mouth_open_raw_ratio_max": figure(
+                s["mouth_open_raw_ratio_max"], "ratio", how + " (plain physics / linear)"
+            ),
             "physics.stress_failed_frames": figure(s["stress_failed_frames"], "frames", how, 0),
         }
         report_area(Path(args.bench_out), "physics_stress", figures)
