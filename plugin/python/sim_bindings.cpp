@@ -45,7 +45,6 @@ nb::dict stats_dict(const SolveStats& s) {
   d["inverted_elements"] = s.inverted_elements;
   d["inversion_rounds"] = s.inversion_rounds;
   d["stiffened_elements"] = s.stiffened_elements;
-  d["released_targets"] = s.released_targets;
   d["local_seconds"] = s.local_seconds;
   d["global_seconds"] = s.global_seconds;
   d["factor_seconds"] = s.factor_seconds;

@@ -154,13 +154,7 @@ void set_target_dynamics(Model& m, const SimulationMesh& mesh, const ParameterSe
 }
 
 // Targets: weight w * area / layer thickness (eq. 14 and 22), divided by gamma when dynamic.
-// `k`: a multiplier per target (empty: 1).
-double target_factor(const Eigen::VectorXd* k, Eigen::Index i) {
-  return k && k->size() > i ? (*k)[i] : 1.0;
-}
-
-void add_target_groups(Model& m, const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, double pa,
-                       const TetStiffening* stiffening) {
+void add_target_groups(Model& m, const SimulationMesh& mesh, const ParameterSet& p, TargetMode mode, double pa) {
   const PhysicalConstants& k = physical_constants();
   const Eigen::Index ns = mesh.skin_count(), nl = mesh.landmark_count();
   const bool dynamic = mode == TargetMode::kDynamic;
@@ -170,8 +164,7 @@ void add_target_groups(Model& m, const SimulationMesh& mesh, const ParameterSet&
     for (Eigen::Index i = 0; i < ns; ++i) {
       auto& e = el[static_cast<std::size_t>(i)];
       e.point = point_row(mesh.skin, i);
-      e.weight = pa * p.at(skin_weight, i) * m.skin_area[i] / k.target_layer_thickness_m *
-                 target_factor(stiffening ? &stiffening->skin_target : nullptr, i);
+      e.weight = pa * p.at(skin_weight, i) * m.skin_area[i] / k.target_layer_thickness_m;
       if (dynamic) e.weight /= m.skin_gamma[i];
     }
     m.skin_row = m.rows;
@@ -186,8 +179,7 @@ void add_target_groups(Model& m, const SimulationMesh& mesh, const ParameterSet&
       const SparseRow r = landmark_row(mesh, l);
       auto& e = el[static_cast<std::size_t>(l)];
       e.point = PointRow{r.vertex, r.weight};
-      e.weight = pa * p.at(Param::w_landmark, l) * area / k.target_layer_thickness_m *
-                 target_factor(stiffening ? &stiffening->landmark : nullptr, l);
+      e.weight = pa * p.at(Param::w_landmark, l) * area / k.target_layer_thickness_m;
       if (dynamic) e.weight /= m.landmark_gamma[l];
       m.landmark_rows.push_back(e.point);
     }
@@ -223,7 +215,7 @@ Model build_model(const SimulationMesh& mesh, const ParameterSet& p, TargetMode 
   add_skull_shell(m, mesh, p, pa);
   m.skin_area = skin_point_areas(mesh);
   set_target_dynamics(m, mesh, p);
-  add_target_groups(m, mesh, p, mode, pa, stiffening);
+  add_target_groups(m, mesh, p, mode, pa);
   m.mass = lumped_masses(mesh);
   return m;
 }

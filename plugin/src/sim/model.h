@@ -36,12 +36,9 @@ struct Model {
 };
 
 // Per-tet multipliers of the volume and strain weights (soft tissue, muscle; empty: 1), beyond
-// the parameters' own ranges: the solver's stiffening of elements a solve left inverted. With
-// them, multipliers of the targets' weights per skin point and per landmark (empty: 1): a
-// target that holds a tet inverted (a linear blend that folds the skin) is released.
+// the parameters' own ranges: the solver's stiffening of elements a solve left inverted.
 struct TetStiffening {
   Eigen::VectorXd soft, muscle;
-  Eigen::VectorXd skin_target, landmark;
 };
 
 Model build_model(const SimulationMesh& mesh, const ParameterSet& params, TargetMode mode, StrainLimit strain,

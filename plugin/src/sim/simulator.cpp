@@ -36,42 +36,16 @@ int inverted_tets(const TetIndices& tets, const Positions& x) {
   return n;
 }
 
-// Multiplies the stiffening of every inverted tet by `factor` and marks its vertices in
-// `touched`; returns how many there were.
-int stiffen(const TetIndices& tets, const Positions& x, double factor, Eigen::VectorXd& k, std::vector<char>& touched) {
+// Multiplies the stiffening of every inverted tet by `factor`; returns how many there were.
+int stiffen(const TetIndices& tets, const Positions& x, double factor, Eigen::VectorXd& k) {
   if (k.size() != tets.rows()) k = Eigen::VectorXd::Ones(tets.rows());
   int n = 0;
   for (Eigen::Index t = 0; t < tets.rows(); ++t)
     if (is_inverted(tets, t, x)) {
       k[t] *= factor;
-      for (int j = 0; j < 4; ++j) touched[static_cast<std::size_t>(tets(t, j))] = 1;
       ++n;
     }
   return n;
-}
-
-// Divides the weight multiplier of every skin target embedded on a `touched` vertex, and of
-// every landmark on such a skin point, by `factor`: a linear blend that folds the skin asks for
-// inverted tissue, and stiffening alone cannot win against the target that pulls it there.
-void release_targets(const SimulationMesh& mesh, const std::vector<char>& touched, double factor, TetStiffening& k) {
-  const Eigen::Index ns = mesh.skin_count(), nl = mesh.landmark_count();
-  if (k.skin_target.size() != ns) k.skin_target = Eigen::VectorXd::Ones(ns);
-  if (k.landmark.size() != nl) k.landmark = Eigen::VectorXd::Ones(nl);
-  std::vector<char> released(static_cast<std::size_t>(ns), 0);
-  for (Eigen::Index i = 0; i < ns; ++i) {
-    bool on = false;
-    for (int j = 0; j < 4; ++j)
-      on = on || (mesh.skin.weight(i, j) != 0 && touched[static_cast<std::size_t>(mesh.skin.vertex(i, j))]);
-    if (!on) continue;
-    k.skin_target[i] /= factor;
-    released[static_cast<std::size_t>(i)] = 1;
-  }
-  for (Eigen::Index l = 0; l < nl; ++l)
-    for (int j = 0; j < 3; ++j)
-      if (mesh.landmark_weights(l, j) != 0 && released[static_cast<std::size_t>(mesh.landmark_points(l, j))]) {
-        k.landmark[l] /= factor;
-        break;
-      }
 }
 
 // The skin target term's element weights (W / 2) per skin point, from the model's group.
@@ -201,12 +175,9 @@ void Simulator::stiffen_inverted(const Prepared& prep, const Positions& P0, Posi
                                  SolveStats& stats) const {
   TetStiffening k;
   for (int round = 0; round < settings_.inversion_rounds; ++round) {
-    std::vector<char> touched(static_cast<std::size_t>(x.rows()), 0);
-    const int n = stiffen(mesh_.soft_tets, x, settings_.inversion_stiffening, k.soft, touched) +
-                  stiffen(mesh_.muscle_tets, x, settings_.inversion_stiffening, k.muscle, touched);
+    const int n = stiffen(mesh_.soft_tets, x, settings_.inversion_stiffening, k.soft) +
+                  stiffen(mesh_.muscle_tets, x, settings_.inversion_stiffening, k.muscle);
     if (n == 0) return;
-    release_targets(mesh_, touched, settings_.inversion_stiffening, k);
-    stats.released_targets = static_cast<int>((k.skin_target.array() < 1.0).count());
     const auto t0 = Clock::now();
     const Model model = build_model(mesh_, params_, prep.mode, settings_.strain_limit, &k);
     const System system(model);

@@ -39,11 +39,9 @@ struct SolverSettings {
   // at zero volume, so where skin targets pull harder than a small tet's volume term resists
   // (its weight scales with its volume, the targets' with their area) a tet can stay flipped.
   // Real tissue stiffens without bound as it is crushed; the solver approximates that by
-  // multiplying the inverted tets' volume and strain weights by `inversion_stiffening`,
-  // dividing the weights of the targets embedded on their vertices by it (a linear blend that
-  // folds the skin asks for inverted tissue) and continuing from the result, at most
-  // `inversion_rounds` times (0: off). Counted in SolveStats::inversion_rounds; tets still
-  // inverted after the last round are reported.
+  // multiplying the inverted tets' volume and strain weights by `inversion_stiffening` and
+  // continuing from the result, at most `inversion_rounds` times (0: off). Counted in
+  // SolveStats::inversion_rounds; tets still inverted after the last round are reported.
   int inversion_rounds = 4;
   double inversion_stiffening = 10.0;
 };
@@ -68,7 +66,6 @@ struct SolveStats {
   int inverted_elements = 0;       // soft and muscle tets with volume <= 0 at the end of the solve
   int inversion_rounds = 0;        // re-solves with inverted tets stiffened (SolverSettings)
   int stiffened_elements = 0;      // tets stiffened over those rounds
-  int released_targets = 0;        // skin targets released in those rounds (on an inverted tet)
   double local_seconds = 0, global_seconds = 0, factor_seconds = 0, total_seconds = 0;
   // Collisions: penetrating points before and after resolution, contacts used, rounds.
   int penetrating_before = 0, penetrating_after = 0, contacts = 0, collision_rounds = 0;
