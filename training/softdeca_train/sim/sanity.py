@@ -193,8 +193,8 @@ def failure_counts(checks: list[FrameCheck]) -> dict[str, int]:
 def bench_figures(checks: list[FrameCheck]) -> dict[str, float | int]:
     """The stress figures of `make bench` over a set of frames: the opening ratio as the bound
     judges it (judged_open_ratio) and, beside it, the plain physics / linear ratio."""
-    ratios = [c.judged_open_ratio for c in checks if not math.isnan(c.open_ratio)]
-    raw = [c.open_ratio for c in checks if not math.isnan(c.open_ratio)]
+    open_ = [c for c in checks if not math.isnan(c.open_ratio)]
+    ratios, raw = [c.judged_open_ratio for c in open_], [c.open_ratio for c in open_]
     return {
         "stress_frames": len(checks),
         "stress_exploded_frames": sum("exploded" in c.failures() for c in checks),

@@ -265,7 +265,8 @@ class SoftDecaHybrid(Trainable):
         # 0.200 on softdeca-l3-c3's test split at latent 32).
         # The moment is regularised relative to its own scale: weights the data (nearly) never
         # moves would otherwise get R^-1 in the thousands, and with them codes z in the
-        # thousands for inputs that do move them (float32 then rounds f_w's output at 1e-4).
+        # thousands for inputs that do move them (f_w's ONNX export then differed from torch by
+        # 2.4e-4: float32 rounding at that scale).
         moment = moment / fit.frames
         ridge_w = 1e-2 * float(torch.trace(moment)) / nw + 1e-12
         chol = torch.linalg.cholesky(moment + ridge_w * torch.eye(nw, dtype=torch.float64))
