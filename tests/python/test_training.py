@@ -17,7 +17,7 @@ from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.networks import BETA_MAX
 from softdeca_train.parameters import load_parameters
 from softdeca_train.paths import REPO_ROOT
-from softdeca_train.train.bundle import BundleBudget, train_bundle
+from softdeca_train.train.bundle import BundleBudget, stage_config, train_bundle
 from softdeca_train.train.loop import LoopConfig, train
 from softdeca_train.train.models import vertex_error
 from softdeca_train.train.run import Run, RunConfig
@@ -132,6 +132,15 @@ def test_training_resumes_from_its_checkpoint(run: Run) -> None:
         run.train("softdeca-vertex", LoopConfig(steps=9, seed=2), progress=False)
     state = torch.load(run.checkpoint("softdeca-vertex"), weights_only=False)
     assert state["step"] == 6 and state["done"]
+
+
+def test_softdeca_step_budget_overrides_only_its_own_stage() -> None:
+    budget = BundleBudget(softdeca_steps=0).scaled(0.5)
+    own = stage_config("softdeca", budget, 0)
+    assert own.steps == 0 and own.minutes is None  # its closed-form start alone
+    other = stage_config("sparse", budget, 0)
+    assert other.minutes == 15.0 and other.steps > 1000
+    assert stage_config("softdeca", BundleBudget(), 0).minutes == 60.0
 
 
 def test_bundle_pipeline_exports_a_bundle_onnxruntime_agrees_with(

@@ -34,6 +34,9 @@ class BundleBudget:
     sparse_dynamics: float = 8.0
     identity_steps: int = 0  # the encoder starts exact (train/identity.py)
     steps: int | None = None  # a step budget per stage instead of the minutes (tests)
+    # SoftDECA's own step budget; 0 keeps its closed-form start (train/models.py), which on
+    # unseen identities measured better than the steps after it (docs/training.md).
+    softdeca_steps: int | None = None
 
     def scaled(self, factor: float) -> BundleBudget:
         return replace(
@@ -53,9 +56,12 @@ def stage_config(stage: str, budget: BundleBudget, seed: int) -> LoopConfig:
     # at 1e-3 once their encoder's features move, 2e-4..3e-4 is stable; the dynamics stage
     # trains only two small per-vertex MLPs and takes a larger step.
     lr, lr_end = {"sparse": (3e-4, 3e-5), "softdeca": (1e-3, 5e-5)}.get(stage, (3e-3, 1e-4))
+    steps = budget.steps
+    if stage == "softdeca" and budget.softdeca_steps is not None:
+        steps = budget.softdeca_steps
     return LoopConfig(
-        steps=budget.steps or 1_000_000,
-        minutes=None if budget.steps else budget.minutes(stage),
+        steps=1_000_000 if steps is None else steps,
+        minutes=None if steps is not None else budget.minutes(stage),
         lr=lr,
         lr_end=lr_end,
         frames=8,

@@ -54,13 +54,21 @@ def add_bundle_args(p: argparse.ArgumentParser) -> None:
         default=0,
         help="identity encoder fine-tuning steps after its exact least-squares start (0)",
     )
+    p.add_argument(
+        "--softdeca-steps",
+        type=int,
+        default=None,
+        help="SoftDECA's step budget instead of its minutes (0: its closed-form start alone)",
+    )
 
 
 def run_bundle(args: argparse.Namespace) -> int:
     from softdeca_train.train.bundle import BundleBudget, default_command, train_bundle
 
     run = _open_run(args)
-    budget = BundleBudget(identity_steps=args.identity_steps).scaled(args.scale)
+    budget = BundleBudget(
+        identity_steps=args.identity_steps, softdeca_steps=args.softdeca_steps
+    ).scaled(args.scale)
     out = train_bundle(run, Path(args.bundle), budget, default_command(), not args.no_progress)
     print(f"bundle written to {out}")
     return 0
