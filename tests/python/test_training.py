@@ -174,6 +174,25 @@ def test_bundle_pipeline_exports_a_bundle_onnxruntime_agrees_with(
     assert nets.has("softdeca") and nets.has("sparse")
 
 
+def test_bundle_at_softdecas_start_is_exported_and_evaluated(small, tmp_path) -> None:
+    """SoftDECA kept at its closed-form start (0 steps, as the committed bundle): the bundle
+    exports, and the evaluation report, whose training curves have no rows for it, says so."""
+    from softdeca_train.train.report import write_report
+
+    folder, _ = small
+    fresh = Run(tmp_path / "run", RunConfig(str(folder), "test", seed=4))
+    bundle = train_bundle(
+        fresh, tmp_path / "bundle", BundleBudget(steps=2, softdeca_steps=0), "test", False
+    )
+    assert json.loads((fresh.folder / "softdeca.summary.json").read_text())["steps"] == 0
+    _check_export_deviation(read_manifest(bundle))
+    readme = write_report(fresh, bundle, tmp_path / "report", progress=False)
+    doc = json.loads((tmp_path / "report" / "evaluation.json").read_text())
+    assert np.isfinite(doc["errors"]["softdeca"]["mean_mm"])
+    assert "closed-form start, no steps" in readme.read_text()
+    assert (tmp_path / "report" / "training_curves.png").is_file()
+
+
 @pytest.mark.skipif(not COMMITTED.is_dir(), reason="no committed bundle yet")
 def test_committed_bundle_is_trained_loads_and_says_what_made_it() -> None:
     m = read_manifest(COMMITTED)

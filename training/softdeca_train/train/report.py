@@ -108,6 +108,8 @@ def _curves(run: Run, names: list[str], path: Path) -> None:
         if not log.is_file():
             continue
         rows = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
+        if not rows:  # a closed-form model kept at its start (0 steps) has no curve
+            continue
         s = np.array([r["s"] for r in rows]) / 60
         e = np.array([r["error_mm"] for r in rows])
         k = max(1, len(e) // 100)
@@ -147,6 +149,8 @@ def _training(run: Run, name: str) -> str:
     if not path.is_file():
         return "–"
     s = json.loads(path.read_text())
+    if s["steps"] == 0:
+        return "closed-form start, no steps"
     return f"{s['steps']:,} steps, {s['minutes']:.0f} min"
 
 
