@@ -182,9 +182,15 @@ def test_bundle_at_softdecas_start_is_exported_and_evaluated(small, tmp_path) ->
     folder, _ = small
     fresh = Run(tmp_path / "run", RunConfig(str(folder), "test", seed=4))
     bundle = train_bundle(
-        fresh, tmp_path / "bundle", BundleBudget(steps=2, softdeca_steps=0), "test", False
+        fresh,
+        tmp_path / "bundle",
+        BundleBudget(steps=2, softdeca_steps=0),
+        "test",
+        False,
     )
-    assert json.loads((fresh.folder / "softdeca.summary.json").read_text())["steps"] == 0
+    assert (
+        json.loads((fresh.folder / "softdeca.summary.json").read_text())["steps"] == 0
+    )
     _check_export_deviation(read_manifest(bundle))
     readme = write_report(fresh, bundle, tmp_path / "report", progress=False)
     doc = json.loads((tmp_path / "report" / "evaluation.json").read_text())

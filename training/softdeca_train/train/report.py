@@ -341,8 +341,8 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "",
         f"{loc['change']} ({loc['faces_changed']} faces) on a test identity and frame, the "
         "rest of p as sampled for it; the displacement the change causes, physics (the same "
-        "value on the soft-tissue tets in the ball) next to SoftDECA (a per-face parameter "
-        f"map into f_ph). Mean displacement inside the ball: physics "
+        "value on the soft-tissue tets in the ball) next to SoftDECA (per-face and per-vertex "
+        f"parameter maps into its hypernetworks). Mean displacement inside the ball: physics "
         f"{loc['physics_mean_in_region_mm']:.3f} mm, SoftDECA "
         f"{loc['softdeca_mean_in_region_mm']:.3f} mm; largest: physics "
         f"{loc['physics_max_mm']:.2f} mm, SoftDECA {loc['softdeca_max_mm']:.2f} mm.",
