@@ -19,6 +19,7 @@ from softdeca_train.sim.stress import (
     StressCase,
     StressPlan,
     build_cases,
+    parse_material,
     run_stress,
     run_stress_parallel,
 )
@@ -120,6 +121,22 @@ def test_expression_library() -> None:
     assert COMBINATIONS["snarl"] is SNARL
     for name, w in combos.items():
         assert (w >= 0).all() and (w <= 1).all(), name
+
+
+def test_extra_material_cases_are_parsed_and_planned() -> None:
+    values = parse_material("w_soft_volume=3, max_strain=1.3")
+    assert values == {"w_soft_volume": 3.0, "max_strain": 1.3}
+    plan = StressPlan(identities=("seed 1", "template"), extra_materials=(values,))
+    case = next(
+        c
+        for c in build_cases(plan)
+        if c.group == "materials w_soft_volume=3,max_strain=1.3"
+    )
+    assert case.identity == "seed 1" and case.parameters == values
+    assert len(case.frames) == len(combinations())
+    for bad in ("w_soft_volume", "nope=1", "w_soft_volume=x", "max_strain=5", ""):
+        with pytest.raises(ValueError):
+            parse_material(bad)
 
 
 def test_plan_covers_the_suite() -> None:

@@ -77,6 +77,9 @@ class StressPlan:
     take_stride: int = 10
     take_identities: int = 3
     combinations_only: bool = False  # the combinations without the single shapes
+    # extra material cases, e.g. ({"w_soft_volume": 3.0},): the combinations on the first
+    # identity with those values (what a wider control range would ask of the physics)
+    extra_materials: tuple[dict[str, float], ...] = ()
 
 
 def identity_coefficients(template: Template, label: str) -> np.ndarray | None:
@@ -103,6 +106,30 @@ def material_ends() -> dict[str, dict[str, float]]:
     }
 
 
+def parse_material(text: str) -> dict[str, float]:
+    """'NAME=VALUE[,NAME=VALUE...]' -> values, each a parameter of plugin/data/parameters.json
+    within the range the physics accepts."""
+    specs = {s.name: s for s in load_parameters().specs}
+    out: dict[str, float] = {}
+    for item in filter(None, (t.strip() for t in text.split(","))):
+        name, sep, value = item.partition("=")
+        if not sep or name not in specs:
+            raise ValueError(
+                f"material {item!r}: expected NAME=VALUE with NAME one of {sorted(specs)}"
+            )
+        try:
+            v = float(value)
+        except ValueError:
+            raise ValueError(f"material {item!r}: {value!r} is not a number") from None
+        spec = specs[name]
+        if not spec.lo <= v <= spec.hi:
+            raise ValueError(f"material {item!r}: outside the physics' range {spec.lo}-{spec.hi}")
+        out[name] = v
+    if not out:
+        raise ValueError(f"material {text!r}: no NAME=VALUE")
+    return out
+
+
 def build_cases(plan: StressPlan) -> list[StressCase]:
     combos = list(combinations().items())
     exprs = combos if plan.combinations_only else list(all_expressions().items())
@@ -113,6 +140,9 @@ def build_cases(plan: StressPlan) -> list[StressCase]:
     if plan.materials:
         for name, values in material_ends().items():
             cases.append(StressCase(f"materials {name}", first, plan.level, combos, values))
+    for values in plan.extra_materials:
+        label = ",".join(f"{k}={v:g}" for k, v in values.items())
+        cases.append(StressCase(f"materials {label}", first, plan.level, combos, values))
     if plan.gravity:
         for name, (tilt, azimuth) in GRAVITY_DIRECTIONS.items():
             g = {"gravity_strength": 2.0, "gravity_tilt": tilt, "gravity_azimuth": azimuth}

@@ -37,6 +37,14 @@ def add_stress_args(p: argparse.ArgumentParser) -> None:
         "--combinations-only", action="store_true", help="leave out the 52 single shapes"
     )
     p.add_argument("--no-materials", action="store_true", help="skip the material cases")
+    p.add_argument(
+        "--material",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE[,...]",
+        help="an extra case: the combinations on the first identity with these parameter "
+        "values (repeatable; e.g. to judge a wider control range's end)",
+    )
     p.add_argument("--no-gravity", action="store_true", help="skip the 2 g cases")
     p.add_argument("--no-dynamic", action="store_true", help="skip the dynamic run")
     p.add_argument("--no-collisions", action="store_true", help="collision rounds 0")
@@ -61,6 +69,7 @@ def run_stress_cli(args: argparse.Namespace) -> int:
     from softdeca_train.sim.stress import (
         StressPlan,
         build_cases,
+        parse_material,
         run_stress,
         run_stress_parallel,
         write_report,
@@ -86,6 +95,7 @@ def run_stress_cli(args: argparse.Namespace) -> int:
         take_stride=args.take_stride,
         take_identities=args.take_identities,
         combinations_only=args.combinations_only,
+        extra_materials=tuple(parse_material(m) for m in args.material),
     )
     template = Template.load(args.ict)
     cases = build_cases(plan)
