@@ -79,6 +79,17 @@ class ParameterSet:
             if np.any(v < s.lo - 1e-9) or np.any(v > s.hi + 1e-9):
                 raise ValueError(f"{s.name} out of range [{s.lo}, {s.hi}]: {np.ravel(v)[:3]}")
 
+    def check_values(self, values: dict[str, float]) -> None:
+        """Named values (a command line's or a file's): each a known parameter within the
+        range the physics accepts."""
+        specs = {s.name: s for s in self.specs}
+        for name, value in values.items():
+            if name not in specs:
+                raise ValueError(f"unknown parameter {name!r}; known: {', '.join(specs)}")
+            s = specs[name]
+            if not (s.lo <= value <= s.hi):
+                raise ValueError(f"parameter {name} = {value} outside its range [{s.lo}, {s.hi}]")
+
     def normalise(self, p: np.ndarray) -> np.ndarray:
         return np.stack([s.normalise(p[..., k]) for k, s in enumerate(self.specs)], axis=-1)
 

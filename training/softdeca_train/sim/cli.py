@@ -86,13 +86,8 @@ def _parameters(path: str | None) -> dict[str, float]:
 def _set_parameters(sim: native.Simulator, values: dict[str, float]) -> None:
     from softdeca_train.parameters import load_parameters
 
-    specs = {s.name: s for s in load_parameters().specs}
+    load_parameters().check_values(values)
     for name, value in values.items():
-        if name not in specs:
-            raise ValueError(f"unknown parameter {name!r}; known: {', '.join(specs)}")
-        s = specs[name]
-        if not (s.lo <= value <= s.hi):
-            raise ValueError(f"parameter {name} = {value} outside its range [{s.lo}, {s.hi}]")
         sim.set_parameter(name, value)
 
 
