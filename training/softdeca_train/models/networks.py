@@ -22,6 +22,7 @@ import torch
 from torch import nn
 
 from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
 
 # The stable, equilibrium-preserving dynamics set (eq. 21 with gamma + 2 alpha - beta = 1):
@@ -170,10 +171,19 @@ GRAVITY_COLUMNS = ("gravity_strength", "gravity_tilt", "gravity_azimuth")
 
 class LocalLinear(nn.Module):
     """Per element, an affine map of the element's own parameters: [1, p_i, g_i] (p_i
-    normalised, g_i its gravity load) times a table (n, 1 + P + 3, k). A region's control
-    then changes the output in that region only."""
+    normalised, g_i its gravity load) times a table (n, 1 + P + 3 [+ S L], k). A region's
+    control then changes the output in and around that region only. With `smoothing` (vertex
+    elements), the L localisable parameters averaged around the element at S scales are
+    inputs too: a material change moves the skin near it, not only above it
+    (models/smoothing.py)."""
 
-    def __init__(self, n_elements: int, specs: Sequence[ParameterSpec], k: int) -> None:
+    def __init__(
+        self,
+        n_elements: int,
+        specs: Sequence[ParameterSpec],
+        k: int,
+        smoothing: FieldSmoothing | None = None,
+    ) -> None:
         super().__init__()
         names = [s.name for s in specs]
         self.normalise = Normalise(specs)
@@ -182,10 +192,13 @@ class LocalLinear(nn.Module):
             if all(c in names for c in GRAVITY_COLUMNS)
             else None
         )
-        self.table = nn.Parameter(torch.zeros(n_elements, 1 + len(specs) + 3, k))
+        self.smoothing = smoothing
+        self.smoothed = [i for i, s in enumerate(specs) if s.localisable] if smoothing else []
+        n_smoothed = len(self.smoothed) * (len(smoothing.scales) if smoothing else 0)
+        self.table = nn.Parameter(torch.zeros(n_elements, 1 + len(specs) + 3 + n_smoothed, k))
 
     def features(self, parameters: torch.Tensor) -> torch.Tensor:
-        """(n, P) raw -> (n, 1 + P + 3)."""
+        """(n, P) raw -> (n, 1 + P + 3 [+ S L])."""
         ones = torch.ones_like(parameters[:, :1])
         if self.gravity is None:
             load = torch.zeros_like(parameters[:, :3])
@@ -197,7 +210,11 @@ class LocalLinear(nn.Module):
                 [torch.sin(t) * torch.cos(a), -torch.cos(t), torch.sin(t) * torch.sin(a)], 1
             )
             load = s[:, None] * d + torch.tensor([0.0, 1.0, 0.0], dtype=d.dtype)
-        return torch.cat([ones, self.normalise(parameters), load], dim=1)
+        own = self.normalise(parameters)
+        if self.smoothing is None or not self.smoothed:
+            return torch.cat([ones, own, load], dim=1)
+        around = self.smoothing(own[:, self.smoothed])
+        return torch.cat([ones, own, load, around], dim=1)
 
     def forward(self, parameters: torch.Tensor) -> torch.Tensor:
         return torch.einsum("nd,ndk->nk", self.features(parameters), self.table)
@@ -222,6 +239,7 @@ class HyperNetwork(nn.Module):
         unit: float = 1.0,
         base: bool = False,
         local_linear: bool = False,
+        smoothing: FieldSmoothing | None = None,
     ) -> None:
         super().__init__()
         self.latent, self.k, self.unit = sizes.latent, k, unit
@@ -231,7 +249,7 @@ class HyperNetwork(nn.Module):
         )
         # With a constant last entry of z (WeightEncoder.constant_slot): that entry's tensor
         # gains an affine map of each element's own parameters.
-        self.local = LocalLinear(n_elements, specs, k) if local_linear else None
+        self.local = LocalLinear(n_elements, specs, k, smoothing) if local_linear else None
 
     def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:
         out = self.body(parameters, identity).reshape(-1, self.latent, self.k)
@@ -352,17 +370,22 @@ def build_random(
     """Random-weight networks (untrained). `dg_scale` sets the size of the deformation-gradient
     corrections (G - I) and `offset_scale` that of the vertex offsets (metres), so that an
     untrained bundle stays close to its input instead of producing noise. `vertex_stage` adds
-    SoftDECA's vertex stage (with its per-vertex affine table, random too)."""
+    SoftDECA's vertex stage (with its per-vertex affine table, random too; with the smoothed
+    parameters among its inputs where the definition has the skin at rest)."""
     torch.manual_seed(seed)
     specs = tuple(specs)
     nf, nv = definition.n_faces, definition.skin_vertices
+    rest = definition.skin_rest
+    smoothing = FieldSmoothing(rest) if vertex_stage and rest is not None else None
     sd = sp = None
     if softdeca:
         sd = SoftDecaNetworks(
             f_w=WeightEncoder(len(definition.blendshapes), sizes),
             f_ph=HyperNetwork(nf, specs, sizes, 9, dg_scale),
             f_dyn=DynamicsNetwork(nv, specs, sizes),
-            f_ph_v=HyperNetwork(nv, specs, sizes, 3, offset_scale, local_linear=True)
+            f_ph_v=HyperNetwork(
+                nv, specs, sizes, 3, offset_scale, local_linear=True, smoothing=smoothing
+            )
             if vertex_stage
             else None,
         )

@@ -116,6 +116,7 @@ def synthetic_head(level: int = 2, seed: int = 0, n_landmarks: int = 20) -> Synt
         ),
         non_skin_bones=bones,
         jaw_anchors=anchors.astype(np.int64),
+        skin_rest=skin,
     )
     return SyntheticHead(definition, neutral, head_triangles, deltas, user_neutral, user_deltas)
 

@@ -46,6 +46,9 @@ class TemplateDefinition:
     non_skin_bones: np.ndarray  # (head_vertices - skin_vertices,) uint8: CRANIUM or JAW
     jaw_anchors: np.ndarray  # skin vertex indices whose rigid motion the JAW vertices follow
     blendshapes: tuple[str, ...] = ARKIT_BLENDSHAPES
+    # (skin_vertices, 3) S at rest, metres: where the vertex stage's smoothing tables come
+    # from (models/smoothing.py); None (a bundle read back) builds no smoothing
+    skin_rest: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         t = self.skin_triangles
@@ -65,6 +68,9 @@ class TemplateDefinition:
         lm = self.landmarks
         if lm.triangle.max() >= len(t) or lm.arkit_vertex.max() >= lm.arkit_vertex_count:
             raise ValueError("landmark indices out of range")
+        r = self.skin_rest
+        if r is not None and (r.shape != (self.skin_vertices, 3) or not np.isfinite(r).all()):
+            raise ValueError("skin_rest must be finite (skin_vertices, 3) positions")
         if self.blendshapes != ARKIT_BLENDSHAPES:
             raise ValueError("bundles use the canonical ARKit blendshape order")
 
@@ -102,4 +108,5 @@ def from_template(template: object | None = None) -> TemplateDefinition:
         ),
         non_skin_bones=np.where(bones[N_SKIN:] == LHM_JAW, JAW, CRANIUM).astype(np.uint8),
         jaw_anchors=np.nonzero(bones[:N_SKIN] == LHM_JAW)[0].astype(np.int64),
+        skin_rest=np.asarray(t.neutral[:N_SKIN], dtype=np.float64),
     )

@@ -25,6 +25,7 @@ from softdeca_train.models.networks import (
     mlp,
 )
 from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
 from softdeca_train.train.batches import Batch, Dataset
 
@@ -211,8 +212,17 @@ class SoftDecaHybrid(Trainable):
         super().__init__()
         self.f_w = WeightEncoder(len(d.blendshapes), sizes, linear_skip=True, constant_slot=True)
         self.f_ph = HyperNetwork(d.n_faces, specs, sizes, 9, 1e-4, base=True)
+        smoothing = None if d.skin_rest is None else FieldSmoothing(d.skin_rest)
         self.f_ph_v = HyperNetwork(
-            d.skin_vertices, specs, sizes, 3, 1e-5, unit=CM, base=True, local_linear=True
+            d.skin_vertices,
+            specs,
+            sizes,
+            3,
+            1e-5,
+            unit=CM,
+            base=True,
+            local_linear=True,
+            smoothing=smoothing,
         )
         self.n_faces, self.n_vertices = d.n_faces, d.skin_vertices
         self.n_weights = len(d.blendshapes)
