@@ -248,7 +248,7 @@ class HyperNetwork(nn.Module):
             n_elements, specs, sizes, sizes.hyper_hidden, sizes.latent * k, out_scale / unit
         )
         # With a constant last entry of z (WeightEncoder.constant_slot): that entry's tensor
-        # gains an affine map of each element's own parameters.
+        # gains an affine map of each element's own parameters (and of those around it).
         self.local = LocalLinear(n_elements, specs, k, smoothing) if local_linear else None
 
     def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:

@@ -201,9 +201,10 @@ class SoftDecaHybrid(Trainable):
     from T where S_t is 0.398 mm off (`linear-baseline --local`, docs/training.md), because its
     pull toward S_t holds back the smooth, low-frequency part of the correction (the sag).
     The vertex stage carries that part. z has a linear path in w and a constant last entry
-    whose L_v tensor is an affine map of each vertex's own parameters, so the model starts at
-    the per-vertex ridge fit (`init_from_dataset`, closed form) and a region's control acts in
-    its region."""
+    whose L_v tensor is an affine map of each vertex's own parameters and of the localisable
+    ones averaged around it (models/smoothing.py), so the model starts at the per-vertex ridge
+    fit (`init_from_dataset`, closed form) and a region's control acts in and around its
+    region."""
 
     hypernetworks = ("f_ph", "f_ph_v")
     hyper_lr = HYPER_LR_SOFTDECA
@@ -245,8 +246,9 @@ class SoftDecaHybrid(Trainable):
         progress: bool = True,
         ridge: float = 1e-3,
     ) -> None:
-        """Start at the per-vertex ridge fit of T - S_t on [w, 1, p_v, g_v] over the kept
-        train frames: its w part (rank latent - 1, by SVD) in f_w's linear path and L_v's
+        """Start at the per-vertex ridge fit of T - S_t on [w, LocalLinear's features] (1,
+        p_v, g_v and the averaged parameters) over the kept train frames: its w part (rank
+        latent - 1, reduced-rank regression) in f_w's linear path and L_v's
         base, its constant and parameter parts in L_v's local map; every MLP's output and the
         DT stage start at zero."""
         from tqdm import tqdm
