@@ -18,7 +18,12 @@ from softdeca_train.controls.definitions import (
     region_controls,
 )
 from softdeca_train.controls.gallery import Collected, control_entry, measure_controls
-from softdeca_train.controls.metrics import control_response, leakage, response_error
+from softdeca_train.controls.metrics import (
+    control_response,
+    identity_spread,
+    leakage,
+    response_error,
+)
 from softdeca_train.controls.report import (
     kept_real_takes,
     merge_into_report,
@@ -99,6 +104,24 @@ def test_metrics_reject_a_region_without_vertices() -> None:
     assert response_error(d, np.zeros_like(d)) is None
     r = control_response(d, d, None)
     assert r.response_error == 0.0 and r.leakage is None
+
+
+def test_identity_spread_is_how_far_one_identitys_change_misses_anothers() -> None:
+    a = np.zeros((2, 6, 3))
+    a[..., 0] = 1e-3
+    assert identity_spread([a]) is None  # one identity: nothing to compare
+    assert identity_spread([a, a.copy()]) == 0.0
+    # the second identity moves twice as far: a for b misses by 1/2, b for a by 1
+    assert identity_spread([a, 2 * a]) == pytest.approx(0.75)
+    assert identity_spread([a, np.zeros_like(a)]) is None  # one identity does not move
+    with pytest.raises(ValueError, match="same cases"):
+        identity_spread([a, a[:1]])
+    # the gallery reports it per control: one case per identity, here both the same
+    acc = Collected()
+    wide = Control("a", "a", 0.0, 2.0)
+    measure_controls([wide], _physics, None, acc)
+    measure_controls([wide], _physics, None, acc)
+    assert control_entry(wide, acc, LABELS)["identity_spread"] == 0.0
 
 
 def test_controls_come_from_the_parameter_definition() -> None:

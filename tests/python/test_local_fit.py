@@ -10,11 +10,13 @@ import numpy as np
 import torch
 from softdeca_train.data.config import GenerateConfig
 from softdeca_train.data.ranges import sampling_parameters
+from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.parameters import load_parameters
 from softdeca_train.train.linear_baseline import ParameterScaling
 from softdeca_train.train.local_fit import (
     LocalFitConfig,
     LocalRidge,
+    averaged_features,
     format_local_table,
     local_features,
     predict,
@@ -42,6 +44,28 @@ def test_features_use_each_elements_own_parameters() -> None:
     assert np.array_equal(x[0], x[2]) and not np.array_equal(x[0], x[1])
     # the element's gravity load: 1 g more along -Y where the strength doubles
     assert np.allclose(x[1, 0, -3:] - x[0, 0, -3:], [0.0, -1.0, 0.0])
+
+
+def test_averaged_features_carry_a_local_change_to_the_neighbours_only() -> None:
+    sc = _scaling()
+    # a row of skin points 5 mm apart along x
+    rest = np.stack([np.arange(40) * 0.005, np.zeros(40), np.zeros(40)], axis=1)
+    smoothing = FieldSmoothing(rest)
+    p = np.repeat(sc.params.defaults()[None], len(rest), axis=0)
+    w = np.zeros((1, 52))
+    base = averaged_features(local_features(w, p, sc), p, sc, smoothing).numpy()
+    n_own = 52 + 1 + len(sc.params.names) + 3
+    local = [i for i, s in enumerate(sc.params.specs) if s.domain != "global"]
+    assert base.shape == (40, 1, n_own + len(local) * len(smoothing.scales))
+    # a constant field averages to itself
+    assert np.allclose(base[:, 0, n_own:], base[0, 0, n_own:])
+    column = sc.params.names.index("target_volume")
+    p[:3, column] = sc.params.specs[column].hi  # a change at one end of the row
+    changed = averaged_features(local_features(w, p, sc), p, sc, smoothing).numpy()
+    delta = np.abs(changed - base)[:, 0, n_own:].sum(axis=1)
+    assert delta[5] > 0 and delta[5] > delta[20] and delta[-1] < 1e-2 * delta[0]
+    # the vertex's own features change only where its own parameter does
+    assert np.array_equal(changed[3:, 0, :n_own], base[3:, 0, :n_own])
 
 
 def test_each_element_recovers_its_own_planted_map() -> None:
@@ -73,6 +97,7 @@ def test_the_small_dataset_gets_every_figure(small) -> None:
     assert all(math.isfinite(v) for v in mm.values())
     # DT of the physics' own gradients lands closer to T than the linear blend does
     assert mm["dt_floor"] < mm["none"]
+    assert {"vertex_local", "vertex_averaged", "gradient_local"} <= set(mm)
     assert "| DT of the physics' own face gradients (clamped) |" in format_local_table(
         result
     )

@@ -44,6 +44,15 @@ def _add(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--no-pictures", action="store_true", help="figures only, no PNGs")
     p.add_argument(
+        "--tolerance",
+        type=float,
+        default=1e-5,
+        help="the physics solver's tolerance (default 1e-5: ten times tighter than the data)",
+    )
+    p.add_argument(
+        "--max-iterations", type=int, default=4000, help="solver iterations at most (4000)"
+    )
+    p.add_argument(
         "--takes",
         type=Path,
         default=None,
@@ -66,6 +75,8 @@ def _run(args: argparse.Namespace) -> int:
         region_parameters=tuple(n for n in args.region_parameters.split(",") if n),
         ranges=args.ranges,
         pictures=not args.no_pictures,
+        tolerance=args.tolerance,
+        max_iterations=args.max_iterations,
         takes=args.takes or default_takes_path(),
         ict=args.ict,
     )

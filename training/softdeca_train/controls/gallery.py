@@ -21,7 +21,7 @@ from softdeca_train.controls.definitions import (
     global_controls,
     region_controls,
 )
-from softdeca_train.controls.metrics import control_response
+from softdeca_train.controls.metrics import control_response, identity_spread
 from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.paths import REPO_ROOT, default_takes_path
@@ -40,6 +40,11 @@ class GalleryConfig:
     region_parameters: tuple[str, ...] = REGION_PARAMETERS
     ranges: str = "control"  # control: the control ranges; physics: the physics' own
     pictures: bool = True
+    # The physics is the reference of every figure: solved ten times tighter than the training
+    # data (1e-4), so that its own convergence error stays small against the changes of the
+    # smaller controls; more iterations allowed to get there.
+    tolerance: float = 1e-5
+    max_iterations: int = 4000
     takes: Path = field(default_factory=default_takes_path)
     ict: str | None = None
 
@@ -48,6 +53,8 @@ class GalleryConfig:
             raise ValueError(f"ranges must be one of {RANGES}")
         if not 1 <= self.identities <= len(IDENTITY_SEEDS):
             raise ValueError(f"identities must be in 1..{len(IDENTITY_SEEDS)}")
+        if not (0 < self.tolerance < 1 and self.max_iterations >= 1):
+            raise ValueError("tolerance must be in (0, 1) and max_iterations at least 1")
 
 
 def controls_of(cfg: GalleryConfig) -> tuple[list[Control], dict[str, float]]:
@@ -134,6 +141,7 @@ def control_entry(c: Control, acc: Collected, labels: np.ndarray) -> dict:
         "unit": c.unit,
         "fixed": dict(c.fixed),
         **asdict(r),
+        "identity_spread": identity_spread(acc.physics[c.name]),
         "model_clamped": c.parameter in acc.clamped,
     }
 
@@ -149,7 +157,14 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
     acc = Collected()
     total = cfg.identities * len(controls)
     cases = [
-        PhysicsCase(template, template.sample_identity(seed), weights, cfg.level)
+        PhysicsCase(
+            template,
+            template.sample_identity(seed),
+            weights,
+            cfg.level,
+            cfg.tolerance,
+            cfg.max_iterations,
+        )
         for seed in IDENTITY_SEEDS[: cfg.identities]
     ]
     with tqdm(total=total, desc="controls", unit="control", disable=not progress) as bar:

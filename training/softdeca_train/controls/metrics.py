@@ -51,6 +51,27 @@ def leakage(delta: np.ndarray, inside: np.ndarray | None) -> float | None:
     return float(d[:, ~inside].mean()) / inner
 
 
+def identity_spread(deltas: list[np.ndarray]) -> float | None:
+    """How much the physics' response differs between identities: the mean over ordered pairs
+    (a, b) of ‖ΔP_a − ΔP_b‖ / ‖ΔP_b‖, one identity's change (cases, V, 3) standing in for
+    another's on the same expressions. A model that gives every identity the same change
+    cannot do much better than about 1/√2 of it (the spread around the mean response). None
+    with fewer than two identities or where an identity's physics does not move."""
+    if len(deltas) < 2:
+        return None
+    errors = []
+    for b, own in enumerate(deltas):
+        for a, other in enumerate(deltas):
+            if a != b:
+                if np.shape(other) != np.shape(own):
+                    raise ValueError("identities must be measured on the same cases")
+                e = response_error(other, own)
+                if e is None:
+                    return None
+                errors.append(e)
+    return float(np.mean(errors))
+
+
 def control_response(
     delta_physics: np.ndarray, delta_model: np.ndarray, inside: np.ndarray | None
 ) -> Response:

@@ -89,6 +89,11 @@ def summary_figure(path: Path, entries: list[dict]) -> None:
     axes[1].bar(
         y, [np.nan if e["response_error"] is None else e["response_error"] for e in entries]
     )
+    spread = [e.get("identity_spread") for e in entries]
+    axes[1].plot(
+        y, [np.nan if v is None else v for v in spread], "k_", ms=14, label="identity spread"
+    )
+    axes[1].legend(loc="upper right", fontsize=8)
     axes[1].axhline(0.3, color="k", lw=0.8, ls="--")
     axes[1].set_ylabel("response error")
     axes[2].bar(
@@ -125,13 +130,14 @@ def markdown(cfg, result: dict) -> str:  # cfg: GalleryConfig
         f"default, on {len(result['identity_seeds'])} identities no dataset holds (seeds "
         f"{', '.join(map(str, result['identity_seeds']))}) x {len(result['expressions'])} "
         "expressions of the held-out take (widest jaw opening, broadest smile, strongest "
-        f"pucker); LHM level {c['level']}, static frames, {c['ranges']} ranges; model: "
+        f"pucker); LHM level {c['level']}, static frames, physics solved to a tolerance of "
+        f"{c.get('tolerance', 1e-4):g}, {c['ranges']} ranges; model: "
         f"`{c['bundle']}`. Written by `python -m softdeca_train controls` "
         f"({result['seconds']:.0f} s); docs/controls.md says what the figures mean.",
         "",
         "| control | region | range | physics max (mm) | physics mean (mm) | SoftDECA max (mm) "
-        "| response error | leakage | physics leakage |",
-        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "| response error | identity spread | leakage | physics leakage |",
+        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for e in result["controls"]:
         rng = f"{e['lo']:g} – {e['hi']:g} {e['unit']}".strip()
@@ -140,7 +146,8 @@ def markdown(cfg, result: dict) -> str:  # cfg: GalleryConfig
         lines.append(
             f"| {e['name']} | {e['region'] or 'global'} | {rng} | {_fmt(e['physics_max_mm'])} "
             f"| {_fmt(e['physics_mean_mm'])} | {_fmt(e['model_max_mm'])} "
-            f"| {_fmt(e['response_error'], 2)} | {_fmt(e['leakage'], 2)} "
+            f"| {_fmt(e['response_error'], 2)} | {_fmt(e.get('identity_spread'), 2)} "
+            f"| {_fmt(e['leakage'], 2)} "
             f"| {_fmt(e['physics_leakage'], 2)} |"
         )
     if cfg.pictures:

@@ -177,8 +177,9 @@ def add_linear_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--local",
         action="store_true",
-        help="also the per-element fits (per vertex; per face through deformation transfer) "
-        "and DT's floor, on each element's own (regional) parameters; needs the template data",
+        help="also the per-element fits (per vertex, also with the parameters averaged around "
+        "each vertex; per face through deformation transfer) and DT's floor, on each "
+        "element's own (regional) parameters; needs the template data",
     )
     p.add_argument("--out", help="also write the figures as JSON here")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")

@@ -6,6 +6,9 @@ element has its own, on its own parameters (a regional pattern's values where th
 one, so a region's control acts in its region only):
 
   vertex-local    T - S_t = A_v [w, 1, p_v, g_v]                  per skin vertex
+  vertex-averaged T - S_t = A_v [w, 1, p_v, g_v, p~_v]            per skin vertex, p~_v the
+                  localisable parameters averaged around the vertex at the vertex stage's
+                  scales (models/smoothing.py): the inputs of SoftDECA's vertex stage
   gradient-local  G_f - I = A_f [w, 1, p_f, g_f], X = DT(S_t, G)   per skin triangle
   DT floor        X = DT(S_t, G*) with the physics' own per-face gradients G* (clamped as
                   SoftDECA's initialisation clamps them): the best any model whose output is
@@ -24,6 +27,7 @@ import torch
 from tqdm import tqdm
 
 from softdeca_train.models.dt import deformation_transfer
+from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.train.batches import EVERY_FRAME, Batch, Dataset
 from softdeca_train.train.linear_baseline import ParameterScaling
 from softdeca_train.train.models import GRADIENT_CLAMP, frame_gradients
@@ -43,6 +47,17 @@ def local_features(weights: np.ndarray, p: np.ndarray, scaling: ParameterScaling
         axis=2,
     )
     return torch.from_numpy(np.ascontiguousarray(x))
+
+
+def averaged_features(
+    x: torch.Tensor, p: np.ndarray, scaling: ParameterScaling, smoothing: FieldSmoothing
+) -> torch.Tensor:
+    """x (n, B, d) of local_features for n vertices, with the vertices' localisable normalised
+    parameters averaged around each vertex appended: (n, B, d + L x scales)."""
+    local = [i for i, s in enumerate(scaling.params.specs) if s.domain != "global"]
+    field = torch.from_numpy(scaling.normalise(p)[:, local])
+    around = smoothing(field)  # (n, L x scales)
+    return torch.cat([x, around[:, None].expand(-1, x.shape[1], -1)], dim=2)
 
 
 class LocalRidge:
@@ -107,33 +122,44 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
         raise ValueError(f"{folder}: no static train frame to fit")
     if test_total == 0:
         raise ValueError(f"{folder}: no static test frame to measure")
-    vert = grad = None
+    smoothing = FieldSmoothing(ds.template.neutral[:n_v])
+    vert = grad = aver = None
     bar = tqdm(total=kept, desc="local fits (train)", unit="frame", disable=not progress)
     for b in ds.batches("static", "train", max_error=limit):
         w = b.weights.numpy()
-        xv = local_features(w, b.vertex_parameters(n_v).numpy(), scaling)
+        pv = b.vertex_parameters(n_v).numpy()
+        xv = local_features(w, pv, scaling)
+        xa = averaged_features(xv, pv, scaling, smoothing)
         xf = local_features(w, b.face_parameters(n_f).numpy(), scaling)
-        if vert is None or grad is None:
+        if vert is None or grad is None or aver is None:
             vert, grad = LocalRidge(n_v, xv.shape[-1], 3), LocalRidge(n_f, xf.shape[-1], 9)
-        vert.add(xv, (b.T - b.S).transpose(0, 1))
+            aver = LocalRidge(n_v, xa.shape[-1], 3)
+        offsets = (b.T - b.S).transpose(0, 1)
+        vert.add(xv, offsets)
+        aver.add(xa, offsets)
         grad.add(xf, _residual_gradients(b, tri).reshape(b.frames, n_f, 9).transpose(0, 1))
         bar.update(b.frames)
     bar.close()
-    assert vert is not None and grad is not None
-    coef_v, coef_f = vert.solve(cfg.ridge), grad.solve(cfg.ridge)
+    assert vert is not None and grad is not None and aver is not None
+    coef_v, coef_f, coef_a = vert.solve(cfg.ridge), grad.solve(cfg.ridge), aver.solve(cfg.ridge)
+    del vert.gram, grad.gram, aver.gram  # the normal equations are the largest arrays here
     err: dict[str, list[float]] = {
         "none": [],
         "vertex_local": [],
+        "vertex_averaged": [],
         "gradient_local": [],
         "dt_floor": [],
     }
     bar = tqdm(total=test_total, desc="local fits (test)", unit="frame", disable=not progress)
     for b in ds.batches("static", "test", max_error=EVERY_FRAME):
         w = b.weights.numpy()
-        xv = local_features(w, b.vertex_parameters(n_v).numpy(), scaling)
+        pv = b.vertex_parameters(n_v).numpy()
+        xv = local_features(w, pv, scaling)
+        xa = averaged_features(xv, pv, scaling, smoothing)
         xf = local_features(w, b.face_parameters(n_f).numpy(), scaling)
         err["none"] += _mean_mm(b.S, b.T)
         err["vertex_local"] += _mean_mm(b.S + predict(xv, coef_v).float(), b.T)
+        err["vertex_averaged"] += _mean_mm(b.S + predict(xa, coef_a).float(), b.T)
         g = predict(xf, coef_f).float().reshape(b.frames, n_f, 3, 3)
         err["gradient_local"] += _mean_mm(deformation_transfer(b.dt, b.S, g), b.T)
         err["dt_floor"] += _mean_mm(
@@ -143,12 +169,13 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
     bar.close()
     return {
         "dataset": str(folder),
-        "train_frames": vert.frames,
+        "train_frames": aver.frames,
         "test_frames": len(err["none"]),
         "config": {
             "ridge": cfg.ridge,
             "error_limit": cfg.error_limit,
             "gradient_clamp": GRADIENT_CLAMP,
+            "smoothing_scales_m": list(smoothing.scales),
         },
         "test_mm": {k: float(np.mean(v)) for k, v in err.items()},
     }
@@ -156,6 +183,7 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
 
 LOCAL_ROWS = {
     "vertex_local": "per vertex: T - S = A_v [w, 1, p_v, g_v]",
+    "vertex_averaged": "per vertex, + localisable p averaged around it: A_v [w, 1, p_v, g_v, p~_v]",
     "gradient_local": "per face: G - I = A_f [w, 1, p_f, g_f], through DT",
     "dt_floor": "DT of the physics' own face gradients (clamped)",
 }
