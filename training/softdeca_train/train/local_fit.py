@@ -9,6 +9,8 @@ one, so a region's control acts in its region only):
   vertex-averaged T - S_t = A_v [w, 1, p_v, g_v, p~_v]            per skin vertex, p~_v the
                   localisable parameters averaged around the vertex at the vertex stage's
                   scales (models/smoothing.py): the inputs of SoftDECA's vertex stage
+  vertex-identity the same, + [p_v, g_v] x the first IDENTITY_TERMS identity coefficients:
+                  whether a linear identity interaction carries over to unseen identities
   gradient-local  G_f - I = A_f [w, 1, p_f, g_f], X = DT(S_t, G)   per skin triangle
   DT floor        X = DT(S_t, G*) with the physics' own per-face gradients G* (clamped as
                   SoftDECA's initialisation clamps them): the best any model whose output is
@@ -58,6 +60,20 @@ def averaged_features(
     field = torch.from_numpy(scaling.normalise(p)[:, local])
     around = smoothing(field)  # (n, L x scales)
     return torch.cat([x, around[:, None].expand(-1, x.shape[1], -1)], dim=2)
+
+
+IDENTITY_TERMS = 3  # identity coefficients the interaction uses (the largest modes first)
+
+
+def identity_features(
+    x: torch.Tensor, p: np.ndarray, h: np.ndarray, scaling: ParameterScaling
+) -> torch.Tensor:
+    """x (n, B, d) with [p_v, g_v] x h[:IDENTITY_TERMS] of each element appended (one
+    identity per batch, h (1, H) or (H,))."""
+    own = np.concatenate([scaling.normalise(p), scaling.gravity_load(p)], axis=1)  # (n, P+3)
+    k = np.asarray(h, float).reshape(-1)[:IDENTITY_TERMS]
+    inter = torch.from_numpy((own[:, :, None] * k[None, None]).reshape(len(own), -1))
+    return torch.cat([x, inter[:, None].expand(-1, x.shape[1], -1)], dim=2)
 
 
 class LocalRidge:
@@ -123,30 +139,35 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
     if test_total == 0:
         raise ValueError(f"{folder}: no static test frame to measure")
     smoothing = FieldSmoothing(ds.template.neutral[:n_v])
-    vert = grad = aver = None
+    vert = grad = aver = ident = None
     bar = tqdm(total=kept, desc="local fits (train)", unit="frame", disable=not progress)
     for b in ds.batches("static", "train", max_error=limit):
         w = b.weights.numpy()
         pv = b.vertex_parameters(n_v).numpy()
         xv = local_features(w, pv, scaling)
         xa = averaged_features(xv, pv, scaling, smoothing)
+        xi = identity_features(xa, pv, b.h.numpy(), scaling)
         xf = local_features(w, b.face_parameters(n_f).numpy(), scaling)
-        if vert is None or grad is None or aver is None:
+        if vert is None or grad is None or aver is None or ident is None:
             vert, grad = LocalRidge(n_v, xv.shape[-1], 3), LocalRidge(n_f, xf.shape[-1], 9)
-            aver = LocalRidge(n_v, xa.shape[-1], 3)
+            aver, ident = LocalRidge(n_v, xa.shape[-1], 3), LocalRidge(n_v, xi.shape[-1], 3)
         offsets = (b.T - b.S).transpose(0, 1)
         vert.add(xv, offsets)
         aver.add(xa, offsets)
+        ident.add(xi, offsets)
         grad.add(xf, _residual_gradients(b, tri).reshape(b.frames, n_f, 9).transpose(0, 1))
         bar.update(b.frames)
     bar.close()
-    assert vert is not None and grad is not None and aver is not None
+    assert vert is not None and grad is not None and aver is not None and ident is not None
     coef_v, coef_f, coef_a = vert.solve(cfg.ridge), grad.solve(cfg.ridge), aver.solve(cfg.ridge)
-    del vert.gram, grad.gram, aver.gram  # the normal equations are the largest arrays here
+    coef_i = ident.solve(cfg.ridge)
+    train_frames = aver.frames
+    del vert, grad, aver, ident  # the normal equations are the largest arrays here
     err: dict[str, list[float]] = {
         "none": [],
         "vertex_local": [],
         "vertex_averaged": [],
+        "vertex_identity": [],
         "gradient_local": [],
         "dt_floor": [],
     }
@@ -156,10 +177,12 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
         pv = b.vertex_parameters(n_v).numpy()
         xv = local_features(w, pv, scaling)
         xa = averaged_features(xv, pv, scaling, smoothing)
+        xi = identity_features(xa, pv, b.h.numpy(), scaling)
         xf = local_features(w, b.face_parameters(n_f).numpy(), scaling)
         err["none"] += _mean_mm(b.S, b.T)
         err["vertex_local"] += _mean_mm(b.S + predict(xv, coef_v).float(), b.T)
         err["vertex_averaged"] += _mean_mm(b.S + predict(xa, coef_a).float(), b.T)
+        err["vertex_identity"] += _mean_mm(b.S + predict(xi, coef_i).float(), b.T)
         g = predict(xf, coef_f).float().reshape(b.frames, n_f, 3, 3)
         err["gradient_local"] += _mean_mm(deformation_transfer(b.dt, b.S, g), b.T)
         err["dt_floor"] += _mean_mm(
@@ -169,13 +192,14 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
     bar.close()
     return {
         "dataset": str(folder),
-        "train_frames": aver.frames,
+        "train_frames": train_frames,
         "test_frames": len(err["none"]),
         "config": {
             "ridge": cfg.ridge,
             "error_limit": cfg.error_limit,
             "gradient_clamp": GRADIENT_CLAMP,
             "smoothing_scales_m": list(smoothing.scales),
+            "identity_terms": IDENTITY_TERMS,
         },
         "test_mm": {k: float(np.mean(v)) for k, v in err.items()},
     }
@@ -184,6 +208,7 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
 LOCAL_ROWS = {
     "vertex_local": "per vertex: T - S = A_v [w, 1, p_v, g_v]",
     "vertex_averaged": "per vertex, + localisable p averaged around it: A_v [w, 1, p_v, g_v, p~_v]",
+    "vertex_identity": f"the same, + [p_v, g_v] x the first {IDENTITY_TERMS} identity coefficients",
     "gradient_local": "per face: G - I = A_f [w, 1, p_f, g_f], through DT",
     "dt_floor": "DT of the physics' own face gradients (clamped)",
 }
