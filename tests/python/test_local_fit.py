@@ -78,6 +78,8 @@ def test_each_element_recovers_its_own_planted_map() -> None:
         fit.add(x, predict(x, truth).transpose(0, 1))
     assert fit.frames == 24
     assert torch.allclose(fit.solve(1e-12), truth, atol=1e-8)
+    # solved a few elements at a time (memory), the same answer
+    assert torch.allclose(fit.solve(1e-3, chunk=2), fit.solve(1e-3), atol=1e-12)
     # a strong ridge shrinks every element's map
     assert fit.solve(1e3).abs().max() < 0.1 * truth.abs().max()
 

@@ -92,12 +92,20 @@ class LocalRidge:
         self.cross.baddbmm_(xt, y.to(torch.float64))
         self.frames += x.shape[1]
 
-    def solve(self, ridge: float) -> torch.Tensor:
-        """(n, d, k); `ridge` relative to each element's mean diagonal of its A^T A."""
+    def solve(self, ridge: float, chunk: int = 1024) -> torch.Tensor:
+        """(n, d, k); `ridge` relative to each element's mean diagonal of its A^T A. Solved
+        `chunk` elements at a time: a copy of every element's system at once would double
+        the memory the normal equations already take (gigabytes for the skin's vertices)."""
         d = self.gram.shape[-1]
-        scale = torch.diagonal(self.gram, dim1=1, dim2=2).mean(dim=1).clamp_min(1e-30)
         eye = torch.eye(d, dtype=torch.float64)
-        return torch.linalg.solve(self.gram + ridge * scale[:, None, None] * eye, self.cross)
+        out = torch.empty_like(self.cross)
+        for i in range(0, len(self.gram), chunk):
+            g = self.gram[i : i + chunk]
+            scale = torch.diagonal(g, dim1=1, dim2=2).mean(dim=1).clamp_min(1e-30)
+            out[i : i + chunk] = torch.linalg.solve(
+                g + ridge * scale[:, None, None] * eye, self.cross[i : i + chunk]
+            )
+        return out
 
 
 def predict(x: torch.Tensor, coef: torch.Tensor) -> torch.Tensor:
@@ -124,7 +132,7 @@ def _residual_gradients(batch: Batch, triangles: torch.Tensor) -> torch.Tensor:
 
 
 def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = True) -> dict:
-    """Fit both per-element models on the train split; measure them, the DT floor and no
+    """Fit the per-element models on the train split; measure them, the DT floor and no
     correction on every static test frame."""
     ds = Dataset(folder)
     scaling = ParameterScaling.of(ds.manifest)
@@ -159,10 +167,16 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
         bar.update(b.frames)
     bar.close()
     assert vert is not None and grad is not None and aver is not None and ident is not None
-    coef_v, coef_f, coef_a = vert.solve(cfg.ridge), grad.solve(cfg.ridge), aver.solve(cfg.ridge)
-    coef_i = ident.solve(cfg.ridge)
     train_frames = aver.frames
-    del vert, grad, aver, ident  # the normal equations are the largest arrays here
+    # each system freed once solved: the normal equations are the largest arrays here
+    coef_v = vert.solve(cfg.ridge)
+    del vert
+    coef_f = grad.solve(cfg.ridge)
+    del grad
+    coef_a = aver.solve(cfg.ridge)
+    del aver
+    coef_i = ident.solve(cfg.ridge)
+    del ident
     err: dict[str, list[float]] = {
         "none": [],
         "vertex_local": [],
