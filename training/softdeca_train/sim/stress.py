@@ -96,11 +96,13 @@ def identity_coefficients(template: Template, label: str) -> np.ndarray | None:
 
 def material_ends() -> dict[str, dict[str, float]]:
     ranges = {s.name: s.control for s in load_parameters().specs if s.control is not None}
-    lo = {n: ranges[n][0] for n in (*MATERIAL_WEIGHTS, "w_target", *TISSUE_SHAPE)}
-    hi = {n: ranges[n][1] for n in (*MATERIAL_WEIGHTS, "w_target", *TISSUE_SHAPE)}
+    # a weight that is no control stays at its default, as in the data
+    weights = [n for n in MATERIAL_WEIGHTS if n in ranges]
+    lo = {n: ranges[n][0] for n in (*weights, "w_target", *TISSUE_SHAPE)}
+    hi = {n: ranges[n][1] for n in (*weights, "w_target", *TISSUE_SHAPE)}
     return {
-        "soft": {**{n: lo[n] for n in MATERIAL_WEIGHTS}, "w_target": hi["w_target"]},
-        "stiff": {**{n: hi[n] for n in MATERIAL_WEIGHTS}, "w_target": lo["w_target"]},
+        "soft": {**{n: lo[n] for n in weights}, "w_target": hi["w_target"]},
+        "stiff": {**{n: hi[n] for n in weights}, "w_target": lo["w_target"]},
         "thin": {n: lo[n] for n in TISSUE_SHAPE},
         "full": {n: hi[n] for n in TISSUE_SHAPE},
     }
