@@ -269,3 +269,37 @@ def test_the_report_readme_section_is_replaced_not_repeated(tmp_path) -> None:
     assert text.startswith("# Evaluation\n\ntext\n") and text.count(SECTION) == 1
     assert "median response error 0.800" in text and "target_volume@lips" in text
     assert "SoftDECA 0.400 mm, linear blendshapes 0.600 mm" in text
+
+
+def test_the_gallery_page_names_the_tolerance_and_the_identity_spread() -> None:
+    from dataclasses import asdict
+
+    from softdeca_train.controls.gallery import GalleryConfig
+    from softdeca_train.controls.pictures import markdown
+
+    cfg = GalleryConfig(pictures=False, tolerance=2e-5)
+    entry = {
+        **{k: None for k in ("region", "leakage", "physics_leakage")},
+        "name": "a",
+        "lo": 0.0,
+        "hi": 1.0,
+        "unit": "",
+        "physics_max_mm": 1.0,
+        "physics_mean_mm": 0.5,
+        "model_max_mm": 0.4,
+        "response_error": 0.5,
+        "identity_spread": 0.25,
+    }
+    config = {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()}
+    page = markdown(
+        cfg,
+        {
+            "config": config,
+            "identity_seeds": [101, 202],
+            "expressions": [[0.0] * 52] * 3,
+            "controls": [entry],
+            "seconds": 1.0,
+        },
+    )
+    assert "tolerance of 2e-05" in page and "| identity spread |" in page
+    assert "| 0.50 | 0.25 | – | – |" in page

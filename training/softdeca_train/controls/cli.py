@@ -10,6 +10,7 @@ from softdeca_train.commands import Command, add_ict_argument
 
 def _add(p: argparse.ArgumentParser) -> None:
     from softdeca_train.controls.definitions import REGION_PARAMETERS
+    from softdeca_train.controls.gallery import GalleryConfig
     from softdeca_train.paths import REPO_ROOT
 
     p.add_argument(
@@ -46,11 +47,15 @@ def _add(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tolerance",
         type=float,
-        default=1e-5,
-        help="the physics solver's tolerance (default 1e-5: ten times tighter than the data)",
+        default=GalleryConfig.tolerance,
+        help=f"the physics solver's tolerance (default {GalleryConfig.tolerance:g}: ten times "
+        "tighter than the data)",
     )
     p.add_argument(
-        "--max-iterations", type=int, default=4000, help="solver iterations at most (4000)"
+        "--max-iterations",
+        type=int,
+        default=GalleryConfig.max_iterations,
+        help=f"solver iterations at most ({GalleryConfig.max_iterations})",
     )
     p.add_argument(
         "--takes",

@@ -89,7 +89,7 @@ def summary_figure(path: Path, entries: list[dict]) -> None:
     axes[1].bar(
         y, [np.nan if e["response_error"] is None else e["response_error"] for e in entries]
     )
-    spread = [e.get("identity_spread") for e in entries]
+    spread = [e["identity_spread"] for e in entries]
     axes[1].plot(
         y, [np.nan if v is None else v for v in spread], "k_", ms=14, label="identity spread"
     )
@@ -131,7 +131,7 @@ def markdown(cfg, result: dict) -> str:  # cfg: GalleryConfig
         f"{', '.join(map(str, result['identity_seeds']))}) x {len(result['expressions'])} "
         "expressions of the held-out take (widest jaw opening, broadest smile, strongest "
         f"pucker); LHM level {c['level']}, static frames, physics solved to a tolerance of "
-        f"{c.get('tolerance', 1e-4):g}, {c['ranges']} ranges; model: "
+        f"{c['tolerance']:g}, {c['ranges']} ranges; model: "
         f"`{c['bundle']}`. Written by `python -m softdeca_train controls` "
         f"({result['seconds']:.0f} s); docs/controls.md says what the figures mean.",
         "",
@@ -146,7 +146,7 @@ def markdown(cfg, result: dict) -> str:  # cfg: GalleryConfig
         lines.append(
             f"| {e['name']} | {e['region'] or 'global'} | {rng} | {_fmt(e['physics_max_mm'])} "
             f"| {_fmt(e['physics_mean_mm'])} | {_fmt(e['model_max_mm'])} "
-            f"| {_fmt(e['response_error'], 2)} | {_fmt(e.get('identity_spread'), 2)} "
+            f"| {_fmt(e['response_error'], 2)} | {_fmt(e['identity_spread'], 2)} "
             f"| {_fmt(e['leakage'], 2)} "
             f"| {_fmt(e['physics_leakage'], 2)} |"
         )

@@ -35,11 +35,16 @@ from softdeca_train.train.linear_baseline import ParameterScaling
 from softdeca_train.train.models import GRADIENT_CLAMP, frame_gradients
 
 
+def _own(p: np.ndarray, scaling: ParameterScaling) -> np.ndarray:
+    """(n, P + 3): each element's normalised parameters and gravity load."""
+    return np.concatenate([scaling.normalise(p), scaling.gravity_load(p)], axis=1)
+
+
 def local_features(weights: np.ndarray, p: np.ndarray, scaling: ParameterScaling) -> torch.Tensor:
     """(n, B, 52 + 1 + P + 3) float64: for each of n elements and B frames, [w, 1, p_e, g_e]
     with the element's own parameters p (n, P)."""
     b, n = len(weights), len(p)
-    own = np.concatenate([scaling.normalise(p), scaling.gravity_load(p)], axis=1)
+    own = _own(p, scaling)
     w1 = np.concatenate([np.asarray(weights, float), np.ones((b, 1))], axis=1)
     x = np.concatenate(
         [
@@ -70,7 +75,7 @@ def identity_features(
 ) -> torch.Tensor:
     """x (n, B, d) with [p_v, g_v] x h[:IDENTITY_TERMS] of each element appended (one
     identity per batch, h (1, H) or (H,))."""
-    own = np.concatenate([scaling.normalise(p), scaling.gravity_load(p)], axis=1)  # (n, P+3)
+    own = _own(p, scaling)
     k = np.asarray(h, float).reshape(-1)[:IDENTITY_TERMS]
     inter = torch.from_numpy((own[:, :, None] * k[None, None]).reshape(len(own), -1))
     return torch.cat([x, inter[:, None].expand(-1, x.shape[1], -1)], dim=2)
