@@ -84,6 +84,20 @@ def test_each_element_recovers_its_own_planted_map() -> None:
     assert fit.solve(1e3).abs().max() < 0.1 * truth.abs().max()
 
 
+def test_a_leading_feature_block_solves_as_its_own_fit() -> None:
+    rng = np.random.default_rng(2)
+    n, d, k, lead = 4, 9, 3, 5
+    full, own = LocalRidge(n, d, k), LocalRidge(n, lead, k)
+    for _ in range(3):
+        x = torch.from_numpy(rng.normal(size=(n, 8, d)))
+        y = torch.from_numpy(rng.normal(size=(n, 8, k)))
+        full.add(x, y)
+        own.add(x[..., :lead], y)
+    sub = full.solve(1e-3, chunk=3, features=lead)
+    assert sub.shape == (n, lead, k)
+    assert torch.allclose(sub, own.solve(1e-3), atol=1e-10)
+
+
 def test_the_small_dataset_gets_every_figure(small) -> None:
     folder, _ = small
     manifest = json.loads((folder / "manifest.json").read_text())

@@ -97,18 +97,20 @@ class LocalRidge:
         self.cross.baddbmm_(xt, y.to(torch.float64))
         self.frames += x.shape[1]
 
-    def solve(self, ridge: float, chunk: int = 1024) -> torch.Tensor:
-        """(n, d, k); `ridge` relative to each element's mean diagonal of its A^T A. Solved
-        `chunk` elements at a time: a copy of every element's system at once would double
-        the memory the normal equations already take (gigabytes for the skin's vertices)."""
-        d = self.gram.shape[-1]
+    def solve(self, ridge: float, chunk: int = 1024, features: int | None = None) -> torch.Tensor:
+        """(n, d, k); `ridge` relative to each element's mean diagonal of its A^T A. With
+        `features`, the fit on the first that many feature columns only: nested feature sets
+        share one accumulation, their systems being its leading blocks. Solved `chunk`
+        elements at a time: a copy of every element's system at once would double the memory
+        the normal equations already take (gigabytes for the skin's vertices)."""
+        d = self.gram.shape[-1] if features is None else features
         eye = torch.eye(d, dtype=torch.float64)
-        out = torch.empty_like(self.cross)
+        out = torch.empty(len(self.cross), d, self.cross.shape[-1], dtype=torch.float64)
         for i in range(0, len(self.gram), chunk):
-            g = self.gram[i : i + chunk]
+            g = self.gram[i : i + chunk, :d, :d]
             scale = torch.diagonal(g, dim1=1, dim2=2).mean(dim=1).clamp_min(1e-30)
             out[i : i + chunk] = torch.linalg.solve(
-                g + ridge * scale[:, None, None] * eye, self.cross[i : i + chunk]
+                g + ridge * scale[:, None, None] * eye, self.cross[i : i + chunk, :d]
             )
         return out
 
@@ -152,36 +154,35 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
     if test_total == 0:
         raise ValueError(f"{folder}: no static test frame to measure")
     smoothing = FieldSmoothing(ds.template.neutral[:n_v])
-    vert = grad = aver = ident = None
+
+    def vertex_features(b: Batch) -> tuple[torch.Tensor, int, int]:
+        """[own | averaged | identity] columns of every vertex, and where the first two end:
+        the three per-vertex models fit nested prefixes of these columns."""
+        pv = b.vertex_parameters(n_v).numpy()
+        xv = local_features(b.weights.numpy(), pv, scaling)
+        xa = averaged_features(xv, pv, scaling, smoothing)
+        return identity_features(xa, pv, b.h.numpy(), scaling), xv.shape[-1], xa.shape[-1]
+
+    vert = grad = None
+    d_own = d_aver = 0
     bar = tqdm(total=kept, desc="local fits (train)", unit="frame", disable=not progress)
     for b in ds.batches("static", "train", max_error=limit):
-        w = b.weights.numpy()
-        pv = b.vertex_parameters(n_v).numpy()
-        xv = local_features(w, pv, scaling)
-        xa = averaged_features(xv, pv, scaling, smoothing)
-        xi = identity_features(xa, pv, b.h.numpy(), scaling)
-        xf = local_features(w, b.face_parameters(n_f).numpy(), scaling)
-        if vert is None or grad is None or aver is None or ident is None:
-            vert, grad = LocalRidge(n_v, xv.shape[-1], 3), LocalRidge(n_f, xf.shape[-1], 9)
-            aver, ident = LocalRidge(n_v, xa.shape[-1], 3), LocalRidge(n_v, xi.shape[-1], 3)
-        offsets = (b.T - b.S).transpose(0, 1)
-        vert.add(xv, offsets)
-        aver.add(xa, offsets)
-        ident.add(xi, offsets)
+        xi, d_own, d_aver = vertex_features(b)
+        xf = local_features(b.weights.numpy(), b.face_parameters(n_f).numpy(), scaling)
+        if vert is None or grad is None:
+            vert, grad = LocalRidge(n_v, xi.shape[-1], 3), LocalRidge(n_f, xf.shape[-1], 9)
+        vert.add(xi, (b.T - b.S).transpose(0, 1))
         grad.add(xf, _residual_gradients(b, tri).reshape(b.frames, n_f, 9).transpose(0, 1))
         bar.update(b.frames)
     bar.close()
-    assert vert is not None and grad is not None and aver is not None and ident is not None
-    train_frames = aver.frames
-    # each system freed once solved: the normal equations are the largest arrays here
-    coef_v = vert.solve(cfg.ridge)
-    del vert
+    assert vert is not None and grad is not None
+    train_frames = vert.frames
+    coef_v = vert.solve(cfg.ridge, features=d_own)
+    coef_a = vert.solve(cfg.ridge, features=d_aver)
+    coef_i = vert.solve(cfg.ridge)
+    del vert  # the normal equations are the largest arrays here
     coef_f = grad.solve(cfg.ridge)
     del grad
-    coef_a = aver.solve(cfg.ridge)
-    del aver
-    coef_i = ident.solve(cfg.ridge)
-    del ident
     err: dict[str, list[float]] = {
         "none": [],
         "vertex_local": [],
@@ -192,15 +193,11 @@ def run_local_fits(folder: str | Path, cfg: LocalFitConfig, progress: bool = Tru
     }
     bar = tqdm(total=test_total, desc="local fits (test)", unit="frame", disable=not progress)
     for b in ds.batches("static", "test", max_error=EVERY_FRAME):
-        w = b.weights.numpy()
-        pv = b.vertex_parameters(n_v).numpy()
-        xv = local_features(w, pv, scaling)
-        xa = averaged_features(xv, pv, scaling, smoothing)
-        xi = identity_features(xa, pv, b.h.numpy(), scaling)
-        xf = local_features(w, b.face_parameters(n_f).numpy(), scaling)
+        xi, _, _ = vertex_features(b)
+        xf = local_features(b.weights.numpy(), b.face_parameters(n_f).numpy(), scaling)
         err["none"] += _mean_mm(b.S, b.T)
-        err["vertex_local"] += _mean_mm(b.S + predict(xv, coef_v).float(), b.T)
-        err["vertex_averaged"] += _mean_mm(b.S + predict(xa, coef_a).float(), b.T)
+        err["vertex_local"] += _mean_mm(b.S + predict(xi[..., :d_own], coef_v).float(), b.T)
+        err["vertex_averaged"] += _mean_mm(b.S + predict(xi[..., :d_aver], coef_a).float(), b.T)
         err["vertex_identity"] += _mean_mm(b.S + predict(xi, coef_i).float(), b.T)
         g = predict(xf, coef_f).float().reshape(b.frames, n_f, 3, 3)
         err["gradient_local"] += _mean_mm(deformation_transfer(b.dt, b.S, g), b.T)
