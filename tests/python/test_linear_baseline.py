@@ -76,8 +76,20 @@ def test_unknown_feature_letters_are_refused() -> None:
     sc = _scaling()
     with pytest.raises(ValueError, match="feature set"):
         features(
-            "wx", np.zeros((1, 52)), sc.params.defaults()[None], np.zeros((1, 3)), sc
+            "wz", np.zeros((1, 52)), sc.params.defaults()[None], np.zeros((1, 3)), sc
         )
+
+
+def test_products_pair_every_weight_with_every_normalised_parameter() -> None:
+    sc = _scaling()
+    rng = np.random.default_rng(3)
+    w = rng.uniform(size=(4, 52))
+    p = np.repeat(sc.params.defaults()[None], 4, axis=0)
+    a = features("x", w, p, np.zeros((4, 3)), sc)
+    n_p = len(sc.params.specs)
+    assert a.shape == (4, 1 + 52 * n_p)
+    q = sc.normalise(p)
+    assert a[2, 1 + 7 * n_p + 5] == pytest.approx(w[2, 7] * q[2, 5])
 
 
 def test_ridge_recovers_a_planted_linear_map() -> None:

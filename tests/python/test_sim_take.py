@@ -62,7 +62,7 @@ def simulated(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
     r = _simulate(
         str(take), "--out", str(out), "--level", str(LEVEL), "--start", "10", "--frames", "2",
         "--stride", "15", "--parameters", str(params), "--obj-every", "1", "--render-frames", "2",
-        "--seed", "3", "--quiet", cwd=tmp_path,
+        "--seed", "3", "--reference-tolerance", "1e-9", "--quiet", cwd=tmp_path,
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
     return out, r.stdout
@@ -92,6 +92,20 @@ def test_simulate_writes_caches_render_and_summary(simulated: tuple[Path, str]) 
     assert "penetrating lip vertices" in stdout
 
 
+def test_simulate_measures_its_distance_to_a_tight_reference(
+    simulated: tuple[Path, str],
+) -> None:
+    out, stdout = simulated
+    summary = json.loads((out / "simulate.json").read_text())
+    ref = summary["reference"]
+    assert summary["tolerance"] == 1e-5 and ref["tolerance"] == 1e-9
+    assert ref["converged"] == 2 and len(ref["per_frame"]) == 2
+    # At 1e-5 of the diagonal the mean distance to the tight solve is a few µm, not zero.
+    assert 0 < ref["mean_mm"] < 0.02
+    assert ref["max_mm"] >= max(f["mean_mm"] for f in ref["per_frame"])
+    assert "distance on S to the solve at tolerance 1e-09" in stdout
+
+
 @pytest.mark.skipif(shutil.which("blender") is None, reason="Blender is not installed")
 def test_simulate_output_imports_into_blender(simulated: tuple[Path, str]) -> None:
     """The documented Blender steps (training/blender/check_import.py) show the caches."""
@@ -117,6 +131,7 @@ def test_simulate_output_imports_into_blender(simulated: tuple[Path, str]) -> No
         (["--coefficients", "{c}"], "identity coefficients"),
         (["--start", "999999"], "past the take"),
         (["--stride", "0"], "--stride >= 1"),
+        (["--reference-tolerance", "0"], "--reference-tolerance < 1"),
     ],
 )
 def test_simulate_refuses_bad_input(
@@ -242,3 +257,28 @@ def test_steps_parse_without_the_native_module(tmp_path: Path) -> None:
             capture_output=True, text=True, env=env, cwd=tmp_path, check=False,
         )  # fmt: skip
         assert r.returncode == 0, r.stderr
+
+
+def test_reference_distances_name_the_largest_and_its_region() -> None:
+    from softdeca_train.data.regions import REGIONS
+    from softdeca_train.sim.run import SimulatedTake, reference_distances
+
+    rng = np.random.default_rng(0)
+    heads = [rng.normal(size=(N_SKIN + 5, 3)).astype(np.float32) for _ in range(2)]
+    labels = np.zeros(N_SKIN, np.int64)
+    labels[7] = REGIONS.index("lips")
+    a, b = (
+        SimulatedTake(physics=heads),
+        SimulatedTake(physics=[h.copy() for h in heads]),
+    )
+    same = reference_distances(a, b, labels)
+    assert same["mean_mm"] == 0 and same["max_mm"] == 0
+    b.physics[1][7, 0] += 0.002  # 2 mm on one vertex of S
+    b.physics[1][N_SKIN + 1] += 1.0  # not S: not measured
+    moved = reference_distances(a, b, labels)
+    assert moved["per_frame"][0]["max_mm"] == 0
+    f = moved["per_frame"][1]
+    assert f["max_mm"] == pytest.approx(2.0, rel=1e-3) and f["max_region"] == "lips"
+    assert f["over_0_1_mm"] == 1 and f["mean_mm"] == pytest.approx(
+        2.0 / N_SKIN, rel=1e-3
+    )

@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from softdeca_train.template import Template
 
 DEFAULT_LEVEL = 4
+REFERENCE_MAX_ITERATIONS = 20000  # a reference solve runs to its tolerance, not to the cap
 
 
 def add_simulate_args(p: argparse.ArgumentParser) -> None:
@@ -48,6 +49,17 @@ def add_simulate_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dynamic", action="store_true", help="second-order dynamics (eq. 9)")
     p.add_argument("--no-collisions", action="store_true", help="skip lip/teeth collisions")
     p.add_argument("--threads", type=int, default=1, help="simulator threads (1)")
+    p.add_argument(
+        "--tolerance", type=float, default=1e-5, help="solver tolerance (1e-5, docs/physics.md)"
+    )
+    p.add_argument("--max-iterations", type=int, default=800, help="solver iteration cap (800)")
+    p.add_argument(
+        "--reference-tolerance",
+        type=float,
+        default=None,
+        help="also solve every frame to this tolerance (e.g. 1e-10, cap 20000 iterations) and "
+        "report how far the result lies from it on S (simulate.json `reference`)",
+    )
     p.add_argument("--obj-every", type=int, default=0, help="also write every Nth frame as OBJ")
     p.add_argument("--render-frames", type=int, default=3, help="rows of simulate.png (3; 0: none)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -92,11 +104,19 @@ def _set_parameters(sim: native.Simulator, values: dict[str, float]) -> None:
 
 
 def run_simulate(args: argparse.Namespace) -> int:
+    from softdeca_train.data.regions import region_labels
     from softdeca_train.lhm import LhmConfig
     from softdeca_train.sim.figure import render_comparison
     from softdeca_train.sim.head import build_head_simulation
     from softdeca_train.sim.output import write_sequences
-    from softdeca_train.sim.run import simulate_frames, summarise, summary_lines
+    from softdeca_train.sim.run import (
+        SimulatedTake,
+        reference_distances,
+        reference_line,
+        simulate_frames,
+        summarise,
+        summary_lines,
+    )
     from softdeca_train.sim.take import read_take
     from softdeca_train.template import Template
 
@@ -105,6 +125,11 @@ def run_simulate(args: argparse.Namespace) -> int:
         raise ValueError(
             "need --threads >= 1, --level >= 1, --obj-every >= 0, --render-frames >= 0"
         )
+    tolerances = [args.tolerance] + (
+        [] if args.reference_tolerance is None else [args.reference_tolerance]
+    )
+    if not all(0 < t < 1 for t in tolerances) or args.max_iterations < 1:
+        raise ValueError("need 0 < --tolerance, --reference-tolerance < 1, --max-iterations >= 1")
     take = read_take(Path(args.take), args.start, args.frames, args.stride)
     values = _parameters(args.parameters)
     template = Template.load(args.ict)
@@ -117,11 +142,21 @@ def run_simulate(args: argparse.Namespace) -> int:
         flush=True,
     )
     hs = build_head_simulation(template, h, LhmConfig(level=args.level))
-    sim = hs.simulator(
-        threads=args.threads, **({"collision_rounds": 0} if args.no_collisions else {})
-    )
-    _set_parameters(sim, values)
-    result = simulate_frames(hs, sim, take.weights, args.dynamic, progress=not args.quiet)
+    settings = {"collision_rounds": 0} if args.no_collisions else {}
+
+    def run(tolerance: float, max_iterations: int) -> SimulatedTake:
+        sim = hs.simulator(
+            threads=args.threads, tolerance=tolerance, max_iterations=max_iterations, **settings
+        )
+        _set_parameters(sim, values)
+        return simulate_frames(hs, sim, take.weights, args.dynamic, progress=not args.quiet)
+
+    result = run(args.tolerance, args.max_iterations)
+    reference = None
+    if args.reference_tolerance is not None:
+        exact = run(args.reference_tolerance, REFERENCE_MAX_ITERATIONS)
+        reference = reference_distances(result, exact, region_labels(template))
+        reference["tolerance"] = args.reference_tolerance
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -159,6 +194,9 @@ def run_simulate(args: argparse.Namespace) -> int:
         "dynamic": args.dynamic,
         "collisions": not args.no_collisions,
         "threads": args.threads,
+        "tolerance": args.tolerance,
+        "max_iterations": args.max_iterations,
+        "reference": reference,
         "simulation_seconds": result.seconds,
         "wall_seconds": time.perf_counter() - t0,
         "summary": summary,
@@ -168,6 +206,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     }
     (out / "simulate.json").write_text(json.dumps(report, indent=2) + "\n")
     print("\n".join(summary_lines(summary, result.seconds)))
+    if reference is not None:
+        print(reference_line(reference, args.tolerance))
     for frame, r in zip(take.frames, result.records, strict=True):
         if r.failures:
             c = r.check

@@ -94,6 +94,48 @@ def simulate_frames(
     return out
 
 
+def reference_distances(
+    result: SimulatedTake, reference: SimulatedTake, labels: np.ndarray
+) -> dict[str, Any]:
+    """How far `result`'s skin S lies from a `reference` run of the same frames (a tighter
+    tolerance): per frame the mean and largest vertex distance (mm) and the region
+    (data/regions.py, `labels` per vertex of S) of the largest."""
+    from softdeca_train.data.regions import REGIONS
+
+    frames = []
+    for a, b in zip(result.physics, reference.physics, strict=True):
+        d = 1e3 * np.linalg.norm(a[:N_SKIN].astype(np.float64) - b[:N_SKIN], axis=1)
+        worst = int(np.argmax(d))
+        frames.append(
+            {
+                "mean_mm": float(d.mean()),
+                "max_mm": float(d[worst]),
+                "max_region": REGIONS[int(labels[worst])],
+                "over_0_1_mm": int((d > 0.1).sum()),
+            }
+        )
+    return {
+        "mean_mm": float(np.mean([f["mean_mm"] for f in frames])),
+        "max_mm": max(f["max_mm"] for f in frames),
+        "converged": sum(r.converged for r in reference.records),
+        "iterations_mean": float(np.mean([r.iterations for r in reference.records]))
+        if reference.records
+        else None,
+        "per_frame": frames,
+    }
+
+
+def reference_line(ref: dict[str, Any], tolerance: float) -> str:
+    """The terminal line of `reference_distances`' figures."""
+    regions = sorted({f["max_region"] for f in ref["per_frame"]})
+    return (
+        f"distance on S to the solve at tolerance {ref['tolerance']:g} (from {tolerance:g}): "
+        f"mean {ref['mean_mm']:.5f} mm, max {ref['max_mm']:.3f} mm (largest in "
+        f"{', '.join(regions)}); reference {ref['converged']} of {len(ref['per_frame'])} "
+        f"converged, {ref['iterations_mean'] or 0:.0f} iterations mean"
+    )
+
+
 def summarise(records: list[FrameRecord]) -> dict[str, Any]:
     """Means and worst values over the frames (volume: of the absolute change)."""
     if not records:
