@@ -34,8 +34,7 @@ GROUPS = {
     "p": "material parameters, normalised to the dataset's ranges",
     "g": "gravity load vector s d - d0 (3; in g)",
     "h": "identity code h",
-    "x": "products of w and the normalised p (52 x P): a response to p that the expression "
-    "changes",
+    "x": "products of w and the normalised p (52 x P): a response to p that the expression changes",
 }
 DEFAULT_SETS = ("w", "p", "wp", "wpg", "wpgh")
 _CAPTURE = np.array([0.0, -1.0, 0.0])  # the neutral's own load: 1 g along -Y
