@@ -271,14 +271,15 @@ def test_reference_distances_name_the_largest_and_its_region() -> None:
         SimulatedTake(physics=heads),
         SimulatedTake(physics=[h.copy() for h in heads]),
     )
-    same = reference_distances(a, b, labels)
+    same = reference_distances(a, b, 1e-9, labels)
     assert same["mean_mm"] == 0 and same["max_mm"] == 0
     b.physics[1][7, 0] += 0.002  # 2 mm on one vertex of S
     b.physics[1][N_SKIN + 1] += 1.0  # not S: not measured
-    moved = reference_distances(a, b, labels)
+    moved = reference_distances(a, b, 1e-9, labels)
     assert moved["per_frame"][0]["max_mm"] == 0
     f = moved["per_frame"][1]
     assert f["max_mm"] == pytest.approx(2.0, rel=1e-3) and f["max_region"] == "lips"
+    assert f["max_vertex"] == 7 and moved["tolerance"] == 1e-9
     assert f["over_0_1_mm"] == 1 and f["mean_mm"] == pytest.approx(
         2.0 / N_SKIN, rel=1e-3
     )

@@ -125,9 +125,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         raise ValueError(
             "need --threads >= 1, --level >= 1, --obj-every >= 0, --render-frames >= 0"
         )
-    tolerances = [args.tolerance] + (
-        [] if args.reference_tolerance is None else [args.reference_tolerance]
-    )
+    tolerances = [t for t in (args.tolerance, args.reference_tolerance) if t is not None]
     if not all(0 < t < 1 for t in tolerances) or args.max_iterations < 1:
         raise ValueError("need 0 < --tolerance, --reference-tolerance < 1, --max-iterations >= 1")
     take = read_take(Path(args.take), args.start, args.frames, args.stride)
@@ -155,8 +153,9 @@ def run_simulate(args: argparse.Namespace) -> int:
     reference = None
     if args.reference_tolerance is not None:
         exact = run(args.reference_tolerance, REFERENCE_MAX_ITERATIONS)
-        reference = reference_distances(result, exact, region_labels(template))
-        reference["tolerance"] = args.reference_tolerance
+        reference = reference_distances(
+            result, exact, args.reference_tolerance, region_labels(template)
+        )
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

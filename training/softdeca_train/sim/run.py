@@ -95,11 +95,11 @@ def simulate_frames(
 
 
 def reference_distances(
-    result: SimulatedTake, reference: SimulatedTake, labels: np.ndarray
+    result: SimulatedTake, reference: SimulatedTake, tolerance: float, labels: np.ndarray
 ) -> dict[str, Any]:
-    """How far `result`'s skin S lies from a `reference` run of the same frames (a tighter
-    tolerance): per frame the mean and largest vertex distance (mm) and the region
-    (data/regions.py, `labels` per vertex of S) of the largest."""
+    """How far `result`'s skin S lies from a `reference` run of the same frames (solved to
+    `tolerance`): per frame the mean and largest vertex distance (mm), the vertex of S with the
+    largest and its region (data/regions.py, `labels` per vertex of S)."""
     from softdeca_train.data.regions import REGIONS
 
     frames = []
@@ -110,11 +110,13 @@ def reference_distances(
             {
                 "mean_mm": float(d.mean()),
                 "max_mm": float(d[worst]),
+                "max_vertex": worst,
                 "max_region": REGIONS[int(labels[worst])],
                 "over_0_1_mm": int((d > 0.1).sum()),
             }
         )
     return {
+        "tolerance": tolerance,
         "mean_mm": float(np.mean([f["mean_mm"] for f in frames])),
         "max_mm": max(f["max_mm"] for f in frames),
         "converged": sum(r.converged for r in reference.records),
