@@ -164,6 +164,28 @@ def test_an_open_jaw_keeps_the_mouth_open_without_exploding(
     assert check.penetrating_physics <= check.penetrating_linear
 
 
+def test_soft_volume_by_group_adds_up_to_the_whole(head: HeadSimulation) -> None:
+    volume = SoftVolume(head)
+    rest = np.asarray(head.mesh.rest)
+    n = len(volume.tets)
+    one = np.zeros(n, np.int64)
+    assert volume.change_percent_by_group(rest, one) == pytest.approx([0.0], abs=1e-9)
+    grown = rest * 1.01  # every volume times 1.01^3
+    assert volume.change_percent_by_group(grown, one)[0] == pytest.approx(
+        volume.change_percent(grown)
+    )
+    halves = (np.arange(n) >= n // 2).astype(
+        np.int64
+    ) * 2  # ids 0 and 2; 1 holds no tet
+    assert volume.change_percent_by_group(grown, halves) == pytest.approx(
+        [3.0301, np.nan, 3.0301], rel=1e-6, nan_ok=True
+    )
+    field = np.where(halves == 0, 0.9, 1.1)
+    assert volume.requested_percent_by_group(field, halves) == pytest.approx(
+        [-10.0, np.nan, 10.0], nan_ok=True
+    )
+
+
 def test_the_mesh_is_cached(template: Template, head: HeadSimulation) -> None:
     again = build_head_simulation(template, None, dataclasses.replace(CONFIG))
     assert np.array_equal(np.asarray(again.mesh.rest), np.asarray(head.mesh.rest))

@@ -90,6 +90,19 @@ def test_bounds_name_each_failure() -> None:
     assert _check(**grown).failures() == ["volume"]
     assert _check(**grown, volume_requested_percent=7.6).failures() == []
     assert _check(**grown, volume_requested_percent=-2.0).failures() == ["volume"]
+    # A regional request (a generated frame: face -11 %, head and neck +14 %; together +0.06 %)
+    # is judged region by region: each moved part of the way, shrinking further than growing,
+    # so the total missed the mean request by 1.1 points without any region failing.
+    regional = {
+        "volume_physics_percent": -1.02,
+        "volume_linear_percent": 0.07,
+        "volume_requested_percent": 0.06,
+    }
+    assert _check(**regional).failures() == ["volume"]
+    met = ((-8.1, -5.9, -11.0), (6.2, 5.8, 13.6))
+    assert _check(**regional, volume_regions=met).failures() == []
+    lost = ((-8.1, -5.9, -11.0), (3.0, 5.8, 13.6), (-2.5, 0.0, 0.0))
+    assert _check(**regional, volume_regions=lost).failures() == ["volume"]
     assert _check(converged=False).failures() == ["not_converged"]
     both = [_check(), _check(penetrating_physics=9, inverted_elements=2)]
     counts = failure_counts(both)

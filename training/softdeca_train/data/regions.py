@@ -81,10 +81,3 @@ def element_regions(
     if domain == "skin_point":
         return labels
     raise ValueError(f"no per-region values for domain {domain!r}")
-
-
-def regional_field(
-    values: np.ndarray, labels: np.ndarray, mesh: object, neutral_skin: np.ndarray, domain: str
-) -> np.ndarray:
-    """Per-element values of one parameter from its value per region (len(REGIONS),)."""
-    return np.asarray(values, np.float64)[element_regions(labels, mesh, neutral_skin, domain)]

@@ -60,6 +60,24 @@ class SoftVolume:
         v = float(native.tet_signed_volumes(np.asarray(vertices, np.float64), self.tets).sum())
         return 100.0 * (v / self.rest_volume - 1.0)
 
+    def change_percent_by_group(self, vertices: np.ndarray, groups: np.ndarray) -> np.ndarray:
+        """Per group of soft tets (`groups`: a non-negative id per tet) its volume change (%);
+        NaN for ids that hold no tet."""
+        v = np.asarray(native.tet_signed_volumes(np.asarray(vertices, np.float64), self.tets))
+        rest = self._by_group(self._rest_volumes, groups)
+        return 100.0 * (self._by_group(v, groups) / rest - 1.0)
+
+    def requested_percent_by_group(self, field: np.ndarray, groups: np.ndarray) -> np.ndarray:
+        """Per group the requested change (%) of a per-tet target_volume field (rest-weighted)."""
+        rest = self._rest_volumes
+        return 100.0 * (self._by_group(rest * field, groups) / self._by_group(rest, groups) - 1.0)
+
+    @staticmethod
+    def _by_group(values: np.ndarray, groups: np.ndarray) -> np.ndarray:
+        sums = np.bincount(groups, weights=values)
+        held = np.bincount(groups) > 0
+        return np.where(held, sums, np.nan)
+
     def linear_vertices(self, skin_target: np.ndarray, simulated: np.ndarray) -> np.ndarray:
         """`simulated` with the soft tissue's own vertices refitted to the skin target."""
         x = np.asarray(simulated, np.float64).copy()

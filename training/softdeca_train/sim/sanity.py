@@ -14,13 +14,15 @@ bounds"). A frame is compared with the linear blend S_t it was simulated from:
   beyond what a contact correction explains (as for `exploded`: a lip the linear blend pushes
   into the teeth must come out of them, and the opening changes by up to that depth);
 - inverted elements: any soft or muscle tet with volume <= 0 at the end of the solve;
-- volume: the soft tissue's volume change farther from the requested one (`target_volume`,
-  its rest-volume-weighted mean where it varies by region) than the linear blend's (refit,
-  measures.py) by more than `volume_slack_percent` (percentage points: both are ~0 near rest
-  at the default target_volume 1). The slack is the tissue's own compliance under the loads a
-  frame may carry: on the neutral face, with nothing but gravity 2 g against the capture's
-  (a 3 g difference), the physics' soft tissue loses 0.6 points at the default volume
-  weights;
+- volume: the soft tissue's volume change farther from the requested one (`target_volume`)
+  than the linear blend's (refit, measures.py) by more than `volume_slack_percent`
+  (percentage points: both are ~0 near rest at the default target_volume 1). The slack is
+  the tissue's own compliance under the loads a frame may carry: on the neutral face, with
+  nothing but gravity 2 g against the capture's (a 3 g difference), the physics' soft tissue
+  loses 0.6 points at the default volume weights. Where target_volume varies by region, each
+  region's tets are judged against that region's request: regions asked to shrink and to
+  grow each move part of the way, by different shares (growth pushes against the held skin),
+  so the total volume is no measure of whether the tissue did what was asked;
 - not converged: the volumetric solve stopped at its iteration cap.
 """
 
@@ -58,6 +60,14 @@ REASONS = (
 )
 
 
+@dataclass(frozen=True)
+class VolumeField:
+    """A target_volume that varies by region: per soft tet its value and its region's id."""
+
+    values: np.ndarray
+    groups: np.ndarray
+
+
 @dataclass
 class FrameCheck:
     """One frame's figures against its linear blend and the reasons it fails (if any)."""
@@ -77,6 +87,9 @@ class FrameCheck:
     # The soft tissue's requested change, 100 (target_volume - 1): the physics grows or
     # shrinks the tissue toward it, so both changes are measured from it.
     volume_requested_percent: float = 0.0
+    # Where target_volume varies by region: per region (physics, linear, requested) change
+    # (%), judged in place of the totals.
+    volume_regions: tuple[tuple[float, float, float], ...] = ()
 
     @property
     def open_ratio(self) -> float:
@@ -109,9 +122,16 @@ class FrameCheck:
                 out.append("mouth_open_ratio")
         if self.inverted_elements > 0:
             out.append("inverted_elements")
-        req = self.volume_requested_percent
-        if abs(self.volume_physics_percent - req) > (
-            abs(self.volume_linear_percent - req) + bounds.volume_slack_percent
+        judged = self.volume_regions or (
+            (
+                self.volume_physics_percent,
+                self.volume_linear_percent,
+                self.volume_requested_percent,
+            ),
+        )
+        if any(
+            abs(phys - req) > abs(lin - req) + bounds.volume_slack_percent
+            for phys, lin, req in judged
         ):
             out.append("volume")
         if not self.converged:
@@ -157,12 +177,24 @@ def check_frame(
     vertices: np.ndarray,
     stats: dict[str, object],
     target_volume: float = 1.0,
+    volume_field: VolumeField | None = None,
 ) -> FrameCheck:
     """`target`: the linear blend's S (S_t); skin / vertices / stats: the solver's result;
-    `target_volume`: the soft tissue's parameter of that name for the frame."""
+    `target_volume`: the soft tissue's parameter of that name for the frame (its
+    rest-volume-weighted mean where it varies); `volume_field`: where it varies by region."""
     linear_pen = _penetrations(hs, target, vertices)
     physics_pen = _penetrations(hs, skin, vertices)
     linear_vertices = volume.linear_vertices(target, vertices)
+    regions: tuple[tuple[float, float, float], ...] = ()
+    if volume_field is not None:
+        g = volume_field.groups
+        by = zip(
+            volume.change_percent_by_group(vertices, g),
+            volume.change_percent_by_group(linear_vertices, g),
+            volume.requested_percent_by_group(volume_field.values, g),
+            strict=True,
+        )
+        regions = tuple((float(a), float(b), float(c)) for a, b, c in by if not math.isnan(c))
     return FrameCheck(
         converged=bool(stats["converged"]),
         iterations=int(stats["iterations"]),  # type: ignore[call-overload]
@@ -177,6 +209,7 @@ def check_frame(
         volume_linear_percent=volume.change_percent(linear_vertices),
         volume_physics_percent=volume.change_percent(vertices),
         volume_requested_percent=100.0 * (target_volume - 1.0),
+        volume_regions=regions,
     )
 
 
