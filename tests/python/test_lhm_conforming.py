@@ -164,6 +164,16 @@ def test_an_open_jaw_keeps_the_mouth_open_without_exploding(
     assert check.penetrating_physics <= check.penetrating_linear
 
 
+def test_the_jaw_reaches_the_tissue_only_through_its_teeth(
+    head: HeadSimulation,
+) -> None:
+    # docs/controls.md (jaw_scale_x): the jaw's vertices are colliders, in no tet.
+    jaw = np.asarray(head.mesh.jaw_vertices)
+    assert len(jaw) > 0
+    for tets in (head.mesh.soft_tets, head.mesh.muscle_tets):
+        assert not np.isin(np.asarray(tets), jaw).any()
+
+
 def test_soft_volume_by_group_adds_up_to_the_whole(head: HeadSimulation) -> None:
     volume = SoftVolume(head)
     rest = np.asarray(head.mesh.rest)
