@@ -184,9 +184,8 @@ def test_soft_volume_by_group_adds_up_to_the_whole(head: HeadSimulation) -> None
     assert volume.change_percent_by_group(grown, one)[0] == pytest.approx(
         volume.change_percent(grown)
     )
-    halves = (np.arange(n) >= n // 2).astype(
-        np.int64
-    ) * 2  # ids 0 and 2; 1 holds no tet
+    # ids 0 and 2; 1 holds no tet
+    halves = (np.arange(n) >= n // 2).astype(np.int64) * 2
     assert volume.change_percent_by_group(grown, halves) == pytest.approx(
         [3.0301, np.nan, 3.0301], rel=1e-6, nan_ok=True
     )

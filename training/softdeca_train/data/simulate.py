@@ -103,14 +103,13 @@ class _Shard:
         volume: SoftVolume,
         targets: np.ndarray,
         solved: list[tuple[np.ndarray, np.ndarray, dict]],
-        target_volume: float,
-        volume_field: VolumeField | None = None,
+        target_volume: float | VolumeField,
     ) -> np.ndarray:
         """Per frame the sanity bounds' failures as a bit mask (bit i: REASONS[i]), counted."""
         masks = np.zeros(len(solved), np.uint8)
         for f, (vertices, skin, st) in enumerate(solved):
             failed = check_frame(
-                hs, volume, targets[f], skin, vertices, st, target_volume, volume_field
+                hs, volume, targets[f], skin, vertices, st, target_volume
             ).failures()
             for r in failed:
                 masks[f] |= 1 << REASONS.index(r)
@@ -129,21 +128,20 @@ def _set_parameters(sim: native.Simulator, names: list[str], p: np.ndarray) -> N
 
 def _set_regional(
     head: _Head, g: GroupSpec, names: list[str]
-) -> tuple[np.ndarray, float, VolumeField | None]:
+) -> tuple[np.ndarray, float | VolumeField]:
     """The group's regional pattern on the simulator (fields over the parameters' element
-    domains). Returns the pattern stored with the instances (p in every region without one),
-    the soft tissue's requested volume (target_volume's rest-volume-weighted mean over the soft
-    tets; p's value without a pattern) and, where target_volume varies by region, its field
-    with each tet's region (the volume bound judges each region against its own request)."""
+    domains). Returns the pattern stored with the instances (p in every region without one)
+    and the soft tissue's requested volume: p's target_volume, or its field with each tet's
+    region where the pattern varies it (the volume bound judges each region on its own)."""
     from softdeca_train.data.regions import REGIONS, element_regions, region_labels
 
     tv = names.index("target_volume")
     if g.p_regions is None:
-        return np.repeat(g.p[None], len(REGIONS), axis=0), float(g.p[tv]), None
+        return np.repeat(g.p[None], len(REGIONS), axis=0), float(g.p[tv])
     labels = region_labels(head.ctx.template)
     domains = {s.name: s.domain for s in load_parameters().specs}
     skin = head.hs.head[:N_SKIN]
-    requested, volume_field = float(g.p[tv]), None
+    requested: float | VolumeField = float(g.p[tv])
     for k, name in enumerate(names):
         column = g.p_regions[:, k]
         if np.any(column != g.p[k]):
@@ -151,9 +149,8 @@ def _set_regional(
             field = np.asarray(column, np.float64)[regions]
             head.sim.set_parameter_field(name, field)
             if k == tv:
-                requested = head.volume.mean_over_tets(field)
-                volume_field = VolumeField(values=field, groups=regions)
-    return g.p_regions, requested, volume_field
+                requested = VolumeField(values=field, groups=regions)
+    return g.p_regions, requested
 
 
 def _stats(stats: list[dict]) -> dict[str, np.ndarray]:
@@ -179,7 +176,7 @@ class _Head:
 def _static_group(head: _Head, g: GroupSpec, sparse: bool, names: list[str]) -> None:
     ctx, hs, sim, cfg, out, volume = (head.ctx, head.hs, head.sim, head.cfg, head.out, head.volume)
     _set_parameters(sim, names, g.p)
-    p_regions, requested_volume, volume_field = _set_regional(head, g, names)
+    p_regions, requested_volume = _set_regional(head, g, names)
     w = g.frames.weights
     targets = ctx.blend.targets(hs.head[:N_SKIN], w)
     jaws = hs.jaw_transforms(hs.blend(w))
@@ -212,7 +209,7 @@ def _static_group(head: _Head, g: GroupSpec, sparse: bool, names: list[str]) -> 
     ]
     skins, stats = [s[1] for s in solved], [s[2] for s in solved]
     out.add(
-        failures=out.judge(hs, volume, targets, solved, requested_volume, volume_field),
+        failures=out.judge(hs, volume, targets, solved, requested_volume),
         param_id=np.full(n, g.param_id, np.int32),
         p=np.repeat(g.p[None], n, axis=0),
         p_regions=np.repeat(p_regions[None], n, axis=0),

@@ -20,9 +20,9 @@ bounds"). A frame is compared with the linear blend S_t it was simulated from:
   the tissue's own compliance under the loads a frame may carry: on the neutral face, with
   nothing but gravity 2 g against the capture's (a 3 g difference), the physics' soft tissue
   loses 0.6 points at the default volume weights. Where target_volume varies by region, each
-  region's tets are judged against that region's request: regions asked to shrink and to
-  grow each move part of the way, by different shares (growth pushes against the held skin),
-  so the total volume is no measure of whether the tissue did what was asked;
+  region's tets are judged against that region's request: the regions move toward their
+  requests by different shares, so the total volume is no measure of whether the tissue did
+  what was asked;
 - not converged: the volumetric solve stopped at its iteration cap.
 """
 
@@ -176,25 +176,28 @@ def check_frame(
     skin: np.ndarray,
     vertices: np.ndarray,
     stats: dict[str, object],
-    target_volume: float = 1.0,
-    volume_field: VolumeField | None = None,
+    target_volume: float | VolumeField = 1.0,
 ) -> FrameCheck:
     """`target`: the linear blend's S (S_t); skin / vertices / stats: the solver's result;
-    `target_volume`: the soft tissue's parameter of that name for the frame (its
-    rest-volume-weighted mean where it varies); `volume_field`: where it varies by region."""
+    `target_volume`: the soft tissue's parameter of that name for the frame, or its field
+    where it varies by region (judged region by region; its rest-volume-weighted mean is the
+    total's request)."""
     linear_pen = _penetrations(hs, target, vertices)
     physics_pen = _penetrations(hs, skin, vertices)
     linear_vertices = volume.linear_vertices(target, vertices)
     regions: tuple[tuple[float, float, float], ...] = ()
-    if volume_field is not None:
-        g = volume_field.groups
+    if not isinstance(target_volume, VolumeField):
+        requested = float(target_volume)
+    else:
+        g = target_volume.groups
         by = zip(
             volume.change_percent_by_group(vertices, g),
             volume.change_percent_by_group(linear_vertices, g),
-            volume.requested_percent_by_group(volume_field.values, g),
+            volume.requested_percent_by_group(target_volume.values, g),
             strict=True,
         )
         regions = tuple((float(a), float(b), float(c)) for a, b, c in by if not math.isnan(c))
+        requested = volume.mean_over_tets(target_volume.values)
     return FrameCheck(
         converged=bool(stats["converged"]),
         iterations=int(stats["iterations"]),  # type: ignore[call-overload]
@@ -208,7 +211,7 @@ def check_frame(
         inverted_elements=int(stats["inverted_elements"]),  # type: ignore[call-overload]
         volume_linear_percent=volume.change_percent(linear_vertices),
         volume_physics_percent=volume.change_percent(vertices),
-        volume_requested_percent=100.0 * (target_volume - 1.0),
+        volume_requested_percent=100.0 * (requested - 1.0),
         volume_regions=regions,
     )
 
