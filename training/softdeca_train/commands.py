@@ -19,6 +19,17 @@ class Command:
     run: Callable[[argparse.Namespace], int]
 
 
+def add_tet_mesh_argument(p: argparse.ArgumentParser) -> None:
+    """The simulation's tets (LhmConfig.tet_mesh), for commands that build heads."""
+    p.add_argument(
+        "--tet-mesh",
+        choices=("carried", "conforming", "prisms"),
+        default="carried",
+        help="the heads' tets: the template's fill carried to each head (default), each "
+        "head's own fill, or the wraps' prisms (docs/physics.md)",
+    )
+
+
 def add_ict_argument(p: argparse.ArgumentParser) -> None:
     """The ICT-FaceKit location option every template-based command shares."""
     p.add_argument(

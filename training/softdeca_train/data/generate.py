@@ -179,6 +179,12 @@ def summarise(m: Manifest) -> dict:
             failures[reason] = failures.get(reason, 0) + count
     out["frames_judged"] = judged
     out["failures"] = failures
+    # Where the heads' tets came from (lhm/carried.py): "carried", or why a head got a fill.
+    sources: dict[str, int] = {}
+    for s in shards:
+        key = s.get("tet_source", "unrecorded")
+        sources[key] = sources.get(key, 0) + 1
+    out["tet_sources"] = dict(sorted(sources.items()))
     out["failed_fraction"] = round(failures.get("failed_frames", 0) / judged, 6) if judged else None
     return out
 

@@ -271,10 +271,13 @@ def _sanity_line(summary: dict) -> str:
     if not judged or failures is None:
         return "Sanity bounds: not judged (generated before the bounds were checked)."
     reasons = ", ".join(f"{k} {v}" for k, v in failures.items() if v and k != "failed_frames")
+    sources = summary.get("tet_sources") or {}
+    tets = "; ".join(f"{k}: {v}" for k, v in sources.items())
     return (
         f"Sanity bounds: {failures.get('failed_frames', 0)} of {judged} judged frames fail "
         f"(failed fraction {summary.get('failed_fraction')}; {reasons or 'no reason'}); "
         "per frame in the shards' `failures` bit mask."
+        + (f" Shards by the source of their head's tets: {tets}." if tets else "")
     )
 
 

@@ -304,6 +304,7 @@ def simulate_shard(
         "frames_solved": out.frames,
         "seconds": round(time.perf_counter() - t0, 3),
         "build_seconds": round(t_build, 3),
+        "tet_source": hs.tet_source,
         "max_quantisation_error_m": out.quant_error,
         "quantisation_sq_sum_m2": out.quant_sq_sum,
         "quantisation_values": out.quant_values,

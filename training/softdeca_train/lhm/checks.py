@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import igl
 import numpy as np
@@ -10,6 +11,9 @@ import softdeca_native as native
 
 from softdeca_train.lhm.model import LayeredHeadModel
 from softdeca_train.lhm.quality import QualityReport, mouth_columns, quality_report
+
+if TYPE_CHECKING:  # conforming.py imports this module
+    from softdeca_train.lhm.conforming import TetMesh
 
 
 @dataclass(frozen=True)
@@ -98,14 +102,12 @@ def mouth_quality(model: LayeredHeadModel) -> QualityReport:
     return quality_report(model.vertices, model.soft_tets, model.muscle_tets, mouth)
 
 
-def conforming_quality(model: LayeredHeadModel) -> QualityReport:
-    """Element quality of the conforming fill of `model` (lhm/conforming.py), overall and in
-    the mouth region (vertices within the region's radius of the slit's middle)."""
-    from softdeca_train.lhm.conforming import conforming_mesh
+def conforming_quality(model: LayeredHeadModel, tm: TetMesh) -> QualityReport:
+    """Element quality of `model`'s conforming tet mesh (its fill, lhm/conforming.py, or the
+    template's carried, lhm/carried.py), overall and in the mouth region (vertices within the
+    region's radius of the slit's middle)."""
     from softdeca_train.lhm.quality import MOUTH_REGION_RADIUS
 
-    cfg = model.config
-    tm = conforming_mesh(model, cfg.tet_edge_length, cfg.tet_envelope, cfg.slit_gap)
     center = _slit_middle(model)
     # the mouth's columns: directions from the head centre within the region's radius of the
     # slit's middle on the skin wrap (as for the prisms, from the skin to the skull)

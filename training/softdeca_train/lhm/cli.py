@@ -1,12 +1,13 @@
 """The layered head model stage's commands: `lhm` (fit, check, save and render one
-identity's model), `demo` (the template's layers, sampled identities, landmarks) and `bench`
-(LHM fitting per resolution)."""
+identity's model), `demo` (the template's layers, sampled identities, landmarks), `carry-check`
+(which heads the template's tet mesh is carried to, and how well) and `bench` (LHM fitting per
+resolution)."""
 
 from __future__ import annotations
 
 import argparse
 
-from softdeca_train.commands import Command, add_ict_argument
+from softdeca_train.commands import Command, add_ict_argument, add_tet_mesh_argument
 
 
 def _bench_args(p: argparse.ArgumentParser) -> None:
@@ -30,12 +31,7 @@ def _lhm_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--level", type=int, default=4, help="wrap resolution: icosphere level (4)")
     p.add_argument("--soft-layers", type=int, default=1, help="tet layers skin..muscle (1)")
     p.add_argument("--muscle-layers", type=int, default=1, help="tet layers muscle..skull (1)")
-    p.add_argument(
-        "--tet-mesh",
-        choices=("conforming", "prisms"),
-        default="conforming",
-        help="the simulation's tets: the conforming fill (default) or the wraps' prisms",
-    )
+    add_tet_mesh_argument(p)
     p.add_argument("--out", default="out/lhm", help="output folder (out/lhm)")
 
 
@@ -59,10 +55,13 @@ def _lhm_run(args: argparse.Namespace) -> int:
     model = fit_lhm(t, h, cfg)
     checked = check_lhm(model, t.identity_neutral(h)[:N_SKIN], t.skin_triangles)
     report = checked.as_dict()
-    if cfg.tet_mesh == "conforming":
+    if cfg.tet_mesh in ("carried", "conforming"):
+        from softdeca_train.lhm.carried import tissue_mesh
         from softdeca_train.lhm.checks import conforming_quality
 
-        report["conforming_quality"] = conforming_quality(model).as_dict()
+        mesh, _ = tissue_mesh(t, h, model)
+        report["tet_source"] = mesh.source
+        report["conforming_quality"] = conforming_quality(model, mesh).as_dict()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     name = "template" if args.seed is None else f"seed{args.seed}"
@@ -74,6 +73,64 @@ def _lhm_run(args: argparse.Namespace) -> int:
     print("valid" if not problems else "INVALID: " + "; ".join(problems))
     print(f"wrote {out}/lhm_{name}.npz, .png and _report.json")
     return 0 if not problems else 1
+
+
+def _carry_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("--level", type=int, default=3, help="wrap resolution: icosphere level (3)")
+    p.add_argument("--seeds", type=int, default=40, help="sampled identities, seeds 1000.. (40)")
+    p.add_argument("--out", default="out/carry-check.json", help="report (out/carry-check.json)")
+
+
+def _carry_run(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    import numpy as np
+    from tqdm import tqdm
+
+    from softdeca_train.lhm import LhmConfig
+    from softdeca_train.lhm.carried import carry_basis, carry_quality
+    from softdeca_train.sim.stress import identity_coefficients
+    from softdeca_train.template import Template
+    from softdeca_train.template.model import N_SKIN
+
+    t = Template.load(args.ict)
+    cfg = LhmConfig(level=args.level, tet_mesh="carried")
+    basis = carry_basis(t, cfg)
+    labels = ["template", "h+2.5σ", "h-2.5σ"] + [f"seed {1000 + k}" for k in range(args.seeds)]
+    rows = []
+    for label in tqdm(labels, desc="carry-check", unit="head"):
+        h = identity_coefficients(t, label)
+        skin = t.identity_neutral(h)[:N_SKIN].astype(np.float64)
+        q = carry_quality(basis.vertices(h), basis.mesh, skin, basis.skin_inside)
+        why = q.shortfall(cfg)
+        rows.append({
+            "identity": label,
+            "carried": not why,
+            "why_not": why or None,
+            "inverted": q.inverted,
+            "min_dihedral_deg": round(q.min_dihedral_deg, 2),
+            "max_aspect": round(q.max_aspect, 2),
+            "skin_outside_mm": round(1e3 * q.skin_outside, 3),
+        })  # fmt: skip
+        print(f"{label:10s} {'carried' if not why else 'fill: ' + why}")
+    carried = [r for r in rows if r["carried"]]
+    summary = {
+        "level": args.level,
+        "heads": len(rows),
+        "carried": len(carried),
+        "carried_min_dihedral_deg": min((r["min_dihedral_deg"] for r in carried), default=None),
+        "carried_max_aspect": max((r["max_aspect"] for r in carried), default=None),
+        "template_fill": {"vertices": len(basis.mesh.vertices), "tets": int(
+            len(basis.mesh.soft_tets) + len(basis.mesh.muscle_tets))},
+    }  # fmt: skip
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps({"summary": summary, "heads": rows}, indent=2) + "\n")
+    print(json.dumps(summary))
+    print(f"wrote {out}")
+    return 0
 
 
 def _demo_args(p: argparse.ArgumentParser) -> None:
@@ -130,6 +187,12 @@ COMMANDS = [
         "Fit the layered head model of one identity, check it, save it and render it.",
         _lhm_args,
         _lhm_run,
+    ),
+    Command(
+        "carry-check",
+        "Which heads the template's tet mesh is carried to (docs/physics.md), and how well.",
+        _carry_args,
+        _carry_run,
     ),
     Command(
         "demo",

@@ -48,6 +48,9 @@ class TetMesh:
     soft_lid_side: np.ndarray  # (T_s,) the same for the eye slits: +1 upper lid's, -1 lower
     bone_vertices: np.ndarray  # vertices on the skull wrap (pinned to a bone)
     bone_wrap_vertex: np.ndarray  # the skull wrap vertex nearest to each of them
+    # "fill" (fTetWild's fill of this head), "carried" (the template's, lhm/carried.py) or
+    # "fill: <why the template's was not carried>"
+    source: str = "fill"
 
 
 def boundary_faces(tets: np.ndarray) -> np.ndarray:

@@ -30,9 +30,18 @@ class LhmConfig:
     # Largest radial change of the muscle and skull wraps per unit of arc between neighbouring
     # directions (0: unbounded); steeper steps lean the prisms over into needles and slivers.
     max_wrap_slope: float = 0.5
-    # The simulation's tets: "conforming" fills the wraps with well-shaped tets
-    # (lhm/conforming.py, fTetWild), "prisms" uses the wraps' own prism tets.
-    tet_mesh: str = "conforming"
+    # The simulation's tets: "carried" deforms the template's conforming fill to the head
+    # (lhm/carried.py; a head it does not suit gets a fill of its own), "conforming" fills
+    # every head's wraps with well-shaped tets of its own (lhm/conforming.py, fTetWild),
+    # "prisms" uses the wraps' own prism tets.
+    tet_mesh: str = "carried"
+    # The carried mesh: weight of its displacement fields' smoothness against following S
+    # (1/m), and the floor it is held to (the template's fill: 9.2 deg / 9.1 at level 3; S
+    # lies skin_margin inside the skin wrap at rest).
+    carry_smoothness: float = 30.0
+    carry_min_dihedral_deg: float = 5.0
+    carry_max_aspect: float = 15.0
+    carry_max_skin_outside: float = 1.0e-3
     tet_edge_length: float = 0.03  # target tet edge, share of the head's bounding box diagonal
     tet_envelope: float = 5.0e-4  # largest boundary deviation, share of that diagonal
     # The mouth slit opened this wide (vertically, metres) for the conforming mesh: at 1.5 mm

@@ -10,7 +10,7 @@ import numpy as np
 import softdeca_native as native
 
 from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
-from softdeca_train.lhm.conforming import conforming_mesh
+from softdeca_train.lhm.carried import tissue_mesh
 from softdeca_train.lhm.fit import embed_skin_by_side, jaw_motion
 from softdeca_train.lhm.model import JAW
 from softdeca_train.sim.lids import LidSets, lid_sets
@@ -38,6 +38,7 @@ class HeadSimulation:
     teeth_lower: np.ndarray
     lips: LipSets
     lids: LidSets
+    tet_source: str = "prisms"  # where its tets came from (_Tissue.source)
 
     def simulator(self, **settings: object) -> native.Simulator:
         return native.Simulator(self.mesh, **settings)
@@ -91,13 +92,17 @@ class _Tissue:
     jaw: np.ndarray
     skin_tet: np.ndarray
     skin_bary: np.ndarray
+    source: str  # "prisms", or the conforming mesh's TetMesh.source
 
 
-def _tissue(head: np.ndarray, lhm: LayeredHeadModel) -> _Tissue:
-    """The LHM's own prism tets, or its conforming fill (LhmConfig.tet_mesh)."""
+def _tissue(
+    template: Template, identity: np.ndarray | None, head: np.ndarray, lhm: LayeredHeadModel
+) -> _Tissue:
+    """The LHM's own prism tets, or a conforming mesh: the template's fill carried to the head
+    or the head's own fill (LhmConfig.tet_mesh)."""
     cfg = lhm.config
-    on_jaw = jaw_skull_vertices(lhm)
     if cfg.tet_mesh == "prisms":
+        on_jaw = jaw_skull_vertices(lhm)
         skull_ids = (lhm.n_layers - 1) * lhm.n_wrap + np.arange(lhm.n_wrap)
         return _Tissue(
             lhm.vertices,
@@ -108,11 +113,12 @@ def _tissue(head: np.ndarray, lhm: LayeredHeadModel) -> _Tissue:
             skull_ids[on_jaw],
             lhm.skin_tet,
             lhm.skin_bary,
+            "prisms",
         )
-    if cfg.tet_mesh != "conforming":
-        raise ValueError(f"unknown tet_mesh {cfg.tet_mesh!r}: 'conforming' or 'prisms'")
-    tm = conforming_mesh(lhm, cfg.tet_edge_length, cfg.tet_envelope, cfg.slit_gap)
-    bone_jaw = on_jaw[tm.bone_wrap_vertex]
+    if cfg.tet_mesh not in ("carried", "conforming"):
+        raise ValueError(f"unknown tet_mesh {cfg.tet_mesh!r}: 'carried', 'conforming' or 'prisms'")
+    tm, wraps = tissue_mesh(template, identity, lhm)
+    bone_jaw = jaw_skull_vertices(wraps)[tm.bone_wrap_vertex]
     skin_tet, skin_bary = embed_skin_by_side(
         tm.vertices,
         tm.soft_tets,
@@ -131,6 +137,7 @@ def _tissue(head: np.ndarray, lhm: LayeredHeadModel) -> _Tissue:
         tm.bone_vertices[bone_jaw],
         np.asarray(skin_tet, np.int32),
         skin_bary,
+        tm.source,
     )
 
 
@@ -144,7 +151,7 @@ def build_head_simulation(
     the sparse variant (SurfaceLandmarks.triangle / .bary)."""
     head = template.identity_neutral(identity)
     lhm = fit_lhm(template, identity, config)
-    tissue = _tissue(head, lhm)
+    tissue = _tissue(template, identity, head, lhm)
     n_lhm = len(tissue.vertices)
     up = template.components["teeth_upper"]
     lo = template.components["teeth_lower"]
@@ -201,4 +208,6 @@ def build_head_simulation(
         landmark_weights=lm_weights,
         collisions=collisions,
     )
-    return HeadSimulation(template, identity, head, lhm, mesh, teeth_upper, teeth_lower, lips, lids)
+    return HeadSimulation(
+        template, identity, head, lhm, mesh, teeth_upper, teeth_lower, lips, lids, tissue.source
+    )

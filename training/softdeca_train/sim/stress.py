@@ -9,7 +9,7 @@ import heapq
 import json
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +63,7 @@ class StressCase:
     parameters: dict[str, float] = field(default_factory=dict)
     dynamic: bool = False
     judge_every: int = 1  # judge frames judge_every-1, 2*judge_every-1, ...
+    tet_mesh: str = "carried"  # LhmConfig.tet_mesh of its head
 
 
 @dataclass(frozen=True)
@@ -70,6 +71,7 @@ class StressPlan:
     identities: tuple[str, ...] = ("template", "seed 1", "seed 2", "h+2.5σ", "h-2.5σ")
     level: int = 3
     fine_level: int | None = 4  # every expression once more at this level (template); None: off
+    tet_mesh: str = "carried"  # LhmConfig.tet_mesh of every head
     materials: bool = True
     gravity: bool = True
     dynamic: bool = True
@@ -152,6 +154,7 @@ def build_cases(plan: StressPlan) -> list[StressCase]:
         for who in plan.identities[: plan.take_identities]:
             cases.append(StressCase(f"take {take.stem}", who, plan.level, frames))
     # One head simulation at a time: group the cases by (identity, level).
+    cases = [replace(c, tet_mesh=plan.tet_mesh) for c in cases]
     return sorted(cases, key=lambda c: (c.identity, c.level))
 
 
@@ -232,7 +235,9 @@ def run_stress(
         if key != (case.identity, case.level):
             key = (case.identity, case.level)
             h = identity_coefficients(template, case.identity)
-            hs = build_head_simulation(template, h, LhmConfig(level=case.level))
+            hs = build_head_simulation(
+                template, h, LhmConfig(level=case.level, tet_mesh=case.tet_mesh)
+            )
             volume = SoftVolume(hs)
         assert hs is not None and volume is not None
         sim = hs.simulator(threads=1, **settings)

@@ -9,6 +9,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from softdeca_train.commands import add_tet_mesh_argument
 from softdeca_train.paths import data_dir
 
 
@@ -48,6 +49,7 @@ def add_stress_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-gravity", action="store_true", help="skip the 2 g cases")
     p.add_argument("--no-dynamic", action="store_true", help="skip the dynamic run")
     p.add_argument("--no-collisions", action="store_true", help="collision rounds 0")
+    add_tet_mesh_argument(p)
     p.add_argument("--keep-worst", type=int, default=6, help="rows of the contact sheet (6)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument(
@@ -96,6 +98,7 @@ def run_stress_cli(args: argparse.Namespace) -> int:
         take_identities=args.take_identities,
         combinations_only=args.combinations_only,
         extra_materials=tuple(parse_material(m) for m in args.material),
+        tet_mesh=args.tet_mesh,
     )
     template = Template.load(args.ict)
     cases = build_cases(plan)
