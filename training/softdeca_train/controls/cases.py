@@ -5,7 +5,7 @@ expression of the case, so the gallery compares like with like."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
 
@@ -52,13 +52,15 @@ class PhysicsCase:
     level: int = 3
     tolerance: float = 1e-4
     max_iterations: int = 800
+    tet_mesh: str = "carried"  # LhmConfig.tet_mesh
 
     @cached_property
     def head(self):  # -> HeadSimulation
         from softdeca_train.lhm import LhmConfig
         from softdeca_train.sim import build_head_simulation
 
-        return build_head_simulation(self.template, self.identity, LhmConfig(level=self.level))
+        cfg = LhmConfig(level=self.level, tet_mesh=self.tet_mesh)
+        return build_head_simulation(self.template, self.identity, cfg)
 
     @cached_property
     def sim(self):  # -> native.Simulator
@@ -83,9 +85,7 @@ class PhysicsCase:
 
     def with_weights(self, weights: np.ndarray) -> PhysicsCase:
         """The same identity (head and simulator shared) with other expressions."""
-        other = PhysicsCase(
-            self.template, self.identity, weights, self.level, self.tolerance, self.max_iterations
-        )
+        other = replace(self, weights=weights)
         other.__dict__.update(head=self.head, sim=self.sim, labels=self.labels)
         return other
 

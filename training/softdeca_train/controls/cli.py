@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from softdeca_train.commands import Command, add_ict_argument
+from softdeca_train.commands import Command, add_ict_argument, add_tet_mesh_argument
 
 
 def _add(p: argparse.ArgumentParser) -> None:
@@ -44,6 +44,7 @@ def _add(p: argparse.ArgumentParser) -> None:
         "physics' whole range (also lists the parameters that are no controls)",
     )
     p.add_argument("--no-pictures", action="store_true", help="figures only, no PNGs")
+    add_tet_mesh_argument(p)
     p.add_argument(
         "--tolerance",
         type=float,
@@ -82,6 +83,7 @@ def _run(args: argparse.Namespace) -> int:
         pictures=not args.no_pictures,
         tolerance=args.tolerance,
         max_iterations=args.max_iterations,
+        tet_mesh=args.tet_mesh,
         takes=args.takes or default_takes_path(),
         ict=args.ict,
     )

@@ -45,6 +45,7 @@ class GalleryConfig:
     # smaller controls; more iterations allowed to get there.
     tolerance: float = 1e-5
     max_iterations: int = 4000
+    tet_mesh: str = "carried"  # the physics' tets (LhmConfig.tet_mesh)
     takes: Path = field(default_factory=default_takes_path)
     ict: str | None = None
 
@@ -164,6 +165,7 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
             cfg.level,
             cfg.tolerance,
             cfg.max_iterations,
+            cfg.tet_mesh,
         )
         for seed in IDENTITY_SEEDS[: cfg.identities]
     ]
