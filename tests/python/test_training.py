@@ -55,6 +55,9 @@ def _train_error(run: Run, model: torch.nn.Module) -> float:
     "name", ["softdeca", "softdeca-dt", "sparse", "mlp-equal-time", "face-mlp"]
 )
 def test_static_models_learn(run: Run, name: str) -> None:
+    # The initial weights from a fixed seed: otherwise they depend on what the tests before
+    # drew (the MLP learned 77 % in 40 steps from one start and 9 % from another).
+    torch.manual_seed(0)
     before = _train_error(run, run.build(name))
     run.train(name, LoopConfig(steps=40, lr=3e-3, lr_end=1e-3, seed=1), progress=False)
     after = _train_error(run, run.load(name))
