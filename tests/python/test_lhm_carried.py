@@ -134,3 +134,12 @@ def test_the_carried_heads_bones(template: Template) -> None:
     basis = carry_basis(template, CONFIG)
     assert np.array_equal(pinned, np.sort(basis.mesh.bone_vertices))
     assert len(pinned) > 500
+
+
+def test_a_mesh_turned_inside_out_is_reported_not_raised(template: Template) -> None:
+    basis = carry_basis(template, CONFIG)
+    mirrored = basis.mesh.vertices * np.array([-1.0, 1.0, 1.0])  # every tet inverted
+    skin = template.neutral[:N_SKIN].astype(np.float64)
+    q = carry_quality(mirrored, basis.mesh, skin, basis.skin_inside)
+    assert q.inverted == len(basis.mesh.soft_tets) + len(basis.mesh.muscle_tets)
+    assert q.shortfall(CONFIG) == f"{q.inverted} inverted tets"

@@ -141,8 +141,8 @@ def carry_quality(
     _, _, outside = native.embed_points(vertices, tets, skin[inside])
     return CarryQuality(
         inverted=int((~ok).sum()),
-        min_dihedral_deg=float(dihedral_angles(vertices, tets[ok]).min()),
-        max_aspect=float(aspect_ratios(vertices, tets[ok]).max()),
+        min_dihedral_deg=float(dihedral_angles(vertices, tets[ok]).min(initial=180.0)),
+        max_aspect=float(aspect_ratios(vertices, tets[ok]).max(initial=0.0)),
         skin_outside=float(np.max(outside, initial=0.0)),
     )
 
