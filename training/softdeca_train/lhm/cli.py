@@ -91,8 +91,8 @@ def _carry_run(args: argparse.Namespace) -> int:
 
     from softdeca_train.lhm import LhmConfig
     from softdeca_train.lhm.carried import carry_basis, carry_quality
-    from softdeca_train.sim.stress import identity_coefficients
     from softdeca_train.template import Template
+    from softdeca_train.template.identities import identity_coefficients
     from softdeca_train.template.model import N_SKIN
 
     t = Template.load(args.ict)

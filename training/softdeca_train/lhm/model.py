@@ -36,7 +36,7 @@ class LhmConfig:
     # "prisms" uses the wraps' own prism tets.
     tet_mesh: str = "carried"
     # The carried mesh: weight of its displacement fields' smoothness against following S
-    # (1/m), and the floor it is held to (the template's fill: 9.2 deg / 9.1 at level 3; S
+    # (1/m), and the floor it is held to (the template's fill: 8.8 deg / 10.9 at level 3; S
     # lies skin_margin inside the skin wrap at rest).
     carry_smoothness: float = 30.0
     carry_min_dihedral_deg: float = 5.0

@@ -24,10 +24,9 @@ from softdeca_train.sim.measures import SoftVolume
 from softdeca_train.sim.sanity import FrameCheck, bench_figures, check_frame, failure_counts
 from softdeca_train.sim.take import read_take
 from softdeca_train.template import Template
+from softdeca_train.template.identities import identity_coefficients
 from softdeca_train.template.model import N_SKIN
 
-EXTREME_SIGMA = 2.5
-EXTREME_MODES = 10  # the identity modes set to ±EXTREME_SIGMA (the leading ones)
 # The material controls put at the ends of their control ranges together (the ranges a user
 # moves them in and data generation samples, plugin/data/parameters.json): "soft" is every
 # tissue weight at the bottom with the targets' weight at the top (the targets' strongest
@@ -82,18 +81,6 @@ class StressPlan:
     # extra material cases, e.g. ({"w_soft_volume": 3.0},): the combinations on the first
     # identity with those values (what a wider control range would ask of the physics)
     extra_materials: tuple[dict[str, float], ...] = ()
-
-
-def identity_coefficients(template: Template, label: str) -> np.ndarray | None:
-    if label == "template":
-        return None
-    if label.startswith("seed "):
-        return template.sample_identity(int(label.split()[1]))
-    if label in ("h+2.5σ", "h-2.5σ"):
-        h = np.zeros(template.identity_modes.shape[0])
-        h[:EXTREME_MODES] = EXTREME_SIGMA * (1 if label[1] == "+" else -1)
-        return h
-    raise ValueError(f"unknown identity {label!r}: template, 'seed N', h+2.5σ or h-2.5σ")
 
 
 def material_ends() -> dict[str, dict[str, float]]:
