@@ -193,6 +193,8 @@ def test_soft_volume_by_group_adds_up_to_the_whole(head: HeadSimulation) -> None
     assert volume.requested_percent_by_group(field, halves) == pytest.approx(
         [-10.0, np.nan, 10.0], nan_ok=True
     )
+    shares = volume.rest_share_by_group(halves)
+    assert np.isnan(shares[1]) and shares[0] + shares[2] == pytest.approx(1.0)
 
 
 def test_the_mesh_is_cached(template: Template, head: HeadSimulation) -> None:

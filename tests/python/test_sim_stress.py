@@ -91,18 +91,35 @@ def test_bounds_name_each_failure() -> None:
     assert _check(**grown, volume_requested_percent=7.6).failures() == []
     assert _check(**grown, volume_requested_percent=-2.0).failures() == ["volume"]
     # A regional request (a generated frame: face -11 %, head and neck +14 %; together +0.06 %)
-    # is judged region by region: each moved part of the way, shrinking further than growing,
-    # so the total missed the mean request by 1.1 points without any region failing.
+    # is judged over its regions: each moved part of the way, shrinking further than growing,
+    # so the total missed the mean request by 1.1 points while the regions came closer.
     regional = {
         "volume_physics_percent": -1.02,
         "volume_linear_percent": 0.07,
         "volume_requested_percent": 0.06,
     }
     assert _check(**regional).failures() == ["volume"]
-    met = ((-8.1, -5.9, -11.0), (6.2, 5.8, 13.6))
+    met = ((-8.1, -5.9, -11.0, 0.5), (6.2, 5.8, 13.6, 0.5))
     assert _check(**regional, volume_regions=met).failures() == []
-    lost = ((-8.1, -5.9, -11.0), (3.0, 5.8, 13.6), (-2.5, 0.0, 0.0))
+    # A region pulled past its request by neighbours asked otherwise (a generated frame's:
+    # physics +0.3 %, linear +2.3 %, asked +2.1 %) does not fail a frame whose regions as a
+    # whole moved toward theirs...
+    pulled = ((0.3, 2.3, 2.1, 0.2), (-7.7, 2.5, -9.5, 0.4), (8.7, 0.3, 12.7, 0.4))
+    check = _check(**regional, volume_regions=pulled)
+    assert check.failures() == []
+    physics, linear = check.volume_errors
+    assert physics == pytest.approx(
+        math.sqrt(0.2 * 1.8**2 + 0.4 * 1.8**2 + 0.4 * 4.0**2)
+    )
+    assert linear > physics
+    # ...but regions that as a whole end farther from what was asked do, and the shares weigh
+    # them: one region far short of its request, one that reached its own, as the volume
+    # between them lies.
+    short, reached = (3.0, 5.8, 13.6), (-10.5, -5.9, -11.0)
+    lost = ((*short, 0.8), (*reached, 0.2))
     assert _check(**regional, volume_regions=lost).failures() == ["volume"]
+    light = ((*short, 0.2), (*reached, 0.8))
+    assert _check(**regional, volume_regions=light).failures() == []
     assert _check(converged=False).failures() == ["not_converged"]
     both = [_check(), _check(penetrating_physics=9, inverted_elements=2)]
     counts = failure_counts(both)

@@ -72,6 +72,10 @@ class SoftVolume:
         rest = self._rest_volumes
         return 100.0 * (self._by_group(rest * field, groups) / self._by_group(rest, groups) - 1.0)
 
+    def rest_share_by_group(self, groups: np.ndarray) -> np.ndarray:
+        """Per group its share of the soft tissue's rest volume; NaN for ids without tets."""
+        return self._by_group(self._rest_volumes, groups) / self.rest_volume
+
     @staticmethod
     def _by_group(values: np.ndarray, groups: np.ndarray) -> np.ndarray:
         sums = np.bincount(groups, weights=values)
