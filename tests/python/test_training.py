@@ -124,6 +124,25 @@ def test_a_step_can_average_several_groups(run: Run, tmp_path) -> None:
         )
 
 
+def test_no_correction_is_the_linear_blend_on_every_test_frame_of_its_kind(
+    run: Run,
+) -> None:
+    from softdeca_train.train.batches import EVERY_FRAME
+    from softdeca_train.train.evaluate import measure, no_correction
+
+    for kind in ("static", "dynamic"):
+        errors = [
+            vertex_error(b.S, b.T).reshape(-1, b.T.shape[-2])
+            for b in run.data.batches(kind, "test", None, 8, EVERY_FRAME)
+        ]
+        frames = torch.cat(errors)
+        got = measure(run, "nc", no_correction(kind)).summary()
+        assert got["frames"] == len(frames) > 0
+        assert got["mean_mm"] == pytest.approx(
+            1e3 * float(frames.double().mean()), rel=1e-9
+        )
+
+
 def test_training_resumes_from_its_checkpoint(run: Run) -> None:
     cfg = LoopConfig(steps=6, seed=2)
     run.train("softdeca-vertex", cfg, progress=False)

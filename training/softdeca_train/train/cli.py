@@ -117,10 +117,15 @@ def run_model(args: argparse.Namespace) -> int:
     summary = run.train(args.model, cfg, not args.no_progress)
     print(f"{args.model}: {summary}")
     if args.test_error:
-        from softdeca_train.train.evaluate import measure
+        from softdeca_train.train.evaluate import measure, no_correction
 
-        mm = measure(run, args.model, run.load(args.model)).summary()["mean_mm"]
-        print(f"{args.model}: test error {mm:.3f} mm")
+        model = run.load(args.model)
+        mm = measure(run, args.model, model).summary()["mean_mm"]
+        base = measure(run, "no-correction", no_correction(model.kind)).summary()["mean_mm"]
+        print(
+            f"{args.model}: test error {mm:.3f} mm, {mm / base:.0%} of no correction "
+            f"({base:.3f} mm; every test frame)"
+        )
     return 0
 
 

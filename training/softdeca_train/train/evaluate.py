@@ -124,8 +124,8 @@ def test_errors(
     manifest's `errors` and the benchmark figures name them."""
     out: dict[str, dict | float] = {}
     jobs: list[tuple[str, Trainable, str | None]] = [
-        ("no_correction_static", NoCorrection(), None),
-        ("no_correction_dynamic", _NoCorrectionDynamic(), None),
+        ("no_correction_static", no_correction("static"), None),
+        ("no_correction_dynamic", no_correction("dynamic"), None),
     ]
     for name, m in models.items():
         if isinstance(m, SparseSoftDeca):
@@ -141,8 +141,11 @@ def test_errors(
     return out
 
 
-class _NoCorrectionDynamic(NoCorrection):
-    kind = "dynamic"
+def no_correction(kind: str) -> NoCorrection:
+    """The linear blend S_t as a model of `kind`'s frames (static, dynamic or sparse)."""
+    m = NoCorrection()
+    m.kind = kind
+    return m
 
 
 class _AsDynamic(Trainable):

@@ -184,9 +184,9 @@ def write_report(
                 errors["softdeca/dynamic"] = measure(run, name, _AsDynamic(m)).summary()
         else:
             errors[name] = measure(run, name, m).summary()
-    from softdeca_train.train.evaluate import _NoCorrectionDynamic
+    from softdeca_train.train.evaluate import no_correction
 
-    errors["no-correction/dynamic"] = measure(run, "nc", _NoCorrectionDynamic()).summary()
+    errors["no-correction/dynamic"] = measure(run, "nc", no_correction("dynamic")).summary()
     oracle = measure(run, "oracle", GroupOffsetOracle())
     errors["group-offset-oracle"] = oracle.summary()
     if oracle.vertex_mm() is not None:
