@@ -259,6 +259,24 @@ def test_regions_cover_s_once(template) -> None:
     assert counts.sum() == N_SKIN and (counts > 50).all()
 
 
+def test_report_counts_tet_sources_by_kind_with_the_span_of_their_figures() -> None:
+    from softdeca_train.data.report import _tet_sources
+
+    sources = {
+        "carried": 781,
+        "fill: the carried mesh has S up to 1.00 mm outside": 1,
+        "fill: the carried mesh has S up to 2.61 mm outside": 2,
+        "fill: the carried mesh has 1 inverted tets": 2,
+        "fill: the carried mesh has 2 inverted tets": 1,
+        "fill: the carried mesh has smallest dihedral angle 5.0 deg": 1,
+    }
+    assert _tet_sources(sources) == (
+        "carried: 781; fill: the carried mesh has S up to 1-2.61 mm outside: 3; "
+        "fill: the carried mesh has 1-2 inverted tets: 3; "
+        "fill: the carried mesh has smallest dihedral angle 5 deg: 1"
+    )
+
+
 def test_report_writes_markdown_and_plots(small, tmp_path) -> None:
     from softdeca_train.data.report import write_report
 

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -271,14 +272,35 @@ def _sanity_line(summary: dict) -> str:
     if not judged or failures is None:
         return "Sanity bounds: not judged (generated before the bounds were checked)."
     reasons = ", ".join(f"{k} {v}" for k, v in failures.items() if v and k != "failed_frames")
-    sources = summary.get("tet_sources") or {}
-    tets = "; ".join(f"{k}: {v}" for k, v in sources.items())
+    tets = _tet_sources(summary.get("tet_sources") or {})
     return (
         f"Sanity bounds: {failures.get('failed_frames', 0)} of {judged} judged frames fail "
         f"(failed fraction {summary.get('failed_fraction')}; {reasons or 'no reason'}); "
         "per frame in the shards' `failures` bit mask."
         + (f" Shards by the source of their head's tets: {tets}." if tets else "")
     )
+
+
+_NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
+
+
+def _tet_sources(sources: dict[str, int]) -> str:
+    """The manifest's shard counts per tet source, one entry per kind of source: a reason that
+    differs between heads only in its figure ("S up to 1.48 mm outside") is counted once, with
+    the span of its figures."""
+    groups: dict[str, tuple[int, list[float]]] = {}
+    for reason, count in sources.items():
+        key = _NUMBER.sub("#", reason)
+        n, figures = groups.get(key, (0, []))
+        groups[key] = (n + count, figures + [float(x) for x in _NUMBER.findall(reason)])
+    out = []
+    for key, (n, figures) in groups.items():
+        if figures and key.count("#") == 1:
+            lo, hi = min(figures), max(figures)
+            span = f"{lo:g}" if lo == hi else f"{lo:g}-{hi:g}"
+            key = key.replace("#", span)
+        out.append(f"{key}: {n}")
+    return "; ".join(out)
 
 
 @dataclass
