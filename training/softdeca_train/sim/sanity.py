@@ -23,7 +23,7 @@ bounds"). A frame is compared with the linear blend S_t it was simulated from:
   regions' errors are taken together: the root mean square over regions, each weighted by its
   share of the tissue's rest volume, of the change's distance from the region's request, for
   the physics against the linear blend. The tissue is continuous, so a region whose
-  neighbours are asked otherwise is pulled along with them and may end farther from its own
+  neighbours are asked otherwise can be carried along by them and end farther from its own
   request than the linear blend (whose refit changes a region's volume by itself, the
   expression's doing, not the request's); what the physics owes is to bring the regions as a
   whole closer to what was asked. With one region this is the rule above;
