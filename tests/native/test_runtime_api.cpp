@@ -134,11 +134,11 @@ TEST_F(Runtime, LoadsFromMemoryAndFromATarFile) {
 
 TEST_F(Runtime, RefusesAnotherFormatVersion) {
   BundleCopy copy(data_dir() + "/bundle", "version");
-  copy.replace_in("manifest.json", "\"format_version\": 1", "\"format_version\": 3");
+  copy.replace_in("manifest.json", "\"format_version\": 1", "\"format_version\": 4");
   softdeca_model* m = nullptr;
   EXPECT_EQ(softdeca_model_load(copy.path().c_str(), nullptr, &m), SOFTDECA_ERROR_FORMAT);
-  EXPECT_NE(error().find("version 3"), std::string::npos) << error();
-  EXPECT_NE(error().find("versions 1 to 2"), std::string::npos) << error();
+  EXPECT_NE(error().find("version 4"), std::string::npos) << error();
+  EXPECT_NE(error().find("versions 1 to 3"), std::string::npos) << error();
   EXPECT_EQ(m, nullptr);
 }
 

@@ -303,3 +303,27 @@ def test_the_gallery_page_names_the_tolerance_and_the_identity_spread() -> None:
     )
     assert "tolerance of 2e-05" in page and "| identity spread |" in page
     assert "| 0.50 | 0.25 | – | – |" in page
+
+
+def test_the_physics_cache_keys_on_inputs_and_physics_version(tmp_path) -> None:
+    from softdeca_train.controls.physics_cache import PhysicsCache, physics_version
+
+    cache = PhysicsCache(tmp_path / "c", "v1")
+    a = np.arange(6.0).reshape(2, 3)
+    key = cache.key((a,), {"setting": {"a": 1.0}})
+    assert cache.get(key) is None
+    cache.put(key, a * 2)
+    np.testing.assert_array_equal(cache.get(key), a * 2)
+    # any input, setting or physics version change is another entry
+    assert cache.key((a + 1,), {"setting": {"a": 1.0}}) != key
+    assert cache.key((a,), {"setting": {"a": 2.0}}) != key
+    assert PhysicsCache(tmp_path / "c", "v2").key((a,), {"setting": {"a": 1.0}}) != key
+    # a damaged entry is solved again, not trusted
+    (tmp_path / "c" / f"{key}.npy").write_bytes(b"not an array")
+    assert cache.get(key) is None
+    # off (uncommitted physics changes): nothing read or written
+    off = PhysicsCache(tmp_path / "off", None)
+    off.put(key, a)
+    assert off.get(key) is None and not (tmp_path / "off").exists()
+    # outside a git checkout there is no version to trust
+    assert physics_version(tmp_path) is None

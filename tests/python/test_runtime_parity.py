@@ -32,12 +32,19 @@ BOUND_MM = {"float": 1e-4, "half": 1e-3, "int8": 0.02}
 def setup(tmp_path_factory):
     head = synthetic_head()
     specs = load_parameter_specs(TEST_PARAMETERS)
-    # with SoftDECA's vertex stage (format version 2); the template-topology test below and
-    # the contract tests run bundles without one
-    nets = build_random(head.definition, specs, TEST_SIZES, seed=7, vertex_stage=True)
+    # with SoftDECA's vertex and residual stages (format version 3); the template-topology
+    # test below and the contract tests run bundles without them
+    nets = build_random(
+        head.definition,
+        specs,
+        TEST_SIZES,
+        seed=7,
+        vertex_stage=True,
+        residual_stage=True,
+    )
     folder = tmp_path_factory.mktemp("parity") / "bundle"
     export_bundle(folder, head.definition, nets, BundleInfo(True, "parity"))
-    return head, nets, NativeModel(folder)
+    return head, nets, NativeModel(folder), folder
 
 
 def frames(n: int, seed: int = 0) -> np.ndarray:
@@ -50,7 +57,7 @@ def frames(n: int, seed: int = 0) -> np.ndarray:
 
 
 def pair(setup, precision: str, localise: bool = False):
-    head, nets, model = setup
+    head, nets, model, _ = setup
     ref = ReferenceAvatar(
         TorchNetworks(as_stored(nets)),
         head.definition,
@@ -156,7 +163,7 @@ def test_sparse_static_dynamic_and_retargeted(setup, precision, localise):
 def test_the_vertex_stage_counts(setup):
     """The runtime adds SoftDECA's vertex stage: without it the reference lands far from the
     native output, and a localised parameter moves the result through the stage's own table."""
-    head, nets, _ = setup
+    head, nets, _, _ = setup
     assert nets.softdeca is not None and nets.softdeca.f_ph_v is not None
     ref, nat = pair(setup, "float")
     without = ReferenceAvatar(
@@ -175,21 +182,57 @@ def test_the_vertex_stage_counts(setup):
     nv = head.definition.skin_vertices
     values = np.full(nv, 1.0)
     values[nv // 2] = 1.4
+    x2 = both_with_volume(ref, nat, values, w)
+    assert err_mm(x2[nv // 2], x[nv // 2]) > 1e-3
+
+
+def both_with_volume(ref, nat, values: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Both avatars prepared with the per-vertex target_volume `values`; the native result
+    for weights w, checked against the reference's."""
     nat.set_parameter_vertices("target_volume", values)
     ref.params.set_vertices("target_volume", values)
     nat.prepare()
     ref.prepare()
-    x2, _ = nat.evaluate_weights(w)
-    assert err_mm(x2, ref.evaluate_weights(w)[0]) < BOUND_MM["float"]
-    assert err_mm(x2[nv // 2], x[nv // 2]) > 1e-3
+    x, _ = nat.evaluate_weights(w)
+    assert err_mm(x, ref.evaluate_weights(w)[0]) < BOUND_MM["float"]
+    return x
 
 
-def replace_stage(nets, stage):
+def replace_stage(nets, stage, name: str = "f_ph_v"):
     import copy
 
     out = copy.deepcopy(nets)
-    out.softdeca.f_ph_v = stage
+    setattr(out.softdeca, name, stage)
     return out
+
+
+def test_the_residual_stage_counts(setup):
+    """The runtime adds SoftDECA's residual stage: without it the reference lands far from the
+    native output, its coefficients follow the weights, and a change of one region's parameter
+    reaches the result through the region means (the stage's condition)."""
+    head, nets, _, _ = setup
+    assert nets.softdeca is not None and nets.softdeca.f_r is not None
+    ref, nat = pair(setup, "float")
+    without = ReferenceAvatar(
+        TorchNetworks(as_stored(replace_stage(nets, None, "f_r"))),
+        head.definition,
+        head.neutral,
+        head.head_triangles,
+        head.blendshapes,
+    )
+    without.prepare()
+    w0, w1 = frames(2, 11)
+    x0, _ = nat.evaluate_weights(w0)
+    x1, _ = nat.evaluate_weights(w1)
+    assert err_mm(x0, ref.evaluate_weights(w0)[0]) < BOUND_MM["float"]
+    assert err_mm(x0, without.evaluate_weights(w0)[0]) > 0.1
+    stage_only = [x - without.evaluate_weights(w)[0] for x, w in ((x0, w0), (x1, w1))]
+    assert err_mm(stage_only[0], stage_only[1]) > 0.01  # not a constant offset
+    # one region (region 0 of the definition) softer: the condition changes, so does the result
+    regions = head.definition.skin_regions
+    values = np.where(regions == 0, 1.4, 1.0)
+    x2 = both_with_volume(ref, nat, values, w0)
+    assert err_mm(x2, x0) > 1e-3
 
 
 def test_linear_blendshapes_are_exact(setup):
@@ -202,7 +245,7 @@ def test_linear_blendshapes_are_exact(setup):
 
 
 def test_native_errors_reach_python(setup):
-    head, _, model = setup
+    head, _, model, _ = setup
     nat = NativeAvatar(model, head.neutral, head.head_triangles, head.blendshapes)
     with pytest.raises(NativeError, match="prepare"):
         nat.evaluate_weights(np.zeros(52))
@@ -246,3 +289,20 @@ def test_parity_on_the_template_topology(tmp_path, template):
     )
     assert worst < BOUND_MM["half"]
     assert err_mm(xs, xsr) < BOUND_MM["half"]
+
+
+def test_the_residual_stage_needs_version_three(setup, tmp_path):
+    """A residual stage under an older version's manifest is refused, not dropped (a runtime
+    reading only that version would run the model without it)."""
+    import json
+    import shutil
+
+    folder = setup[3]
+    copy = tmp_path / "bundle"
+    shutil.copytree(folder, copy)
+    manifest = json.loads((copy / "manifest.json").read_text())
+    assert manifest["format_version"] == 3 and "residual_stage" in manifest
+    manifest["format_version"] = 2
+    (copy / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(NativeError, match="format version 3"):
+        NativeModel(copy)

@@ -118,8 +118,9 @@ typedef struct softdeca_model softdeca_model;
 typedef struct softdeca_avatar softdeca_avatar;
 
 /* The newest bundle format version this library reads (manifest "format_version"); it reads
- * every version from 1 up to it. Version 2 adds SoftDECA's optional vertex stage. */
-#define SOFTDECA_BUNDLE_FORMAT_VERSION 2
+ * every version from 1 up to it. Version 2 adds SoftDECA's optional vertex stage, version 3
+ * its optional residual stage. */
+#define SOFTDECA_BUNDLE_FORMAT_VERSION 3
 
 typedef struct softdeca_model_options {
   uint32_t struct_size;            /* sizeof(softdeca_model_options) */

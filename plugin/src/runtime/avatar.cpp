@@ -44,7 +44,8 @@ HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float
 }
 
 std::size_t Preparation::bytes() const {
-  return face_l.bytes() + vertex_l.bytes() + softdeca_vertex_l.bytes() + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4;
+  return face_l.bytes() + vertex_l.bytes() + softdeca_vertex_l.bytes() + residual_modes.bytes() +
+         residual_condition.size() * 4 + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4;
 }
 
 class Avatar::FrameGuard {
@@ -79,6 +80,8 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       offsets_(3 * m_.landmarks.size()),
       head_(vh_ * 3),
       static_(vs_ * 3),
+      residual_condition_(static_cast<std::size_t>(m_.residual_condition)),
+      residual_coefficients_(static_cast<std::size_t>(m_.residual_modes)),
       solve_work_(vs_ * 4),
       dynamics_(vs_),
       normals_(triangles_, vh_) {
@@ -104,6 +107,8 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
   identity_ = run_identity_encoder(*model_, neutral_.data());
   if (model_->has(false)) f_w_ = model_->encoder(false)->bind({weights_.data()}, {z_.data()}, 1);
   if (model_->has(true)) f_l_ = model_->encoder(true)->bind({offsets_.data()}, {z_.data()}, 1);
+  if (const OnnxNetwork* r = model_->residual_coefficients())
+    f_r_w_ = r->bind({weights_.data(), residual_condition_.data()}, {residual_coefficients_.data()}, 1);
   stats_.threads = worker_.parts();
 }
 
@@ -196,6 +201,7 @@ void Avatar::prepare() {
       params->vertex_matrix(stage->spec().parameter_columns, pv.data());
       prep->softdeca_vertex_l = hyper_tensor(*stage, pv, identity, vs_, 3);
     }
+    if (!sparse) prepare_residual(*params, *prep);
     // Dynamics coefficients per skin vertex.
     const OnnxNetwork& dyn = *model_->dynamics(sparse);
     const auto& dcols = dyn.spec().parameter_columns;
@@ -219,6 +225,22 @@ void Avatar::prepare() {
   stats_.prepare_ms = ms(t0, Clock::now());
   stats_.prepare_networks_ms = networks_ms;
   if (factorisation_ms > 0) stats_.factorisation_ms = factorisation_ms;
+}
+
+// The residual stage's prepare half: its condition and modes for these parameters.
+void Avatar::prepare_residual(const ParameterState& params, Preparation& prep) const {
+  const OnnxNetwork* net = model_->residual_condition();
+  if (!net) return;
+  const auto& cols = net->spec().parameter_columns;
+  std::vector<float> pv(vs_ * cols.size());
+  params.vertex_matrix(cols, pv.data());
+  const std::size_t k = static_cast<std::size_t>(m_.residual_modes);
+  std::vector<float> condition(static_cast<std::size_t>(m_.residual_condition)), modes(vs_ * k * 3);
+  net->run({pv.data()}, {condition.data(), modes.data()}, 1);
+  if (!all_finite(condition.data(), condition.size()) || !all_finite(modes.data(), modes.size()))
+    throw Error(SOFTDECA_ERROR_FORMAT, net->spec().key + " produced non-finite values for these parameters");
+  prep.residual_condition = std::move(condition);
+  prep.residual_modes = HyperTensor(modes.data(), vs_, m_.residual_modes, 3, precision_);
 }
 
 std::shared_ptr<const Preparation> Avatar::current() const {
@@ -280,15 +302,25 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   }
   auto t3 = Clock::now();
   st.solve_ms = ms(t2, t3);
-  if (prep.softdeca_vertex_l.empty()) return;
   // The vertex stage on top of DT's result, in place: static_ += z . L_v.
-  const std::size_t vblocks = prep.softdeca_vertex_l.blocks();
-  auto stage = [&](std::size_t part, std::size_t parts) {
-    vertex_offsets(prep.softdeca_vertex_l, z_.data(), static_.data(), vblocks * part / parts,
-                   vblocks * (part + 1) / parts, static_.data());
-  };
-  worker_.run(stage);
+  if (!prep.softdeca_vertex_l.empty()) add_vertex_offsets(prep.softdeca_vertex_l, z_.data());
+  // The residual stage: its coefficients from w and the preparation's condition, then
+  // static_ += c . modes.
+  if (!prep.residual_modes.empty()) {
+    std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
+    model_->residual_coefficients()->run(f_r_w_);
+    add_vertex_offsets(prep.residual_modes, residual_coefficients_.data());
+  }
   st.hyper_ms += ms(t3, Clock::now());
+}
+
+void Avatar::add_vertex_offsets(const HyperTensor& modes, const float* coefficients) {
+  const std::size_t blocks = modes.blocks();
+  auto pass = [&](std::size_t part, std::size_t parts) {
+    vertex_offsets(modes, coefficients, static_.data(), blocks * part / parts, blocks * (part + 1) / parts,
+                   static_.data());
+  };
+  worker_.run(pass);
 }
 
 void Avatar::write_rigid_non_skin(const float* skin, float* head) const {

@@ -63,6 +63,10 @@ struct Preparation {
   std::vector<float> identity;
   HyperTensor face_l, vertex_l;       // SoftDECA: [F][latent][9]; sparse: [Vs][latent][3]
   HyperTensor softdeca_vertex_l;      // SoftDECA's vertex stage, [Vs][latent][3] (empty: none)
+  // SoftDECA's residual stage: the condition its frame half reads, and its modes
+  // [Vs][modes][3] (empty: none)
+  std::vector<float> residual_condition;
+  HyperTensor residual_modes;
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   std::size_t bytes() const;
 };
@@ -109,6 +113,8 @@ class Avatar {
   void finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
               AvatarStats& st);
   void softdeca_frame(const Preparation& prep, AvatarStats& st);
+  void add_vertex_offsets(const HyperTensor& modes, const float* coefficients);  // static_ += c . modes
+  void prepare_residual(const ParameterState& params, Preparation& prep) const;
   void write_rigid_non_skin(const float* skin, float* head) const;
   void compute_normals(const float* head, float* normals);
   void record(AvatarStats st);  // a frame's timings, keeping the counters
@@ -141,10 +147,11 @@ class Avatar {
   std::atomic<bool> busy_{false};
   std::atomic<bool> dynamics_enabled_{false}, reset_requested_{false};
   AlignedArray<float> weights_, z_, offsets_, head_, static_;
+  AlignedArray<float> residual_condition_, residual_coefficients_;  // the residual stage's frame half
   std::vector<AlignedArray<float>> rhs_;  // one right-hand side per thread
   std::vector<const float*> rhs_parts_;
   AlignedArray<double> solve_work_;
-  OnnxNetwork::Binding f_w_, f_l_;
+  OnnxNetwork::Binding f_w_, f_l_, f_r_w_;
   DynamicsState dynamics_;
   Normals normals_;
   bool calibrated_ = false;

@@ -97,6 +97,12 @@ NetworkSpec expected_network(const Manifest& m, const std::string& key, int p) {
   } else if (key == "sparse.f_ph_v" || key == "softdeca.f_ph_v") {
     n.inputs = per_vertex;
     n.outputs = {{"L", {V, L, 3}}};
+  } else if (key == "softdeca.f_r_ph") {
+    n.inputs = {{"parameters", {V, p}}};
+    n.outputs = {{"condition", {1, m.residual_condition}}, {"modes", {V, m.residual_modes, 3}}};
+  } else if (key == "softdeca.f_r_w") {
+    n.inputs = {{"weights", {-1, kBlendshapeCount}}, {"condition", {1, m.residual_condition}}};
+    n.outputs = {{"coefficients", {-1, m.residual_modes}}};
   } else if (key == "softdeca.f_dyn" || key == "sparse.f_dyn") {
     n.inputs = per_vertex;
     n.outputs = dyn_out;
@@ -133,6 +139,11 @@ void parse_sizes(const Json& doc, Manifest& m) {
   m.skin_vertices = bounded_int(t.at("skin_vertices", "template"), "template.skin_vertices", 3, m.head_vertices);
   m.skin_triangles = bounded_int(t.at("skin_triangles", "template"), "template.skin_triangles", 1, kMaxElements);
   m.latent = bounded_int(doc.at("latent_size", "manifest"), "latent_size", 1, 1024);
+  if (doc.has("residual_stage")) {
+    const Json& r = doc.at("residual_stage", "manifest");
+    m.residual_modes = bounded_int(r.at("modes", "residual_stage"), "residual_stage.modes", 1, 1024);
+    m.residual_condition = bounded_int(r.at("condition", "residual_stage"), "residual_stage.condition", 1, 1 << 16);
+  }
   m.identity = bounded_int(doc.at("identity_size", "manifest"), "identity_size", 1, 4096);
 
   const auto& names = doc.at("blendshapes", "manifest").array("blendshapes");
@@ -269,8 +280,12 @@ NetworkSpec parse_network(const Json& j, const char* key, const Manifest& m) {
 void parse_networks(const Json& doc, Manifest& m) {
   const Json& nets = doc.at("networks", "manifest");
   for (const char* key : {"identity_encoder", "softdeca.f_w", "softdeca.f_ph", "softdeca.f_dyn", "softdeca.f_ph_v",
-                          "sparse.f_l", "sparse.f_ph_v", "sparse.f_dyn"}) {
-    if (nets.has(key)) m.networks[key] = parse_network(nets.at(key, "networks"), key, m);
+                          "softdeca.f_r_ph", "softdeca.f_r_w", "sparse.f_l", "sparse.f_ph_v", "sparse.f_dyn"}) {
+    if (!nets.has(key)) continue;
+    const bool residual = std::string(key).rfind("softdeca.f_r_", 0) == 0;
+    check(!residual || m.residual_modes > 0,
+          std::string(key) + " (SoftDECA's residual stage) needs the manifest's residual_stage sizes");
+    m.networks[key] = parse_network(nets.at(key, "networks"), key, m);
   }
   check(m.networks.count("identity_encoder") > 0, "networks.identity_encoder is required");
   // SoftDECA's optional vertex stage (X = DT(S_t, I + z.L) + z.L_v) belongs to its model.
@@ -282,6 +297,11 @@ void parse_networks(const Json& doc, Manifest& m) {
     for (const char* k : keys) c += static_cast<int>(m.networks.count(k));
     return c;
   };
+  const int residual = count({"softdeca.f_r_ph", "softdeca.f_r_w"});
+  check(residual == 0 || residual == 2, "SoftDECA's residual stage needs both softdeca.f_r_ph and softdeca.f_r_w");
+  m.has_softdeca_residual_stage = residual == 2;
+  check(!m.has_softdeca_residual_stage || m.format_version >= 3,
+        "softdeca.f_r_ph and softdeca.f_r_w (SoftDECA's residual stage) need bundle format version 3");
   const int sd = count({"softdeca.f_w", "softdeca.f_ph", "softdeca.f_dyn"});
   const int sp = count({"sparse.f_l", "sparse.f_ph_v", "sparse.f_dyn"});
   check(sd == 0 || sd == 3, "the SoftDECA model needs softdeca.f_w, softdeca.f_ph and softdeca.f_dyn");
@@ -290,6 +310,8 @@ void parse_networks(const Json& doc, Manifest& m) {
   m.has_sparse = sp == 3;
   check(!m.has_softdeca_vertex_stage || m.has_softdeca,
         "softdeca.f_ph_v (SoftDECA's vertex stage) needs the SoftDECA model (softdeca.f_w, softdeca.f_ph, softdeca.f_dyn)");
+  check(!m.has_softdeca_residual_stage || m.has_softdeca,
+        "SoftDECA's residual stage needs the SoftDECA model (softdeca.f_w, softdeca.f_ph, softdeca.f_dyn)");
   check(m.has_softdeca || m.has_sparse, "the bundle holds neither model");
 }
 }  // namespace

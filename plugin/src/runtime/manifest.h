@@ -11,8 +11,9 @@
 
 namespace softdeca::runtime {
 
-// Versions this runtime reads: 1, and 2 (which adds SoftDECA's optional vertex stage).
-constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 2;
+// Versions this runtime reads: 1, 2 (adds SoftDECA's optional vertex stage) and 3 (adds its
+// optional residual stage).
+constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 3;
 constexpr const char* kBundleFormat = "softdeca-bundle";
 constexpr const char* kDtFormulation = "cotangent-poisson-1";
 // The 52 ARKit shapes in canonical order: names from the one definition, stream/arkit_names.h.
@@ -62,6 +63,10 @@ struct Manifest {
   std::map<std::string, NetworkSpec> networks;
   bool has_softdeca = false, has_sparse = false;
   bool has_softdeca_vertex_stage = false;  // softdeca.f_ph_v present (format version 2)
+  // SoftDECA's residual stage (softdeca.f_r_ph, softdeca.f_r_w; format version 3): its modes
+  // (incl. the mean) and the length of the condition the prepare half hands the frame half.
+  bool has_softdeca_residual_stage = false;
+  int residual_modes = 0, residual_condition = 0;
 
   const NetworkSpec& network(const std::string& key) const;
   int find_parameter(const std::string& name) const;  // -1 when absent

@@ -14,8 +14,9 @@ namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, message); }
 
 // The order of Model::networks_ (the accessors in model.h index it).
-const char* const kNetworkKeys[] = {"identity_encoder", "softdeca.f_w",  "softdeca.f_ph", "softdeca.f_dyn",
-                                    "sparse.f_l",       "sparse.f_ph_v", "sparse.f_dyn",  "softdeca.f_ph_v"};
+const char* const kNetworkKeys[] = {"identity_encoder", "softdeca.f_w",    "softdeca.f_ph",  "softdeca.f_dyn",
+                                    "sparse.f_l",       "sparse.f_ph_v",   "sparse.f_dyn",   "softdeca.f_ph_v",
+                                    "softdeca.f_r_ph",  "softdeca.f_r_w"};
 
 std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
 
@@ -130,7 +131,8 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
       m->networks_.emplace_back();
       continue;
     }
-    const bool per_frame = std::strcmp(key, "softdeca.f_w") == 0 || std::strcmp(key, "sparse.f_l") == 0;
+    const bool per_frame = std::strcmp(key, "softdeca.f_w") == 0 || std::strcmp(key, "sparse.f_l") == 0 ||
+                           std::strcmp(key, "softdeca.f_r_w") == 0;
     m->networks_.push_back(std::make_unique<OnnxNetwork>(*m->env_, *network_bytes[k], it->second,
                                                          per_frame ? 1 : options.prepare_threads));
   }

@@ -19,7 +19,7 @@ namespace softdeca::runtime {
 constexpr std::uint64_t kDefaultMemoryBudget = std::uint64_t{2} << 30;
 
 struct ModelOptions {
-  int prepare_threads = 1;  // intra-op threads of the per-avatar networks (f_ph, f_ph_v, f_dyn)
+  int prepare_threads = 1;  // intra-op threads of the per-avatar networks (f_ph, f_ph_v, f_r_ph, f_dyn)
   // Upper bound on what the bundle's networks may ask for (initializers, declared tensor
   // shapes, constant-shaped outputs, the contract's tensors), checked before any ONNX Runtime
   // session is created.
@@ -51,6 +51,10 @@ class Model {
   bool has(bool sparse) const { return sparse ? manifest_.has_sparse : manifest_.has_softdeca; }
   // SoftDECA's vertex stage L_v(p, h) (per skin vertex, like the sparse model's), or null.
   const OnnxNetwork* softdeca_vertex_stage() const { return networks_.at(7).get(); }
+  // SoftDECA's residual stage: the prepare half (condition and modes from p) and the
+  // per-frame half (coefficients from w and the condition), or null.
+  const OnnxNetwork* residual_condition() const { return networks_.at(8).get(); }
+  const OnnxNetwork* residual_coefficients() const { return networks_.at(9).get(); }
 
  private:
   Model() = default;

@@ -44,6 +44,7 @@ def _add(p: argparse.ArgumentParser) -> None:
         "physics' whole range (also lists the parameters that are no controls)",
     )
     p.add_argument("--no-pictures", action="store_true", help="figures only, no PNGs")
+    add_physics_cache_argument(p)
     add_tet_mesh_argument(p)
     p.add_argument(
         "--tolerance",
@@ -86,6 +87,7 @@ def _run(args: argparse.Namespace) -> int:
         tet_mesh=args.tet_mesh,
         takes=args.takes or default_takes_path(),
         ict=args.ict,
+        physics_cache=physics_cache_of(args),
     )
     result = run_gallery(cfg)
     path = write_gallery(cfg, result)
@@ -99,6 +101,21 @@ def _run(args: argparse.Namespace) -> int:
         )
     print(f"wrote {path} ({result['seconds']:.0f} s)")
     return 0
+
+
+def add_physics_cache_argument(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--no-physics-cache",
+        action="store_true",
+        help="solve the physics again instead of reusing solves of the same physics sources "
+        "($SOFTDECA_CACHE/controls-physics; never used with uncommitted physics changes)",
+    )
+
+
+def physics_cache_of(args: argparse.Namespace) -> Path | None:
+    from softdeca_train.paths import cache_dir
+
+    return None if args.no_physics_cache else cache_dir() / "controls-physics"
 
 
 def add_report_arguments(p: argparse.ArgumentParser, standalone: bool = True) -> None:
@@ -135,6 +152,7 @@ def add_report_arguments(p: argparse.ArgumentParser, standalone: bool = True) ->
     p.add_argument("--real-every", type=int, default=10, help="every n-th frame (default 10)")
     p.add_argument("--real-identities", type=int, default=3, help="identities, 1-3 (default 3)")
     p.add_argument("--no-real-takes", action="store_true", help="leave `real_takes` as it is")
+    add_physics_cache_argument(p)
 
 
 def report_parts(args: argparse.Namespace, bundle: Path) -> tuple[list[dict], dict | None]:
@@ -147,10 +165,17 @@ def report_parts(args: argparse.Namespace, bundle: Path) -> tuple[list[dict], di
     if args.controls_json is not None:
         gallery = json.loads(Path(args.controls_json).read_text())
     else:
-        gallery = run_gallery(GalleryConfig(bundle=bundle, pictures=False))
+        gallery = run_gallery(
+            GalleryConfig(bundle=bundle, pictures=False, physics_cache=physics_cache_of(args))
+        )
     real = None
     if not args.no_real_takes:
-        cfg = RealTakes(args.recordings, args.real_identities, args.real_every)
+        cfg = RealTakes(
+            args.recordings,
+            args.real_identities,
+            args.real_every,
+            physics_cache=physics_cache_of(args),
+        )
         real = real_takes(cfg, bundle)
     return report_entries(gallery), real
 

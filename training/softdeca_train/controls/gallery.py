@@ -22,9 +22,10 @@ from softdeca_train.controls.definitions import (
     region_controls,
 )
 from softdeca_train.controls.metrics import control_response, identity_spread
+from softdeca_train.controls.physics_cache import open_cache, solve_cached
 from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.parameters import ParameterSet, load_parameters
-from softdeca_train.paths import REPO_ROOT, default_takes_path
+from softdeca_train.paths import REPO_ROOT, cache_dir, default_takes_path
 
 RANGES = ("control", "physics")
 
@@ -48,6 +49,8 @@ class GalleryConfig:
     tet_mesh: str = "carried"  # the physics' tets (LhmConfig.tet_mesh)
     takes: Path = field(default_factory=default_takes_path)
     ict: str | None = None
+    # solved physics reused across runs (controls/physics_cache.py); None: always solve
+    physics_cache: Path | None = field(default_factory=lambda: cache_dir() / "controls-physics")
 
     def __post_init__(self) -> None:
         if self.ranges not in RANGES:
@@ -111,6 +114,7 @@ def _measure_case(
     bar: tqdm,
 ) -> None:
     domains = {s.name: s.domain for s in load_parameters().specs}
+    cache = open_cache(cfg.physics_cache)
     model = None
     if cfg.bundle is not None:
         from softdeca_train.models.bundle import OnnxNetworks
@@ -118,7 +122,7 @@ def _measure_case(
         model = ModelCase(OnnxNetworks(cfg.bundle), case)
 
     def physics(s: Setting) -> np.ndarray:
-        return case.solve(s, defaults, domains)
+        return solve_cached(cache, case, s, defaults, domains)
 
     for c in controls:
         measure_controls([c], physics, None if model is None else model.solve, acc)
@@ -175,7 +179,8 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
     labels = region_labels(template)
     entries = [control_entry(c, acc, labels) for c in controls]
     result = {
-        "config": {k: _shown_path(v) for k, v in asdict(cfg).items()},
+        # where this machine keeps its cache is no property of the gallery
+        "config": {k: _shown_path(v) for k, v in asdict(cfg).items() if k != "physics_cache"},
         "identity_seeds": list(IDENTITY_SEEDS[: cfg.identities]),
         "expressions": weights.tolist(),
         "controls": entries,

@@ -15,6 +15,7 @@ from tqdm import tqdm
 
 from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase
 from softdeca_train.controls.definitions import Setting
+from softdeca_train.controls.physics_cache import open_cache, solve_cached
 
 CONTROL_KEYS = ("name", "region", "physics_max_mm", "response_error", "leakage")
 REAL_TAKE_KEYS = ("frames", "identities", "softdeca_mm", "linear_mm")
@@ -65,6 +66,7 @@ class RealTakes:
     every: int = 10
     level: int = 3
     chunk: int = 32  # frames solved per batch (memory)
+    physics_cache: Path | None = None  # controls/physics_cache.py; None: always solve
 
 
 def take_frames(recordings: Path, every: int) -> np.ndarray:
@@ -97,6 +99,7 @@ def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
     defaults = {s.name: s.default for s in physics.specs}
     defaults.update({s.name: s.default for s in physics.controls().specs})
     domains = {s.name: s.domain for s in physics.specs}
+    cache = open_cache(cfg.physics_cache)
     sums = {"softdeca": 0.0, "linear": 0.0}
     count = 0
     total = cfg.identities * len(weights)
@@ -107,7 +110,7 @@ def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
             for start in range(0, len(weights), cfg.chunk):
                 case = first.with_weights(weights[start : start + cfg.chunk])
                 model.use(case)
-                t = case.solve(Setting(), defaults, domains)
+                t = solve_cached(cache, case, Setting(), defaults, domains)
                 x = model.solve(Setting())
                 sums["softdeca"] += float(np.linalg.norm(x - t, axis=-1).mean(axis=1).sum())
                 sums["linear"] += float(

@@ -26,13 +26,15 @@ from softdeca_train.models.networks import (
 )
 from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.reference import Model
+from softdeca_train.models.residual import ResidualCoefficients, ResidualCondition
 from softdeca_train.models.topology import LandmarkSet, TemplateDefinition
 
 FORMAT = "softdeca-bundle"
-# Version 2 adds SoftDECA's optional vertex stage (softdeca.f_ph_v); a bundle without one is
-# written as version 1, so runtimes that read only version 1 still run it.
-FORMAT_VERSION = 2
-FORMAT_VERSIONS = (1, 2)
+# Version 2 adds SoftDECA's optional vertex stage (softdeca.f_ph_v), version 3 its optional
+# residual stage (softdeca.f_r_ph, softdeca.f_r_w); a bundle is written with the lowest
+# version that holds it, so runtimes that read only older versions still run what they can.
+FORMAT_VERSION = 3
+FORMAT_VERSIONS = (1, 2, 3)
 OPSET = 17
 MANIFEST = "manifest.json"
 SKIN_TRIANGLES_FILE = "skin_triangles.i32"
@@ -98,6 +100,20 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
                 "outputs": [_tensor("L", [v, lat, 3])],
                 "parameter_columns": cols,
             }
+        if (stage := nets.softdeca.f_r) is not None:
+            c, modes = stage.sizes.members * stage.sizes.hidden, stage.sizes.modes + 1
+            specs["softdeca.f_r_ph"] = {
+                "inputs": [_tensor("parameters", [v, p])],
+                "outputs": [_tensor("condition", [1, c]), _tensor("modes", [v, modes, 3])],
+                "parameter_columns": cols,
+            }
+            specs["softdeca.f_r_w"] = {
+                "inputs": [
+                    _tensor("weights", ["batch", len(d.blendshapes)]),
+                    _tensor("condition", [1, c]),
+                ],
+                "outputs": [_tensor("coefficients", ["batch", modes])],
+            }
     if nets.sparse is not None:
         specs["sparse.f_l"] = {
             "inputs": [_tensor("landmark_offsets", ["batch", 3 * k])],
@@ -117,7 +133,14 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
 def _modules(nets: BundleNetworks) -> dict[str, nn.Module]:
     out: dict[str, nn.Module] = {"identity_encoder": nets.identity_encoder}
     if nets.softdeca is not None:
-        out |= {f"softdeca.{k}": m for k, m in vars(nets.softdeca).items() if m is not None}
+        out |= {
+            f"softdeca.{k}": m
+            for k, m in vars(nets.softdeca).items()
+            if m is not None and k != "f_r"
+        }
+        if (stage := nets.softdeca.f_r) is not None:
+            out["softdeca.f_r_ph"] = ResidualCondition(stage)
+            out["softdeca.f_r_w"] = ResidualCoefficients(stage)
     if nets.sparse is not None:
         out |= {f"sparse.{k}": m for k, m in vars(nets.sparse).items()}
     return out
@@ -157,7 +180,29 @@ def _export_onnx(
             opset_version=OPSET,
             dynamo=False,
         )
-    return buf.getvalue()
+    return _name_constant_outputs(buf.getvalue(), names_out)
+
+
+def _name_constant_outputs(data: bytes, names: list[str]) -> bytes:
+    """An output the exporter folded into a constant (the residual stage's mode table) keeps
+    the constant's generated name; give it its contract name through an Identity, and the
+    constant a table name, so that _store_half stores it in float16 like the other tables."""
+    import onnx
+    from onnx import helper
+
+    model = onnx.load_from_string(data)
+    graph = model.graph
+    inits = {i.name: i for i in graph.initializer}
+    renamed = False
+    for out, name in zip(graph.output, names, strict=True):
+        if out.name == name or out.name not in inits:
+            continue
+        table = f"{name}.{HALF_TABLES[-1]}"
+        inits[out.name].name = table
+        graph.node.append(helper.make_node("Identity", [table], [name]))
+        out.name = name
+        renamed = True
+    return model.SerializeToString() if renamed else data
 
 
 def _store_half(data: bytes) -> tuple[bytes, list[str]]:
@@ -247,7 +292,11 @@ def export_bundle(
     lm = definition.landmarks
     manifest: dict[str, Any] = {
         "format": FORMAT,
-        "format_version": 2 if "softdeca.f_ph_v" in specs else 1,
+        "format_version": 3
+        if "softdeca.f_r_ph" in specs
+        else 2
+        if "softdeca.f_ph_v" in specs
+        else 1,
         "untrained": info.untrained,
         "description": info.description,
         "units": "metre",
@@ -306,12 +355,28 @@ def export_bundle(
             "gamma_range": [GAMMA_MIN, GAMMA_MAX],
         },
         "networks": specs,
+        **_residual_sizes(nets),
         "export_check_max_abs": deviations or None,
         "training": info.training,
         "errors": info.errors,
     }
     (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
     return folder
+
+
+def _residual_sizes(nets: BundleNetworks) -> dict[str, Any]:
+    """The manifest's `residual_stage` entry (the sizes its networks' shapes use), if any."""
+    stage = nets.softdeca.f_r if nets.softdeca is not None else None
+    if stage is None:
+        return {}
+    sizes = stage.sizes
+    return {
+        "residual_stage": {
+            "modes": sizes.modes + 1,
+            "condition": sizes.members * sizes.hidden,
+            "regions": int(stage.regions.shape[0]),
+        }
+    }
 
 
 def _check_onnx(
@@ -434,6 +499,16 @@ class OnnxNetworks:
             return None
         p = self._columns("softdeca.f_ph_v", parameters)
         return self._run("softdeca.f_ph_v", parameters=p, identity=identity[None])[0]
+
+    def residual(self, parameters: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        if "softdeca.f_r_ph" not in self.sessions:
+            return None
+        p = self._columns("softdeca.f_r_ph", parameters)
+        condition, modes = self._run("softdeca.f_r_ph", parameters=p)
+        return condition, modes
+
+    def residual_coefficients(self, weights: np.ndarray, condition: np.ndarray) -> np.ndarray:
+        return self._run("softdeca.f_r_w", weights=weights, condition=condition)[0]
 
     def f_dyn(
         self, model: Model, parameters: np.ndarray, identity: np.ndarray

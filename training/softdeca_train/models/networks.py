@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -24,6 +25,9 @@ from torch import nn
 from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
+
+if TYPE_CHECKING:
+    from softdeca_train.models.residual import ResidualStage
 
 # The stable, equilibrium-preserving dynamics set (eq. 21 with gamma + 2 alpha - beta = 1):
 # beta in [0, BETA_MAX], gamma in [GAMMA_MIN, GAMMA_MAX] keep both roots of
@@ -45,6 +49,12 @@ class NetworkSizes:
     positional: int = 32
     encoder_points: int = 1024
     encoder_hidden: tuple[int, ...] = (256,)
+    # SoftDECA's residual stage (models/residual.py): modes besides the mean, the members'
+    # width and count, and the steps each member trains
+    residual_modes: int = 31
+    residual_hidden: int = 256
+    residual_members: int = 5
+    residual_steps: int = 3000
 
 
 FULL_SIZES = NetworkSizes()
@@ -58,6 +68,10 @@ TEST_SIZES = NetworkSizes(
     positional=8,
     encoder_points=64,
     encoder_hidden=(16,),
+    residual_modes=7,
+    residual_hidden=16,
+    residual_members=2,
+    residual_steps=100,
 )
 
 
@@ -169,6 +183,27 @@ class ElementMLP(nn.Module):
 GRAVITY_COLUMNS = ("gravity_strength", "gravity_tilt", "gravity_azimuth")
 
 
+def gravity_columns(specs: Sequence[ParameterSpec]) -> list[int] | None:
+    """The indices of GRAVITY_COLUMNS among `specs`, or None where gravity is no input."""
+    names = [s.name for s in specs]
+    return (
+        [names.index(c) for c in GRAVITY_COLUMNS]
+        if all(c in names for c in GRAVITY_COLUMNS)
+        else None
+    )
+
+
+def gravity_load(parameters: torch.Tensor, columns: list[int] | None) -> torch.Tensor:
+    """(n, P) raw parameters -> (n, 3) gravity load in g (zero without gravity columns)."""
+    if columns is None:
+        return torch.zeros_like(parameters[:, :3])
+    s, tilt, azimuth = (parameters[:, i] for i in columns)
+    # degrees by a constant factor: ONNX opset 17 has no deg2rad
+    t, a = tilt * (np.pi / 180.0), azimuth * (np.pi / 180.0)
+    d = torch.stack([torch.sin(t) * torch.cos(a), -torch.cos(t), torch.sin(t) * torch.sin(a)], 1)
+    return s[:, None] * d + torch.tensor([0.0, 1.0, 0.0], dtype=d.dtype)
+
+
 class LocalLinear(nn.Module):
     """Per element, an affine map of the element's own parameters: [1, p_i, g_i] (p_i
     normalised, g_i its gravity load) times a table (n, 1 + P + 3 [+ S L], k). A region's
@@ -185,13 +220,8 @@ class LocalLinear(nn.Module):
         smoothing: FieldSmoothing | None = None,
     ) -> None:
         super().__init__()
-        names = [s.name for s in specs]
         self.normalise = Normalise(specs)
-        self.gravity = (
-            [names.index(c) for c in GRAVITY_COLUMNS]
-            if all(c in names for c in GRAVITY_COLUMNS)
-            else None
-        )
+        self.gravity = gravity_columns(specs)
         self.smoothing = smoothing
         self.smoothed = [i for i, s in enumerate(specs) if s.localisable] if smoothing else []
         n_smoothed = len(self.smoothed) * (len(smoothing.scales) if smoothing else 0)
@@ -200,16 +230,7 @@ class LocalLinear(nn.Module):
     def features(self, parameters: torch.Tensor) -> torch.Tensor:
         """(n, P) raw -> (n, 1 + P + 3 [+ S L])."""
         ones = torch.ones_like(parameters[:, :1])
-        if self.gravity is None:
-            load = torch.zeros_like(parameters[:, :3])
-        else:
-            s, tilt, azimuth = (parameters[:, i] for i in self.gravity)
-            # degrees by a constant factor: ONNX opset 17 has no deg2rad
-            t, a = tilt * (np.pi / 180.0), azimuth * (np.pi / 180.0)
-            d = torch.stack(
-                [torch.sin(t) * torch.cos(a), -torch.cos(t), torch.sin(t) * torch.sin(a)], 1
-            )
-            load = s[:, None] * d + torch.tensor([0.0, 1.0, 0.0], dtype=d.dtype)
+        load = gravity_load(parameters, self.gravity)
         own = self.normalise(parameters)
         if self.smoothing is None or not self.smoothed:
             return torch.cat([ones, own, load], dim=1)
@@ -324,6 +345,8 @@ class SoftDecaNetworks:
     f_dyn: DynamicsNetwork
     # the optional vertex stage: X = DT(S_t, I + z . L) + z . L_v (bundle format version 2)
     f_ph_v: HyperNetwork | None = None
+    # the optional residual stage: + sum_k c_k(w, p) M_k (models/residual.py; version 3)
+    f_r: ResidualStage | None = None
 
 
 @dataclass
@@ -366,12 +389,15 @@ def build_random(
     dg_scale: float = 0.02,
     offset_scale: float = 1e-3,
     vertex_stage: bool = False,
+    residual_stage: bool = False,
 ) -> BundleNetworks:
     """Random-weight networks (untrained). `dg_scale` sets the size of the deformation-gradient
     corrections (G - I) and `offset_scale` that of the vertex offsets (metres), so that an
     untrained bundle stays close to its input instead of producing noise. `vertex_stage` adds
     SoftDECA's vertex stage (with its per-vertex affine table, random too; with the smoothed
-    parameters among its inputs where the definition has the skin at rest)."""
+    parameters among its inputs where the definition has the skin at rest); `residual_stage`
+    adds the residual stage (models/residual.py) over the definition's regions (one region
+    where it has none), its modes random of size `offset_scale`."""
     torch.manual_seed(seed)
     specs = tuple(specs)
     nf, nv = definition.n_faces, definition.skin_vertices
@@ -395,6 +421,14 @@ def build_random(
             f_ph_v=HyperNetwork(nv, specs, sizes, 3, offset_scale),
             f_dyn=DynamicsNetwork(nv, specs, sizes, gamma0=0.6, beta0=0.25),
         )
+    if sd is not None and residual_stage:
+        from softdeca_train.models.residual import ResidualSizes, ResidualStage
+
+        regions = definition.skin_regions
+        labels = np.zeros(nv, np.int64) if regions is None else regions
+        sd.f_r = ResidualStage(labels, specs, ResidualSizes.of(sizes))
+        with torch.no_grad():
+            sd.f_r.table.normal_(0.0, 0.2 * offset_scale)
     if sd is not None and sd.f_ph_v is not None and sd.f_ph_v.local is not None:
         with torch.no_grad():  # the affine table starts at zero in training; random here
             sd.f_ph_v.local.table.normal_(0.0, offset_scale)

@@ -4,7 +4,8 @@ the same pieces (dt.py, parameters.py); parity tests compare the runtime against
 
 Per frame, SoftDECA: S_t = neutral + sum_i w_i B_i (whole head), z = f_w(w),
 G_f = I + sum_k z_k L[f, k], X = DT(S_t, G) on the skin, plus sum_k z_k L_v[v, k] where the
-bundle has SoftDECA's vertex stage. SparseSoftDECA: offsets of the
+bundle has SoftDECA's vertex stage and sum_k c_k M[v, k] where it has the residual stage
+(c = f_r_w(w, f_r_ph(p)), M its modes). SparseSoftDECA: offsets of the
 retargeted landmarks from the avatar's neutral landmarks, z = f_l(offsets),
 X = neutral_skin + sum_k z_k L_v[v, k]. Then, if enabled, dynamics per skin vertex
 X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, the non-skin vertices, and normals."""
@@ -38,6 +39,8 @@ class Networks(Protocol):
     def f_ph(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray: ...
     def f_ph_v(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray: ...
     def vertex_stage(self, parameters: np.ndarray, identity: np.ndarray) -> np.ndarray | None: ...
+    def residual(self, parameters: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None: ...
+    def residual_coefficients(self, weights: np.ndarray, condition: np.ndarray) -> np.ndarray: ...
     def f_dyn(
         self, model: Model, parameters: np.ndarray, identity: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
@@ -90,6 +93,20 @@ class TorchNetworks:
         return self.nets.softdeca.f_ph_v(self._t(parameters), h).numpy()
 
     @torch.no_grad()
+    def residual(self, parameters: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        assert self.nets.softdeca is not None
+        stage = self.nets.softdeca.f_r
+        if stage is None:
+            return None
+        p = self._t(parameters)
+        return stage.condition(p).numpy(), stage.table.numpy().copy()
+
+    @torch.no_grad()
+    def residual_coefficients(self, weights: np.ndarray, condition: np.ndarray) -> np.ndarray:
+        assert self.nets.softdeca is not None and self.nets.softdeca.f_r is not None
+        return self.nets.softdeca.f_r.coefficients(self._t(weights), self._t(condition)).numpy()
+
+    @torch.no_grad()
     def f_dyn(
         self, model: Model, parameters: np.ndarray, identity: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -117,6 +134,8 @@ class Preparation:
     face_l: np.ndarray | None  # (F, latent, 9)
     vertex_l: np.ndarray | None  # (Vs, latent, 3)
     softdeca_vertex_l: np.ndarray | None  # SoftDECA's vertex stage (Vs, latent, 3), or None
+    # SoftDECA's residual stage: its condition (1, C) and modes (Vs, K, 3), or None
+    residual: tuple[np.ndarray, np.ndarray] | None
     dynamics: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]  # model -> alpha, beta, gamma
 
 
@@ -161,19 +180,20 @@ class ReferenceAvatar:
         names = [s.name for s in self.nets.specs]
         pf, pv = self.params.face_matrix(names), self.params.vertex_matrix(names)
         h = self.identity
-        face_l = vertex_l = stage = None
+        face_l = vertex_l = stage = residual = None
         dyn = {}
         if self.nets.has("softdeca"):
             face_l = self.nets.f_ph(pf, h).astype(np.float64)
             stage = self.nets.vertex_stage(pv, h)
             stage = None if stage is None else stage.astype(np.float64)
+            residual = self.nets.residual(pv)
             dyn["softdeca"] = tuple(
                 x.astype(np.float64) for x in self.nets.f_dyn("softdeca", pv, h)
             )
         if self.nets.has("sparse"):
             vertex_l = self.nets.f_ph_v(pv, h).astype(np.float64)
             dyn["sparse"] = tuple(x.astype(np.float64) for x in self.nets.f_dyn("sparse", pv, h))
-        self.prep = Preparation(h.copy(), face_l, vertex_l, stage, dyn)  # type: ignore[arg-type]
+        self.prep = Preparation(h.copy(), face_l, vertex_l, stage, residual, dyn)  # type: ignore[arg-type]
         return self.prep
 
     def calibrate(self, user_neutral: np.ndarray) -> None:
@@ -207,9 +227,15 @@ class ReferenceAvatar:
         z = self.nets.f_w(np.asarray(weights, np.float32)[None])[0].astype(np.float64)
         g = np.einsum("k,fkc->fc", z, prep.face_l).reshape(-1, 3, 3)
         x = deformation_transfer(self.dt, torch.from_numpy(skin[None]), torch.from_numpy(g[None]))
-        if prep.softdeca_vertex_l is None:
-            return x[0].numpy()
-        return x[0].numpy() + np.einsum("k,vkc->vc", z, prep.softdeca_vertex_l)
+        out = x[0].numpy()
+        if prep.softdeca_vertex_l is not None:
+            out = out + np.einsum("k,vkc->vc", z, prep.softdeca_vertex_l)
+        if prep.residual is not None:
+            condition, modes = prep.residual
+            w = np.asarray(weights, np.float32)[None]
+            c = self.nets.residual_coefficients(w, condition)[0].astype(np.float64)
+            out = out + np.einsum("k,vkc->vc", c, modes.astype(np.float64))
+        return out
 
     def landmark_offsets(self, points: np.ndarray) -> np.ndarray:
         u = self._select(points)

@@ -117,6 +117,9 @@ def synthetic_head(level: int = 2, seed: int = 0, n_landmarks: int = 20) -> Synt
         non_skin_bones=bones,
         jaw_anchors=anchors.astype(np.int64),
         skin_rest=skin,
+        # four regions by quadrant of the rest skin (x and y signs): enough to exercise the
+        # residual stage's region means
+        skin_regions=((skin[:, 0] > 0).astype(np.int64) + 2 * (skin[:, 1] > 0)),
     )
     return SyntheticHead(definition, neutral, head_triangles, deltas, user_neutral, user_deltas)
 

@@ -49,6 +49,9 @@ class TemplateDefinition:
     # (skin_vertices, 3) S at rest, metres: where the vertex stage's smoothing tables come
     # from (models/smoothing.py); None (a bundle read back) builds no smoothing
     skin_rest: np.ndarray | None = None
+    # (skin_vertices,) region index of every skin vertex (data/regions.py): where the residual
+    # stage reads each region's parameters; None (a bundle read back) builds no residual stage
+    skin_regions: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         t = self.skin_triangles
@@ -71,6 +74,9 @@ class TemplateDefinition:
         r = self.skin_rest
         if r is not None and (r.shape != (self.skin_vertices, 3) or not np.isfinite(r).all()):
             raise ValueError("skin_rest must be finite (skin_vertices, 3) positions")
+        g = self.skin_regions
+        if g is not None and (g.shape != (self.skin_vertices,) or g.min() < 0):
+            raise ValueError("skin_regions must be one non-negative region index per skin vertex")
         if self.blendshapes != ARKIT_BLENDSHAPES:
             raise ValueError("bundles use the canonical ARKit blendshape order")
 
@@ -82,6 +88,7 @@ class TemplateDefinition:
 def from_template(template: object | None = None) -> TemplateDefinition:
     """The definition of the ICT-based template: S, the 149 landmarks registered to S, and the
     bone labels of the layered head model (JAW where jawOpen moves a vertex like the teeth)."""
+    from softdeca_train.data.regions import region_labels
     from softdeca_train.landmarks import template_landmarks
     from softdeca_train.landmarks.definition import load_definition
     from softdeca_train.lhm.fit import bone_labels
@@ -109,4 +116,5 @@ def from_template(template: object | None = None) -> TemplateDefinition:
         non_skin_bones=np.where(bones[N_SKIN:] == LHM_JAW, JAW, CRANIUM).astype(np.uint8),
         jaw_anchors=np.nonzero(bones[:N_SKIN] == LHM_JAW)[0].astype(np.int64),
         skin_rest=np.asarray(t.neutral[:N_SKIN], dtype=np.float64),
+        skin_regions=region_labels(t).astype(np.int64),
     )

@@ -1,7 +1,7 @@
 """`make bench`'s runtime figures: a full-size untrained bundle on the template topology (with
-SoftDECA's vertex stage, as the trained bundles have it), the avatar of identity seed 1, and
-`softdeca bench-runtime` on the frames of a real take -> build/bench/runtime.json
-(docs/ARCHITECTURE.md, Conventions)."""
+SoftDECA's vertex and residual stages, as the trained bundles have them), the avatar of
+identity seed 1, and `softdeca bench-runtime` on the frames of a real take ->
+build/bench/runtime.json (docs/ARCHITECTURE.md, Conventions)."""
 
 from __future__ import annotations
 
@@ -33,7 +33,9 @@ def bench_runtime(
     work = out / "runtime-inputs"
     specs = specs_or_test_list(parameters)
     definition = from_template(Template.load(ict))
-    nets = build_random(definition, specs, FULL_SIZES, seed=0, vertex_stage=True)
+    nets = build_random(
+        definition, specs, FULL_SIZES, seed=0, vertex_stage=True, residual_stage=True
+    )
     info = BundleInfo(True, "UNTRAINED full-size random networks for the runtime benchmark")
     bundle = export_bundle(work / "bundle", definition, nets, info, check=False)
     avatar = work / "avatar-seed1"
@@ -43,7 +45,7 @@ def bench_runtime(
     how = (
         f"make bench (softdeca bench-runtime, {len(specs)} parameters, "
         f"{FULL_SIZES.latent} latents, hyper hidden {FULL_SIZES.hyper_hidden}, "
-        "SoftDECA with its vertex stage)"
+        "SoftDECA with its vertex and residual stages)"
     )
     cmd = [
         str(CLI), "bench-runtime", "--bundle", str(bundle), "--avatar", str(avatar),

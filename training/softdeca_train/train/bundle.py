@@ -92,7 +92,7 @@ def train_bundle(
         sizes=run.sizes,
         specs=run.specs,
         identity_encoder=enc,
-        softdeca=SoftDecaNetworks(sd.f_w, sd.f_ph, sd_dyn.f_dyn, sd.f_ph_v),
+        softdeca=SoftDecaNetworks(sd.f_w, sd.f_ph, sd_dyn.f_dyn, sd.f_ph_v, sd.f_r),
         sparse=SparseNetworks(sp.f_l, sp.f_ph_v, sp_dyn.f_dyn),
     ).eval()
     manifest = run.data.manifest

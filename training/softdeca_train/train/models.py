@@ -25,6 +25,7 @@ from softdeca_train.models.networks import (
     mlp,
 )
 from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.residual import ResidualFit, ResidualSizes, ResidualStage
 from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
 from softdeca_train.train.batches import Batch, Dataset
@@ -195,7 +196,8 @@ class SoftDeca(Trainable):
 
 
 class SoftDecaHybrid(Trainable):
-    """SoftDECA with a vertex stage: X = DT(S_t, I + z(w) . L(p, h)) + z(w) . L_v(p, h).
+    """SoftDECA with a vertex stage and a residual stage:
+    X = DT(S_t, I + z(w) . L(p, h)) + z(w) . L_v(p, h) + c(w, p) . M.
 
     DT alone cannot reach the physics: fed the physics' own face gradients it stays 0.187 mm
     from T where S_t is 0.398 mm off (`linear-baseline --local`, docs/training.md), because its
@@ -204,13 +206,20 @@ class SoftDecaHybrid(Trainable):
     whose L_v tensor is an affine map of each vertex's own parameters and of the localisable
     ones averaged around it (models/smoothing.py), so the model starts at the per-vertex ridge
     fit (`init_from_dataset`, closed form) and a region's control acts in and around its
-    region."""
+    region. What that fit leaves is largely shared between heads but nonlinear in w and p: the
+    residual stage (models/residual.py), fitted to it right after, carries that part."""
 
     hypernetworks = ("f_ph", "f_ph_v")
     hyper_lr = HYPER_LR_SOFTDECA
 
-    def __init__(self, d: TemplateDefinition, specs: Sequence[ParameterSpec], sizes: NetworkSizes):
+    def __init__(
+        self,
+        d: TemplateDefinition,
+        specs: Sequence[ParameterSpec],
+        sizes: NetworkSizes,
+    ):
         super().__init__()
+        self.residual_fit = ResidualFit(steps=sizes.residual_steps)
         self.f_w = WeightEncoder(len(d.blendshapes), sizes, linear_skip=True, constant_slot=True)
         self.f_ph = HyperNetwork(d.n_faces, specs, sizes, 9, 1e-4, base=True)
         smoothing = None if d.skin_rest is None else FieldSmoothing(d.skin_rest)
@@ -227,6 +236,10 @@ class SoftDecaHybrid(Trainable):
         )
         self.n_faces, self.n_vertices = d.n_faces, d.skin_vertices
         self.n_weights = len(d.blendshapes)
+        regions = d.skin_regions
+        self.f_r = (
+            None if regions is None else ResidualStage(regions, specs, ResidualSizes.of(sizes))
+        )
 
     def vertex_features(self, weights: torch.Tensor, p_vertices: torch.Tensor) -> torch.Tensor:
         """(V, B, 52 + 1 + P + 3): [w, local features of each vertex] (the vertex stage's
@@ -299,13 +312,44 @@ class SoftDecaHybrid(Trainable):
             assert isinstance(last, nn.Linear)
             last.weight.zero_()
             last.bias.zero_()
+        if self.f_r is not None:
+            self.fit_residual(data, kept, progress)
+
+    def fit_residual(self, data: Dataset, frames: int, progress: bool = True) -> dict[str, float]:
+        """The residual stage from what the model (without it) leaves on the kept static train
+        frames: its modes and the members that give their coefficients (models/residual.py)."""
+        from tqdm import tqdm
+
+        assert self.f_r is not None
+        with torch.no_grad():
+            self.f_r.table.zero_()  # the model without the stage
+        weights, features, residual = [], [], []
+        bar = tqdm(total=frames, desc="residual of the start", unit="frame", disable=not progress)
+        for b in data.batches("static", "train"):
+            with torch.no_grad():
+                residual.append((b.T - self.predict(b)).float())
+                pv = b.vertex_parameters(self.n_vertices)
+                features.append(self.f_r.parameter_features(pv).expand(b.frames, -1))
+            weights.append(b.weights.float())
+            bar.update(b.frames)
+        bar.close()
+        return self.f_r.fit(
+            torch.cat(weights),
+            torch.cat(features),
+            torch.cat(residual),
+            self.residual_fit,
+            progress,
+        )
 
     def predict(self, batch: Batch) -> torch.Tensor:
         z = self.f_w(batch.weights)  # (B, latent), last entry 1
         hyper = self.f_ph(batch.face_parameters(self.n_faces), batch.h)  # (F, latent, 9)
         g = torch.einsum("bk,fkn->bfn", z, hyper).reshape(len(z), self.n_faces, 3, 3)
         vertex = self.f_ph_v(batch.vertex_parameters(self.n_vertices), batch.h)  # (V, latent, 3)
-        return deformation_transfer(batch.dt, batch.S, g) + torch.einsum("bk,vkn->bvn", z, vertex)
+        x = deformation_transfer(batch.dt, batch.S, g) + torch.einsum("bk,vkn->bvn", z, vertex)
+        if self.f_r is None:
+            return x
+        return x + self.f_r(batch.weights, batch.vertex_parameters(self.n_vertices))
 
 
 class SoftDecaVertex(Trainable):

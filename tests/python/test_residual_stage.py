@@ -1,0 +1,125 @@
+"""SoftDECA's residual stage (models/residual.py): its modes reproduce a low-rank residual, the
+split at the first layer (prepare half, frame half) is the members' own forward pass, region
+means read a regional pattern back, and the fit learns a residual nonlinear in the weights."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+from softdeca_train.models import load_parameter_specs
+from softdeca_train.models.residual import (
+    ResidualFit,
+    ResidualSizes,
+    ResidualStage,
+    region_means,
+)
+from softdeca_train.models.synthetic import TEST_PARAMETERS
+
+SPECS = load_parameter_specs(TEST_PARAMETERS)
+V = 40
+LABELS = np.arange(V) % 4  # four regions
+
+
+def stage(modes: int = 3, members: int = 2, dropout: float = 0.3) -> ResidualStage:
+    torch.manual_seed(0)
+    sizes = ResidualSizes(modes=modes, hidden=32, members=members, dropout=dropout)
+    return ResidualStage(LABELS, SPECS, sizes)
+
+
+def defaults(n: int = V) -> torch.Tensor:
+    return torch.tensor([[s.default for s in SPECS]], dtype=torch.float32).repeat(n, 1)
+
+
+def test_region_means_average_each_region_and_skip_empty_ones():
+    m = region_means(np.array([0, 0, 2, 2, 2]), 4)
+    assert m.shape == (4, 5)
+    np.testing.assert_allclose(m.sum(1), [1, 0, 1, 0])
+    field = np.array([1.0, 3.0, 5.0, 5.0, 8.0])
+    np.testing.assert_allclose(m @ field, [2.0, 0.0, 6.0, 0.0])
+
+
+def test_parameter_features_read_a_regional_pattern_back():
+    s = stage()
+    p = defaults()
+    col = [x.name for x in SPECS].index("target_volume")
+    p[LABELS == 2, col] = 1.4
+    features = s.parameter_features(p)
+    region_values = features[0, 3:].reshape(4, len(SPECS))
+    norm = s.normalise(p)
+    assert torch.allclose(region_values[2, col], norm[LABELS == 2, col][0])
+    assert torch.allclose(region_values[0, col], norm[LABELS == 0, col][0])
+    assert region_values[2, col] > region_values[0, col]
+
+
+def test_modes_reproduce_a_residual_of_low_rank():
+    s = stage(modes=3)
+    rng = np.random.default_rng(1)
+    basis = torch.from_numpy(rng.normal(size=(3, V, 3))).float() * 1e-3
+    mean = torch.from_numpy(rng.normal(size=(V, 3))).float() * 1e-3
+    c = torch.from_numpy(rng.normal(size=(50, 3))).float()
+    residual = mean + torch.einsum("nk,kvc->nvc", c, basis)
+    coef = s.set_modes(residual)
+    with torch.no_grad():
+        rebuilt = torch.einsum("nk,vkc->nvc", coef, s.table[:, :3]) + s.table[:, 3]
+    assert float((rebuilt - residual).abs().max()) < 1e-7
+
+
+def test_the_split_at_the_first_layer_is_the_members_forward_pass():
+    s = stage(members=3).eval()
+    with torch.no_grad():
+        s.input_mean.normal_()
+        s.input_std.uniform_(0.5, 2.0)
+    w = torch.rand(4, 52)
+    p = defaults()
+    x = (s.inputs(w, p) - s.input_mean) / s.input_std
+    full = torch.stack([m(x) for m in s.members]).mean(0)
+    split = s.coefficients(w, s.condition(p))
+    assert torch.allclose(split[:, :-1], full, atol=1e-5)
+    assert torch.all(split[:, -1] == 1)  # the mean mode's constant slot
+
+
+def test_the_fit_learns_a_residual_nonlinear_in_the_weights():
+    s = stage(modes=2, members=2, dropout=0.0)
+    rng = np.random.default_rng(2)
+    n = 400
+    w = torch.from_numpy(rng.uniform(0, 1, (n, 52))).float()
+    basis = torch.from_numpy(rng.normal(size=(2, V, 3))).float() * 1e-3
+    c = torch.stack([torch.sin(3 * w[:, 0]) * w[:, 1], (w[:, 2] - 0.5) ** 2], 1)
+    c = c - c.mean(0)  # all in the coefficients: the mean mode alone explains nothing
+    residual = torch.einsum("nk,kvc->nvc", c, basis)
+    features = s.parameter_features(defaults()).expand(n, -1)
+    out = s.fit(w, features, residual, ResidualFit(steps=800, batch=64), progress=False)
+    # the mean alone (the stage with its coefficients at zero) leaves most of it
+    mean_only = float((residual - residual.mean(0)).norm(dim=-1).mean()) * 1e3
+    assert mean_only > 0.95 * out["residual_mm"]
+    assert out["after_mm"] < 0.4 * out["residual_mm"], out
+    s.eval()
+    with torch.no_grad():
+        got = s(w[:50], defaults())
+    assert (
+        float((got - residual[:50]).norm(dim=-1).mean()) * 1e3
+        < 0.4 * out["residual_mm"]
+    )
+
+
+def test_inputs_the_train_frames_never_move_are_read_as_nothing():
+    """A parameter constant over the train frames gets no weight: moving it at run time (a
+    value the data never had) leaves the coefficients as they are."""
+    s = stage(modes=2, members=2)
+    rng = np.random.default_rng(3)
+    n = 64
+    w = torch.from_numpy(rng.uniform(0, 1, (n, 52))).float()
+    residual = torch.einsum(
+        "n,vc->nvc",
+        w[:, 0] - 0.5,
+        torch.from_numpy(rng.normal(size=(V, 3))).float() * 1e-3,
+    )
+    features = s.parameter_features(defaults()).expand(n, -1)
+    s.fit(w, features, residual, ResidualFit(steps=20, batch=16), progress=False)
+    s.eval()
+    p = defaults()
+    p[:, [x.name for x in SPECS].index("target_volume")] = 1.4
+    with torch.no_grad():
+        moved = s.coefficients(w[:3], s.condition(p))
+        still = s.coefficients(w[:3], s.condition(defaults()))
+    assert torch.equal(moved, still)

@@ -1,0 +1,270 @@
+"""SoftDECA's residual stage: what the per-vertex stages leave of the physics, as a few modes
+of the whole skin shared by every head, with coefficients from an MLP of the frame's weights,
+the gravity load and each region's mean parameter values.
+
+Why this form: the start's residual on unseen heads lies mostly in modes shared between heads
+(projected on 64 modes of the train residual it drops to a quarter), but its coefficients
+depend nonlinearly on the weights and on the material; ridge maps of them gained nothing, an
+MLP did, and the regions' values of p (not only the global p) made the difference
+(docs/training.md, "The residual stage").
+
+Split for the runtime (docs/bundle.md): `condition` is computed once per preparation from the
+per-vertex parameters (the region means and the parameters' share of the first layer), and
+`coefficients` per frame from the weights and that condition; the modes are a constant table,
+the frame adds sum_k c_k modes[:, k] to the skin. The last mode is the residual's mean, with a
+coefficient fixed at 1."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import nn
+
+from softdeca_train.models.networks import (
+    NetworkSizes,
+    Normalise,
+    gravity_columns,
+    gravity_load,
+)
+from softdeca_train.models.parameters import ParameterSpec
+
+N_WEIGHTS = 52
+
+
+@dataclass(frozen=True)
+class ResidualSizes:
+    """The stage's shape. Measured on softdeca-l3-c5's static split (docs/training.md): 32 and
+    64 modes did as well; dropout 0.3 generalised best to unseen heads; averaging several
+    independently trained members gained a little more."""
+
+    modes: int = 31  # plus the mean: 32 slots, the latent size of the other stages
+    hidden: int = 256
+    members: int = 5
+    dropout: float = 0.3
+
+    @staticmethod
+    def of(sizes: NetworkSizes) -> ResidualSizes:
+        return ResidualSizes(sizes.residual_modes, sizes.residual_hidden, sizes.residual_members)
+
+
+DEFAULT_SIZES = ResidualSizes()
+
+
+@dataclass(frozen=True)
+class ResidualFit:
+    """How the members are trained on the modes' coefficients (AdamW, cosine decay)."""
+
+    steps: int = 3000
+    batch: int = 128
+    lr: float = 1e-3
+    weight_decay: float = 1e-2
+    seed: int = 0
+
+
+DEFAULT_FIT = ResidualFit()
+
+
+def region_means(labels: np.ndarray, n_regions: int) -> np.ndarray:
+    """(R, V) rows averaging a per-vertex field over each region's vertices (a region without
+    vertices gets a zero row)."""
+    labels = np.asarray(labels, np.int64)
+    m = np.zeros((n_regions, len(labels)), np.float32)
+    for r in range(n_regions):
+        idx = np.nonzero(labels == r)[0]
+        if len(idx):
+            m[r, idx] = 1.0 / len(idx)
+    return m
+
+
+class ResidualStage(nn.Module):
+    """offsets (B, V, 3) = sum_k c_k(w, g, p_regions) table[:, k], c_last = 1."""
+
+    def __init__(
+        self,
+        labels: np.ndarray,
+        specs: Sequence[ParameterSpec],
+        sizes: ResidualSizes = DEFAULT_SIZES,
+    ) -> None:
+        super().__init__()
+        self.sizes = sizes
+        labels = np.asarray(labels)
+        n_regions = int(labels.max()) + 1
+        self.normalise = Normalise(specs)
+        self.gravity = gravity_columns(specs)
+        self.register_buffer("regions", torch.from_numpy(region_means(labels, n_regions)))
+        n_p = 3 + n_regions * len(specs)
+        self.n_inputs = N_WEIGHTS + n_p
+        # the inputs' standardisation, from the train frames (ResidualStage.fit)
+        self.register_buffer("input_mean", torch.zeros(self.n_inputs))
+        self.register_buffer("input_std", torch.ones(self.n_inputs))
+        h = sizes.hidden
+        self.members = nn.ModuleList(
+            nn.Sequential(
+                nn.Linear(self.n_inputs, h),
+                nn.SiLU(),
+                nn.Dropout(sizes.dropout),
+                nn.Linear(h, h),
+                nn.SiLU(),
+                nn.Dropout(sizes.dropout),
+                nn.Linear(h, sizes.modes),
+            )
+            for _ in range(sizes.members)
+        )
+        # (V, modes + 1, 3) metres; zero until fitted, so the stage starts as a no-op. A buffer:
+        # the modes come from the data in closed form; gradient steps train the members only
+        # (Adam would move every entry by about its learning rate, metres, per step).
+        self.register_buffer("table", torch.zeros(len(labels), sizes.modes + 1, 3))
+
+    # ---- the inputs ----------------------------------------------------------------------
+    def parameter_features(self, parameters: torch.Tensor) -> torch.Tensor:
+        """(V, P) raw per-vertex parameters -> (1, 3 + R P): the gravity load and each
+        region's mean normalised values."""
+        load = gravity_load(parameters.mean(0, keepdim=True), self.gravity)
+        own = self.regions.to(parameters.dtype) @ self.normalise(parameters)  # (R, P)
+        return torch.cat([load, own.reshape(1, -1)], dim=1)
+
+    def inputs(self, weights: torch.Tensor, parameters: torch.Tensor) -> torch.Tensor:
+        """(B, 52 + 3 + R P) unstandardised inputs of the members."""
+        pf = self.parameter_features(parameters)
+        return torch.cat([weights, pf.expand(len(weights), -1)], dim=1)
+
+    # ---- the two runtime halves -----------------------------------------------------------
+    def condition(self, parameters: torch.Tensor) -> torch.Tensor:
+        """(1, members x hidden): the parameters' share of every member's first layer."""
+        n = N_WEIGHTS
+        x = (self.parameter_features(parameters) - self.input_mean[n:]) / self.input_std[n:]
+        parts = []
+        for m in self.members:
+            first = m[0]
+            assert isinstance(first, nn.Linear)
+            parts.append(x @ first.weight[:, n:].T + first.bias)
+        return torch.cat(parts, dim=1)
+
+    def coefficients(self, weights: torch.Tensor, condition: torch.Tensor) -> torch.Tensor:
+        """(B, modes + 1): the members' mean, then the mean mode's constant 1."""
+        n, h = N_WEIGHTS, self.sizes.hidden
+        xw = (weights - self.input_mean[:n]) / self.input_std[:n]
+        out = 0
+        for i, m in enumerate(self.members):
+            first = m[0]
+            assert isinstance(first, nn.Linear)
+            a = xw @ first.weight[:, :n].T + condition[:, i * h : (i + 1) * h]
+            out = out + m[1:](a)
+        c = out / len(self.members)
+        return torch.cat([c, torch.ones_like(c[:, :1])], dim=1)
+
+    def forward(self, weights: torch.Tensor, parameters: torch.Tensor) -> torch.Tensor:
+        c = self.coefficients(weights, self.condition(parameters))
+        return torch.einsum("bk,vkc->bvc", c, self.table)
+
+    # ---- fitting ---------------------------------------------------------------------------
+    @torch.no_grad()
+    def set_modes(self, residual: torch.Tensor) -> torch.Tensor:
+        """Take the mean and leading modes of `residual` (N, V, 3) metres as the table and
+        return the modes' coefficients per frame (N, modes), in units of each mode's spread
+        (the table holds the modes scaled by their singular values over sqrt N)."""
+        n, k = len(residual), self.sizes.modes
+        r = residual.reshape(n, -1).double()
+        mean = r.mean(0)
+        rc = r - mean
+        # the modes from the N x N Gram matrix: N is thousands, 3V tens of thousands
+        ev, u = torch.linalg.eigh(rc @ rc.T)
+        order = torch.argsort(ev, descending=True)[:k]  # fewer than k with fewer frames
+        s = ev[order].clamp_min(0).sqrt()
+        keep = (s > s[0] * 1e-9).double() if len(s) else s
+        u, s = u[:, order], s.clamp_min(1e-30)
+        modes = (u.T @ rc) / s[:, None]  # (k', 3V) orthonormal rows
+        scale = s / np.sqrt(n)
+        coef = torch.zeros(n, k, dtype=torch.float64)  # rc @ modes.T / scale
+        coef[:, : len(s)] = u * np.sqrt(n) * keep
+        table = torch.zeros_like(self.table, dtype=torch.float64)
+        v = self.table.shape[0]
+        table[:, : len(s)] = (
+            (modes * (scale * keep)[:, None]).reshape(len(s), v, 3).permute(1, 0, 2)
+        )
+        table[:, -1] = mean.reshape(v, 3)
+        self.table.copy_(table.float())
+        return coef.float()
+
+    def fit(
+        self,
+        weights: torch.Tensor,
+        parameter_features: torch.Tensor,
+        residual: torch.Tensor,
+        cfg: ResidualFit = DEFAULT_FIT,
+        progress: bool = True,
+    ) -> dict[str, float]:
+        """Fit the table to `residual` (N, V, 3) and train every member on the modes'
+        coefficients from the frames' weights (N, 52) and parameter features (N, 3 + R P).
+        Returns the fit's train errors (mm, mean per-vertex distance)."""
+        from tqdm import tqdm
+
+        x = torch.cat([weights, parameter_features], dim=1).float()
+        with torch.no_grad():
+            self.input_mean.copy_(x.mean(0))
+            # an input the train frames (nearly) never move is no input: dividing by its
+            # spread would turn rounding, or a value the data never had, into huge activations
+            std = x.std(0)
+            constant = std < 1e-3
+            self.input_std.copy_(torch.where(constant, torch.ones_like(std), std))
+        xn = (x - self.input_mean) / self.input_std
+        target = self.set_modes(residual)
+        gen = torch.Generator().manual_seed(cfg.seed)
+        bar = tqdm(total=cfg.steps * len(self.members), desc="residual stage", disable=not progress)
+        for i, m in enumerate(self.members):
+            torch.manual_seed(cfg.seed * 1000 + i)
+            for layer in m:
+                if isinstance(layer, nn.Linear):
+                    layer.reset_parameters()
+            opt = torch.optim.AdamW(m.parameters(), cfg.lr, weight_decay=cfg.weight_decay)
+            sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps)
+            m.train()
+            with torch.enable_grad():  # also when called under no_grad (a model's start)
+                for _ in range(cfg.steps):
+                    idx = torch.randint(0, len(xn), (min(cfg.batch, len(xn)),), generator=gen)
+                    loss = ((m(xn[idx]) - target[idx]) ** 2).mean()
+                    opt.zero_grad()
+                    loss.backward()
+                    opt.step()
+                    sched.step()
+                    bar.update()
+            m.eval()
+            first = m[0]
+            assert isinstance(first, nn.Linear)
+            with torch.no_grad():  # what never varied in training is read as nothing at all
+                first.weight[:, constant] = 0.0
+        bar.close()
+        with torch.no_grad():
+            c = torch.stack([m(xn) for m in self.members]).mean(0)
+            c = torch.cat([c, torch.ones_like(c[:, :1])], dim=1)
+            fitted = torch.einsum("bk,vkc->bvc", c, self.table)
+            before = residual.norm(dim=-1).mean()
+            after = (residual - fitted).norm(dim=-1).mean()
+        return {"residual_mm": float(before) * 1e3, "after_mm": float(after) * 1e3}
+
+
+class ResidualCondition(nn.Module):
+    """The exported prepare half: parameters (V, P) -> condition (1, C), modes (V, K, 3)."""
+
+    def __init__(self, stage: ResidualStage) -> None:
+        super().__init__()
+        self.stage = stage
+        self.train(stage.training)  # a fresh module trains; export restores this mode
+
+    def forward(self, parameters: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        return self.stage.condition(parameters), self.stage.table * 1.0
+
+
+class ResidualCoefficients(nn.Module):
+    """The exported per-frame half: weights (B, 52), condition (1, C) -> coefficients (B, K)."""
+
+    def __init__(self, stage: ResidualStage) -> None:
+        super().__init__()
+        self.stage = stage
+        self.train(stage.training)
+
+    def forward(self, weights: torch.Tensor, condition: torch.Tensor) -> torch.Tensor:
+        return self.stage.coefficients(weights, condition)
