@@ -189,7 +189,9 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
     if cfg.pictures:
         from softdeca_train.controls.pictures import draw_gallery
 
-        draw_gallery(cfg.out, controls, acc.shown, cases[0], entries, progress)
+        draw_gallery(
+            cfg.out, controls, acc.shown, cases[0], entries, progress, complete=not cfg.only
+        )
     return result
 
 

@@ -114,11 +114,20 @@ def draw_gallery(
     case: PhysicsCase,
     entries: list[dict],
     progress: bool = True,
+    complete: bool = False,
 ) -> None:
+    """One picture per control and the summary; with `complete` (every control drawn) the
+    folder's other pictures, of controls the gallery no longer has, are removed."""
     out.mkdir(parents=True, exist_ok=True)
+    drawn = {out / "summary.png"}
     for c in tqdm(controls, desc="pictures", disable=not progress):
-        control_picture(out / f"{c.name.replace('@', '-')}.png", c, shown[c.name], case)
+        path = out / f"{c.name.replace('@', '-')}.png"
+        control_picture(path, c, shown[c.name], case)
+        drawn.add(path)
     summary_figure(out / "summary.png", entries)
+    if complete:
+        for old in set(out.glob("*.png")) - drawn:
+            old.unlink()
 
 
 def markdown(cfg, result: dict) -> str:  # cfg: GalleryConfig
