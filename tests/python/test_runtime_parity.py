@@ -306,3 +306,24 @@ def test_the_residual_stage_needs_version_three(setup, tmp_path):
     (copy / "manifest.json").write_text(json.dumps(manifest))
     with pytest.raises(NativeError, match="format version 3"):
         NativeModel(copy)
+
+
+def test_a_zero_deformation_stage_skips_the_solve_and_keeps_parity(setup, tmp_path):
+    """A bundle whose f_ph is zero (SoftDECA at its closed-form start): every G_f is I, so the
+    runtime leaves DT out (S_t itself) and the stages after it still match the reference."""
+    import copy
+
+    head, nets, _, _ = setup
+    zero = copy.deepcopy(nets)
+    last = zero.softdeca.f_ph.body.rest[-1][-1]
+    last.weight.data.zero_()
+    last.bias.data.zero_()
+    export_bundle(tmp_path / "b", head.definition, zero, BundleInfo(True, "zero f_ph"))
+    ref, nat = pair((head, zero, NativeModel(tmp_path / "b"), None), "float")
+    for w in frames(3, 13):
+        x, _ = nat.evaluate_weights(w)
+        assert err_mm(x, ref.evaluate_weights(w)[0]) < BOUND_MM["float"]
+        assert (
+            err_mm(x, ref.blend(w)) > 0.05
+        )  # the vertex and residual stages still act
+    assert nat.stats().solve_ms == 0.0

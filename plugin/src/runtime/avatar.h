@@ -9,6 +9,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -114,6 +115,8 @@ class Avatar {
               AvatarStats& st);
   void softdeca_frame(const Preparation& prep, AvatarStats& st);
   void add_vertex_offsets(const HyperTensor& modes, const float* coefficients);  // static_ += c . modes
+  // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.
+  void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since);
   void prepare_residual(const ParameterState& params, Preparation& prep) const;
   void write_rigid_non_skin(const float* skin, float* head) const;
   void compute_normals(const float* head, float* normals);

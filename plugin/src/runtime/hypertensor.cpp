@@ -16,6 +16,8 @@ namespace softdeca::runtime {
 HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision)
     : n_(n), latent_(latent), width_(width), precision_(precision) {
   const std::size_t total = blocks() * block_stride();
+  const std::size_t count = n * static_cast<std::size_t>(latent) * static_cast<std::size_t>(width);
+  zero_ = std::all_of(source, source + count, [](float v) { return v == 0.0f; });
   const auto source_at = [&](std::size_t e, int k, int c) {
     return source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
                   static_cast<std::size_t>(c)];

@@ -25,6 +25,8 @@ class HyperTensor {
   HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision);
 
   bool empty() const { return n_ == 0; }
+  // Every entry of the source was zero: the product z . L is zero for every z.
+  bool zero() const { return zero_; }
   std::size_t elements() const { return n_; }
   std::size_t blocks() const { return (n_ + kLanes - 1) / kLanes; }
   int latent() const { return latent_; }
@@ -51,6 +53,7 @@ class HyperTensor {
  private:
   std::size_t n_ = 0;
   int latent_ = 0, width_ = 0;
+  bool zero_ = false;
   Precision precision_ = Precision::Half;
   AlignedArray<std::uint16_t> half_;
   AlignedArray<float> float_;
