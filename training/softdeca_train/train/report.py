@@ -65,7 +65,8 @@ def _trained(run: Run) -> dict[str, Trainable]:
 
 def _bundle_errors(run: Run, bundle: Path, progress: bool) -> dict[str, dict]:
     """SoftDECA static and SparseSoftDECA (other head, noisy) through the bundle's ONNX
-    networks with the identity its encoder estimates from each test head's neutral."""
+    networks with the identity its encoder estimates from each test head's neutral, and each
+    group's parameters: p, and per skin vertex its regional pattern where it has one."""
     nets = OnnxNetworks(bundle)
     d = run.definition
     t = run.template
@@ -85,6 +86,9 @@ def _bundle_errors(run: Run, bundle: Path, progress: bool) -> dict[str, dict]:
                 )
                 for k, s in enumerate(nets.specs):
                     av.params.set_global(s.name, float(b.p[0, k]))
+                    if b.p_vertices is not None and s.localisable:
+                        # the group's regional pattern, as the physics and training had it
+                        av.params.set_vertices(s.name, b.p_vertices[:, k].double().numpy())
                 av.prepare()
                 avatars = {key: av}  # one at a time: memory
             av = avatars[key]
