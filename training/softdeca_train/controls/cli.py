@@ -113,9 +113,9 @@ def add_physics_cache_argument(p: argparse.ArgumentParser) -> None:
 
 
 def physics_cache_of(args: argparse.Namespace) -> Path | None:
-    from softdeca_train.paths import cache_dir
+    from softdeca_train.controls.physics_cache import default_folder
 
-    return None if args.no_physics_cache else cache_dir() / "controls-physics"
+    return None if args.no_physics_cache else default_folder()
 
 
 def add_report_arguments(p: argparse.ArgumentParser, standalone: bool = True) -> None:

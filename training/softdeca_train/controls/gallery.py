@@ -22,10 +22,10 @@ from softdeca_train.controls.definitions import (
     region_controls,
 )
 from softdeca_train.controls.metrics import control_response, identity_spread
-from softdeca_train.controls.physics_cache import open_cache, solve_cached
+from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
 from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.parameters import ParameterSet, load_parameters
-from softdeca_train.paths import REPO_ROOT, cache_dir, default_takes_path
+from softdeca_train.paths import REPO_ROOT, default_takes_path
 
 RANGES = ("control", "physics")
 
@@ -50,7 +50,7 @@ class GalleryConfig:
     takes: Path = field(default_factory=default_takes_path)
     ict: str | None = None
     # solved physics reused across runs (controls/physics_cache.py); None: always solve
-    physics_cache: Path | None = field(default_factory=lambda: cache_dir() / "controls-physics")
+    physics_cache: Path | None = field(default_factory=default_folder)
 
     def __post_init__(self) -> None:
         if self.ranges not in RANGES:

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softdeca_train.paths import REPO_ROOT
+from softdeca_train.paths import REPO_ROOT, cache_dir
 
 if TYPE_CHECKING:
     from softdeca_train.controls.cases import PhysicsCase
@@ -90,6 +90,11 @@ class PhysicsCache:
         tmp = self.folder / f"{key}.{os.getpid()}.tmp.npy"
         np.save(tmp, np.asarray(value), allow_pickle=False)
         tmp.replace(self.folder / f"{key}.npy")  # atomic: a killed run leaves no half entry
+
+
+def default_folder() -> Path:
+    """Where the gallery and the real takes keep their solves unless told otherwise."""
+    return cache_dir() / "controls-physics"
 
 
 def open_cache(folder: Path | None) -> PhysicsCache:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +15,7 @@ from tqdm import tqdm
 
 from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase
 from softdeca_train.controls.definitions import Setting
-from softdeca_train.controls.physics_cache import open_cache, solve_cached
+from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
 
 CONTROL_KEYS = ("name", "region", "physics_max_mm", "response_error", "leakage")
 REAL_TAKE_KEYS = ("frames", "identities", "softdeca_mm", "linear_mm")
@@ -66,7 +66,8 @@ class RealTakes:
     every: int = 10
     level: int = 3
     chunk: int = 32  # frames solved per batch (memory)
-    physics_cache: Path | None = None  # controls/physics_cache.py; None: always solve
+    # solves reused across runs (controls/physics_cache.py); None: always solve
+    physics_cache: Path | None = field(default_factory=default_folder)
 
 
 def take_frames(recordings: Path, every: int) -> np.ndarray:
