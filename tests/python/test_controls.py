@@ -258,6 +258,48 @@ def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:
     assert GenerateConfig.from_dict(legacy).region_share == 0.0
 
 
+def test_contrasts_share_frames_and_change_one_factor() -> None:
+    from softdeca_train.data.config import GenerateConfig
+    from softdeca_train.data.expressions import expression_sources, load_takes
+    from softdeca_train.data.plan import FIXED, make_plan
+    from softdeca_train.data.ranges import sampling_parameters
+    from softdeca_train.paths import default_takes_path
+
+    cfg = GenerateConfig(
+        static=30, dynamic=0, sparse=0, seed=4, frames_per_params=2, params_per_identity=4,
+        contrasts=True,
+    )  # fmt: skip
+    params = sampling_parameters(load_parameters(), cfg.ranges)
+    sources, _ = expression_sources(
+        load_takes(default_takes_path()), cfg.test_take, cfg.seed, cfg.test_share
+    )
+    plan = make_plan(cfg, params, sources)
+    regional = changed = 0
+    for shard in plan:
+        first, *rest = shard.groups
+        for g in rest:
+            n = len(g.frames.weights)
+            assert np.array_equal(g.frames.weights, first.frames.weights[:n])
+            a, b = (
+                x.p_regions
+                if x.p_regions is not None
+                else np.repeat(x.p[None], len(REGIONS), 0)
+                for x in (first, g)
+            )
+            moved = np.flatnonzero(np.any(a != b, axis=0))
+            assert len(moved) <= 1  # one factor (a redraw may land on the same value)
+            for k in moved:
+                assert params.specs[k].name not in FIXED["static"]
+                changed += 1
+                regional += int(np.array_equal(g.p, first.p))
+    assert changed > 0 and 0 < regional < changed
+    # the last shard has fewer instances than the others: its groups still share frames
+    assert sum(s.instances for s in plan) == cfg.static
+    # datasets written before contrasts existed have none
+    legacy = {k: v for k, v in cfg.as_dict().items() if k != "contrasts"}
+    assert not GenerateConfig.from_dict(legacy).contrasts
+
+
 def test_the_report_readme_section_is_replaced_not_repeated(tmp_path) -> None:
     from softdeca_train.controls.report import SECTION, update_readme
 

@@ -90,6 +90,12 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
     )
     _add_config_options(g, _SAMPLING)
     g.add_argument(
+        "--contrasts",
+        action="store_true",
+        help="a shard's static/sparse groups share their frames and differ from its first "
+        "group's p in one parameter (or one region's value) each",
+    )
+    g.add_argument(
         "--no-collisions",
         dest="collisions",
         action="store_false",
@@ -122,7 +128,7 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
 
 def config_from_args(args: argparse.Namespace) -> GenerateConfig:
     kw = {field: getattr(args, _dest(option)) for option, field, _ in (*_SAMPLING, *_SOLVER)}
-    kw |= {"collisions": args.collisions, "ranges": args.ranges}
+    kw |= {"collisions": args.collisions, "ranges": args.ranges, "contrasts": args.contrasts}
     if args.instances is not None:
         return GenerateConfig.from_total(args.instances, args.sparse, **kw)
     return GenerateConfig(static=args.static, dynamic=args.dynamic, sparse=args.sparse, **kw)

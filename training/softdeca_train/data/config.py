@@ -68,6 +68,11 @@ class GenerateConfig:
     # Share of static and sparse groups with a regional pattern: localisable parameters set
     # per region of S (data/plan.py regional_pattern), what region controls do at run time.
     region_share: float = 0.5
+    # Contrasts: the static and sparse groups of a shard share their frames, and every group
+    # after the first differs from the first's p in one factor only (one parameter, or its
+    # value in one region), so the data holds the physics' response to that factor with the
+    # identity, the expression and every other parameter fixed (data/plan.py contrast).
+    contrasts: bool = False
 
     def __post_init__(self) -> None:
         problems = []
@@ -129,7 +134,7 @@ class GenerateConfig:
     def from_dict(cls, d: dict) -> GenerateConfig:
         names = {f.name for f in fields(cls)}
         # written before range profiles and regional patterns existed
-        d = {"ranges": LEGACY_PROFILE, "region_share": 0.0, **d}
+        d = {"ranges": LEGACY_PROFILE, "region_share": 0.0, "contrasts": False, **d}
         return cls(**{k: v for k, v in d.items() if k in names})
 
 

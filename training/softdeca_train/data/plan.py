@@ -117,6 +117,38 @@ def regional_pattern(
     return pattern
 
 
+def contrast(
+    params: ParameterSet,
+    p: np.ndarray,
+    pattern: np.ndarray | None,
+    fixed: tuple[str, ...],
+    rng: np.random.Generator,
+    region_share: float,
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """(p, pattern) with one factor drawn again: one parameter that is not fixed, everywhere,
+    or (with probability `region_share`, for a localisable one) its value in one region of
+    the face a control can set. Everything else stays as it was."""
+    from softdeca_train.controls.definitions import CONTROL_REGIONS
+    from softdeca_train.data.regions import REGIONAL_DOMAINS, REGIONS
+
+    free = [k for k, s in enumerate(params.specs) if s.name not in fixed]
+    if not free:
+        raise ValueError("contrasts need a parameter that is not fixed")
+    k = free[int(rng.integers(len(free)))]
+    spec = params.specs[k]
+    value = float(np.clip(spec.sample(rng, 1)[0], spec.lo, spec.hi))
+    p = p.copy()
+    if spec.domain in REGIONAL_DOMAINS and rng.random() < region_share:
+        pattern = np.repeat(p[None], len(REGIONS), axis=0) if pattern is None else pattern.copy()
+        pattern[REGIONS.index(CONTROL_REGIONS[int(rng.integers(len(CONTROL_REGIONS)))]), k] = value
+        return p, pattern
+    p[k] = value
+    if pattern is not None:
+        pattern = pattern.copy()
+        pattern[:, k] = value
+    return p, pattern
+
+
 def _test_shards(n_shards: int, share: float, rng: np.random.Generator) -> set[int]:
     if share <= 0 or n_shards < 2:
         return set()
@@ -137,6 +169,8 @@ def make_plan(
         test = _test_shards(n_shards, cfg.test_share, np.random.default_rng([cfg.seed, 20, code]))
         rng_p = np.random.default_rng([cfg.seed, 21, code])
         rng_r = np.random.default_rng([cfg.seed, 22, code])  # regional patterns
+        rng_c = np.random.default_rng([cfg.seed, 23, code])  # contrasts
+        contrasts = cfg.contrasts and kind != "dynamic"
         fixed = fixed_outside_profile(params, cfg.ranges)
         for s in range(n_shards):
             split = TEST if s in test else TRAIN
@@ -147,16 +181,24 @@ def make_plan(
             while left > 0:
                 k = min(per_group, left) if kind != "dynamic" else 1
                 left -= k
-                p = sample_parameters(params, kind, rng_p, fixed)
-                p_regions = None
-                if kind != "dynamic" and cfg.region_share > 0:
-                    held = (*FIXED[kind], *fixed)
-                    p_regions = regional_pattern(params, p, held, rng_r, cfg.region_share)
+                held = (*FIXED[kind], *fixed)
                 src = sources[split]
-                if kind == "dynamic":
-                    frames = src.window(cfg.lead_in + cfg.sequence_length)
+                if contrasts and groups:  # the shard's first group with one factor changed
+                    first = groups[0]
+                    p, p_regions = contrast(
+                        params, first.p, first.p_regions, held, rng_c, cfg.region_share
+                    )
+                    f = first.frames
+                    frames = Draws(f.weights[:k], f.source_take[:k], f.source_index[:k])
                 else:
-                    frames = src.frames(k, cfg.real_share)
+                    p = sample_parameters(params, kind, rng_p, fixed)
+                    p_regions = None
+                    if kind != "dynamic" and cfg.region_share > 0:
+                        p_regions = regional_pattern(params, p, held, rng_r, cfg.region_share)
+                    if kind == "dynamic":
+                        frames = src.window(cfg.lead_in + cfg.sequence_length)
+                    else:
+                        frames = src.frames(k, cfg.real_share)
                 donor_id = donor_seed = noise_seed = -1
                 if kind == "sparse":
                     donor_id = next_identity
