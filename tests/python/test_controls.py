@@ -369,3 +369,16 @@ def test_the_physics_cache_keys_on_inputs_and_physics_version(tmp_path) -> None:
     assert off.get(key) is None and not (tmp_path / "off").exists()
     # outside a git checkout there is no version to trust
     assert physics_version(tmp_path) is None
+
+
+def test_the_physics_version_ignores_control_ranges_only() -> None:
+    from softdeca_train.controls.physics_cache import physics_parameters
+    from softdeca_train.paths import REPO_ROOT
+
+    text = (REPO_ROOT / "plugin" / "data" / "parameters.json").read_text()
+    data = json.loads(text)
+    spec = next(p for p in data["parameters"] if p["control"] is not None)
+    spec["control"] = None  # no control any more: the same physics
+    assert physics_parameters(json.dumps(data)) == physics_parameters(text)
+    spec["default"] *= 1.5  # another default: other physics
+    assert physics_parameters(json.dumps(data)) != physics_parameters(text)

@@ -123,3 +123,67 @@ def test_inputs_the_train_frames_never_move_are_read_as_nothing():
         moved = s.coefficients(w[:3], s.condition(p))
         still = s.coefficients(w[:3], s.condition(defaults()))
     assert torch.equal(moved, still)
+
+
+def test_contrast_modes_span_a_response_the_residual_modes_miss():
+    """A response to p far smaller than what differs between frames is no leading mode of the
+    residual; the contrasts' own modes hold it."""
+    s = stage(modes=3)
+    rng = np.random.default_rng(4)
+    big = torch.from_numpy(rng.normal(size=(3, V, 3))).float() * 1e-3
+    response = torch.from_numpy(rng.normal(size=(V, 3))).float() * 1e-5
+    n = 60
+    c = torch.from_numpy(rng.normal(size=(n, 3))).float()
+    dp = torch.from_numpy(rng.uniform(-1, 1, n)).float()
+    residual = torch.einsum("nk,kvc->nvc", c, big) + dp[:, None, None] * response
+    base = torch.einsum("nk,kvc->nvc", c, big)  # the same frames at p's base value
+    contrasts = residual - base
+
+    def unexplained(table: torch.Tensor) -> float:
+        m = table[:, :-1].permute(0, 2, 1).reshape(-1, table.shape[1] - 1)  # (3V, K)
+        r = response.reshape(-1)
+        fit = m @ torch.linalg.lstsq(m.double(), r.double()[:, None]).solution.float()
+        return float((fit[:, 0] - r).norm() / r.norm())
+
+    s.set_modes(residual)
+    assert unexplained(s.table) > 0.5
+    s.set_modes(residual, contrasts, extra=1)
+    assert unexplained(s.table) < 1e-3
+
+
+def test_pairs_teach_a_response_that_differences_between_heads_hide():
+    """Frames whose residual is mostly a per-head offset the inputs cannot predict and a
+    little the response to one parameter: paired frames (same head and weights, the
+    parameter changed) give the response far better than the frames alone."""
+    rng = np.random.default_rng(5)
+    col = [x.name for x in SPECS].index("target_volume")
+    spec = SPECS[col]
+    groups, n = 48, 96
+    w = torch.from_numpy(np.repeat(rng.uniform(0, 1, (groups, 52)), 2, axis=0)).float()
+    head = torch.from_numpy(np.repeat(rng.normal(size=(groups, 2)), 2, axis=0)).float()
+    big = torch.from_numpy(rng.normal(size=(2, V, 3))).float() * 1e-3
+    response = torch.from_numpy(rng.normal(size=(V, 3))).float() * 1e-4
+    values = torch.from_numpy(rng.uniform(spec.min, spec.max, n)).float()
+    t = (values - spec.min) / (spec.max - spec.min)
+    residual = torch.einsum("nk,kvc->nvc", head, big) + t[:, None, None] * response
+    p = defaults(1).repeat(n, 1)
+    p[:, col] = values
+    pairs = torch.arange(n).reshape(groups, 2)
+
+    def learned(with_pairs: bool) -> float:
+        s = stage(modes=3, members=1, dropout=0.0)
+        features = torch.cat(
+            [s.parameter_features(p[i : i + 1].expand(V, -1)) for i in range(n)]
+        )
+        cfg = ResidualFit(steps=600, batch=32, contrast_modes=1, contrast_weight=10.0)
+        s.fit(w, features, residual, cfg, False, pairs if with_pairs else None)
+        s.eval()
+        lo, hi = defaults(), defaults()
+        lo[:, col], hi[:, col] = spec.min, spec.max
+        with torch.no_grad():
+            got = s(w[:8], hi) - s(w[:8], lo)
+        return float((got - response).norm() / (response.norm() * 8**0.5))
+
+    paired, alone = learned(True), learned(False)
+    assert alone > 2.0  # the heads' offsets swamp the response...
+    assert paired < 0.9 and paired < 0.25 * alone  # ...which the pairs bring out

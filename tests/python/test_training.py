@@ -247,3 +247,22 @@ def test_identity_encoder_recovers_identities_exactly(template) -> None:
     )
     assert errors["coefficients_rms"] < 1e-3  # h has unit variance
     assert errors["neutral_mm"] < 1e-3
+
+
+def test_contrast_pairs_join_each_frame_to_its_base() -> None:
+    from softdeca_train.train.models import contrast_pairs
+
+    a, b = b"a", b"b"
+    keys = [
+        (-1, -1, b""),
+        (7, 3, a),
+        (7, 1, a),
+        (7, 2, a),
+        (7, 1, b),
+        (8, 5, a),
+        (8, 4, a),
+    ]
+    pairs = {tuple(x) for x in contrast_pairs(keys).tolist()}
+    # identity 7, weights a: base param 1 (frame 2); weights b alone; identity 8: base frame 6
+    assert pairs == {(1, 2), (3, 2), (5, 6)}
+    assert contrast_pairs([(-1, -1, b"")]).shape == (0, 2)

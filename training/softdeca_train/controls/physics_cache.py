@@ -25,6 +25,9 @@ if TYPE_CHECKING:
     from softdeca_train.controls.definitions import Setting
 
 # What the physics of a gallery case is built from (native solver, parameters, head model).
+# The parameter file counts without its control ranges (PARAMETERS: physics_parameters): which
+# parameters a bundle offers as controls, and over what, changes no solve.
+PARAMETERS = "plugin/data/parameters.json"
 PHYSICS_SOURCES = (
     "plugin/src/sim",
     "plugin/src/geometry",
@@ -50,10 +53,23 @@ def physics_version(root: Path = REPO_ROOT) -> str | None:
     try:
         if git("status", "--porcelain", "--", *PHYSICS_SOURCES).strip():
             return None
-        trees = [git("rev-parse", f"HEAD:{p}").strip() for p in PHYSICS_SOURCES]
+        others = git("ls-tree", "-r", "HEAD", "--", "plugin/data").splitlines()
+        trees = [
+            git("rev-parse", f"HEAD:{p}").strip() for p in PHYSICS_SOURCES if p != "plugin/data"
+        ]
+        trees += [line for line in others if not line.endswith("\t" + PARAMETERS)]
+        trees.append(physics_parameters(git("show", f"HEAD:{PARAMETERS}")))
     except (OSError, subprocess.CalledProcessError):
         return None
     return hashlib.sha256("\n".join(trees).encode()).hexdigest()
+
+
+def physics_parameters(text: str) -> str:
+    """The parameter file as the physics reads it: every entry without its control range."""
+    data = json.loads(text)
+    for p in data.get("parameters", []):
+        p.pop("control", None)
+    return json.dumps(data, sort_keys=True)
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,11 @@ class ResidualFit:
     lr: float = 1e-3
     weight_decay: float = 1e-2
     seed: int = 0
+    # With contrasts (frames of one identity and expression that differ in one factor of p):
+    # modes of their differences join the table, and the members also learn the differences
+    # of the coefficients, weighted against the plain fit by this factor.
+    contrast_modes: int = 16
+    contrast_weight: float = 1.0
 
 
 DEFAULT_FIT = ResidualFit()
@@ -162,28 +167,36 @@ class ResidualStage(nn.Module):
 
     # ---- fitting ---------------------------------------------------------------------------
     @torch.no_grad()
-    def set_modes(self, residual: torch.Tensor) -> torch.Tensor:
+    def set_modes(
+        self, residual: torch.Tensor, contrasts: torch.Tensor | None = None, extra: int = 0
+    ) -> torch.Tensor:
         """Take the mean and leading modes of `residual` (N, V, 3) metres as the table and
         return the modes' coefficients per frame (N, modes), in units of each mode's spread
-        (the table holds the modes scaled by their singular values over sqrt N)."""
+        (the table holds the modes scaled by it). With `contrasts` (M, V, 3), differences
+        between frames that differ in one factor of p, the last `extra` modes are theirs
+        (orthogonal to the others): the response to p is small next to what differs between
+        heads and expressions, and the residual's leading modes alone miss part of it."""
         n, k = len(residual), self.sizes.modes
         r = residual.reshape(n, -1).double()
         mean = r.mean(0)
         rc = r - mean
-        # the modes from the N x N Gram matrix: N is thousands, 3V tens of thousands
-        ev, u = torch.linalg.eigh(rc @ rc.T)
-        order = torch.argsort(ev, descending=True)[:k]  # fewer than k with fewer frames
-        s = ev[order].clamp_min(0).sqrt()
-        keep = (s > s[0] * 1e-9).double() if len(s) else s
-        u, s = u[:, order], s.clamp_min(1e-30)
-        modes = (u.T @ rc) / s[:, None]  # (k', 3V) orthonormal rows
-        scale = s / np.sqrt(n)
-        coef = torch.zeros(n, k, dtype=torch.float64)  # rc @ modes.T / scale
-        coef[:, : len(s)] = u * np.sqrt(n) * keep
+        extra = 0 if contrasts is None else min(extra, k)
+        basis = _leading_rows(rc, k - extra)  # (k1, 3V) orthonormal
+        scale = _rms(rc @ basis.T)
+        if extra:
+            assert contrasts is not None
+            d = contrasts.reshape(len(contrasts), -1).double()
+            more = _leading_rows(d - (d @ basis.T) @ basis, extra)
+            basis = torch.cat([basis, more])
+            scale = torch.cat([scale, _rms(d @ more.T)])  # over the frames it can be tiny
+        keep = scale > scale.max() * 1e-9 if len(scale) else scale > 0
+        scale = torch.where(keep, scale, torch.ones_like(scale))
+        coef = torch.zeros(n, k, dtype=torch.float64)
+        coef[:, : len(basis)] = (rc @ basis.T) / scale * keep
         table = torch.zeros_like(self.table, dtype=torch.float64)
         v = self.table.shape[0]
-        table[:, : len(s)] = (
-            (modes * (scale * keep)[:, None]).reshape(len(s), v, 3).permute(1, 0, 2)
+        table[:, : len(basis)] = (
+            (basis * (scale * keep)[:, None]).reshape(len(basis), v, 3).permute(1, 0, 2)
         )
         table[:, -1] = mean.reshape(v, 3)
         self.table.copy_(table.float())
@@ -196,9 +209,12 @@ class ResidualStage(nn.Module):
         residual: torch.Tensor,
         cfg: ResidualFit = DEFAULT_FIT,
         progress: bool = True,
+        pairs: torch.Tensor | None = None,
     ) -> dict[str, float]:
         """Fit the table to `residual` (N, V, 3) and train every member on the modes'
         coefficients from the frames' weights (N, 52) and parameter features (N, 3 + R P).
+        `pairs` (M, 2): frames of one identity and expression whose p differs in one factor;
+        the members then also learn their coefficients' differences (ResidualFit).
         Returns the fit's train errors (mm, mean per-vertex distance)."""
         from tqdm import tqdm
 
@@ -211,7 +227,14 @@ class ResidualStage(nn.Module):
             constant = std < 1e-3
             self.input_std.copy_(torch.where(constant, torch.ones_like(std), std))
         xn = (x - self.input_mean) / self.input_std
-        target = self.set_modes(residual)
+        contrasts = None
+        if pairs is not None and len(pairs):
+            contrasts = residual[pairs[:, 0]] - residual[pairs[:, 1]]
+        target = self.set_modes(residual, contrasts, cfg.contrast_modes)
+        if contrasts is not None:
+            assert pairs is not None
+            change = target[pairs[:, 0]] - target[pairs[:, 1]]
+            change_scale = change.pow(2).mean().clamp_min(1e-12)
         gen = torch.Generator().manual_seed(cfg.seed)
         bar = tqdm(total=cfg.steps * len(self.members), desc="residual stage", disable=not progress)
         for i, m in enumerate(self.members):
@@ -226,6 +249,20 @@ class ResidualStage(nn.Module):
                 for _ in range(cfg.steps):
                     idx = torch.randint(0, len(xn), (min(cfg.batch, len(xn)),), generator=gen)
                     loss = ((m(xn[idx]) - target[idx]) ** 2).mean()
+                    if contrasts is not None:
+                        assert pairs is not None
+                        j = torch.randint(
+                            0, len(pairs), (min(cfg.batch, len(pairs)),), generator=gen
+                        )
+                        # one dropout mask for both frames of a pair: their difference is
+                        # the response, not two masks' noise
+                        seed = int(torch.randint(0, 2**31 - 1, (1,), generator=gen))
+                        torch.manual_seed(seed)
+                        ya = m(xn[pairs[j, 0]])
+                        torch.manual_seed(seed)
+                        yb = m(xn[pairs[j, 1]])
+                        miss = ((ya - yb - change[j]) ** 2).mean() / change_scale
+                        loss = loss + cfg.contrast_weight * miss
                     opt.zero_grad()
                     loss.backward()
                     opt.step()
@@ -244,6 +281,24 @@ class ResidualStage(nn.Module):
             before = residual.norm(dim=-1).mean()
             after = (residual - fitted).norm(dim=-1).mean()
         return {"residual_mm": float(before) * 1e3, "after_mm": float(after) * 1e3}
+
+
+def _leading_rows(x: torch.Tensor, k: int) -> torch.Tensor:
+    """(k', D) orthonormal rows spanning the k leading directions of the rows of x (N, D),
+    from the N x N Gram matrix (N is thousands, D tens of thousands); k' <= k where x has
+    fewer independent rows."""
+    if k <= 0 or len(x) == 0:
+        return x.new_zeros(0, x.shape[1])
+    ev, u = torch.linalg.eigh(x @ x.T)
+    order = torch.argsort(ev, descending=True)[:k]
+    s = ev[order].clamp_min(0).sqrt()
+    order = order[s > s[0] * 1e-9]
+    return (u[:, order].T @ x) / s[: len(order), None]
+
+
+def _rms(x: torch.Tensor) -> torch.Tensor:
+    """Per column: the root mean square over the rows."""
+    return x.pow(2).mean(0).sqrt()
 
 
 class ResidualCondition(nn.Module):

@@ -16,6 +16,7 @@ from pathlib import Path
 from softdeca_train.data.generate import code_version
 from softdeca_train.models.bundle import BundleInfo, export_bundle
 from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, SparseNetworks
+from softdeca_train.train.batches import Dataset
 from softdeca_train.train.evaluate import test_errors
 from softdeca_train.train.identity import IdentityConfig
 from softdeca_train.train.loop import LoopConfig
@@ -113,6 +114,7 @@ def train_bundle(
                     for k, v in manifest["dataset"]["splits"].items()
                 },
             },
+            "contrasts": _dataset_summary(run.contrasts),
             "sizes": asdict(run.sizes),
             "budget_minutes": asdict(budget),
             "stages": summaries,
@@ -121,6 +123,17 @@ def train_bundle(
         errors=errors,
     )
     return export_bundle(bundle, run.definition, nets, info)
+
+
+def _dataset_summary(data: Dataset | None) -> dict | None:
+    """Name, configuration and instance counts of a dataset the bundle learned from."""
+    if data is None:
+        return None
+    return {
+        "name": data.folder.name,
+        "config": data.manifest["header"]["config"],
+        "kinds": data.manifest["dataset"]["kinds"],
+    }
 
 
 def default_command() -> str:

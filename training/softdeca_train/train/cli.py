@@ -21,6 +21,12 @@ def _run_args(p: argparse.ArgumentParser, dataset_required: bool = True) -> None
         required=False,
         help="generated dataset folder (needed when the run folder is new)",
     )
+    p.add_argument(
+        "--contrasts",
+        default=None,
+        help="a dataset generated with --contrasts whose pairs also teach SoftDECA's residual "
+        "stage the response to p (with --dataset, when the run folder is new)",
+    )
     p.add_argument("--sizes", choices=["full", "test"], default="full", help="network sizes")
     p.add_argument("--seed", type=int, default=0, help="training seed (0)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
@@ -35,7 +41,11 @@ def _open_run(args: argparse.Namespace):  # -> Run
     if args.threads:
         torch.set_num_threads(args.threads)
     if args.dataset:
-        return Run(args.run, RunConfig(str(Path(args.dataset)), args.sizes, args.seed))
+        contrasts = str(Path(args.contrasts)) if args.contrasts else None
+        config = RunConfig(str(Path(args.dataset)), args.sizes, args.seed, contrasts=contrasts)
+        return Run(args.run, config)
+    if args.contrasts:
+        raise SystemExit("--contrasts is part of a new run: give --dataset with it")
     return Run(args.run)
 
 

@@ -53,10 +53,16 @@ class Trainable(nn.Module):
         """Data-driven initialisation from a sample of batches (default: none)."""
 
     def init_from_dataset(
-        self, data: Dataset, rng: np.random.Generator, progress: bool = True
+        self,
+        data: Dataset,
+        rng: np.random.Generator,
+        progress: bool = True,
+        contrasts: Dataset | None = None,
     ) -> None:
         """Initialisation before the first step: by default `init_from_data` on 48 shuffled
-        train batches; a model with a closed-form start over all the data overrides it."""
+        train batches; a model with a closed-form start over all the data overrides it.
+        `contrasts`: a contrasts dataset (data/plan.py contrast), for the models that use
+        one (SoftDECA's residual stage); the others ignore it."""
         if type(self).init_from_data is not Trainable.init_from_data:
             self.init_from_data(list(itertools.islice(data.batches(self.kind, "train", rng), 48)))
 
@@ -257,6 +263,7 @@ class SoftDecaHybrid(Trainable):
         data: Dataset,
         rng: np.random.Generator | None = None,
         progress: bool = True,
+        contrasts: Dataset | None = None,
         ridge: float = 1e-3,
     ) -> None:
         """Start at the per-vertex ridge fit of T - S_t on [w, LocalLinear's features] (1,
@@ -313,25 +320,42 @@ class SoftDecaHybrid(Trainable):
             last.weight.zero_()
             last.bias.zero_()
         if self.f_r is not None:
-            self.fit_residual(data, kept, progress)
+            self.fit_residual(data, kept, progress, contrasts)
 
-    def fit_residual(self, data: Dataset, frames: int, progress: bool = True) -> dict[str, float]:
+    def fit_residual(
+        self,
+        data: Dataset,
+        frames: int,
+        progress: bool = True,
+        contrasts: Dataset | None = None,
+    ) -> dict[str, float]:
         """The residual stage from what the model (without it) leaves on the kept static train
-        frames: its modes and the members that give their coefficients (models/residual.py)."""
+        frames: its modes and the members that give their coefficients (models/residual.py).
+        `contrasts`: a dataset generated with contrasts (data/plan.py contrast), whose static
+        train frames join the fit with their pairs."""
         from tqdm import tqdm
 
         assert self.f_r is not None
         with torch.no_grad():
             self.f_r.table.zero_()  # the model without the stage
         weights, features, residual = [], [], []
+        keys: list[tuple[int, int, bytes]] = []  # (identity, param_id, weights) of each frame
+        sources = [data] if contrasts is None else [data, contrasts]
+        if contrasts is not None:
+            frames += contrasts.left_out("static", "train")["kept"]
         bar = tqdm(total=frames, desc="residual of the start", unit="frame", disable=not progress)
-        for b in data.batches("static", "train"):
-            with torch.no_grad():
-                residual.append((b.T - self.predict(b)).float())
-                pv = b.vertex_parameters(self.n_vertices)
-                features.append(self.f_r.parameter_features(pv).expand(b.frames, -1))
-            weights.append(b.weights.float())
-            bar.update(b.frames)
+        for k, source in enumerate(sources):
+            for b in source.batches("static", "train"):
+                with torch.no_grad():
+                    residual.append((b.T - self.predict(b)).float())
+                    pv = b.vertex_parameters(self.n_vertices)
+                    features.append(self.f_r.parameter_features(pv).expand(b.frames, -1))
+                weights.append(b.weights.float())
+                if k == 1:
+                    keys += [(b.identity_id, b.param_id, w.numpy().tobytes()) for w in b.weights]
+                else:
+                    keys += [(-1, -1, b"")] * b.frames
+                bar.update(b.frames)
         bar.close()
         return self.f_r.fit(
             torch.cat(weights),
@@ -339,6 +363,7 @@ class SoftDecaHybrid(Trainable):
             torch.cat(residual),
             self.residual_fit,
             progress,
+            contrast_pairs(keys) if contrasts is not None else None,
         )
 
     def predict(self, batch: Batch) -> torch.Tensor:
@@ -346,10 +371,31 @@ class SoftDecaHybrid(Trainable):
         hyper = self.f_ph(batch.face_parameters(self.n_faces), batch.h)  # (F, latent, 9)
         g = torch.einsum("bk,fkn->bfn", z, hyper).reshape(len(z), self.n_faces, 3, 3)
         vertex = self.f_ph_v(batch.vertex_parameters(self.n_vertices), batch.h)  # (V, latent, 3)
-        x = deformation_transfer(batch.dt, batch.S, g) + torch.einsum("bk,vkn->bvn", z, vertex)
+        # DT(S_t, I) = S_t: a zero DG stage (the closed-form start) needs no solve, unless a
+        # gradient has to flow through it
+        moved = torch.is_grad_enabled() or bool(g.any())
+        x = deformation_transfer(batch.dt, batch.S, g) if moved else batch.S
+        x = x + torch.einsum("bk,vkn->bvn", z, vertex)
         if self.f_r is None:
             return x
         return x + self.f_r(batch.weights, batch.vertex_parameters(self.n_vertices))
+
+
+def contrast_pairs(keys: Sequence[tuple[int, int, bytes]]) -> torch.Tensor:
+    """(M, 2) frame pairs of a contrasts dataset from each frame's (identity, param_id,
+    weights): every frame paired with the frame of the same identity and expression whose
+    p came first (the shard's base p; the others differ from it in one factor). Frames with
+    identity -1 take part in no pair."""
+    base: dict[tuple[int, bytes], tuple[int, int]] = {}
+    for i, (identity, param, w) in enumerate(keys):
+        if identity >= 0 and ((identity, w) not in base or param < base[(identity, w)][0]):
+            base[(identity, w)] = (param, i)
+    pairs = [
+        (i, base[(identity, w)][1])
+        for i, (identity, param, w) in enumerate(keys)
+        if identity >= 0 and base[(identity, w)][1] != i
+    ]
+    return torch.tensor(pairs, dtype=torch.long).reshape(-1, 2)
 
 
 class SoftDecaVertex(Trainable):

@@ -39,6 +39,9 @@ class RunConfig:
     sizes: str = "full"  # full: docs/bundle.md's networks; test: tiny ones for the tests
     seed: int = 0
     extra: dict = field(default_factory=dict)
+    # a dataset generated with --contrasts whose static train frames also fit SoftDECA's
+    # residual stage (its pairs teach the response to p); None: the dataset alone
+    contrasts: str | None = None
 
 
 class Run:
@@ -51,10 +54,12 @@ class Run:
             config = RunConfig(**json.loads(path.read_text()))
         elif path.is_file():
             old = RunConfig(**json.loads(path.read_text()))
-            if (old.dataset, old.sizes, old.seed) != (config.dataset, config.sizes, config.seed):
+            key = lambda c: (c.dataset, c.sizes, c.seed, c.contrasts)  # noqa: E731
+            if key(old) != key(config):
                 raise ValueError(
-                    f"{self.folder} trains on {old.dataset} ({old.sizes}, seed {old.seed}); "
-                    "use another folder for another dataset, sizes or seed"
+                    f"{self.folder} trains on {old.dataset} ({old.sizes}, seed {old.seed}, "
+                    f"contrasts {old.contrasts}); use another folder for another dataset, "
+                    "sizes, seed or contrasts"
                 )
         else:
             self.folder.mkdir(parents=True, exist_ok=True)
@@ -70,6 +75,15 @@ class Run:
     @cached_property
     def data(self) -> Dataset:
         return Dataset(self.config.dataset, self.template, [s.name for s in self.specs])
+
+    @cached_property
+    def contrasts(self) -> Dataset | None:
+        if self.config.contrasts is None:
+            return None
+        data = Dataset(self.config.contrasts, self.template, [s.name for s in self.specs])
+        if not data.manifest["header"]["config"].get("contrasts"):
+            raise ValueError(f"{self.config.contrasts} was not generated with --contrasts")
+        return data
 
     @cached_property
     def definition(self) -> TemplateDefinition:
@@ -120,7 +134,8 @@ class Run:
         model = self.build(name)
         fresh = not self.checkpoint(name).is_file()
         if fresh:
-            model.init_from_dataset(self.data, np.random.default_rng(cfg.seed), progress)
+            rng = np.random.default_rng(cfg.seed)
+            model.init_from_dataset(self.data, rng, progress, self.contrasts)
         summary = train(model, self.data, cfg, self.folder, name, progress)
         summary["config"] = asdict(cfg)
         (self.folder / f"{name}.summary.json").write_text(json.dumps(summary, indent=1) + "\n")
