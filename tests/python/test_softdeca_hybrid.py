@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pytest
 import torch
 from softdeca_train.models.networks import TEST_SIZES, LocalLinear, WeightEncoder
 from softdeca_train.train.linear_baseline import ParameterScaling
@@ -77,3 +78,44 @@ def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
         assert (model.predict(b) - b.T).norm(dim=-1).mean() < (b.S - b.T).norm(
             dim=-1
         ).mean()
+
+
+def test_a_run_with_contrasts_fits_the_residual_stage_on_their_pairs(
+    small, tmp_path
+) -> None:
+    from softdeca_train.data.config import GenerateConfig, RunSettings
+    from softdeca_train.data.generate import generate
+
+    folder, _ = small
+    contrasts = tmp_path / "contrasts"
+    cfg = GenerateConfig(
+        static=8, dynamic=0, sparse=0, level=2, frames_per_params=1, params_per_identity=4,
+        test_share=0.0, seed=9, contrasts=True,
+    )  # fmt: skip
+    generate(cfg, RunSettings(out=contrasts, workers=1, progress=False))
+    run = Run(
+        tmp_path / "run",
+        RunConfig(str(folder), "test", seed=3, contrasts=str(contrasts)),
+    )
+    assert run.contrasts is not None
+    # a dataset without contrasts is refused as one
+    plain = Run(
+        tmp_path / "plain",
+        RunConfig(str(folder), "test", seed=3, contrasts=str(folder)),
+    )
+    with pytest.raises(ValueError, match="--contrasts"):
+        _ = plain.contrasts
+    model = SoftDecaHybrid(run.definition, run.specs, run.sizes)
+    assert model.f_r is not None
+    seen = {}
+    fit = model.f_r.fit
+
+    def spy(weights, features, residual, cfg, progress=True, pairs=None):
+        seen.update(frames=len(weights), pairs=pairs)
+        return fit(weights, features, residual, cfg, progress, pairs)
+
+    model.f_r.fit = spy  # type: ignore[method-assign]
+    kept = run.data.left_out("static", "train")["kept"]
+    model.fit_residual(run.data, kept, False, run.contrasts)
+    # 2 shards of one frame at 4 parameter sets: each shard's 3 later sets against its first
+    assert seen["frames"] == kept + 8 and seen["pairs"].shape == (6, 2)

@@ -196,14 +196,12 @@ def write_report(
     if oracle.vertex_mm() is not None:
         maps["group-offset-oracle"] = oracle.vertex_mm()
     # the generalisation gap: the same models on the frames they trained on
-    for name in ("no-correction", "softdeca", "mlp-equal-time"):
-        if name in static_models:
-            errors[f"{name}/train"] = measure(
-                run, name, static_models[name], split="train"
-            ).summary()
+    gap = [n for n in ("no-correction", "softdeca", "mlp-equal-time") if n in static_models]
+    for name in tqdm(gap, desc="train-split errors", disable=not progress):
+        errors[f"{name}/train"] = measure(run, name, static_models[name], split="train").summary()
     batch = next(run.data.batches("static", "test", None, 8))
     times = {}
-    for name, m in static_models.items():
+    for name, m in tqdm(static_models.items(), desc="timings", disable=not progress):
         if m.kind in ("static", "sparse"):
             b = batch if m.kind == "static" else next(run.data.batches("sparse", "test", None, 8))
             times[name] = time_per_frame(m, b)
