@@ -24,8 +24,8 @@ def _run_args(p: argparse.ArgumentParser, dataset_required: bool = True) -> None
     p.add_argument(
         "--contrasts",
         default=None,
-        help="a dataset generated with --contrasts whose pairs also teach SoftDECA's residual "
-        "stage the response to p (with --dataset, when the run folder is new)",
+        help="a dataset generated with --contrasts: SoftDECA's residual stage also fits its "
+        "frames and their pairs (with --dataset, when the run folder is new)",
     )
     p.add_argument("--sizes", choices=["full", "test"], default="full", help="network sizes")
     p.add_argument("--seed", type=int, default=0, help="training seed (0)")
