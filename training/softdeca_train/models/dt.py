@@ -137,5 +137,10 @@ def _solve_batch(system: DtSystem, r: torch.Tensor) -> torch.Tensor:
 def deformation_transfer(
     system: DtSystem, skin: torch.Tensor, dg_minus_i: torch.Tensor
 ) -> torch.Tensor:
-    """DT(S_t, G) for a batch: skin (B, V, 3) and G - I (B, F, 3, 3) -> X (B, V, 3)."""
+    """DT(S_t, G) for a batch: skin (B, V, 3) and G - I (B, F, 3, 3) -> X (B, V, 3).
+    DT(S_t, I) = S_t: with G - I zero everywhere (a model at its closed-form start) and no
+    gradient to carry there is no right-hand side to build and nothing to solve, as in the
+    native runtime."""
+    if not torch.is_grad_enabled() and not bool(dg_minus_i.any()):
+        return skin
     return skin + _SolveK.apply(residual_rhs(system, skin, dg_minus_i), system)

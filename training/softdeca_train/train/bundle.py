@@ -96,7 +96,6 @@ def train_bundle(
         softdeca=SoftDecaNetworks(sd.f_w, sd.f_ph, sd_dyn.f_dyn, sd.f_ph_v, sd.f_r),
         sparse=SparseNetworks(sp.f_l, sp.f_ph_v, sp_dyn.f_dyn),
     ).eval()
-    manifest = run.data.manifest
     info = BundleInfo(
         untrained=False,
         description="SoftDECA and SparseSoftDECA trained on "
@@ -105,15 +104,7 @@ def train_bundle(
             "command": command,
             "code_version": code_version(),
             "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
-            "dataset": {
-                "name": Path(run.config.dataset).name,
-                "config": manifest["header"]["config"],
-                "kinds": manifest["dataset"]["kinds"],
-                "splits": {
-                    k: {"identities": len(v["identities"]), "takes": v["takes"]}
-                    for k, v in manifest["dataset"]["splits"].items()
-                },
-            },
+            "dataset": _dataset_summary(run.data),
             "contrasts": _dataset_summary(run.contrasts),
             "sizes": asdict(run.sizes),
             "budget_minutes": asdict(budget),
@@ -126,13 +117,18 @@ def train_bundle(
 
 
 def _dataset_summary(data: Dataset | None) -> dict | None:
-    """Name, configuration and instance counts of a dataset the bundle learned from."""
+    """Name, configuration, instance counts and splits of a dataset the bundle learned from."""
     if data is None:
         return None
+    m = data.manifest
     return {
         "name": data.folder.name,
-        "config": data.manifest["header"]["config"],
-        "kinds": data.manifest["dataset"]["kinds"],
+        "config": m["header"]["config"],
+        "kinds": m["dataset"]["kinds"],
+        "splits": {
+            k: {"identities": len(v["identities"]), "takes": v["takes"]}
+            for k, v in m["dataset"]["splits"].items()
+        },
     }
 
 

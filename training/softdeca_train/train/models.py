@@ -371,11 +371,7 @@ class SoftDecaHybrid(Trainable):
         hyper = self.f_ph(batch.face_parameters(self.n_faces), batch.h)  # (F, latent, 9)
         g = torch.einsum("bk,fkn->bfn", z, hyper).reshape(len(z), self.n_faces, 3, 3)
         vertex = self.f_ph_v(batch.vertex_parameters(self.n_vertices), batch.h)  # (V, latent, 3)
-        # DT(S_t, I) = S_t: a zero DG stage (the closed-form start) needs no solve, unless a
-        # gradient has to flow through it
-        moved = torch.is_grad_enabled() or bool(g.any())
-        x = deformation_transfer(batch.dt, batch.S, g) if moved else batch.S
-        x = x + torch.einsum("bk,vkn->bvn", z, vertex)
+        x = deformation_transfer(batch.dt, batch.S, g) + torch.einsum("bk,vkn->bvn", z, vertex)
         if self.f_r is None:
             return x
         return x + self.f_r(batch.weights, batch.vertex_parameters(self.n_vertices))

@@ -39,8 +39,8 @@ class RunConfig:
     sizes: str = "full"  # full: docs/bundle.md's networks; test: tiny ones for the tests
     seed: int = 0
     extra: dict = field(default_factory=dict)
-    # a dataset generated with --contrasts whose static train frames also fit SoftDECA's
-    # residual stage (its pairs teach the response to p); None: the dataset alone
+    # a dataset generated with --contrasts whose static train frames and their pairs also
+    # fit SoftDECA's residual stage (docs/training.md); None: the dataset alone
     contrasts: str | None = None
 
 
