@@ -353,6 +353,20 @@ def test_parameters_are_sampled_in_the_range_profile(small) -> None:
             assert s.default == physics[s.name].default, (profile, s.name)
 
 
+def test_a_sample_at_the_top_of_a_log_range_stays_inside_it() -> None:
+    from dataclasses import replace
+
+    class Top:  # a generator that always draws the top of the interval it is given
+        def uniform(self, lo, hi, size=None):
+            return hi if size is None else np.full(size, hi)
+
+    # exp(log(100)) is 100 + 4e-14 in float64: without the clip a value leaves its range
+    assert np.exp(np.log(100.0)) > 100.0
+    spec = replace(load_parameters().specs[0], lo=0.001, hi=100.0, scale="log")
+    assert spec.sample(Top()) == 100.0  # type: ignore[arg-type]
+    assert (spec.sample(Top(), 3) == 100.0).all()  # type: ignore[arg-type]
+
+
 def test_offset_structure_splits_shared_and_expression_parts(small) -> None:
     from softdeca_train.data.offset_structure import offset_structure
     from softdeca_train.data.report import dataset_parameters

@@ -44,6 +44,36 @@ def test_local_features_carry_the_gravity_load_of_the_baselines(small) -> None:
     assert np.allclose(x[:, -3:], scaling.gravity_load(full), atol=1e-6)
 
 
+def test_only_the_tissues_weights_reach_the_expression_slots(small) -> None:
+    from softdeca_train.models.networks import EXPRESSION_PARAMETERS, HyperNetwork
+
+    folder, _ = small
+    run = Run(folder / "run-slots", RunConfig(str(folder), "test", seed=3))
+    names = [s.name for s in run.specs]
+    hyper = HyperNetwork(3, run.specs, run.sizes, 3, 1e-3, local_linear=True, slots=2)
+    local = hyper.local
+    assert local is not None and local.slot_table is not None
+    assert [names[i] for i in local.expression] == [
+        n for n in names if n in EXPRESSION_PARAMETERS
+    ]
+    with torch.no_grad():
+        local.slot_table.normal_()
+        hyper.body.rest[-1][-1].weight.zero_()  # the MLP's share off, as at the start
+        hyper.body.rest[-1][-1].bias.zero_()
+    p = torch.tensor([[s.default for s in run.specs]] * 3)
+    h = torch.zeros(1, run.sizes.identity)
+    base = hyper(p, h)
+    for name in ("gravity_strength", "target_volume", "w_soft_strain"):
+        q = p.clone()
+        s = run.specs[names.index(name)]
+        q[:, names.index(name)] = s.max
+        change = (hyper(q, h) - base).abs().amax(dim=(0, 2))  # per latent slot
+        # the expression slots move with the tissues' weights only; the other slots of z
+        # (beyond the constant one and those two) never move with a local parameter change
+        assert (change[:2] > 0).all() == (name in EXPRESSION_PARAMETERS), name
+        assert torch.equal(change[2:-1], torch.zeros_like(change[2:-1]))
+
+
 def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
     folder, _ = small
     run = Run(folder / "run-hybrid", RunConfig(str(folder), "test", seed=3))
@@ -54,8 +84,20 @@ def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
     batches = list(run.data.batches("static", "train"))
     picked = np.arange(0, model.n_vertices, 997)  # an independent fit on a few vertices
     xs, ys = [], []
+    local = model.f_ph_v.local
+    # the tissues' weights are among the specs: the start has its expression terms
+    assert local is not None and local.slots > 0
+    width = (
+        model.f_ph_v.latent
+        - 1
+        + local.table.shape[1]
+        + local.slots * len(local.expression)
+    )
     for b in batches:
-        x = model.vertex_features(b.weights, b.vertex_parameters(model.n_vertices))
+        # the start's final fit: on z's codes (fixed by the first fit), the local features and
+        # the leading codes times the expression-dependent parameters
+        x = model.code_features(b.weights, b.vertex_parameters(model.n_vertices))
+        assert x.shape[-1] == width
         xs.append(x[picked].numpy())
         ys.append(((b.T - b.S).transpose(0, 1)[picked] / CM).double().numpy())
     x, y = (
@@ -65,7 +107,7 @@ def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
     with torch.no_grad():
         for b in batches[:2]:
             got = (model.predict(b) - b.S)[:, picked].numpy()
-            xb = model.vertex_features(b.weights, b.vertex_parameters(model.n_vertices))
+            xb = model.code_features(b.weights, b.vertex_parameters(model.n_vertices))
             for j, vtx in enumerate(picked):
                 gram = x[j].T @ x[j]
                 lam = ridge * np.trace(gram) / len(gram)

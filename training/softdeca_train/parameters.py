@@ -32,9 +32,14 @@ class ParameterSpec:
     control: tuple[float, float] | None = None  # the control range; None: not a control
 
     def sample(self, rng: np.random.Generator, size: int | None = None) -> np.ndarray | float:
+        """Uniform (or log-uniform) in [lo, hi]; exp(log(hi)) may round past hi, so the value
+        is clipped into the range exactly."""
         if self.scale == "log":
-            return np.exp(rng.uniform(np.log(self.lo), np.log(self.hi), size))
-        return rng.uniform(self.lo, self.hi, size)
+            v = np.exp(rng.uniform(np.log(self.lo), np.log(self.hi), size))
+        else:
+            v = rng.uniform(self.lo, self.hi, size)
+        clipped = np.clip(v, self.lo, self.hi)
+        return clipped if size is not None else float(clipped)
 
     def normalise(self, value: np.ndarray | float) -> np.ndarray | float:
         """Map [lo, hi] to [0, 1] on the parameter's own scale (network inputs use this)."""

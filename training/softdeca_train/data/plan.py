@@ -78,13 +78,11 @@ def sample_parameters(
     """One parameter vector; the kind's FIXED entries and `fixed` at their defaults. The
     dynamics pair (gamma, beta) is drawn again until eq. 9 amplifies no motion by more than
     MAX_PEAK_GAIN (sim/dynamics.py: past it the tissue resonates)."""
-    lo, hi = [s.lo for s in params.specs], [s.hi for s in params.specs]
-    # exp(log(hi)) may round past hi: keep every value inside its range exactly.
-    p = np.clip(params.sample(rng), lo, hi)
+    p = params.sample(rng)
     g, b = params.names.index("dyn_gamma"), params.names.index("dyn_beta")
     dynamics_fixed = {"dyn_gamma", "dyn_beta"} <= {*FIXED[kind], *fixed}
     while not dynamics_fixed and peak_gain(p[g], p[b]) > MAX_PEAK_GAIN:
-        p[[g, b]] = np.clip(params.sample(rng), lo, hi)[[g, b]]
+        p[[g, b]] = params.sample(rng)[[g, b]]
     defaults = params.defaults()
     for name in (*FIXED[kind], *fixed):
         k = params.names.index(name)
@@ -113,7 +111,7 @@ def regional_pattern(
     for k, s in enumerate(params.specs):
         if s.domain not in REGIONAL_DOMAINS or s.name in fixed or rng.random() < 0.5:
             continue
-        pattern[rows, k] = np.clip(s.sample(rng, len(rows)), s.lo, s.hi)
+        pattern[rows, k] = s.sample(rng, len(rows))
     return pattern
 
 
@@ -136,7 +134,7 @@ def contrast(
         raise ValueError("contrasts need a parameter that is not fixed")
     k = free[int(rng.integers(len(free)))]
     spec = params.specs[k]
-    value = float(np.clip(spec.sample(rng, 1)[0], spec.lo, spec.hi))
+    value = float(spec.sample(rng))
     p = p.copy()
     if spec.domain in REGIONAL_DOMAINS and rng.random() < region_share:
         pattern = np.repeat(p[None], len(REGIONS), axis=0) if pattern is None else pattern.copy()

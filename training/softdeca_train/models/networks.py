@@ -204,13 +204,25 @@ def gravity_load(parameters: torch.Tensor, columns: list[int] | None) -> torch.T
     return s[:, None] * d + torch.tensor([0.0, 1.0, 0.0], dtype=d.dtype)
 
 
+# The parameters whose response depends on the expression: a tissue's strain and volume
+# weights matter where the expression strains that tissue (measured: their physics response
+# differs by 0.76-0.90 of its norm between expressions, a region's volume by 0.06-0.50). The
+# vertex stage gives them terms per leading expression code (LocalLinear.slot_table); for
+# the other parameters such terms fit noise (docs/training.md).
+EXPRESSION_PARAMETERS = ("w_soft_volume", "w_soft_strain", "w_muscle_strain", "w_skin_strain")
+EXPRESSION_SLOTS = 4  # leading codes of z (the largest modes of the start's w part)
+
+
 class LocalLinear(nn.Module):
     """Per element, an affine map of the element's own parameters: [1, p_i, g_i] (p_i
     normalised, g_i its gravity load) times a table (n, 1 + P + 3 [+ S L], k). A region's
     control then changes the output in and around that region only. With `smoothing` (vertex
     elements), the L localisable parameters averaged around the element at S scales are
     inputs too: a material change moves the skin near it, not only above it
-    (models/smoothing.py)."""
+    (models/smoothing.py). With `slots`, the EXPRESSION_PARAMETERS among the specs also map
+    into the first `slots` latent entries (`slot_table` (n, slots, E, k)): multiplied by those
+    codes of z, their change depends on the expression (the paper's z(w) L(p) with p inside
+    L), at no cost per frame."""
 
     def __init__(
         self,
@@ -218,6 +230,7 @@ class LocalLinear(nn.Module):
         specs: Sequence[ParameterSpec],
         k: int,
         smoothing: FieldSmoothing | None = None,
+        slots: int = 0,
     ) -> None:
         super().__init__()
         self.normalise = Normalise(specs)
@@ -226,6 +239,13 @@ class LocalLinear(nn.Module):
         self.smoothed = [i for i, s in enumerate(specs) if s.localisable] if smoothing else []
         n_smoothed = len(self.smoothed) * (len(smoothing.scales) if smoothing else 0)
         self.table = nn.Parameter(torch.zeros(n_elements, 1 + len(specs) + 3 + n_smoothed, k))
+        self.expression = [i for i, s in enumerate(specs) if s.name in EXPRESSION_PARAMETERS]
+        self.slots = slots if self.expression else 0
+        self.slot_table = (
+            nn.Parameter(torch.zeros(n_elements, self.slots, len(self.expression), k))
+            if self.slots
+            else None
+        )
 
     def features(self, parameters: torch.Tensor) -> torch.Tensor:
         """(n, P) raw -> (n, 1 + P + 3 [+ S L])."""
@@ -237,8 +257,18 @@ class LocalLinear(nn.Module):
         around = self.smoothing(own[:, self.smoothed])
         return torch.cat([ones, own, load, around], dim=1)
 
+    def slot_features(self, parameters: torch.Tensor) -> torch.Tensor:
+        """(n, P) raw -> (n, E): the normalised EXPRESSION_PARAMETERS of each element."""
+        return self.normalise(parameters)[:, self.expression]
+
     def forward(self, parameters: torch.Tensor) -> torch.Tensor:
+        """The constant slot's share (n, k)."""
         return torch.einsum("nd,ndk->nk", self.features(parameters), self.table)
+
+    def slot_offsets(self, parameters: torch.Tensor) -> torch.Tensor:
+        """The first `slots` latent entries' share (n, slots, k)."""
+        assert self.slot_table is not None
+        return torch.einsum("ne,nsek->nsk", self.slot_features(parameters), self.slot_table)
 
 
 class HyperNetwork(nn.Module):
@@ -261,6 +291,7 @@ class HyperNetwork(nn.Module):
         base: bool = False,
         local_linear: bool = False,
         smoothing: FieldSmoothing | None = None,
+        slots: int = 0,
     ) -> None:
         super().__init__()
         self.latent, self.k, self.unit = sizes.latent, k, unit
@@ -269,8 +300,9 @@ class HyperNetwork(nn.Module):
             n_elements, specs, sizes, sizes.hyper_hidden, sizes.latent * k, out_scale / unit
         )
         # With a constant last entry of z (WeightEncoder.constant_slot): that entry's tensor
-        # gains an affine map of each element's own parameters (and of those around it).
-        self.local = LocalLinear(n_elements, specs, k, smoothing) if local_linear else None
+        # gains an affine map of each element's own parameters (and of those around it);
+        # with `slots`, the first entries gain one of the expression-dependent parameters.
+        self.local = LocalLinear(n_elements, specs, k, smoothing, slots) if local_linear else None
 
     def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:
         out = self.body(parameters, identity).reshape(-1, self.latent, self.k)
@@ -279,6 +311,9 @@ class HyperNetwork(nn.Module):
         if self.local is not None:
             last = out[:, -1:] + self.local(parameters)[:, None]
             out = torch.cat([out[:, :-1], last], dim=1)
+            if self.local.slots:
+                s = self.local.slots
+                out = torch.cat([out[:, :s] + self.local.slot_offsets(parameters), out[:, s:]], 1)
         return out * self.unit if self.unit != 1.0 else out
 
 

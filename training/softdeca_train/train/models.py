@@ -15,6 +15,7 @@ from torch import nn
 
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.models.networks import (
+    EXPRESSION_SLOTS,
     DynamicsNetwork,
     ElementMLP,
     HyperNetwork,
@@ -212,7 +213,9 @@ class SoftDecaHybrid(Trainable):
     whose L_v tensor is an affine map of each vertex's own parameters and of the localisable
     ones averaged around it (models/smoothing.py), so the model starts at the per-vertex ridge
     fit (`init_from_dataset`, closed form) and a region's control acts in and around its
-    region. What that fit leaves is largely shared between heads but nonlinear in w and p: the
+    region. The tissues' strain and volume weights also enter the L_v tensors of z's leading
+    codes (LocalLinear.slot_table): their response changes with the expression. What the fit
+    leaves is largely shared between heads but nonlinear in w and p: the
     residual stage (models/residual.py), fitted to it right after, carries that part."""
 
     hypernetworks = ("f_ph", "f_ph_v")
@@ -239,6 +242,7 @@ class SoftDecaHybrid(Trainable):
             base=True,
             local_linear=True,
             smoothing=smoothing,
+            slots=EXPRESSION_SLOTS,
         )
         self.n_faces, self.n_vertices = d.n_faces, d.skin_vertices
         self.n_weights = len(d.blendshapes)
@@ -256,6 +260,23 @@ class SoftDecaHybrid(Trainable):
         return torch.cat(
             [weights.double()[None].expand(v, b, -1), own[:, None].expand(v, b, -1)], dim=2
         )
+
+    @torch.no_grad()
+    def code_features(self, weights: torch.Tensor, p_vertices: torch.Tensor) -> torch.Tensor:
+        """(V, B, r + 1 + P + 3 [+ S L] + slots E): [z's first r codes, local features of each
+        vertex, the leading `slots` codes times the vertex's expression-dependent parameters]
+        (the vertex stage's inputs once f_w's linear path is set; r = latent - 1)."""
+        local = self.f_ph_v.local
+        assert local is not None
+        z = self.f_w(weights).double()[:, :-1]  # (B, r), the constant slot left out
+        own = local.features(p_vertices).double()  # (V, F)
+        v, b = len(own), len(z)
+        parts = [z[None].expand(v, b, -1), own[:, None].expand(v, b, -1)]
+        if local.slots:
+            e = local.slot_features(p_vertices).double()  # (V, E)
+            prod = torch.einsum("bs,ve->vbse", z[:, : local.slots], e)
+            parts.append(prod.reshape(v, b, -1))
+        return torch.cat(parts, dim=2)
 
     @torch.no_grad()
     def init_from_dataset(
@@ -319,8 +340,40 @@ class SoftDecaHybrid(Trainable):
             assert isinstance(last, nn.Linear)
             last.weight.zero_()
             last.bias.zero_()
+        if hyper.local.slots:
+            self._fit_on_codes(data, kept, progress, ridge)
         if self.f_r is not None:
             self.fit_residual(data, kept, progress, contrasts)
+
+    @torch.no_grad()
+    def _fit_on_codes(self, data: Dataset, frames: int, progress: bool, ridge: float) -> None:
+        """With z's codes fixed by the first fit, the vertex stage again as a per-vertex ridge
+        fit on `code_features`: its code part in L_v's base, the local features' in the
+        constant slot's table, the products in the slot table. One more pass over the data."""
+        from tqdm import tqdm
+
+        from softdeca_train.train.local_fit import LocalRidge
+
+        hyper = self.f_ph_v
+        assert hyper.base is not None and hyper.local is not None
+        assert hyper.local.slot_table is not None
+        fit: LocalRidge | None = None
+        bar = tqdm(
+            total=frames, desc="vertex stage on the codes", unit="frame", disable=not progress
+        )
+        for b in data.batches("static", "train"):
+            x = self.code_features(b.weights, b.vertex_parameters(self.n_vertices))
+            fit = fit or LocalRidge(self.n_vertices, x.shape[-1], 3)
+            fit.add(x, (b.T - b.S).transpose(0, 1) / CM)
+            bar.update(b.frames)
+        bar.close()
+        assert fit is not None
+        coef = fit.solve(ridge)  # (V, r + F + slots E, 3), centimetres
+        r, f = hyper.latent - 1, hyper.local.table.shape[1]
+        hyper.base[:, :r] = coef[:, :r].float()
+        hyper.base[:, r:] = 0.0
+        hyper.local.table.copy_(coef[:, r : r + f].float())
+        hyper.local.slot_table.copy_(coef[:, r + f :].reshape(hyper.local.slot_table.shape).float())
 
     def fit_residual(
         self,
