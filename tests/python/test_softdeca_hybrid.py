@@ -44,6 +44,31 @@ def test_local_features_carry_the_gravity_load_of_the_baselines(small) -> None:
     assert np.allclose(x[:, -3:], scaling.gravity_load(full), atol=1e-6)
 
 
+def test_region_means_are_inputs_of_every_vertex() -> None:
+    from softdeca_train.models.parameters import load_parameter_specs
+    from softdeca_train.models.synthetic import TEST_PARAMETERS
+
+    specs = load_parameter_specs(TEST_PARAMETERS)
+    loc = [i for i, s in enumerate(specs) if s.localisable]
+    labels = np.array([0, 0, 1, 1, 2, 2])
+    plain = LocalLinear(6, specs, 3)
+    local = LocalLinear(6, specs, 3, regions=labels)
+    assert local.table.shape[1] - plain.table.shape[1] == 3 * len(loc)
+    p = torch.tensor([[s.default for s in specs]] * 6)
+    f = local.features(p)
+    # every vertex sees each region's mean; at a constant field that is the own value
+    own = f[:, 1 : 1 + len(specs)][:, loc]
+    np.testing.assert_allclose(f[:, -3 * len(loc) :].numpy(), own.repeat(1, 3).numpy())
+    q = p.clone()
+    s0 = specs[loc[0]]
+    q[4:, loc[0]] = s0.min if s0.default != s0.min else s0.max  # region 2 only
+    g = local.features(q)
+    assert torch.equal(g[:, 1 : 1 + len(specs)][:4], f[:, 1 : 1 + len(specs)][:4])
+    assert (g[:4, -3 * len(loc) :] != f[:4, -3 * len(loc) :]).any(dim=1).all()
+    with pytest.raises(ValueError, match="one label per element"):
+        LocalLinear(5, specs, 3, regions=labels)
+
+
 def test_only_the_tissues_weights_reach_the_expression_slots(small) -> None:
     from softdeca_train.models.networks import EXPRESSION_PARAMETERS, HyperNetwork
 

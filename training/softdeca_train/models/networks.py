@@ -204,6 +204,18 @@ def gravity_load(parameters: torch.Tensor, columns: list[int] | None) -> torch.T
     return s[:, None] * d + torch.tensor([0.0, 1.0, 0.0], dtype=d.dtype)
 
 
+def region_means(labels: np.ndarray, n_regions: int) -> np.ndarray:
+    """(R, V) rows averaging a per-vertex field over each region's vertices (a region without
+    vertices gets a zero row)."""
+    labels = np.asarray(labels, np.int64)
+    m = np.zeros((n_regions, len(labels)), np.float32)
+    for r in range(n_regions):
+        idx = np.nonzero(labels == r)[0]
+        if len(idx):
+            m[r, idx] = 1.0 / len(idx)
+    return m
+
+
 # The parameters whose response depends on the expression: a tissue's strain and volume
 # weights matter where the expression strains that tissue (measured: their physics response
 # differs by 0.76-0.90 of its norm between expressions, a region's volume by 0.06-0.50). The
@@ -215,14 +227,17 @@ EXPRESSION_SLOTS = 4  # leading codes of z (the largest modes of the start's w p
 
 class LocalLinear(nn.Module):
     """Per element, an affine map of the element's own parameters: [1, p_i, g_i] (p_i
-    normalised, g_i its gravity load) times a table (n, 1 + P + 3 [+ S L], k). A region's
-    control then changes the output in and around that region only. With `smoothing` (vertex
-    elements), the L localisable parameters averaged around the element at S scales are
-    inputs too: a material change moves the skin near it, not only above it
-    (models/smoothing.py). With `slots`, the EXPRESSION_PARAMETERS among the specs also map
-    into the first `slots` latent entries (`slot_table` (n, slots, E, k)): multiplied by those
-    codes of z, their change depends on the expression (the paper's z(w) L(p) with p inside
-    L), at no cost per frame."""
+    normalised, g_i its gravity load) times a table (n, 1 + P + 3 [+ S L] [+ R L], k). A
+    region's control then changes the output in and around that region only. With `smoothing`
+    (vertex elements), the L localisable parameters averaged around the element at S scales
+    are inputs too: a material change moves the skin near it, not only above it
+    (models/smoothing.py). With `regions` (a region label per element), each of the R regions'
+    mean of the localisable parameters is an input of every element: a region's change then
+    moves each vertex by a field of its own (the physics' response to a region's volume
+    reaches past what averaging sees). With `slots`, the EXPRESSION_PARAMETERS among the specs
+    also map into the first `slots` latent entries (`slot_table` (n, slots, E, k)): multiplied
+    by those codes of z, their change depends on the expression (the paper's z(w) L(p) with p
+    inside L), at no cost per frame."""
 
     def __init__(
         self,
@@ -231,14 +246,24 @@ class LocalLinear(nn.Module):
         k: int,
         smoothing: FieldSmoothing | None = None,
         slots: int = 0,
+        regions: np.ndarray | None = None,
     ) -> None:
         super().__init__()
         self.normalise = Normalise(specs)
         self.gravity = gravity_columns(specs)
         self.smoothing = smoothing
-        self.smoothed = [i for i, s in enumerate(specs) if s.localisable] if smoothing else []
+        localisable = [i for i, s in enumerate(specs) if s.localisable]
+        self.smoothed = localisable if smoothing else []
         n_smoothed = len(self.smoothed) * (len(smoothing.scales) if smoothing else 0)
-        self.table = nn.Parameter(torch.zeros(n_elements, 1 + len(specs) + 3 + n_smoothed, k))
+        self.regional = localisable if regions is not None else []
+        n_regions = int(np.max(regions)) + 1 if regions is not None else 0
+        if regions is not None:
+            if len(regions) != n_elements:
+                raise ValueError("regions: one label per element")
+            self.register_buffer("region_mean", torch.from_numpy(region_means(regions, n_regions)))
+        n_regional = n_regions * len(self.regional)
+        width = 1 + len(specs) + 3 + n_smoothed + n_regional
+        self.table = nn.Parameter(torch.zeros(n_elements, width, k))
         self.expression = [i for i, s in enumerate(specs) if s.name in EXPRESSION_PARAMETERS]
         self.slots = slots if self.expression else 0
         self.slot_table = (
@@ -248,14 +273,17 @@ class LocalLinear(nn.Module):
         )
 
     def features(self, parameters: torch.Tensor) -> torch.Tensor:
-        """(n, P) raw -> (n, 1 + P + 3 [+ S L])."""
+        """(n, P) raw -> (n, 1 + P + 3 [+ S L] [+ R L])."""
         ones = torch.ones_like(parameters[:, :1])
         load = gravity_load(parameters, self.gravity)
         own = self.normalise(parameters)
-        if self.smoothing is None or not self.smoothed:
-            return torch.cat([ones, own, load], dim=1)
-        around = self.smoothing(own[:, self.smoothed])
-        return torch.cat([ones, own, load, around], dim=1)
+        parts = [ones, own, load]
+        if self.smoothing is not None and self.smoothed:
+            parts.append(self.smoothing(own[:, self.smoothed]))
+        if self.regional:
+            means = self.region_mean.to(own.dtype) @ own[:, self.regional]  # (R, L)
+            parts.append(means.reshape(1, -1).expand(len(own), -1))
+        return torch.cat(parts, dim=1)
 
     def slot_features(self, parameters: torch.Tensor) -> torch.Tensor:
         """(n, P) raw -> (n, E): the normalised EXPRESSION_PARAMETERS of each element."""
@@ -292,6 +320,7 @@ class HyperNetwork(nn.Module):
         local_linear: bool = False,
         smoothing: FieldSmoothing | None = None,
         slots: int = 0,
+        regions: np.ndarray | None = None,
     ) -> None:
         super().__init__()
         self.latent, self.k, self.unit = sizes.latent, k, unit
@@ -301,8 +330,11 @@ class HyperNetwork(nn.Module):
         )
         # With a constant last entry of z (WeightEncoder.constant_slot): that entry's tensor
         # gains an affine map of each element's own parameters (and of those around it);
-        # with `slots`, the first entries gain one of the expression-dependent parameters.
-        self.local = LocalLinear(n_elements, specs, k, smoothing, slots) if local_linear else None
+        # with `slots`, the first entries gain one of the expression-dependent parameters;
+        # with `regions`, every region's mean parameters are inputs of each element.
+        self.local = (
+            LocalLinear(n_elements, specs, k, smoothing, slots, regions) if local_linear else None
+        )
 
     def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:
         out = self.body(parameters, identity).reshape(-1, self.latent, self.k)

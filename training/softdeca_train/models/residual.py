@@ -28,6 +28,7 @@ from softdeca_train.models.networks import (
     Normalise,
     gravity_columns,
     gravity_load,
+    region_means,
 )
 from softdeca_train.models.parameters import ParameterSpec
 
@@ -70,18 +71,6 @@ class ResidualFit:
 
 
 DEFAULT_FIT = ResidualFit()
-
-
-def region_means(labels: np.ndarray, n_regions: int) -> np.ndarray:
-    """(R, V) rows averaging a per-vertex field over each region's vertices (a region without
-    vertices gets a zero row)."""
-    labels = np.asarray(labels, np.int64)
-    m = np.zeros((n_regions, len(labels)), np.float32)
-    for r in range(n_regions):
-        idx = np.nonzero(labels == r)[0]
-        if len(idx):
-            m[r, idx] = 1.0 / len(idx)
-    return m
 
 
 class ResidualStage(nn.Module):

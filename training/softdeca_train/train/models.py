@@ -210,8 +210,9 @@ class SoftDecaHybrid(Trainable):
     from T where S_t is 0.398 mm off (`linear-baseline --local`, docs/training.md), because its
     pull toward S_t holds back the smooth, low-frequency part of the correction (the sag).
     The vertex stage carries that part. z has a linear path in w and a constant last entry
-    whose L_v tensor is an affine map of each vertex's own parameters and of the localisable
-    ones averaged around it (models/smoothing.py), so the model starts at the per-vertex ridge
+    whose L_v tensor is an affine map of each vertex's own parameters, of the localisable
+    ones averaged around it (models/smoothing.py) and of each region's mean of them, so the
+    model starts at the per-vertex ridge
     fit (`init_from_dataset`, closed form) and a region's control acts in and around its
     region. The tissues' strain and volume weights also enter the L_v tensors of z's leading
     codes (LocalLinear.slot_table): their response changes with the expression. What the fit
@@ -243,6 +244,7 @@ class SoftDecaHybrid(Trainable):
             local_linear=True,
             smoothing=smoothing,
             slots=EXPRESSION_SLOTS,
+            regions=d.skin_regions,
         )
         self.n_faces, self.n_vertices = d.n_faces, d.skin_vertices
         self.n_weights = len(d.blendshapes)
@@ -263,7 +265,7 @@ class SoftDecaHybrid(Trainable):
 
     @torch.no_grad()
     def code_features(self, weights: torch.Tensor, p_vertices: torch.Tensor) -> torch.Tensor:
-        """(V, B, r + 1 + P + 3 [+ S L] + slots E): [z's first r codes, local features of each
+        """(V, B, r + F + slots E): [z's first r codes, the F local features of each
         vertex, the leading `slots` codes times the vertex's expression-dependent parameters]
         (the vertex stage's inputs once f_w's linear path is set; r = latent - 1)."""
         local = self.f_ph_v.local
