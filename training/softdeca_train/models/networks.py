@@ -461,8 +461,9 @@ def build_random(
     """Random-weight networks (untrained). `dg_scale` sets the size of the deformation-gradient
     corrections (G - I) and `offset_scale` that of the vertex offsets (metres), so that an
     untrained bundle stays close to its input instead of producing noise. `vertex_stage` adds
-    SoftDECA's vertex stage (with its per-vertex affine table, random too; with the smoothed
-    parameters among its inputs where the definition has the skin at rest); `residual_stage`
+    SoftDECA's vertex stage (with its per-vertex affine tables, random too; with the smoothed
+    parameters among its inputs where the definition has the skin at rest, the region means
+    where it has regions); `residual_stage`
     adds the residual stage (models/residual.py) over the definition's regions (one region
     where it has none), its modes random of size `offset_scale`."""
     torch.manual_seed(seed)
@@ -477,7 +478,15 @@ def build_random(
             f_ph=HyperNetwork(nf, specs, sizes, 9, dg_scale),
             f_dyn=DynamicsNetwork(nv, specs, sizes),
             f_ph_v=HyperNetwork(
-                nv, specs, sizes, 3, offset_scale, local_linear=True, smoothing=smoothing
+                nv,
+                specs,
+                sizes,
+                3,
+                offset_scale,
+                local_linear=True,
+                smoothing=smoothing,
+                slots=EXPRESSION_SLOTS,
+                regions=definition.skin_regions,
             )
             if vertex_stage
             else None,
@@ -497,7 +506,9 @@ def build_random(
         with torch.no_grad():
             sd.f_r.table.normal_(0.0, 0.2 * offset_scale)
     if sd is not None and sd.f_ph_v is not None and sd.f_ph_v.local is not None:
-        with torch.no_grad():  # the affine table starts at zero in training; random here
+        with torch.no_grad():  # the affine tables start at zero in training; random here
             sd.f_ph_v.local.table.normal_(0.0, offset_scale)
+            if sd.f_ph_v.local.slot_table is not None:
+                sd.f_ph_v.local.slot_table.normal_(0.0, offset_scale)
     enc = IdentityEncoder(nv, sizes, seed)
     return BundleNetworks(sizes, specs, enc, sd, sp).eval()
