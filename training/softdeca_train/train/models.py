@@ -212,12 +212,12 @@ class SoftDecaHybrid(Trainable):
     The vertex stage carries that part. z has a linear path in w and a constant last entry
     whose L_v tensor is an affine map of each vertex's own parameters, of the localisable
     ones averaged around it (models/smoothing.py) and of each region's mean of them, so the
-    model starts at the per-vertex ridge
-    fit (`init_from_dataset`, closed form) and a region's control acts in and around its
-    region. The tissues' strain and volume weights also enter the L_v tensors of z's leading
-    codes (LocalLinear.slot_table): their response changes with the expression. What the fit
-    leaves is largely shared between heads but nonlinear in w and p: the
-    residual stage (models/residual.py), fitted to it right after, carries that part."""
+    model starts at the per-vertex ridge fit (`init_from_dataset`, closed form) and a
+    region's control acts in and around its region. The tissues' strain and volume weights
+    also enter the L_v tensors of z's leading codes (LocalLinear.slot_table): their response
+    changes with the expression. What the fit leaves is largely shared between heads but
+    nonlinear in w and p: the residual stage (models/residual.py), fitted to it right after,
+    carries that part."""
 
     hypernetworks = ("f_ph", "f_ph_v")
     hyper_lr = HYPER_LR_SOFTDECA
@@ -343,6 +343,7 @@ class SoftDecaHybrid(Trainable):
             last.weight.zero_()
             last.bias.zero_()
         if hyper.local.slots:
+            del fit, coef  # gigabytes of normal equations: the second fit needs its own
             self._fit_on_codes(data, kept, progress, ridge)
         if self.f_r is not None:
             self.fit_residual(data, kept, progress, contrasts)
