@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import torch
+from softdeca_train.data.plan import FIXED
 from softdeca_train.models.networks import TEST_SIZES, LocalLinear, WeightEncoder
 from softdeca_train.train.linear_baseline import ParameterScaling
 from softdeca_train.train.models import CM, SoftDecaHybrid
@@ -67,6 +68,20 @@ def test_region_means_are_inputs_of_every_vertex() -> None:
     assert (g[:4, -3 * len(loc) :] != f[:4, -3 * len(loc) :]).any(dim=1).all()
     with pytest.raises(ValueError, match="one label per element"):
         LocalLinear(5, specs, 3, regions=labels)
+    # only the named parameters are inputs; a region labelled -1 is in no mean
+    taken = [specs[i].name for i in loc[:2]]
+    some = LocalLinear(
+        6, specs, 3, regions=np.array([0, 0, 1, 1, -1, -1]), inputs=taken
+    )
+    assert some.table.shape[1] == 1 + 2 + 3 + 2 * 2
+    q = p.clone()
+    q[4:, loc[0]] = (
+        s0.min if s0.default != s0.min else s0.max
+    )  # the unnumbered region only
+    h = some.features(q) - some.features(p)
+    assert torch.equal(h[:4], torch.zeros_like(h[:4])) and (h[4:, 1] != 0).all()
+    with pytest.raises(ValueError, match="no parameters"):
+        LocalLinear(6, specs, 3, inputs=("no_such_parameter",))
 
 
 def test_only_the_tissues_weights_reach_the_expression_slots(small) -> None:
@@ -145,6 +160,35 @@ def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
         assert (model.predict(b) - b.T).norm(dim=-1).mean() < (b.S - b.T).norm(
             dim=-1
         ).mean()
+    # a parameter static frames hold at its default (the dynamics, the tracking weights) is no
+    # input of the vertex stage: turning it leaves a static frame where it was
+    names = [s.name for s in run.specs]
+    held = [n for n in FIXED["static"] if n in names]
+    assert held
+    with torch.no_grad():
+        before = model.predict(b)
+        for name in held:
+            spec = run.specs[names.index(name)]
+            q = b.p.clone()
+            q[:, names.index(name)] = spec.max if spec.default != spec.max else spec.min
+            moved = replace(b, p=q, p_faces=None, p_vertices=None)
+            if b.p_vertices is not None:
+                moved = replace(
+                    moved, p_vertices=_with(b.p_vertices, names.index(name), q)
+                )
+                moved = replace(moved, p_faces=_with(b.p_faces, names.index(name), q))
+            assert torch.equal(model.predict(moved), before), name
+
+
+def _with(
+    field: torch.Tensor | None, column: int, p: torch.Tensor
+) -> torch.Tensor | None:
+    """A per-element parameter field with one column set to p's value."""
+    if field is None:
+        return None
+    out = field.clone()
+    out[:, column] = p[0, column]
+    return out
 
 
 def test_a_run_with_contrasts_fits_the_residual_stage_on_their_pairs(

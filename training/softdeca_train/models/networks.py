@@ -206,7 +206,7 @@ def gravity_load(parameters: torch.Tensor, columns: list[int] | None) -> torch.T
 
 def region_means(labels: np.ndarray, n_regions: int) -> np.ndarray:
     """(R, V) rows averaging a per-vertex field over each region's vertices (a region without
-    vertices gets a zero row)."""
+    vertices gets a zero row; a vertex labelled -1 is in none)."""
     labels = np.asarray(labels, np.int64)
     m = np.zeros((n_regions, len(labels)), np.float32)
     for r in range(n_regions):
@@ -237,7 +237,10 @@ class LocalLinear(nn.Module):
     reaches past what averaging sees). With `slots`, the EXPRESSION_PARAMETERS among the specs
     also map into the first `slots` latent entries (`slot_table` (n, slots, E, k)): multiplied
     by those codes of z, their change depends on the expression (the paper's z(w) L(p) with p
-    inside L), at no cost per frame."""
+    inside L), at no cost per frame. With `inputs` (parameter names), only those are inputs
+    of the tables: a parameter the fit never sees vary has no coefficient to learn, and a
+    collinear one would move the output when a user turns it. An element labelled -1 in
+    `regions` is in no region's mean."""
 
     def __init__(
         self,
@@ -247,12 +250,17 @@ class LocalLinear(nn.Module):
         smoothing: FieldSmoothing | None = None,
         slots: int = 0,
         regions: np.ndarray | None = None,
+        inputs: Sequence[str] | None = None,
     ) -> None:
         super().__init__()
         self.normalise = Normalise(specs)
         self.gravity = gravity_columns(specs)
         self.smoothing = smoothing
-        localisable = [i for i, s in enumerate(specs) if s.localisable]
+        unknown = set(inputs or ()) - {s.name for s in specs}
+        if unknown:
+            raise ValueError(f"inputs: no parameters {sorted(unknown)}")
+        self.own = [i for i, s in enumerate(specs) if inputs is None or s.name in inputs]
+        localisable = [i for i in self.own if specs[i].localisable]
         self.smoothed = localisable if smoothing else []
         n_smoothed = len(self.smoothed) * (len(smoothing.scales) if smoothing else 0)
         self.regional = localisable if regions is not None else []
@@ -262,9 +270,9 @@ class LocalLinear(nn.Module):
                 raise ValueError("regions: one label per element")
             self.register_buffer("region_mean", torch.from_numpy(region_means(regions, n_regions)))
         n_regional = n_regions * len(self.regional)
-        width = 1 + len(specs) + 3 + n_smoothed + n_regional
+        width = 1 + len(self.own) + 3 + n_smoothed + n_regional
         self.table = nn.Parameter(torch.zeros(n_elements, width, k))
-        self.expression = [i for i, s in enumerate(specs) if s.name in EXPRESSION_PARAMETERS]
+        self.expression = [i for i in self.own if specs[i].name in EXPRESSION_PARAMETERS]
         self.slots = slots if self.expression else 0
         self.slot_table = (
             nn.Parameter(torch.zeros(n_elements, self.slots, len(self.expression), k))
@@ -273,11 +281,12 @@ class LocalLinear(nn.Module):
         )
 
     def features(self, parameters: torch.Tensor) -> torch.Tensor:
-        """(n, P) raw -> (n, 1 + P + 3 [+ S L] [+ R L])."""
+        """(n, P) raw -> (n, 1 + P' + 3 [+ S L] [+ R L]) (P' the parameters that are
+        inputs, L the localisable ones among them)."""
         ones = torch.ones_like(parameters[:, :1])
         load = gravity_load(parameters, self.gravity)
         own = self.normalise(parameters)
-        parts = [ones, own, load]
+        parts = [ones, own[:, self.own], load]
         if self.smoothing is not None and self.smoothed:
             parts.append(self.smoothing(own[:, self.smoothed]))
         if self.regional:
@@ -321,6 +330,7 @@ class HyperNetwork(nn.Module):
         smoothing: FieldSmoothing | None = None,
         slots: int = 0,
         regions: np.ndarray | None = None,
+        inputs: Sequence[str] | None = None,
     ) -> None:
         super().__init__()
         self.latent, self.k, self.unit = sizes.latent, k, unit
@@ -333,7 +343,9 @@ class HyperNetwork(nn.Module):
         # with `slots`, the first entries gain one of the expression-dependent parameters;
         # with `regions`, every region's mean parameters are inputs of each element.
         self.local = (
-            LocalLinear(n_elements, specs, k, smoothing, slots, regions) if local_linear else None
+            LocalLinear(n_elements, specs, k, smoothing, slots, regions, inputs)
+            if local_linear
+            else None
         )
 
     def forward(self, parameters: torch.Tensor, identity: torch.Tensor) -> torch.Tensor:

@@ -13,6 +13,9 @@ import numpy as np
 import torch
 from torch import nn
 
+from softdeca_train.controls.definitions import CONTROL_REGIONS
+from softdeca_train.data.plan import FIXED
+from softdeca_train.data.regions import REGIONS
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.models.networks import (
     EXPRESSION_SLOTS,
@@ -202,6 +205,22 @@ class SoftDeca(Trainable):
         return deformation_transfer(batch.dt, batch.S, self.deformation_gradients(batch))
 
 
+def static_inputs(specs: Sequence[ParameterSpec]) -> tuple[str, ...]:
+    """The parameters static frames vary (data/plan.py FIXED holds the others at their
+    defaults): the only ones a closed-form fit on them can learn a response to."""
+    return tuple(s.name for s in specs if s.name not in FIXED["static"])
+
+
+def varied_region_labels(labels: np.ndarray) -> np.ndarray:
+    """Region labels (data/regions.py REGIONS) renumbered over the regions a regional pattern
+    sets (controls/definitions.py CONTROL_REGIONS); -1 for the others, which keep the group's
+    p and so add no input of their own."""
+    number = np.full(len(REGIONS), -1, np.int64)
+    for k, name in enumerate(CONTROL_REGIONS):
+        number[REGIONS.index(name)] = k
+    return number[np.asarray(labels, np.int64)]
+
+
 class SoftDecaHybrid(Trainable):
     """SoftDECA with a vertex stage and a residual stage:
     X = DT(S_t, I + z(w) . L(p, h)) + z(w) . L_v(p, h) + c(w, p) . M.
@@ -244,7 +263,8 @@ class SoftDecaHybrid(Trainable):
             local_linear=True,
             smoothing=smoothing,
             slots=EXPRESSION_SLOTS,
-            regions=d.skin_regions,
+            regions=None if d.skin_regions is None else varied_region_labels(d.skin_regions),
+            inputs=static_inputs(specs),
         )
         self.n_faces, self.n_vertices = d.n_faces, d.skin_vertices
         self.n_weights = len(d.blendshapes)
