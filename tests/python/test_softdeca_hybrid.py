@@ -230,3 +230,49 @@ def test_a_run_with_contrasts_fits_the_residual_stage_on_their_pairs(
     model.fit_residual(run.data, kept, False, run.contrasts)
     # 2 shards of one frame at 4 parameter sets: each shard's 3 later sets against its first
     assert seen["frames"] == kept + 8 and seen["pairs"].shape == (6, 2)
+
+
+class _Alternate:
+    """Every other static train batch of a dataset (the even or the odd ones), as a dataset."""
+
+    def __init__(self, data, odd: bool) -> None:
+        self.data, self.odd = data, odd
+
+    def batches(self, kind: str, split: str, rng=None):
+        for i, b in enumerate(self.data.batches(kind, split)):
+            if i % 2 == self.odd:
+                yield b
+
+    def left_out(self, kind: str, split: str) -> dict:
+        return {"kept": sum(b.frames for b in self.batches(kind, split))}
+
+
+def test_more_static_data_joins_the_closed_form_start(small) -> None:
+    folder, _ = small
+    run = Run(
+        folder / "run-more",
+        RunConfig(str(folder), "test", seed=3, more_static=[folder]),
+    )
+    # run.json keeps the list; reopened, the run has the same configuration and datasets
+    again = Run(folder / "run-more")
+    assert again.config.more_static == (str(folder),)
+    assert [d.folder for d in again.more_static] == [folder]
+    with pytest.raises(ValueError, match="more static data"):
+        Run(folder / "run-more", RunConfig(str(folder), "test", seed=3))
+    sizes = replace(run.sizes, latent=53)
+
+    def start(data, more=()) -> torch.Tensor:
+        model = SoftDecaHybrid(run.definition, run.specs, sizes)
+        model.f_r = (
+            None  # the closed-form vertex stage only (the residual stage is stochastic)
+        )
+        model.init_from_dataset(data, progress=False, more=more)
+        local = model.f_ph_v.local
+        assert local is not None
+        return local.table.detach().clone()
+
+    whole = start(run.data)
+    even, odd = _Alternate(run.data, False), _Alternate(run.data, True)
+    # half the frames as the dataset and the other half as more data: the fit on all of them
+    # (on half of them alone it would differ: the ridge fit is not that of its half)
+    assert torch.allclose(start(even, [odd]), whole, rtol=1e-4, atol=1e-6)

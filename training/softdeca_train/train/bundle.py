@@ -106,6 +106,7 @@ def train_bundle(
             "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
             "dataset": _dataset_summary(run.data),
             "contrasts": _dataset_summary(run.contrasts),
+            "more_static": [_dataset_summary(d) for d in run.more_static],
             "sizes": asdict(run.sizes),
             "budget_minutes": asdict(budget),
             "stages": summaries,

@@ -27,6 +27,15 @@ def _run_args(p: argparse.ArgumentParser, dataset_required: bool = True) -> None
         help="a dataset generated with --contrasts: SoftDECA's residual stage also fits its "
         "frames and their pairs (with --dataset, when the run folder is new)",
     )
+    p.add_argument(
+        "--more-static",
+        action="append",
+        default=[],
+        metavar="DATASET",
+        help="a dataset generated like --dataset (another seed) whose static train frames "
+        "join SoftDECA's closed-form start and residual stage; repeatable (with --dataset, "
+        "when the run folder is new)",
+    )
     p.add_argument("--sizes", choices=["full", "test"], default="full", help="network sizes")
     p.add_argument("--seed", type=int, default=0, help="training seed (0)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
@@ -42,10 +51,13 @@ def _open_run(args: argparse.Namespace):  # -> Run
         torch.set_num_threads(args.threads)
     if args.dataset:
         contrasts = str(Path(args.contrasts)) if args.contrasts else None
-        config = RunConfig(str(Path(args.dataset)), args.sizes, args.seed, contrasts=contrasts)
+        more = tuple(str(Path(d)) for d in args.more_static)
+        config = RunConfig(
+            str(Path(args.dataset)), args.sizes, args.seed, contrasts=contrasts, more_static=more
+        )
         return Run(args.run, config)
-    if args.contrasts:
-        raise SystemExit("--contrasts is part of a new run: give --dataset with it")
+    if args.contrasts or args.more_static:
+        raise SystemExit("--contrasts and --more-static are part of a new run: give --dataset")
     return Run(args.run)
 
 

@@ -6,7 +6,7 @@ static model, and the Table 1 baselines. Errors are per-vertex Euclidean distanc
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -62,11 +62,13 @@ class Trainable(nn.Module):
         rng: np.random.Generator,
         progress: bool = True,
         contrasts: Dataset | None = None,
+        more: Sequence[Dataset] = (),
     ) -> None:
         """Initialisation before the first step: by default `init_from_data` on 48 shuffled
         train batches; a model with a closed-form start over all the data overrides it.
         `contrasts`: a contrasts dataset (data/plan.py contrast), for the models that use
-        one (SoftDECA's residual stage); the others ignore it."""
+        one (SoftDECA's residual stage); `more`: datasets drawn like `data` whose static
+        train frames join a closed-form start (SoftDECA's); the others ignore both."""
         if type(self).init_from_data is not Trainable.init_from_data:
             self.init_from_data(list(itertools.islice(data.batches(self.kind, "train", rng), 48)))
 
@@ -307,22 +309,24 @@ class SoftDecaHybrid(Trainable):
         rng: np.random.Generator | None = None,
         progress: bool = True,
         contrasts: Dataset | None = None,
+        more: Sequence[Dataset] = (),
         ridge: float = 1e-3,
     ) -> None:
         """Start at the per-vertex ridge fit of T - S_t on [w, LocalLinear's features] (1,
-        p_v, g_v and the averaged parameters) over the kept train frames: its w part (rank
-        latent - 1, reduced-rank regression) in f_w's linear path and L_v's
-        base, its constant and parameter parts in L_v's local map; every MLP's output and the
-        DT stage start at zero."""
+        p_v, g_v and the averaged parameters) over the kept static train frames of `data`
+        and of `more`: its w part (rank latent - 1, reduced-rank regression) in f_w's linear
+        path and L_v's base, its constant and parameter parts in L_v's local map; every MLP's
+        output and the DT stage start at zero."""
         from tqdm import tqdm
 
         from softdeca_train.train.local_fit import LocalRidge
 
         fit: LocalRidge | None = None
         moment = torch.zeros(self.n_weights, self.n_weights, dtype=torch.float64)
-        kept = data.left_out("static", "train")["kept"]
+        sources = [data, *more]
+        kept = sum(d.left_out("static", "train")["kept"] for d in sources)
         bar = tqdm(total=kept, desc="vertex stage fit", unit="frame", disable=not progress)
-        for b in data.batches("static", "train"):
+        for b in static_train(sources):
             x = self.vertex_features(b.weights, b.vertex_parameters(self.n_vertices))
             fit = fit or LocalRidge(self.n_vertices, x.shape[-1], 3)
             fit.add(x, (b.T - b.S).transpose(0, 1) / CM)
@@ -364,12 +368,14 @@ class SoftDecaHybrid(Trainable):
             last.bias.zero_()
         if hyper.local.slots:
             del fit, coef  # gigabytes of normal equations: the second fit needs its own
-            self._fit_on_codes(data, kept, progress, ridge)
+            self._fit_on_codes(sources, kept, progress, ridge)
         if self.f_r is not None:
-            self.fit_residual(data, kept, progress, contrasts)
+            self.fit_residual(data, kept, progress, contrasts, more)
 
     @torch.no_grad()
-    def _fit_on_codes(self, data: Dataset, frames: int, progress: bool, ridge: float) -> None:
+    def _fit_on_codes(
+        self, sources: Sequence[Dataset], frames: int, progress: bool, ridge: float
+    ) -> None:
         """With z's codes fixed by the first fit, the vertex stage again as a per-vertex ridge
         fit on `code_features`: its code part in L_v's base, the local features' in the
         constant slot's table, the products in the slot table. One more pass over the data."""
@@ -384,7 +390,7 @@ class SoftDecaHybrid(Trainable):
         bar = tqdm(
             total=frames, desc="vertex stage on the codes", unit="frame", disable=not progress
         )
-        for b in data.batches("static", "train"):
+        for b in static_train(sources):
             x = self.code_features(b.weights, b.vertex_parameters(self.n_vertices))
             fit = fit or LocalRidge(self.n_vertices, x.shape[-1], 3)
             fit.add(x, (b.T - b.S).transpose(0, 1) / CM)
@@ -404,11 +410,13 @@ class SoftDecaHybrid(Trainable):
         frames: int,
         progress: bool = True,
         contrasts: Dataset | None = None,
+        more: Sequence[Dataset] = (),
     ) -> dict[str, float]:
         """The residual stage from what the model (without it) leaves on the kept static train
-        frames: its modes and the members that give their coefficients (models/residual.py).
-        `contrasts`: a dataset generated with contrasts (data/plan.py contrast), whose static
-        train frames join the fit with their pairs."""
+        frames (`frames` of them in `data` and `more`): its modes and the members that give
+        their coefficients (models/residual.py). `contrasts`: a dataset generated with
+        contrasts (data/plan.py contrast), whose static train frames join the fit with their
+        pairs."""
         from tqdm import tqdm
 
         assert self.f_r is not None
@@ -416,18 +424,18 @@ class SoftDecaHybrid(Trainable):
             self.f_r.table.zero_()  # the model without the stage
         weights, features, residual = [], [], []
         keys: list[tuple[int, int, bytes]] = []  # (identity, param_id, weights) of each frame
-        sources = [data] if contrasts is None else [data, contrasts]
+        sources = [data, *more] + ([] if contrasts is None else [contrasts])
         if contrasts is not None:
             frames += contrasts.left_out("static", "train")["kept"]
         bar = tqdm(total=frames, desc="residual of the start", unit="frame", disable=not progress)
-        for k, source in enumerate(sources):
+        for source in sources:
             for b in source.batches("static", "train"):
                 with torch.no_grad():
                     residual.append((b.T - self.predict(b)).float())
                     pv = b.vertex_parameters(self.n_vertices)
                     features.append(self.f_r.parameter_features(pv).expand(b.frames, -1))
                 weights.append(b.weights.float())
-                if k == 1:
+                if source is contrasts:
                     keys += [(b.identity_id, b.param_id, w.numpy().tobytes()) for w in b.weights]
                 else:
                     keys += [(-1, -1, b"")] * b.frames
@@ -451,6 +459,12 @@ class SoftDecaHybrid(Trainable):
         if self.f_r is None:
             return x
         return x + self.f_r(batch.weights, batch.vertex_parameters(self.n_vertices))
+
+
+def static_train(sources: Sequence[Dataset]) -> Iterator[Batch]:
+    """The kept static train batches of every dataset in turn."""
+    for data in sources:
+        yield from data.batches("static", "train")
 
 
 def contrast_pairs(keys: Sequence[tuple[int, int, bytes]]) -> torch.Tensor:

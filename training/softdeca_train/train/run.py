@@ -42,6 +42,12 @@ class RunConfig:
     # a dataset generated with --contrasts whose static train frames and their pairs also
     # fit SoftDECA's residual stage (docs/training.md); None: the dataset alone
     contrasts: str | None = None
+    # datasets generated like `dataset` (its range profile and level, another seed) whose
+    # static train frames join SoftDECA's closed-form start and residual stage
+    more_static: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:  # run.json holds a list (and a caller may give paths)
+        object.__setattr__(self, "more_static", tuple(str(d) for d in self.more_static))
 
 
 class Run:
@@ -54,12 +60,12 @@ class Run:
             config = RunConfig(**json.loads(path.read_text()))
         elif path.is_file():
             old = RunConfig(**json.loads(path.read_text()))
-            key = lambda c: (c.dataset, c.sizes, c.seed, c.contrasts)  # noqa: E731
+            key = lambda c: (c.dataset, c.sizes, c.seed, c.contrasts, c.more_static)  # noqa: E731
             if key(old) != key(config):
                 raise ValueError(
                     f"{self.folder} trains on {old.dataset} ({old.sizes}, seed {old.seed}, "
-                    f"contrasts {old.contrasts}); use another folder for another dataset, "
-                    "sizes, seed or contrasts"
+                    f"contrasts {old.contrasts}, more static data {list(old.more_static)}); use "
+                    "another folder for another dataset, sizes, seed, contrasts or more data"
                 )
         else:
             self.folder.mkdir(parents=True, exist_ok=True)
@@ -84,6 +90,27 @@ class Run:
         if not data.manifest["header"]["config"].get("contrasts"):
             raise ValueError(f"{self.config.contrasts} was not generated with --contrasts")
         return data
+
+    @cached_property
+    def more_static(self) -> list[Dataset]:
+        """The datasets whose static train frames join SoftDECA's start; each must be drawn
+        like the run's dataset (the same range profile and level), or its frames would teach
+        another physics or other ranges."""
+        out = []
+        main = GenerateConfig.from_dict(self.data.manifest["header"]["config"])
+        for folder in self.config.more_static:
+            data = Dataset(folder, self.template, [s.name for s in self.specs])
+            cfg = GenerateConfig.from_dict(data.manifest["header"]["config"])
+            for name in ("ranges", "level", "tolerance", "collisions", "contrasts"):
+                if getattr(cfg, name) != getattr(main, name):
+                    raise ValueError(
+                        f"{folder}: {name} {getattr(cfg, name)!r}, the run's dataset has "
+                        f"{getattr(main, name)!r}: more static data must be drawn like it"
+                    )
+            if not data.left_out("static", "train")["kept"]:
+                raise ValueError(f"{folder} holds no static train frame")
+            out.append(data)
+        return out
 
     @cached_property
     def definition(self) -> TemplateDefinition:
@@ -135,7 +162,7 @@ class Run:
         fresh = not self.checkpoint(name).is_file()
         if fresh:
             rng = np.random.default_rng(cfg.seed)
-            model.init_from_dataset(self.data, rng, progress, self.contrasts)
+            model.init_from_dataset(self.data, rng, progress, self.contrasts, self.more_static)
         summary = train(model, self.data, cfg, self.folder, name, progress)
         summary["config"] = asdict(cfg)
         (self.folder / f"{name}.summary.json").write_text(json.dumps(summary, indent=1) + "\n")
