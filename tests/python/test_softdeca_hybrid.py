@@ -4,6 +4,8 @@ fit, checked against an independent fit on the small generated dataset."""
 
 from __future__ import annotations
 
+import json
+import shutil
 from dataclasses import replace
 
 import numpy as np
@@ -247,18 +249,39 @@ class _Alternate:
         return {"kept": sum(b.frames for b in self.batches(kind, split))}
 
 
-def test_more_static_data_joins_the_closed_form_start(small) -> None:
+def _drawn_again(folder, out, **config):
+    """A copy of a dataset whose manifest says it was generated with `config` changed."""
+    shutil.copytree(folder, out, ignore=shutil.ignore_patterns("run-*"))
+    manifest = json.loads((out / "manifest.json").read_text())
+    manifest["header"]["config"].update(config)
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    return out
+
+
+def test_more_static_data_joins_the_closed_form_start(small, tmp_path) -> None:
     folder, _ = small
+    drawn = json.loads((folder / "manifest.json").read_text())["header"]["config"]
+    seed, level = drawn["seed"], drawn["level"] + 1
+    other = _drawn_again(folder, tmp_path / "other", seed=seed + 1)
     run = Run(
-        folder / "run-more",
-        RunConfig(str(folder), "test", seed=3, more_static=[folder]),
+        tmp_path / "run-more",
+        RunConfig(str(folder), "test", seed=3, more_static=[other]),
     )
     # run.json keeps the list; reopened, the run has the same configuration and datasets
-    again = Run(folder / "run-more")
-    assert again.config.more_static == (str(folder),)
-    assert [d.folder for d in again.more_static] == [folder]
+    again = Run(tmp_path / "run-more")
+    assert again.config.more_static == (str(other),)
+    assert [d.folder for d in again.more_static] == [other]
     with pytest.raises(ValueError, match="more static data"):
-        Run(folder / "run-more", RunConfig(str(folder), "test", seed=3))
+        Run(tmp_path / "run-more", RunConfig(str(folder), "test", seed=3))
+    # drawn otherwise, or from the same identities: refused
+    finer = _drawn_again(folder, tmp_path / "level", seed=seed + 2, level=level)
+    for data, problem in ((finer, f"level {level}"), (folder, f"seed {seed} again")):
+        bad = Run(
+            tmp_path / f"run-{problem}",
+            RunConfig(str(folder), "test", more_static=[data]),
+        )
+        with pytest.raises(ValueError, match=problem):
+            _ = bad.more_static
     sizes = replace(run.sizes, latent=53)
 
     def start(data, more=()) -> torch.Tensor:

@@ -94,13 +94,20 @@ class Run:
     @cached_property
     def more_static(self) -> list[Dataset]:
         """The datasets whose static train frames join SoftDECA's start; each must be drawn
-        like the run's dataset (the same range profile and level), or its frames would teach
-        another physics or other ranges."""
+        like the run's dataset (the same range profile, level, tolerance and collisions: else
+        its frames teach another physics or other ranges) from a seed of its own."""
         out = []
         main = GenerateConfig.from_dict(self.data.manifest["header"]["config"])
+        seeds = {main.seed}
         for folder in self.config.more_static:
             data = Dataset(folder, self.template, [s.name for s in self.specs])
             cfg = GenerateConfig.from_dict(data.manifest["header"]["config"])
+            if cfg.seed in seeds:  # identities come from the seed: the test split's among them
+                raise ValueError(
+                    f"{folder}: seed {cfg.seed} again; its identities would repeat those of "
+                    "the run's dataset (its test identities too) or of another: use another seed"
+                )
+            seeds.add(cfg.seed)
             for name in ("ranges", "level", "tolerance", "collisions", "contrasts"):
                 if getattr(cfg, name) != getattr(main, name):
                     raise ValueError(
