@@ -271,6 +271,21 @@ def test_more_static_data_joins_the_closed_form_start(small, tmp_path) -> None:
     again = Run(tmp_path / "run-more")
     assert again.config.more_static == (str(other),)
     assert [d.folder for d in again.more_static] == [other]
+    # the evaluation report counts the frames it leaves out and names it
+    from softdeca_train.train.report import _more_static_clause, left_out_counts
+
+    counts = left_out_counts(again)
+    assert counts[f"static/train of {other.name}"] == again.more_static[0].left_out(
+        "static", "train"
+    )
+    assert counts[f"static/train of {other.name}"]["kept"] > 0
+    assert f"`{other.name}`" in _more_static_clause(again)
+    assert (
+        _more_static_clause(
+            run.__class__(tmp_path / "plain", RunConfig(str(folder), "test"))
+        )
+        == ""
+    )
     with pytest.raises(ValueError, match="more static data"):
         Run(tmp_path / "run-more", RunConfig(str(folder), "test", seed=3))
     # drawn otherwise, or from the same identities: refused

@@ -219,13 +219,7 @@ def write_report(
     from softdeca_train.train.localisation import localisation_figure
 
     local = localisation_figure(run, models["softdeca"], out / "localisation.png")
-    # Frames training leaves out because the volumetric solver's estimated error is above 3x
-    # the dataset's tolerance or the frame fails a sanity bound; the evaluation reads every
-    # test frame.
-    left_out = {
-        f"{kind}/train": run.data.left_out(kind, "train")
-        for kind in ("static", "sparse", "dynamic")
-    }
+    left_out = left_out_counts(run)
     result = {
         "errors": errors,
         "ms_per_frame": times,
@@ -238,6 +232,20 @@ def write_report(
     if bench is not None:
         _write_bench(bench, result, run)
     return out / "README.md"
+
+
+def left_out_counts(run: Run) -> dict[str, dict[str, int]]:
+    """Frames training leaves out because the volumetric solver's estimated error is above 3x
+    the dataset's tolerance or the frame fails a sanity bound, per kind, and of each dataset
+    whose static train frames SoftDECA's start also reads; the evaluation reads every test
+    frame."""
+    out = {
+        f"{kind}/train": run.data.left_out(kind, "train")
+        for kind in ("static", "sparse", "dynamic")
+    }
+    for extra in run.more_static:
+        out[f"static/train of {extra.folder.name}"] = extra.left_out("static", "train")
+    return out
 
 
 def _left_out_line(left: dict[str, dict[str, int]]) -> str:
@@ -256,6 +264,14 @@ def _left_out_line(left: dict[str, dict[str, int]]) -> str:
     )
 
 
+def _more_static_clause(run: Run) -> str:
+    """Where SoftDECA's start also read static frames of other datasets (--more-static)."""
+    names = [f"`{Path(d).name}`" for d in run.config.more_static]
+    if not names:
+        return ""
+    return f", SoftDECA's start also on the static train frames of {', '.join(names)}"
+
+
 def _markdown(run: Run, bundle: Path, r: dict) -> str:
     e, ms = r["errors"], r["ms_per_frame"]
     m = run.data.manifest
@@ -265,7 +281,8 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "",
         f"Run `{run.folder}` on dataset `{Path(run.config.dataset).name}` (LHM level "
         f"{cfg['level']}, {cfg['static']} static frames, {cfg['dynamic']} dynamic sequences, "
-        f"{cfg['sparse']} sparse frames; range profile `{cfg.get('ranges', 'appendix-a')}`); "
+        f"{cfg['sparse']} sparse frames; range profile `{cfg.get('ranges', 'appendix-a')}`)"
+        f"{_more_static_clause(run)}; "
         f"bundle `{bundle}`. Errors: mean per-vertex Euclidean distance to the simulated skin "
         "T over all skin vertices of S, in mm, on the test split (identities, parameter sets "
         f"and expression frames unseen in training: the held-out take `{cfg['test_take']}` and "
