@@ -281,9 +281,7 @@ def test_more_static_data_joins_the_closed_form_start(small, tmp_path) -> None:
     assert counts[f"static/train of {other.name}"]["kept"] > 0
     assert f"`{other.name}`" in _more_static_clause(again)
     assert (
-        _more_static_clause(
-            run.__class__(tmp_path / "plain", RunConfig(str(folder), "test"))
-        )
+        _more_static_clause(Run(tmp_path / "plain", RunConfig(str(folder), "test")))
         == ""
     )
     with pytest.raises(ValueError, match="more static data"):
