@@ -7,8 +7,10 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -275,4 +277,30 @@ TEST_F(HostileBundle, MemoryBudgetIsConfigurable) {
   EXPECT_NE(std::string(softdeca_last_error()).find("over the memory budget of 32 MiB"), std::string::npos)
       << softdeca_last_error();
   EXPECT_EQ(m, nullptr);
+}
+
+// The physics at prepare's head (rest_head.bin): a file that does not match its manifest's
+// sizes, an index out of range and a non-finite position are refused at load, by name.
+TEST_F(HostileBundle, RestHeadFileIsCheckedAtLoad) {
+  const std::string good = read_text(bundle_ / "rest_head.bin");
+  ASSERT_FALSE(good.empty());
+  replace("rest_head.bin", good.substr(0, good.size() - 4));
+  EXPECT_NE(load_error().find("rest_head.bin: shorter than its manifest says"), std::string::npos) << load_error();
+  replace("rest_head.bin", good + std::string(8, '\0'));
+  EXPECT_NE(load_error().find("more than its manifest says"), std::string::npos) << load_error();
+  // The first soft tet starts right after the fill's vertices (float64 x 3 each).
+  const std::string manifest = read_text(bundle_ / "manifest.json");
+  const std::size_t at = manifest.find("\"fill_vertices\": ");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t fill = std::stoul(manifest.substr(at + 17));
+  std::string bad = good;
+  const std::int32_t huge = 1 << 30;
+  std::memcpy(&bad[fill * 24], &huge, 4);
+  replace("rest_head.bin", bad);
+  EXPECT_NE(load_error().find("soft tets: index 1073741824"), std::string::npos) << load_error();
+  bad = good;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(&bad[8], &nan, 8);
+  replace("rest_head.bin", bad);
+  EXPECT_NE(load_error().find("fill vertices: value 1 is not finite"), std::string::npos) << load_error();
 }

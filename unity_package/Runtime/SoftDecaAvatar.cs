@@ -1,6 +1,7 @@
 using System;
 using System.Collections.Generic;
 using System.IO;
+using System.Threading.Tasks;
 using SoftDeca;
 using Unity.Collections;
 using UnityEngine;
@@ -60,8 +61,14 @@ namespace SoftDeca.Unity
         private int[] skinTriangles;
         private NativeArray<Vector3> positions, normals;
         private bool dirty;
+        // The running prepare: material changes are prepared off the main thread (the physics
+        // at prepare takes a second or more) while frames keep the last preparation.
+        private Task preparing;
+        private bool prepared;
 
         public Avatar Native { get { return avatar; } }
+        /// <summary>Whether a material change is still being prepared (frames show the previous one).</summary>
+        public bool Preparing { get { return preparing != null && !preparing.IsCompleted; } }
         public Model Model { get { return model; } }
 
         private void OnEnable()
@@ -77,11 +84,13 @@ namespace SoftDeca.Unity
             positions = new NativeArray<Vector3>(mesh.vertexCount, Allocator.Persistent);
             normals = new NativeArray<Vector3>(mesh.vertexCount, Allocator.Persistent);
             if (model.Info.HasSparse != 0) landmarks = new LandmarkInput(model);
+            prepared = false;
             ApplyMaterial();
         }
 
         private void OnDisable()
         {
+            FinishPrepare(true);
             if (avatar != null) avatar.Dispose();
             if (model != null) model.Dispose();
             avatar = null;
@@ -189,14 +198,39 @@ namespace SoftDeca.Unity
                 RegionMap.Paint(libraryNeutral, skinTriangles, faces, -r.centre.x, r.centre.y, r.centre.z, r.radius, r.value);
             }
             foreach (var kv in byParameter) avatar.SetParameterFaces(kv.Key, kv.Value);
-            avatar.Prepare();
             dirty = false;
+#if UNITY_WEBGL && !UNITY_EDITOR
+            avatar.Prepare();  // no threads
+            prepared = true;
+#else
+            Avatar target = avatar;
+            preparing = Task.Run(() => target.Prepare());
+#endif
+        }
+
+        // Collects a finished prepare (wait: block until it finishes); a failed one is logged and
+        // the avatar keeps its previous preparation.
+        private void FinishPrepare(bool wait)
+        {
+            if (preparing == null || (!wait && !preparing.IsCompleted)) return;
+            try
+            {
+                preparing.Wait();
+                prepared = true;
+            }
+            catch (AggregateException e)
+            {
+                Debug.LogException(e.InnerException ?? e, this);
+            }
+            preparing = null;
         }
 
         private void Update()
         {
             if (avatar == null || input == null) return;
-            if (dirty) ApplyMaterial();
+            FinishPrepare(false);
+            if (dirty && preparing == null) ApplyMaterial();
+            if (!prepared) return;  // the first preparation is still running
             if (method == Method.Sparse && landmarks != null && input.TryGetLandmarks(landmarks))
                 avatar.EvaluateLandmarks(landmarks.Points);
             else if (input.TryGetWeights(weights))

@@ -73,7 +73,7 @@ typedef enum softdeca_status {
 } softdeca_status;
 
 /* The version of the ABI convention and signatures in this header; see softdeca_abi_version. */
-#define SOFTDECA_ABI_VERSION 1u
+#define SOFTDECA_ABI_VERSION 2u
 
 /* softdeca_bool: 0 false, 1 true (inputs: non-zero is true). */
 typedef int32_t softdeca_bool;
@@ -307,6 +307,9 @@ typedef struct softdeca_stats {
   double prepare_networks_ms; /* its networks (f_ph, f_ph_v, f_dyn) */
   double factorisation_ms;    /* deformation-transfer assembly and factorisation */
   uint64_t memory_bytes;      /* memory the avatar holds (preparation, factor, buffers) */
+  double prepare_physics_ms;  /* its physics at rest (bundles with rest physics; 0 at the defaults) */
+  uint32_t physics_iterations; /* solver iterations of that solve (0: none ran) */
+  uint32_t reserved;
 } softdeca_stats;
 
 SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* avatar, softdeca_stats* out_stats);

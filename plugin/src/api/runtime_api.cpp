@@ -346,6 +346,9 @@ SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* av
     out_stats->prepare_networks_ms = s.prepare_networks_ms;
     out_stats->factorisation_ms = s.factorisation_ms;
     out_stats->memory_bytes = s.memory_bytes;
+    out_stats->prepare_physics_ms = s.prepare_physics_ms;
+    out_stats->physics_iterations = static_cast<uint32_t>(s.physics_iterations);
+    out_stats->reserved = 0;
   });
 }
 

@@ -45,7 +45,8 @@ HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float
 
 std::size_t Preparation::bytes() const {
   return face_l.bytes() + vertex_l.bytes() + softdeca_vertex_l.bytes() + residual_modes.bytes() +
-         residual_condition.size() * 4 + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4;
+         residual_condition.size() * 4 + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4 +
+         rest_offset.size() * 4;
 }
 
 class Avatar::FrameGuard {
@@ -181,40 +182,17 @@ void Avatar::prepare() {
                                                       worker_.parts());
     factorisation_ms = ms(f0, Clock::now());
   }
-  auto prep = std::make_shared<Preparation>();
-  prep->dt = dt_;
-  prep->identity = identity;
   const auto n0 = Clock::now();
-  for (const int model : {kSoftDeca, kSparse}) {
-    const bool sparse = model == kSparse;
-    if (!model_->has(sparse)) continue;
-    // Hyper-tensor: per face (SoftDECA) or per vertex (sparse).
-    const OnnxNetwork& hyper = *model_->hyper(sparse);
-    const auto& cols = hyper.spec().parameter_columns;
-    const std::size_t n = sparse ? vs_ : nf_, width = sparse ? 3 : 9;
-    std::vector<float> p(n * cols.size());
-    if (sparse) params->vertex_matrix(cols, p.data());
-    else params->face_matrix(cols, p.data());
-    (sparse ? prep->vertex_l : prep->face_l) = hyper_tensor(hyper, p, identity, n, width);
-    if (const OnnxNetwork* stage = sparse ? nullptr : model_->softdeca_vertex_stage()) {
-      std::vector<float> pv(vs_ * stage->spec().parameter_columns.size());
-      params->vertex_matrix(stage->spec().parameter_columns, pv.data());
-      prep->softdeca_vertex_l = hyper_tensor(*stage, pv, identity, vs_, 3);
-    }
-    if (!sparse) prepare_residual(*params, *prep);
-    // Dynamics coefficients per skin vertex.
-    const OnnxNetwork& dyn = *model_->dynamics(sparse);
-    const auto& dcols = dyn.spec().parameter_columns;
-    std::vector<float> pv(vs_ * dcols.size());
-    params->vertex_matrix(dcols, pv.data());
-    DynamicsCoefficients& c = prep->dynamics[model];
-    c.alpha.resize(vs_);
-    c.beta.resize(vs_);
-    c.gamma.resize(vs_);
-    dyn.run({pv.data(), identity.data()}, {c.alpha.data(), c.beta.data(), c.gamma.data()}, 1);
-    c.check(m_, dyn.spec().key.c_str());
-  }
+  std::shared_ptr<Preparation> prep = prepare_networks(*params, identity);
   const double networks_ms = ms(n0, Clock::now());
+  // The physics at prepare: nothing to correct at the defaults (c(p0) = 0).
+  double physics_ms = 0;
+  int physics_iterations = 0;
+  if (model_->rest_head() && model_->has(false) && !params->at_defaults()) {
+    const auto r0 = Clock::now();
+    prep->rest_offset = rest_offset(*params, *prep, identity, physics_iterations);
+    physics_ms = ms(r0, Clock::now());
+  }
   {
     std::lock_guard<std::mutex> lock(current_mutex_);
     prep->generation = ++generation_;
@@ -224,7 +202,107 @@ void Avatar::prepare() {
   stats_.preparations += 1;
   stats_.prepare_ms = ms(t0, Clock::now());
   stats_.prepare_networks_ms = networks_ms;
+  stats_.prepare_physics_ms = physics_ms;
+  stats_.physics_iterations = physics_iterations;
   if (factorisation_ms > 0) stats_.factorisation_ms = factorisation_ms;
+}
+
+// The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
+std::shared_ptr<Preparation> Avatar::prepare_networks(const ParameterState& params,
+                                                      const std::vector<float>& identity) const {
+  auto prep = std::make_shared<Preparation>();
+  prep->dt = dt_;
+  prep->identity = identity;
+  for (const int model : {kSoftDeca, kSparse}) {
+    const bool sparse = model == kSparse;
+    if (!model_->has(sparse)) continue;
+    // Hyper-tensor: per face (SoftDECA) or per vertex (sparse).
+    const OnnxNetwork& hyper = *model_->hyper(sparse);
+    const auto& cols = hyper.spec().parameter_columns;
+    const std::size_t n = sparse ? vs_ : nf_, width = sparse ? 3 : 9;
+    std::vector<float> p(n * cols.size());
+    if (sparse) params.vertex_matrix(cols, p.data());
+    else params.face_matrix(cols, p.data());
+    (sparse ? prep->vertex_l : prep->face_l) = hyper_tensor(hyper, p, identity, n, width);
+    if (const OnnxNetwork* stage = sparse ? nullptr : model_->softdeca_vertex_stage()) {
+      std::vector<float> pv(vs_ * stage->spec().parameter_columns.size());
+      params.vertex_matrix(stage->spec().parameter_columns, pv.data());
+      prep->softdeca_vertex_l = hyper_tensor(*stage, pv, identity, vs_, 3);
+    }
+    if (!sparse) prepare_residual(params, *prep);
+    // Dynamics coefficients per skin vertex.
+    const OnnxNetwork& dyn = *model_->dynamics(sparse);
+    const auto& dcols = dyn.spec().parameter_columns;
+    std::vector<float> pv(vs_ * dcols.size());
+    params.vertex_matrix(dcols, pv.data());
+    DynamicsCoefficients& c = prep->dynamics[model];
+    c.alpha.resize(vs_);
+    c.beta.resize(vs_);
+    c.gamma.resize(vs_);
+    dyn.run({pv.data(), identity.data()}, {c.alpha.data(), c.beta.data(), c.gamma.data()}, 1);
+    c.check(m_, dyn.spec().key.c_str());
+  }
+  return prep;
+}
+
+std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
+  const std::vector<float> weights(kBlendshapeCount, 0.0f);
+  std::vector<float> z(static_cast<std::size_t>(m_.latent)), out(vs_ * 3);
+  model_->encoder(false)->run({weights.data()}, {z.data()}, 1);
+  if (prep.face_l.zero()) {
+    std::copy(neutral_.begin(), neutral_.begin() + static_cast<std::ptrdiff_t>(vs_ * 3), out.begin());
+  } else {
+    std::vector<float> rhs(vs_ * 3, 0.0f);
+    dg_rhs(prep.face_l, prep.dt->faces(), z.data(), neutral_.data(), 0, prep.face_l.blocks(), rhs.data());
+    std::vector<double> work(prep.dt->work_size());
+    const float* parts[] = {rhs.data()};
+    prep.dt->solve(parts, 1, neutral_.data(), work.data(), out.data());
+  }
+  if (!prep.softdeca_vertex_l.empty())
+    vertex_offsets(prep.softdeca_vertex_l, z.data(), out.data(), 0, prep.softdeca_vertex_l.blocks(), out.data());
+  if (!prep.residual_modes.empty()) {
+    std::vector<float> c(static_cast<std::size_t>(m_.residual_modes));
+    model_->residual_coefficients()->run({weights.data(), prep.residual_condition.data()}, {c.data()}, 1);
+    vertex_offsets(prep.residual_modes, c.data(), out.data(), 0, prep.residual_modes.blocks(), out.data());
+  }
+  return out;
+}
+
+std::vector<float> Avatar::rest_offset(const ParameterState& params, const Preparation& prep,
+                                       const std::vector<float>& identity, int& iterations) {
+  if (!rest_physics_) {
+    rest_physics_ = std::make_unique<RestPhysics>(*model_->rest_head(), m_, neutral_.data(), model_->skin_triangles(),
+                                                  static_cast<int>(worker_.parts()));
+    rest_physics0_ = rest_physics_->solve(ParameterState(m_, model_->skin_triangles(), geometry_.face_area));
+  }
+  if (rest_model0_.empty() || rest_model0_identity_ != identity) {
+    const ParameterState defaults(m_, model_->skin_triangles(), geometry_.face_area);
+    rest_model0_ = softdeca_rest(*prepare_networks(defaults, identity));
+    rest_model0_identity_ = identity;
+  }
+  const sim::Positions physics = rest_physics_->solve(params);
+  iterations = rest_physics_->iterations();
+  // The model at rest under p with the rest-inert parameters at their defaults: the physics
+  // says nothing about those at rest, so their response stays the networks'.
+  ParameterState kept(params);
+  bool inert_moved = false;
+  for (const int i : m_.rest_physics.inert_parameters) {
+    const double d = m_.parameters[static_cast<std::size_t>(i)].default_value;
+    if (params.kind(i) == ParameterState::Kind::Global && params.global(i) == d) continue;
+    kept.set_global(i, d);
+    inert_moved = true;
+  }
+  const std::vector<float> model = softdeca_rest(inert_moved ? *prepare_networks(kept, identity) : prep);
+  std::vector<float> offset(vs_ * 3);
+  for (std::size_t v = 0; v < vs_; ++v)
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::size_t i = 3 * v + c;
+      const auto row = static_cast<Eigen::Index>(v), col = static_cast<Eigen::Index>(c);
+      offset[i] = static_cast<float>((physics(row, col) - rest_physics0_(row, col)) - (double(model[i]) - double(rest_model0_[i])));
+    }
+  if (!all_finite(offset.data(), offset.size()))
+    throw Error(SOFTDECA_ERROR_NON_FINITE, "the physics at prepare produced a non-finite skin for these parameters");
+  return offset;
 }
 
 // The residual stage's prepare half: its condition and modes for these parameters.
@@ -321,6 +399,11 @@ void Avatar::add_vertex_stages(const Preparation& prep, AvatarStats& st, Clock::
     std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
     model_->residual_coefficients()->run(f_r_w_);
     add_vertex_offsets(prep.residual_modes, residual_coefficients_.data());
+  }
+  // The physics at prepare's correction (empty at the defaults).
+  if (!prep.rest_offset.empty()) {
+    float* x = static_.data();
+    for (std::size_t i = 0; i < prep.rest_offset.size(); ++i) x[i] += prep.rest_offset[i];
   }
   st.hyper_ms += ms(since, Clock::now());
 }
@@ -541,6 +624,8 @@ void Avatar::record(AvatarStats st) {
   if (st.generation == 0) st.generation = stats_.generation;
   st.prepare_ms = stats_.prepare_ms;
   st.prepare_networks_ms = stats_.prepare_networks_ms;
+  st.prepare_physics_ms = stats_.prepare_physics_ms;
+  st.physics_iterations = stats_.physics_iterations;
   st.factorisation_ms = stats_.factorisation_ms;
   stats_ = st;
 }

@@ -25,6 +25,7 @@
 #include "runtime/normals.h"
 #include "runtime/onnx_network.h"
 #include "runtime/parameters.h"
+#include "runtime/rest_physics.h"
 #include "runtime/rigid.h"
 #include "runtime/worker.h"
 
@@ -53,7 +54,8 @@ struct AvatarStats {
   std::uint64_t frames = 0, preparations = 0, generation = 0;
   double frame_ms = 0, encoder_ms = 0, blend_ms = 0, hyper_ms = 0, solve_ms = 0, dynamics_ms = 0, output_ms = 0,
          normals_ms = 0;
-  double prepare_ms = 0, prepare_networks_ms = 0, factorisation_ms = 0;
+  double prepare_ms = 0, prepare_networks_ms = 0, factorisation_ms = 0, prepare_physics_ms = 0;
+  int physics_iterations = 0;
   std::uint64_t memory_bytes = 0;
 };
 
@@ -69,6 +71,10 @@ struct Preparation {
   std::vector<float> residual_condition;
   HyperTensor residual_modes;
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
+  // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
+  // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p~) - M_rest(p0)], p~ being p with
+  // the bundle's rest-inert parameters at their defaults (runtime/rest_physics.h).
+  std::vector<float> rest_offset;
   std::size_t bytes() const;
 };
 
@@ -118,6 +124,14 @@ class Avatar {
   // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.
   void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since);
   void prepare_residual(const ParameterState& params, Preparation& prep) const;
+  // The networks' part of a preparation for these parameters and identity.
+  std::shared_ptr<Preparation> prepare_networks(const ParameterState& params, const std::vector<float>& identity) const;
+  // SoftDECA's static frame at rest (zero weights on the neutral) for a preparation, without
+  // touching the frame thread's buffers (prepare runs beside frames).
+  std::vector<float> softdeca_rest(const Preparation& prep) const;
+  // c(p) of Preparation::rest_offset (prepare_mutex_ held); iterations: of the physics' solve.
+  std::vector<float> rest_offset(const ParameterState& params, const Preparation& prep, const std::vector<float>& identity,
+                                 int& iterations);
   void write_rigid_non_skin(const float* skin, float* head) const;
   void compute_normals(const float* head, float* normals);
   void record(AvatarStats st);  // a frame's timings, keeping the counters
@@ -142,6 +156,12 @@ class Avatar {
 
   std::mutex prepare_mutex_;
   std::shared_ptr<const DeformationTransfer> dt_;  // built by the first prepare
+  // The physics at prepare (bundles with a rest head): the avatar's head, built by the first
+  // prepare away from the defaults, and P_rest(p0) and M_rest(p0) (for the identity they were
+  // computed with); all under prepare_mutex_.
+  std::unique_ptr<RestPhysics> rest_physics_;
+  sim::Positions rest_physics0_;
+  std::vector<float> rest_model0_, rest_model0_identity_;
   std::uint64_t generation_ = 0;
   mutable std::mutex current_mutex_;
   std::shared_ptr<const Preparation> current_;

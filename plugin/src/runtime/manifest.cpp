@@ -316,6 +316,59 @@ void parse_networks(const Json& doc, Manifest& m) {
 }
 }  // namespace
 
+namespace {
+void parse_rest_physics(const Json& doc, Manifest& m) {
+  if (!doc.has("rest_physics")) return;
+  const std::string what = "rest_physics";
+  check(m.format_version >= 4, "rest_physics (the physics at prepare) needs bundle format version 4");
+  check(m.has_softdeca, "rest_physics corrects the SoftDECA model: the bundle has none");
+  const Json& r = doc.at("rest_physics", "manifest");
+  RestPhysicsSpec& s = m.rest_physics;
+  s.file = r.at("file", what).string(what + ".file");
+  s.sha256 = sha256_of(r, what);
+  const auto count = [&](const Json& j, const char* key, long long lo) {
+    return bounded_int(j.at(key, what), what + "." + key, lo, kMaxElements);
+  };
+  s.fill_vertices = count(r, "fill_vertices", 4);
+  s.soft_tets = count(r, "soft_tets", 1);
+  s.muscle_tets = count(r, "muscle_tets", 0);
+  s.teeth_upper = count(r, "teeth_upper", 0);
+  s.teeth_lower = count(r, "teeth_lower", 0);
+  s.cranium = count(r, "cranium", 0);
+  s.jaw = count(r, "jaw", 0);
+  s.upper_teeth_triangles = count(r, "upper_teeth_triangles", 0);
+  s.lower_teeth_triangles = count(r, "lower_teeth_triangles", 0);
+  check(s.teeth_upper + s.teeth_lower <= m.head_vertices - m.skin_vertices,
+        what + ": more teeth vertices than the head has non-skin vertices");
+  const Json& c = r.at("contacts", what);
+  if (!c.is_null()) {
+    s.has_contacts = true;
+    s.lid_candidates = bounded_int(c.at("lid_candidates", what), what + ".contacts.lid_candidates", 0, m.skin_vertices);
+    const auto length = [&](const char* key) {
+      const double v = finite(c.at(key, what), what + ".contacts." + key);
+      check(v > 0 && v < 1, what + ".contacts." + key + " must lie in (0, 1)");
+      return v;
+    };
+    s.lip_radius = length("lip_radius");
+    s.lip_corner_radius = length("lip_corner_radius");
+    s.lid_reach = length("lid_reach");
+    s.lid_corner_radius = length("lid_corner_radius");
+    s.eye_zone_share = length("eye_zone_share");
+    check(m.skin_vertices >= 68, what + ".contacts need the 68 landmarks on the skin");
+  }
+  for (const Json& name : r.at("inert_parameters", what).array(what + ".inert_parameters")) {
+    const int index = m.find_parameter(name.string(what + ".inert_parameters"));
+    check(index >= 0, what + ".inert_parameters: " + name.string("name") + " is not one of the bundle's parameters");
+    s.inert_parameters.push_back(index);
+  }
+  s.carry_smoothness = finite(r.at("carry_smoothness", what), what + ".carry_smoothness");
+  s.tolerance = finite(r.at("tolerance", what), what + ".tolerance");
+  check(s.carry_smoothness > 0 && s.tolerance > 0, what + ": carry_smoothness and tolerance must be positive");
+  s.max_iterations = bounded_int(r.at("max_iterations", what), what + ".max_iterations", 1, 100000);
+  m.has_rest_physics = true;
+}
+}  // namespace
+
 Manifest parse_manifest(const std::string& text) {
   const Json doc = Json::parse(text);
   Manifest m;
@@ -325,6 +378,7 @@ Manifest parse_manifest(const std::string& text) {
   parse_files(doc, m);
   parse_deformation_and_dynamics(doc, m);
   parse_networks(doc, m);
+  parse_rest_physics(doc, m);
   return m;
 }
 

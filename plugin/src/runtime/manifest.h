@@ -11,9 +11,9 @@
 
 namespace softdeca::runtime {
 
-// Versions this runtime reads: 1, 2 (adds SoftDECA's optional vertex stage) and 3 (adds its
-// optional residual stage).
-constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 3;
+// Versions this runtime reads: 1, 2 (adds SoftDECA's optional vertex stage), 3 (adds its
+// optional residual stage) and 4 (adds the optional physics at prepare, `rest_physics`).
+constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 4;
 constexpr const char* kBundleFormat = "softdeca-bundle";
 constexpr const char* kDtFormulation = "cotangent-poisson-1";
 // The 52 ARKit shapes in canonical order: names from the one definition, stream/arkit_names.h.
@@ -45,6 +45,21 @@ struct LandmarkSpec {
   double bary[3] = {0, 0, 0};
 };
 
+// The physics at prepare (docs/bundle.md, "Rest physics"): the sizes of rest_head.bin's arrays
+// and the solver's settings; the arrays themselves are read by runtime/rest_head.h.
+struct RestPhysicsSpec {
+  std::string file, sha256;
+  int fill_vertices = 0, soft_tets = 0, muscle_tets = 0, teeth_upper = 0, teeth_lower = 0, cranium = 0, jaw = 0;
+  int upper_teeth_triangles = 0, lower_teeth_triangles = 0;
+  // The lip and lid sets' rules (runtime/contact_sets.h); absent: no collision sets.
+  bool has_contacts = false;
+  int lid_candidates = 0;
+  double lip_radius = 0, lip_corner_radius = 0, lid_reach = 0, lid_corner_radius = 0, eye_zone_share = 0;
+  std::vector<int> inert_parameters;  // indices into Manifest::parameters
+  double carry_smoothness = 0, tolerance = 0;
+  int max_iterations = 0;
+};
+
 struct Manifest {
   int format_version = 0;
   bool untrained = false;
@@ -67,6 +82,8 @@ struct Manifest {
   // (incl. the mean) and the length of the condition the prepare half hands the frame half.
   bool has_softdeca_residual_stage = false;
   int residual_modes = 0, residual_condition = 0;
+  bool has_rest_physics = false;  // format version 4
+  RestPhysicsSpec rest_physics;
 
   const NetworkSpec& network(const std::string& key) const;
   int find_parameter(const std::string& name) const;  // -1 when absent

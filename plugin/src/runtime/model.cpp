@@ -1,5 +1,6 @@
 #include "runtime/model.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <iterator>
@@ -7,6 +8,7 @@
 #include "core/error.h"
 #include "runtime/onnx_model_scan.h"
 #include "runtime/sha256.h"
+#include "sim/parameters.h"
 
 namespace softdeca::runtime {
 
@@ -99,6 +101,19 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
   }
   if (any_jaw && mf.jaw_anchors.size() < 3) fail("manifest: jaw vertices need at least 3 non_skin.jaw_anchors");
   m->non_skin_bones_.assign(bones.begin(), bones.end());
+
+  if (mf.has_rest_physics) {
+    // Every parameter must be one the physics knows, over a range it accepts.
+    for (const ParameterSpec& p : mf.parameters) {
+      const auto& table = sim::parameter_table();
+      const auto it = std::find_if(table.begin(), table.end(), [&](const sim::ParameterInfo& i) { return p.name == i.name; });
+      if (it == table.end()) fail("rest_physics: parameter " + p.name + " is not one of the physics' parameters");
+      if (p.min < it->lo || p.max > it->hi)
+        fail("rest_physics: parameter " + p.name + "'s range is wider than the physics accepts");
+    }
+    const Bytes& data = verified(files, mf.rest_physics.file, mf.rest_physics.sha256);
+    m->rest_head_ = std::make_unique<const RestHead>(parse_rest_head(mf, data));
+  }
 
   // Every network is verified and scanned before the first session exists: nothing a bundle
   // declares is allocated until the whole bundle fits the budget.

@@ -13,6 +13,7 @@
 #include "runtime/bundle_files.h"
 #include "runtime/manifest.h"
 #include "runtime/onnx_network.h"
+#include "runtime/rest_head.h"
 
 namespace softdeca::runtime {
 
@@ -55,12 +56,15 @@ class Model {
   // per-frame half (coefficients from w and the condition), or null.
   const OnnxNetwork* residual_condition() const { return networks_.at(8).get(); }
   const OnnxNetwork* residual_coefficients() const { return networks_.at(9).get(); }
+  // The physics at prepare's head (format version 4), or null.
+  const RestHead* rest_head() const { return rest_head_.get(); }
 
  private:
   Model() = default;
   Manifest manifest_;
   std::vector<std::int32_t> skin_triangles_;
   std::vector<std::uint8_t> non_skin_bones_;
+  std::unique_ptr<const RestHead> rest_head_;
   std::unique_ptr<Ort::Env> env_;  // before the sessions: they must go first
   std::vector<std::unique_ptr<OnnxNetwork>> networks_;
 };

@@ -25,6 +25,12 @@ void ParameterState::reset() {
   for (std::size_t i = 0; i < specs_->size(); ++i) values_[i].global = (*specs_)[i].default_value;
 }
 
+bool ParameterState::at_defaults() const {
+  for (std::size_t i = 0; i < values_.size(); ++i)
+    if (values_[i].kind != Kind::Global || values_[i].global != (*specs_)[i].default_value) return false;
+  return true;
+}
+
 void ParameterState::check_index(int index) const {
   require(index >= 0 && static_cast<std::size_t>(index) < specs_->size(),
           "parameter index " + std::to_string(index) + " is not below the bundle's " + std::to_string(specs_->size()) +

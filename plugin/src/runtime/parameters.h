@@ -25,6 +25,8 @@ class ParameterState {
   void reset();
 
   Kind kind(int index) const { return values_.at(static_cast<std::size_t>(index)).kind; }
+  // Every parameter a global value at its default.
+  bool at_defaults() const;
   double global(int index) const { return values_.at(static_cast<std::size_t>(index)).global; }
 
   // Row-major [faces or vertices][columns.size()] raw values for the given parameter columns.

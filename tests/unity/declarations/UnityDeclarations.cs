@@ -22,7 +22,11 @@ namespace UnityEngine
     }
     public class Behaviour : Component { public bool enabled; }
     public class GameObject : Object { public T AddComponent<T>() where T : Component { throw new NotImplementedException(); } }
-    public static class Debug { public static void Log(object message) { throw new NotImplementedException(); } }
+    public static class Debug
+    {
+        public static void Log(object message) { throw new NotImplementedException(); }
+        public static void LogException(Exception exception, Object context) { throw new NotImplementedException(); }
+    }
     public enum KeyCode { Space, LeftArrow, RightArrow }
     public static class Input { public static bool GetKeyDown(KeyCode key) { throw new NotImplementedException(); } }
     public class MonoBehaviour : Behaviour { }

@@ -124,7 +124,6 @@ class ModelCase:
             networks, from_template(t), t.identity_neutral(case.identity), t.triangles
         )
         self.specs = {s.name: s for s in networks.specs}
-        self.face_regions = case.labels[t.skin_triangles[:, 0]]
         self.clamped: set[str] = set()
 
     def _value(self, name: str, value: float) -> float:
@@ -148,11 +147,12 @@ class ModelCase:
             if name in self.specs:
                 params.set_global(name, self._value(name, value))
         if setting.local is not None and setting.local[0] in self.specs:
+            # A region is a set of skin vertices (region_labels), as the physics and the
+            # training data read it: the model gets it as a vertex map.
             name, region, value = setting.local
-            base = params.face_matrix([name])[:, 0]
-            field = base.copy()
-            field[self.face_regions == REGIONS.index(region)] = self._value(name, value)
-            params.set_faces(name, field)
+            field = params.vertex_matrix([name])[:, 0].copy()
+            field[self.case.labels == REGIONS.index(region)] = self._value(name, value)
+            params.set_vertices(name, field)
         self.avatar.prepare()
         return np.stack(
             [

@@ -27,14 +27,21 @@ from softdeca_train.models.networks import (
 from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.reference import Model
 from softdeca_train.models.residual import ResidualCoefficients, ResidualCondition
+from softdeca_train.models.rest_head import (
+    REST_HEAD_FILE,
+    RestHead,
+    read_rest_head,
+    rest_head_file,
+)
 from softdeca_train.models.topology import LandmarkSet, TemplateDefinition
 
 FORMAT = "softdeca-bundle"
 # Version 2 adds SoftDECA's optional vertex stage (softdeca.f_ph_v), version 3 its optional
-# residual stage (softdeca.f_r_ph, softdeca.f_r_w); a bundle is written with the lowest
+# residual stage (softdeca.f_r_ph, softdeca.f_r_w), version 4 the physics at prepare
+# (rest_physics, rest_head.bin); a bundle is written with the lowest
 # version that holds it, so runtimes that read only older versions still run what they can.
-FORMAT_VERSION = 3
-FORMAT_VERSIONS = (1, 2, 3)
+FORMAT_VERSION = 4
+FORMAT_VERSIONS = (1, 2, 3, 4)
 OPSET = 17
 MANIFEST = "manifest.json"
 SKIN_TRIANGLES_FILE = "skin_triangles.i32"
@@ -262,10 +269,12 @@ def export_bundle(
     nets: BundleNetworks,
     info: BundleInfo,
     check: bool = True,
+    rest_head: RestHead | None = None,
 ) -> Path:
     """Write a bundle folder: manifest.json, the skin triangulation, the non-skin bone labels
-    and one ONNX file per network. With `check`, every ONNX file is run in onnxruntime against
-    its torch module and the largest deviation is recorded in the manifest."""
+    and one ONNX file per network, and with `rest_head` the physics at prepare
+    (rest_physics.py). With `check`, every ONNX file is run in onnxruntime against its torch
+    module and the largest deviation is recorded in the manifest."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     specs = _network_specs(definition, nets)
@@ -361,7 +370,36 @@ def export_bundle(
         "errors": info.errors,
     }
     (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+    if rest_head is not None:
+        add_rest_physics(folder, rest_head)
     return folder
+
+
+def add_rest_physics(folder: str | Path, head: RestHead) -> None:
+    """Add (or replace) a bundle's physics at prepare: rest_head.bin and the manifest's
+    `rest_physics` entry; the format version becomes 4."""
+    folder = Path(folder)
+    manifest = read_manifest(folder)
+    if manifest["template"]["skin_vertices"] != head.skin_count:
+        raise ValueError("the rest head's skin does not match the bundle's template")
+    if "softdeca.f_w" not in manifest["networks"]:
+        raise ValueError("the physics at prepare corrects SoftDECA: the bundle has no SoftDECA")
+    data, entry = rest_head_file(head)
+    (folder / REST_HEAD_FILE).write_bytes(data)
+    manifest["rest_physics"] = {**entry, "sha256": hashlib.sha256(data).hexdigest()}
+    manifest["format_version"] = 4
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+
+
+def read_rest_physics(folder: str | Path, manifest: dict[str, Any]) -> RestHead | None:
+    """A bundle's rest head, or None when it has none."""
+    entry = manifest.get("rest_physics")
+    if entry is None:
+        return None
+    data = (Path(folder) / entry["file"]).read_bytes()
+    if hashlib.sha256(data).hexdigest() != entry["sha256"]:
+        raise ValueError(f"{entry['file']}: sha256 does not match the manifest")
+    return read_rest_head(entry, data, manifest["template"]["skin_vertices"])
 
 
 def _residual_sizes(nets: BundleNetworks) -> dict[str, Any]:
@@ -456,6 +494,7 @@ class OnnxNetworks:
         folder = Path(folder)
         self.manifest = read_manifest(folder)
         self.specs = tuple(ParameterSpec.from_dict(p) for p in self.manifest["parameters"])
+        self.rest_head = read_rest_physics(folder, self.manifest)
         so = ort.SessionOptions()
         so.log_severity_level = 3
         self.sessions = {

@@ -5,6 +5,7 @@ docs/bundle.md states them."""
 
 from __future__ import annotations
 
+import copy
 import json
 import os
 from collections.abc import Sequence
@@ -16,7 +17,7 @@ import numpy as np
 
 from softdeca_train.paths import REPO_ROOT
 
-# The one list of parameters (written by the physics issue). The exporter reads it when present.
+# The one list of parameters (the physics'). The exporter reads it when present.
 PARAMETERS_JSON = REPO_ROOT / "plugin" / "data" / "parameters.json"
 
 Scale = Literal["linear", "log"]
@@ -202,6 +203,29 @@ class ParameterState:
         acc = np.zeros(self.n_vertices)  # face map -> vertices: area-weighted incident mean
         np.add.at(acc, self.triangles.ravel(), np.repeat(data * self.face_areas, 3))
         return acc / np.maximum(self._vertex_area, 1e-300)
+
+    def with_defaults(self, names: Sequence[str] | None = None) -> ParameterState:
+        """A copy with the named parameters (default: all) back at their global defaults."""
+        out = copy.copy(self)
+        out._values = [
+            _Value("global", s.default) if names is None or s.name in names else v
+            for v, s in zip(self._values, self.specs, strict=True)
+        ]
+        return out
+
+    def same(self, other: ParameterState) -> bool:
+        """Whether both hold the same values (kinds and data)."""
+        return all(
+            a.kind == b.kind and np.array_equal(np.asarray(a.data), np.asarray(b.data))
+            for a, b in zip(self._values, other._values, strict=True)
+        )
+
+    def at_defaults(self) -> bool:
+        """Every parameter a global value at its default."""
+        return all(
+            v.kind == "global" and float(v.data) == s.default  # type: ignore[arg-type]
+            for v, s in zip(self._values, self.specs, strict=True)
+        )
 
     def face_matrix(self, names: Sequence[str] | None = None) -> np.ndarray:
         """(F, P) raw values, columns in `names` order (default: all specs)."""

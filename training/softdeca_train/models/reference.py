@@ -22,6 +22,8 @@ from softdeca_train.geometry import Similarity, umeyama
 from softdeca_train.models.dt import DtSystem, deformation_transfer, dt_system
 from softdeca_train.models.networks import BundleNetworks
 from softdeca_train.models.parameters import ParameterSpec, ParameterState
+from softdeca_train.models.rest_head import RestHead
+from softdeca_train.models.rest_physics import RestSolver
 from softdeca_train.models.topology import JAW, TemplateDefinition
 
 Model = Literal["softdeca", "sparse"]
@@ -31,6 +33,7 @@ class Networks(Protocol):
     """What the reference needs from a bundle's networks (torch modules or ONNX sessions)."""
 
     specs: tuple[ParameterSpec, ...]
+    rest_head: RestHead | None  # the bundle's physics at prepare, if it has one
 
     def has(self, model: Model) -> bool: ...
     def identity(self, neutral_skin: np.ndarray) -> np.ndarray: ...
@@ -49,9 +52,10 @@ class Networks(Protocol):
 class TorchNetworks:
     """Networks from torch modules (float32, no gradient)."""
 
-    def __init__(self, nets: BundleNetworks) -> None:
+    def __init__(self, nets: BundleNetworks, rest_head: RestHead | None = None) -> None:
         self.nets = nets
         self.specs = nets.specs
+        self.rest_head = rest_head
 
     def has(self, model: Model) -> bool:
         return (self.nets.softdeca if model == "softdeca" else self.nets.sparse) is not None
@@ -137,6 +141,8 @@ class Preparation:
     # SoftDECA's residual stage: its condition (1, C) and modes (Vs, K, 3), or None
     residual: tuple[np.ndarray, np.ndarray] | None
     dynamics: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]  # model -> alpha, beta, gamma
+    # SoftDECA's rest physics c(p) (Vs, 3) added to every frame (rest_physics.py), or None
+    rest_offset: np.ndarray | None = None
 
 
 class ReferenceAvatar:
@@ -151,6 +157,7 @@ class ReferenceAvatar:
         blendshapes: np.ndarray | None = None,
         regularisation: float = 1e-3,
         identity: np.ndarray | None = None,
+        rest_physics: bool = True,
     ) -> None:
         self.nets = nets
         self.d = definition
@@ -174,11 +181,16 @@ class ReferenceAvatar:
         self.dynamics = False
         self._state: tuple[Model, np.ndarray, np.ndarray] | None = None
         self.prep: Preparation | None = None
+        # Physics at prepare: the avatar's head at rest, where the bundle has it (the runtime
+        # always uses it then; `rest_physics=False` measures the networks alone).
+        self.rest_head = nets.rest_head if rest_physics else None
+        self._rest_solver: RestSolver | None = None
+        self._rest_defaults: tuple[np.ndarray, np.ndarray] | None = None  # P_rest(p0), M_rest(p0)
 
     # ---- per avatar ------------------------------------------------------------------------
-    def prepare(self) -> Preparation:
+    def _networks(self, params: ParameterState) -> Preparation:
         names = [s.name for s in self.nets.specs]
-        pf, pv = self.params.face_matrix(names), self.params.vertex_matrix(names)
+        pf, pv = params.face_matrix(names), params.vertex_matrix(names)
         h = self.identity
         face_l = vertex_l = stage = residual = None
         dyn = {}
@@ -193,8 +205,32 @@ class ReferenceAvatar:
         if self.nets.has("sparse"):
             vertex_l = self.nets.f_ph_v(pv, h).astype(np.float64)
             dyn["sparse"] = tuple(x.astype(np.float64) for x in self.nets.f_dyn("sparse", pv, h))
-        self.prep = Preparation(h.copy(), face_l, vertex_l, stage, residual, dyn)  # type: ignore[arg-type]
-        return self.prep
+        return Preparation(h.copy(), face_l, vertex_l, stage, residual, dyn)  # type: ignore[arg-type]
+
+    def prepare(self) -> Preparation:
+        prep = self._networks(self.params)
+        head = self.rest_head
+        if head is not None and self.nets.has("softdeca") and not self.params.at_defaults():
+            if self._rest_solver is None:
+                self._rest_solver = RestSolver(head, self.neutral, self.d.skin_triangles)
+            if self._rest_defaults is None:
+                defaults = self.params.with_defaults()
+                self._rest_defaults = (
+                    self._rest_solver.solve(defaults),
+                    self._softdeca_rest(self._networks(defaults)),
+                )
+            physics0, model0 = self._rest_defaults
+            # The model at rest under p with the rest-inert parameters at their defaults.
+            kept = self.params.with_defaults(head.inert)
+            model = self._softdeca_rest(prep if kept.same(self.params) else self._networks(kept))
+            prep.rest_offset = (self._rest_solver.solve(self.params) - physics0) - (model - model0)
+        self.prep = prep
+        return prep
+
+    def _softdeca_rest(self, prep: Preparation) -> np.ndarray:
+        """SoftDECA's static frame at rest: zero weights on the neutral."""
+        vs = self.d.skin_vertices
+        return self._softdeca_static(prep, np.zeros(52), self.neutral[:vs])
 
     def calibrate(self, user_neutral: np.ndarray) -> None:
         """The user's neutral landmarks (K, 3): similarity user -> avatar neutral landmarks."""
@@ -223,6 +259,13 @@ class ReferenceAvatar:
 
     def softdeca_static(self, weights: np.ndarray, skin: np.ndarray) -> np.ndarray:
         prep = self._need()
+        out = self._softdeca_static(prep, weights, skin)
+        return out if prep.rest_offset is None else out + prep.rest_offset
+
+    def _softdeca_static(
+        self, prep: Preparation, weights: np.ndarray, skin: np.ndarray
+    ) -> np.ndarray:
+        """The networks' static frame (without the rest physics)."""
         assert prep.face_l is not None
         z = self.nets.f_w(np.asarray(weights, np.float32)[None])[0].astype(np.float64)
         g = np.einsum("k,fkc->fc", z, prep.face_l).reshape(-1, 3, 3)

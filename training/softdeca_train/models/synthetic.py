@@ -135,3 +135,58 @@ TEST_PARAMETERS: tuple[dict[str, object], ...] = (
     {"name": "gravity_strength", "default": 1.0, "lo": 1.0, "hi": 2.0, "unit": "g",
      "domain": "global"},
 )  # fmt: skip
+
+
+def _prism_tets(tris: np.ndarray, outer: int, inner: int) -> np.ndarray:
+    """Three tets per skin triangle between two shells (vertex offsets `outer`, `inner`), each
+    quad split from its larger-index outer corner to its smaller-index inner corner, so
+    neighbouring prisms agree; oriented to positive volume by the caller."""
+    a, b, c = np.sort(tris, axis=1).T
+    return np.concatenate([
+        np.stack([a + outer, b + outer, c + outer, a + inner], 1),
+        np.stack([b + outer, c + outer, a + inner, b + inner], 1),
+        np.stack([c + outer, a + inner, b + inner, c + inner], 1),
+    ]).astype(np.int32)  # fmt: skip
+
+
+def synthetic_rest_head(head: SyntheticHead, shells: tuple[float, ...] = (1.0, 0.9, 0.8)):
+    """A rest head for the synthetic skin (rest_physics.RestHead): shells of S scaled about its
+    centre, soft tissue between the first two, muscle between the last two, the innermost the
+    pinned cranium; S is the outer shell itself."""
+    from softdeca_train.models.rest_head import RestHead
+
+    d = head.definition
+    vs = d.skin_vertices
+    skin = head.neutral[:vs]
+    centre = skin.mean(axis=0)
+    vertices = np.vstack([centre + (skin - centre) * r for r in shells])
+    tets = [_prism_tets(d.skin_triangles, k * vs, (k + 1) * vs) for k in range(2)]
+    for t in tets:
+        p = vertices[t]
+        vol = np.einsum(
+            "ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0]
+        )
+        t[vol < 0, :2] = t[vol < 0, 1::-1]
+    # S is the outer shell: each skin vertex embedded as the first corner of a soft tet of it
+    tet_of = np.zeros(vs, np.int64)
+    for t, corners in enumerate(tets[0]):
+        tet_of[corners[corners < vs]] = t
+    corners = tets[0][tet_of]
+    first = np.argsort(corners != np.arange(vs)[:, None], axis=1, kind="stable")
+    skin_vertex = np.take_along_axis(corners, first, axis=1)
+    return RestHead(
+        vertices=vertices,
+        soft_tets=tets[0],
+        muscle_tets=tets[1],
+        skin_vertex=skin_vertex.astype(np.int32),
+        skin_weight=np.tile(np.array([1.0, 0.0, 0.0, 0.0]), (vs, 1)),
+        carry_weight=np.ones(vs),
+        carry_smoothness=30.0,
+        teeth_upper=np.zeros(0, np.int32),
+        teeth_lower=np.zeros(0, np.int32),
+        cranium=np.arange(2 * vs, 3 * vs, dtype=np.int32),
+        jaw=np.zeros(0, np.int32),
+        upper_teeth_triangles=np.zeros((0, 3), np.int32),
+        lower_teeth_triangles=np.zeros((0, 3), np.int32),
+        contacts=None,
+    )

@@ -59,6 +59,38 @@ def _runtime_bundle_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _rest_physics_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("bundle", help="bundle folder (SoftDECA, the template's topology)")
+    p.add_argument("--level", type=int, default=3, help="LHM level of the tissue fill (3)")
+
+
+def _rest_physics_run(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from softdeca_train.lhm import LhmConfig
+    from softdeca_train.models.bundle import add_rest_physics, read_manifest
+    from softdeca_train.models.parameters import ParameterSpec
+    from softdeca_train.models.rest_head import rest_head_for_bundle
+    from softdeca_train.template import Template
+
+    folder = Path(args.bundle)
+    specs = tuple(ParameterSpec.from_dict(p) for p in read_manifest(folder)["parameters"])
+    print("building the template's tissue fill and measuring the rest-inert parameters ...")
+    cfg = LhmConfig(level=args.level, tet_mesh="carried")
+    head = rest_head_for_bundle(Template.load(args.ict), specs, cfg)
+    add_rest_physics(folder, head)
+    size = (folder / "rest_head.bin").stat().st_size
+    entry = json.loads((folder / "manifest.json").read_text())["rest_physics"]
+    print(
+        f"{folder}: rest_head.bin ({size / 2**20:.1f} MiB, {entry['fill_vertices']} fill "
+        f"vertices, {entry['soft_tets'] + entry['muscle_tets']} tets); rest-inert: "
+        f"{', '.join(head.inert) or 'none'}"
+    )
+    return 0
+
+
 def _avatar_args(p: argparse.ArgumentParser) -> None:
     add_ict_argument(p)
     p.add_argument("--seed", type=int, required=True, help="identity seed")
@@ -135,6 +167,13 @@ COMMANDS = [
         "Export an UNTRAINED model bundle (random networks of the contract's shapes).",
         _runtime_bundle_args,
         _runtime_bundle_run,
+    ),
+    Command(
+        "bundle-rest-physics",
+        "Add the physics at prepare to a bundle: the template's tissue fill (rest_head.bin) "
+        "and its rest-inert parameters (format version 4).",
+        _rest_physics_args,
+        _rest_physics_run,
     ),
     Command(
         "avatar",

@@ -13,6 +13,7 @@ from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
 from softdeca_train.lhm.carried import tissue_mesh
 from softdeca_train.lhm.fit import embed_skin_by_side, jaw_motion
 from softdeca_train.lhm.model import JAW
+from softdeca_train.sim.collision_spec import collision_sets
 from softdeca_train.sim.lids import LidSets, lid_sets
 from softdeca_train.sim.lips import LipSets, lip_sets
 from softdeca_train.template import Template
@@ -163,31 +164,13 @@ def build_head_simulation(
     skin_vertices, skin_weights = native.skin_embedding_from_tets(
         tissue.soft_tets, tissue.skin_tet.tolist(), tissue.skin_bary
     )
-    lips = lip_sets(template, head)
-    zone = lips.zone.astype(np.int32)
-    upper_teeth_tris = template.component_triangles("teeth_upper") - up.start + teeth_upper[0]
-    lower_teeth_tris = template.component_triangles("teeth_lower") - lo.start + teeth_lower[0]
+    lips, lids = lip_sets(template, head), lid_sets(template, head)
+    upper_teeth = template.component_triangles("teeth_upper") - up.start + teeth_upper[0]
+    lower_teeth = template.component_triangles("teeth_lower") - lo.start + teeth_lower[0]
     collisions = [
-        native.CollisionSet("upper_lip_over_lower_lip", lips.upper.tolist(), lips.lower_triangles),
-        native.CollisionSet("lower_lip_over_upper_lip", lips.lower.tolist(), lips.upper_triangles),
-        native.CollisionSet(
-            "lips_over_upper_teeth",
-            zone.tolist(),
-            upper_teeth_tris.astype(np.int32),
-            surface_on_skin=False,
-        ),
-        native.CollisionSet(
-            "lips_over_lower_teeth",
-            zone.tolist(),
-            lower_teeth_tris.astype(np.int32),
-            surface_on_skin=False,
-        ),
+        native.CollisionSet(c.name, c.points.tolist(), c.surface, surface_on_skin=c.surface_on_skin)
+        for c in collision_sets(lips, lids, upper_teeth, lower_teeth)
     ]
-    # The eyelids: placed on their targets like the lips, with no surface to stay out of
-    # (sim/lids.py says why no lid contacts).
-    lids = lid_sets(template, head)
-    eyelids = np.concatenate([lids.upper, lids.lower]).tolist()
-    collisions.append(native.CollisionSet("eyelids", eyelids, np.zeros((0, 3), np.int32)))
     lm_points = lm_weights = None
     if landmarks is not None:
         tri, bary = landmarks

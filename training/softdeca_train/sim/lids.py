@@ -34,17 +34,32 @@ class LidSets:
     lower: np.ndarray
 
 
-def lid_sets(
-    template: Template, head: np.ndarray, reach: float = 0.008, corner_radius: float = 0.004
-) -> LidSets:
-    skin = head[:N_SKIN]
-    lm68 = template.landmarks68
-    candidates = np.concatenate([
+def lid_candidates(template: Template) -> np.ndarray:
+    """The S points that may belong to a lid: the face and the eye sockets."""
+    return np.concatenate([
         np.arange(template.components[c].slice.start, template.components[c].slice.stop)
         for c in ("face", "eye_socket_left", "eye_socket_right")
     ])  # fmt: skip
+
+
+def lid_sets(
+    template: Template, head: np.ndarray, reach: float = 0.008, corner_radius: float = 0.004
+) -> LidSets:
+    """The lid sets of a head of the template (lid_sets_of)."""
+    skin = np.asarray(head)[:N_SKIN]
+    return lid_sets_of(skin, template.landmarks68, lid_candidates(template), reach, corner_radius)
+
+
+def lid_sets_of(
+    skin: np.ndarray,
+    lm68: np.ndarray,
+    candidates: np.ndarray,
+    reach: float = 0.008,
+    corner_radius: float = 0.004,
+) -> LidSets:
+    """`lm68`: the 68 landmarks' skin vertex indices; `candidates`: lid_candidates."""
     side = lid_side_of_points(skin, lm68)
-    chosen = np.zeros(N_SKIN, bool)
+    chosen = np.zeros(len(skin), bool)
     for eye in EYES:
         line = fissure_line(skin, lm68, eye)
         p = skin[candidates]

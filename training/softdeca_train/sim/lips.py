@@ -31,24 +31,37 @@ class LipSets:
 def lip_sets(
     template: Template, head: np.ndarray, radius: float = 0.012, corner_radius: float = 0.008
 ) -> LipSets:
-    """Split the lip contact zone into upper and lower lip by the mouth line: the segment
-    between the inner mouth corners (ICT landmarks 60 and 64), per x; points within
-    `corner_radius` of those corners belong to neither."""
-    zone = np.flatnonzero(lip_contact_zone(head, template.landmarks68, radius))
-    lm = head[template.landmarks68]
+    """The lip sets of a head of the template (lip_sets_of)."""
+    skin = np.asarray(head)[:N_SKIN]
+    return lip_sets_of(skin, template.landmarks68, template.skin_triangles, radius, corner_radius)
+
+
+def lip_sets_of(
+    skin: np.ndarray,
+    lm68: np.ndarray,
+    skin_triangles: np.ndarray,
+    radius: float = 0.012,
+    corner_radius: float = 0.008,
+) -> LipSets:
+    """Split the lip contact zone (S points within `radius` of the inner lip contour) into
+    upper and lower lip by the mouth line: the segment between the inner mouth corners (ICT
+    landmarks 60 and 64), per x; points within `corner_radius` of those corners belong to
+    neither. `lm68`: the 68 landmarks' skin vertex indices."""
+    zone = np.flatnonzero(lip_contact_zone(skin, lm68, radius))
+    lm = skin[lm68]
     left, right = lm[64], lm[60]
-    t = np.clip((head[zone, 0] - right[0]) / (left[0] - right[0]), 0.0, 1.0)
+    t = np.clip((skin[zone, 0] - right[0]) / (left[0] - right[0]), 0.0, 1.0)
     mouth_y = right[1] + t * (left[1] - right[1])
     # The inner lip contour's midpoint between the upper (62) and lower (66) middles.
     mouth_y += 0.5 * (lm[62, 1] + lm[66, 1]) - 0.5 * (left[1] + right[1])
-    corner = np.linalg.norm(head[zone, None] - lm[None, [60, 64]], axis=2).min(axis=1)
+    corner = np.linalg.norm(skin[zone, None] - lm[None, [60, 64]], axis=2).min(axis=1)
     away = corner > corner_radius
-    upper = zone[away & (head[zone, 1] >= mouth_y)]
-    lower = zone[away & (head[zone, 1] < mouth_y)]
-    tris = template.skin_triangles
+    upper = zone[away & (skin[zone, 1] >= mouth_y)]
+    lower = zone[away & (skin[zone, 1] < mouth_y)]
+    tris = np.asarray(skin_triangles)
 
     def inside(ids: np.ndarray) -> np.ndarray:
-        mask = np.zeros(N_SKIN, bool)
+        mask = np.zeros(len(skin), bool)
         mask[ids] = True
         return tris[mask[tris].all(axis=1)]
 

@@ -114,7 +114,12 @@ def train_bundle(
         },
         errors=errors,
     )
-    return export_bundle(bundle, run.definition, nets, info)
+    from softdeca_train.models.rest_head import rest_head_for_bundle
+
+    if progress:
+        print("physics at prepare: the template's tissue fill and its rest-inert parameters")
+    rest = rest_head_for_bundle(run.template, run.specs)
+    return export_bundle(bundle, run.definition, nets, info, rest_head=rest)
 
 
 def _dataset_summary(data: Dataset | None) -> dict | None:

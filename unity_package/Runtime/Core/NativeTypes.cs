@@ -162,6 +162,9 @@ namespace SoftDeca
         public double PrepareNetworksMs;
         public double FactorisationMs;
         public ulong MemoryBytes;
+        public double PreparePhysicsMs;
+        public uint PhysicsIterations;
+        public uint Reserved;
 
         public static AvatarStats Create()
         {

@@ -219,6 +219,38 @@ namespace SoftDeca.Tests
     public class ParameterTests
     {
         [Test]
+        public void AMaterialChangeSimulatesTheHeadAtRestOnAnotherThreadWhileFramesRun()
+        {
+            Rig rig = TestData.SmallRig;
+            ObjMesh head = rig.Neutral;
+            using (var model = Model.Load(TestData.SmallBundle))
+            using (var avatar = new Avatar(model, head.Vertices, head.Triangles, rig.Deltas))
+            {
+                var rest = new float[BlendshapeMap.Count];
+                avatar.Prepare();
+                Assert.AreEqual(0.0, avatar.Stats().PreparePhysicsMs, "nothing is simulated at the defaults");
+                avatar.EvaluateWeights(rest);
+                var before = (float[])avatar.Vertices.Clone();
+                avatar.SetParameter("gravity_strength", 1.8);
+                var preparing = System.Threading.Tasks.Task.Run(() => avatar.Prepare());
+                int frames = 0;
+                while (!preparing.IsCompleted)
+                {
+                    avatar.EvaluateWeights(rest);  // frames keep the last preparation meanwhile
+                    ++frames;
+                }
+                preparing.Wait();
+                AvatarStats stats = avatar.Stats();
+                Assert.Greater(stats.PreparePhysicsMs, 0.0);
+                Assert.Greater(stats.PhysicsIterations, 0u);
+                avatar.EvaluateWeights(rest);
+                float moved = 0;
+                for (int i = 0; i < before.Length; ++i) moved = Math.Max(moved, Math.Abs(avatar.Vertices[i] - before[i]));
+                Assert.Greater(moved, 1e-5f, "heavier gravity sags the head at rest (" + frames + " frames ran meanwhile)");
+            }
+        }
+
+        [Test]
         public void ParametersByNameAndIndexAgree()
         {
             ObjMesh head = TestData.SmallRig.Neutral;
