@@ -136,6 +136,41 @@ void record_prepare_and_memory(Bench& bench, const Avatar& a, const softdeca_sta
                                " dynamic (7.45 / 9.87 ms for 71,358 faces, i5-12600K, PyTorch)"));
 }
 
+// The physics at prepare (bundles with rest physics): the first prepare away from the defaults
+// (carrying the tissue fill, the contact sets, the defaults' solve and p's) and later prepares
+// after a gravity change (p's solve only) and after a soft-tissue weight change (refactorised).
+void measure_rest_physics(Bench& bench) {
+  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  check(softdeca_avatar_prepare(a.handle), "prepare");
+  const auto gravity = static_cast<uint32_t>(bench.model.parameter("gravity_strength"));
+  const auto soft = static_cast<uint32_t>(bench.model.parameter("w_soft_strain"));
+  check(softdeca_avatar_set_parameter(a.handle, gravity, 2.0), "gravity");
+  check(softdeca_avatar_prepare(a.handle), "prepare");
+  const softdeca_stats first = a.stats();
+  if (first.prepare_physics_ms == 0) return;  // the bundle has no rest physics
+  std::vector<double> by_gravity, by_tissue;
+  for (long i = 0; i < bench.prepares; ++i) {
+    check(softdeca_avatar_set_parameter(a.handle, gravity, i % 2 ? 2.0 : 1.5), "gravity");
+    check(softdeca_avatar_prepare(a.handle), "prepare");
+    by_gravity.push_back(a.stats().prepare_physics_ms);
+    check(softdeca_avatar_set_parameter(a.handle, soft, i % 2 ? 5.0 : 2.0), "soft strain");
+    check(softdeca_avatar_prepare(a.handle), "prepare");
+    by_tissue.push_back(a.stats().prepare_physics_ms);
+  }
+  const std::string how = "; 1 thread; " + bench.how;
+  bench.figures.raw("runtime.prepare_physics_first_ms",
+                    figure(first.prepare_ms, "ms", "the first prepare away from the defaults (gravity 2 g): the tissue fill "
+                                                   "carried to the avatar, its contact sets, the physics at rest under the "
+                                                   "defaults and under p (" + std::to_string(first.prepare_physics_ms) +
+                                                   " ms of it)" + how));
+  bench.figures.raw("runtime.prepare_physics_gravity_ms",
+                    figure(median(by_gravity), "ms", "the physics at rest of a prepare after a gravity change (no "
+                                                     "refactorisation); median of " + std::to_string(by_gravity.size()) + how));
+  bench.figures.raw("runtime.prepare_physics_tissue_ms",
+                    figure(median(by_tissue), "ms", "the physics at rest of a prepare after a soft-tissue weight change "
+                                                    "(refactorised); median of " + std::to_string(by_tissue.size()) + how));
+}
+
 // Every model per frame with half-precision hyper-tensors on `threads` threads.
 void measure_with_threads(Bench& bench, unsigned threads) {
   const std::string suffix = threads == 1 ? "" : "_2threads";
@@ -322,6 +357,7 @@ int run_bench_runtime(const Args& args) {
   for (const unsigned threads : {1u, 2u}) measure_with_threads(bench, threads);
   for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) measure_storage(bench, precision);
   measure_storage_error(bench);
+  measure_rest_physics(bench);
 
   const std::string path = o.text("--out");
   const std::size_t slash = path.rfind('/');

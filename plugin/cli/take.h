@@ -1,4 +1,4 @@
-// Takes for the runtime tools: a Live Link Face CSV (read by the streaming issue's reader:
+// Takes for the runtime tools: a Live Link Face CSV (read by the streaming side's reader:
 // columns by name, face-lost rows skipped and counted) or a recording of the streaming format
 // (frames the tracker lost are skipped too). Weights in canonical ARKit order.
 #pragma once

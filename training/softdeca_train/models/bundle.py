@@ -60,8 +60,8 @@ def _is_half_table(name: str) -> bool:
 
 @dataclass(frozen=True)
 class BundleInfo:
-    """What a bundle says about where it came from. `training` and `errors` are filled by the
-    training issue; random bundles leave them None and set `untrained`."""
+    """What a bundle says about where it came from. `training` and `errors` are filled by
+    training (train-bundle); random bundles leave them None and set `untrained`."""
 
     untrained: bool
     description: str

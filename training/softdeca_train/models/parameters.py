@@ -94,7 +94,7 @@ def load_parameter_specs(
     if source is None:
         if not PARAMETERS_JSON.is_file():
             raise FileNotFoundError(
-                f"{PARAMETERS_JSON} does not exist yet (physics issue); pass a parameter list "
+                f"{PARAMETERS_JSON} does not exist; pass a parameter list "
                 "or a file in its format"
             )
         source = PARAMETERS_JSON

@@ -37,7 +37,11 @@ def bench_runtime(
         definition, specs, FULL_SIZES, seed=0, vertex_stage=True, residual_stage=True
     )
     info = BundleInfo(True, "UNTRAINED full-size random networks for the runtime benchmark")
-    bundle = export_bundle(work / "bundle", definition, nets, info, check=False)
+    from softdeca_train.models.rest_head import rest_head_for_bundle
+
+    template = Template.load(ict)
+    rest = rest_head_for_bundle(template, specs)  # the physics at prepare, as trained bundles
+    bundle = export_bundle(work / "bundle", definition, nets, info, check=False, rest_head=rest)
     avatar = work / "avatar-seed1"
     if not (avatar / "neutral.obj").is_file():
         write_identity_avatar(1, avatar, ict)
@@ -45,7 +49,7 @@ def bench_runtime(
     how = (
         f"make bench (softdeca bench-runtime, {len(specs)} parameters, "
         f"{FULL_SIZES.latent} latents, hyper hidden {FULL_SIZES.hyper_hidden}, "
-        "SoftDECA with its vertex and residual stages)"
+        "SoftDECA with its vertex and residual stages, the physics at prepare)"
     )
     cmd = [
         str(CLI), "bench-runtime", "--bundle", str(bundle), "--avatar", str(avatar),

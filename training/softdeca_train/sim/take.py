@@ -1,4 +1,4 @@
-"""The frames of a Live Link Face take that `simulate` runs: the streaming issue's CSV reader
+"""The frames of a Live Link Face take that `simulate` runs: the streaming side's CSV reader
 (columns by name, face-lost rows skipped and counted), then a start / count / stride window."""
 
 from __future__ import annotations

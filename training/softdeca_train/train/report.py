@@ -81,8 +81,13 @@ def _bundle_errors(run: Run, bundle: Path, progress: bool) -> dict[str, dict]:
             if key not in avatars:
                 h = b.h[0].double().numpy()
                 neutral = t.identity_neutral(h)
+                # the physics at prepare acts on SoftDECA only: the sparse frames skip it
                 av = ReferenceAvatar(
-                    nets, d, neutral, tris if tris is not None else d.skin_triangles
+                    nets,
+                    d,
+                    neutral,
+                    tris if tris is not None else d.skin_triangles,
+                    rest_physics=model == "softdeca",
                 )
                 for k, s in enumerate(nets.specs):
                     av.params.set_global(s.name, float(b.p[0, k]))
