@@ -305,6 +305,45 @@ def test_parity_on_the_template_topology(tmp_path, template):
     assert err_mm(xs, xsr) < BOUND_MM["half"]
 
 
+def test_rest_physics_parity_on_the_template_topology(tmp_path, template):
+    """The physics at prepare on the real head: the tissue fill carried to an ICT identity, its
+    lip and lid sets and each tet's skin vertex found on it, natively as in the reference."""
+    from softdeca_train.data.regions import REGIONS, region_labels
+    from softdeca_train.models.rest_head import rest_head_from_template
+    from softdeca_train.models.topology import from_template
+
+    d = from_template(template)
+    nets = build_random(d, load_parameter_specs(TEST_PARAMETERS), TEST_SIZES, seed=3)
+    rest = rest_head_from_template(template)
+    export_bundle(
+        tmp_path / "b", d, nets, BundleInfo(True, "rest physics"), rest_head=rest
+    )
+    neutral = template.identity_neutral(template.sample_identity(2))
+    ref = ReferenceAvatar(
+        TorchNetworks(as_stored(nets), rest_head=rest), d, neutral, template.triangles
+    )
+    nat = NativeAvatar(
+        NativeModel(tmp_path / "b"), neutral, template.triangles, precision="float"
+    )
+    lips = np.where(region_labels(template) == REGIONS.index("lips"), 1.3, 1.0)
+    for set_vertices in (ref.params.set_vertices, nat.set_parameter_vertices):
+        set_vertices("target_volume", lips)
+    for set_global in (ref.params.set_global, nat.set_parameter):
+        set_global("gravity_strength", 1.8)
+    ref.prepare()
+    nat.prepare()
+    assert ref.prep is not None and ref.prep.rest_offset is not None
+    moved = float(np.abs(ref.prep.rest_offset).max() * 1e3)
+    skin = neutral[: d.skin_vertices]
+    x, _ = nat.evaluate_surface(np.zeros(52), skin)
+    worst = err_mm(x[: d.skin_vertices], ref.softdeca_static(np.zeros(52), skin))
+    print(
+        f"\ntemplate rest physics: offset up to {moved:.3f} mm, native - reference {worst:.6f} mm"
+    )
+    assert moved > 0.05  # a fuller lip region and heavier gravity move the head at rest
+    assert worst < 3 * BOUND_MM["float"]
+
+
 def test_the_residual_stage_needs_version_three(setup, tmp_path):
     """A residual stage under an older version's manifest is refused, not dropped (a runtime
     reading only that version would run the model without it)."""
