@@ -94,8 +94,7 @@ def load_parameter_specs(
     if source is None:
         if not PARAMETERS_JSON.is_file():
             raise FileNotFoundError(
-                f"{PARAMETERS_JSON} does not exist; pass a parameter list "
-                "or a file in its format"
+                f"{PARAMETERS_JSON} does not exist; pass a parameter list or a file in its format"
             )
         source = PARAMETERS_JSON
     if isinstance(source, (str, os.PathLike)):
