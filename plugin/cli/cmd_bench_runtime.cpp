@@ -157,7 +157,25 @@ void measure_rest_physics(Bench& bench) {
     check(softdeca_avatar_prepare(a.handle), "prepare");
     by_tissue.push_back(a.stats().prepare_physics_ms);
   }
+  // A frame with the rest offset against one at the defaults, alternately on two avatars.
+  Avatar plain(bench.model, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  check(softdeca_avatar_prepare(plain.handle), "prepare");
+  const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
+  Times with{}, without{};
+  for (int round = 0; round < 2; ++round) {
+    const Times x = median_ms(bench.frames, bench.warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_weights(a.handle, w(f), 52, &bench.output), "softdeca");
+    });
+    const Times y = median_ms(bench.frames, bench.warmup, [&](std::size_t f) {
+      check(softdeca_avatar_evaluate_weights(plain.handle, w(f), 52, &bench.output), "softdeca");
+    });
+    with.wall += x.wall / 2, with.cpu += x.cpu / 2, without.wall += y.wall / 2, without.cpu += y.cpu / 2;
+  }
   const std::string how = "; 1 thread; " + bench.how;
+  bench.figures.raw("runtime.softdeca_static_ms_rest_physics",
+                    figure(with.cpu, "ms", "as softdeca_static_cpu_ms (thread CPU time) with the rest offset of a gravity "
+                                           "change added; the same avatar at the defaults, alternately: " +
+                                               std::to_string(without.cpu) + " ms" + how));
   bench.figures.raw("runtime.prepare_physics_first_ms",
                     figure(first.prepare_ms, "ms", "the first prepare away from the defaults (gravity 2 g): the tissue fill "
                                                    "carried to the avatar, its contact sets, the physics at rest under the "

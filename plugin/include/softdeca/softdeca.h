@@ -98,9 +98,11 @@ SOFTDECA_API const char* softdeca_status_name(softdeca_status status);
  * softdeca_avatar made from a model and the host's own mesh. Per avatar:
  *   create -> set parameters (optional) -> prepare -> evaluate every frame.
  * prepare computes the hyper-tensors L(p, h), the dynamics coefficients and (first time) the
- * deformation-transfer factorisation. It may run on a worker thread while frames keep using the
- * previous preparation: a frame uses exactly one preparation (never a mix), and picks up a new
- * one at its start once prepare has returned.
+ * deformation-transfer factorisation; with a bundle's rest physics (format version 4) and
+ * parameters away from their defaults it also simulates the avatar's head at rest (about a
+ * second; docs/runtime.md "Physics at prepare"). It may run on a worker thread while frames keep
+ * using the previous preparation: a frame uses exactly one preparation (never a mix), and picks
+ * up a new one at its start once prepare has returned.
  *
  * Threads: a model may be used from any number of threads. An avatar's evaluate_* and
  * calibrate calls must come from one thread at a time (a concurrent call fails with
@@ -243,7 +245,9 @@ SOFTDECA_API softdeca_status softdeca_avatar_get_identity(const softdeca_avatar*
 SOFTDECA_API softdeca_status softdeca_avatar_set_identity(softdeca_avatar* avatar, const float* identity,
                                                           uint32_t count);
 
-/* Builds a new preparation from the current parameters and identity and publishes it. */
+/* Builds a new preparation from the current parameters and identity and publishes it (with the
+ * bundle's rest physics, a static solve of the avatar's head at rest when a parameter is away
+ * from its default: run it off the frame thread). */
 SOFTDECA_API softdeca_status softdeca_avatar_prepare(softdeca_avatar* avatar);
 
 /* Where a frame's result goes: vertices of the whole head, and optionally unit normals. */

@@ -270,10 +270,11 @@ std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
 
 std::vector<float> Avatar::rest_offset(const ParameterState& params, const Preparation& prep,
                                        const std::vector<float>& identity, int& iterations) {
-  if (!rest_physics_) {
-    rest_physics_ = std::make_unique<RestPhysics>(*model_->rest_head(), m_, neutral_.data(), model_->skin_triangles(),
-                                                  static_cast<int>(worker_.parts()));
-    rest_physics0_ = rest_physics_->solve(ParameterState(m_, model_->skin_triangles(), geometry_.face_area));
+  if (!rest_physics_) {  // kept only once its defaults' solve succeeded
+    auto physics = std::make_unique<RestPhysics>(*model_->rest_head(), m_, neutral_.data(), model_->skin_triangles(),
+                                                 static_cast<int>(worker_.parts()));
+    rest_physics0_ = physics->solve(ParameterState(m_, model_->skin_triangles(), geometry_.face_area));
+    rest_physics_ = std::move(physics);
   }
   if (rest_model0_.empty() || rest_model0_identity_ != identity) {
     const ParameterState defaults(m_, model_->skin_triangles(), geometry_.face_area);
