@@ -283,23 +283,18 @@ std::vector<float> Avatar::rest_offset(const ParameterState& params, const Prepa
   }
   const sim::Positions physics = rest_physics_->solve(params);
   iterations = rest_physics_->iterations();
-  // The model at rest under p with the rest-inert parameters at their defaults: the physics
-  // says nothing about those at rest, so their response stays the networks'.
-  ParameterState kept(params);
-  bool inert_moved = false;
-  for (const int i : m_.rest_physics.inert_parameters) {
-    const double d = m_.parameters[static_cast<std::size_t>(i)].default_value;
-    if (params.kind(i) == ParameterState::Kind::Global && params.global(i) == d) continue;
-    kept.set_global(i, d);
-    inert_moved = true;
-  }
-  const std::vector<float> model = softdeca_rest(inert_moved ? *prepare_networks(kept, identity) : prep);
+  // The networks' own rest response to p, less their response to p's rest-inert parameters
+  // alone: the physics says nothing about those at rest, so that part stays the networks'.
+  const ParameterState inert_only = params.only(m_.rest_physics.inert_parameters);
+  const std::vector<float> model = softdeca_rest(prep);
+  const std::vector<float> model_inert =
+      inert_only.at_defaults() ? rest_model0_ : softdeca_rest(*prepare_networks(inert_only, identity));
   std::vector<float> offset(vs_ * 3);
   for (std::size_t v = 0; v < vs_; ++v)
     for (std::size_t c = 0; c < 3; ++c) {
       const std::size_t i = 3 * v + c;
       const auto row = static_cast<Eigen::Index>(v), col = static_cast<Eigen::Index>(c);
-      offset[i] = static_cast<float>((physics(row, col) - rest_physics0_(row, col)) - (double(model[i]) - double(rest_model0_[i])));
+      offset[i] = static_cast<float>((physics(row, col) - rest_physics0_(row, col)) - (double(model[i]) - double(model_inert[i])));
     }
   if (!all_finite(offset.data(), offset.size()))
     throw Error(SOFTDECA_ERROR_NON_FINITE, "the physics at prepare produced a non-finite skin for these parameters");

@@ -72,8 +72,8 @@ struct Preparation {
   HyperTensor residual_modes;
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
-  // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p~) - M_rest(p0)], p~ being p with
-  // the bundle's rest-inert parameters at their defaults (runtime/rest_physics.h).
+  // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)], p_inert being
+  // p's rest-inert parameters alone, the others at their defaults (runtime/rest_physics.h).
   std::vector<float> rest_offset;
   std::size_t bytes() const;
 };

@@ -31,6 +31,16 @@ bool ParameterState::at_defaults() const {
   return true;
 }
 
+ParameterState ParameterState::only(const std::vector<int>& indices) const {
+  ParameterState out(*this);
+  out.reset();
+  for (const int i : indices) {
+    check_index(i);
+    out.values_[static_cast<std::size_t>(i)] = values_[static_cast<std::size_t>(i)];
+  }
+  return out;
+}
+
 void ParameterState::check_index(int index) const {
   require(index >= 0 && static_cast<std::size_t>(index) < specs_->size(),
           "parameter index " + std::to_string(index) + " is not below the bundle's " + std::to_string(specs_->size()) +

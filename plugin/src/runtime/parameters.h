@@ -27,6 +27,8 @@ class ParameterState {
   Kind kind(int index) const { return values_.at(static_cast<std::size_t>(index)).kind; }
   // Every parameter a global value at its default.
   bool at_defaults() const;
+  // A copy holding only the listed parameters' values, the others at their defaults.
+  ParameterState only(const std::vector<int>& indices) const;
   double global(int index) const { return values_.at(static_cast<std::size_t>(index)).global; }
 
   // Row-major [faces or vertices][columns.size()] raw values for the given parameter columns.

@@ -220,10 +220,18 @@ class ReferenceAvatar:
                     self._softdeca_rest(self._networks(defaults)),
                 )
             physics0, model0 = self._rest_defaults
-            # The model at rest under p with the rest-inert parameters at their defaults.
-            kept = self.params.with_defaults(head.inert)
-            model = self._softdeca_rest(prep if kept.same(self.params) else self._networks(kept))
-            prep.rest_offset = (self._rest_solver.solve(self.params) - physics0) - (model - model0)
+            # The networks' own rest response to p, less their response to p's rest-inert
+            # parameters alone (kept: the physics says nothing about those at rest).
+            others = [s.name for s in self.nets.specs if s.name not in head.inert]
+            inert_only = self.params.with_defaults(others)
+            model_inert = (
+                model0
+                if inert_only.at_defaults()
+                else self._softdeca_rest(self._networks(inert_only))
+            )
+            model = self._softdeca_rest(prep)
+            physics = self._rest_solver.solve(self.params)
+            prep.rest_offset = (physics - physics0) - (model - model_inert)
         self.prep = prep
         return prep
 

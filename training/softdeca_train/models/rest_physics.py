@@ -6,13 +6,15 @@ a wider cranium, a region's fuller volume) depends on the head more than they le
 identities they saw. So at prepare the runtime solves the avatar's head once at rest under p
 (and once under the defaults, kept per avatar), and adds to every frame
 
-    c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p~) - M_rest(p0)]
+    c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)]
 
 P_rest the simulated skin at rest, M_rest the model's own output at rest (zero weights on the
-neutral): the model's rest response is replaced by the physics'. p~ is p with the parameters
-that leave the unloaded head at rest as it is (the bundle's `rest_inert` list: the tissue
-weights, max_strain) at their defaults: the physics says nothing about them at rest, and their
-response stays the networks'. At the defaults c = 0; a frame costs one add.
+neutral): the model's rest response is replaced by the physics'. p_inert is p with only the
+parameters that leave the unloaded head at rest as it is (the bundle's `inert_parameters`: the
+tissue weights, w_target, max_strain), the others at their defaults: the physics says nothing
+about those at rest, so the networks' response to them alone stays; what they do together
+with a load (softer tissue sagging more under heavier gravity) is the physics'. At the
+defaults c = 0; a frame costs one add.
 
 The head is the bundle's (rest_head.py) carried to the avatar. Parameter maps reach the
 physics' elements as the data's regions do (data/regions.py, element_regions): a tet takes the
