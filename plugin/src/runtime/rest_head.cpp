@@ -21,6 +21,7 @@ class Reader {
     const std::size_t size = count * sizeof(T);
     if (size / sizeof(T) != count || size > data_.size() - at_)
       fail(name_ + ": shorter than its manifest says (reading " + what + ")");
+    if (size == 0) return;  // an empty array: no bytes, and `out` may be null
     std::memcpy(out, data_.data() + at_, size);  // little-endian hosts only, like every bundle file
     at_ += size;
   }
