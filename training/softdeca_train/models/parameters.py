@@ -212,13 +212,6 @@ class ParameterState:
         ]
         return out
 
-    def same(self, other: ParameterState) -> bool:
-        """Whether both hold the same values (kinds and data)."""
-        return all(
-            a.kind == b.kind and np.array_equal(np.asarray(a.data), np.asarray(b.data))
-            for a, b in zip(self._values, other._values, strict=True)
-        )
-
     def at_defaults(self) -> bool:
         """Every parameter a global value at its default."""
         return all(
