@@ -19,7 +19,7 @@ export SOFTDECA_DATA := $(abspath $(DATA))
 export SOFTDECA_ICT := $(abspath $(ICT))
 export SOFTDECA_CACHE := $(CURDIR)/.cache
 export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
-# ccache, when installed, makes rebuilds and other checkouts of the same tree cheap; the build
+# ccache (setup installs it) makes rebuilds and other checkouts of the same tree cheap; the build
 # never needs it. Paths under the checkout are hashed relative to it, and the working directory
 # is left out of the hash (it only names the debug info's compilation directory), so checkouts
 # share hits.
@@ -68,13 +68,14 @@ test: lint test-native test-fuzz test-python test-swift test-unity ## every test
 
 # The demo's replay: frames DEMO_START.. of a real Live Link Face take through linear
 # blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,
-# plus one localised change (stiffer soft tissue in a 3 cm ball on the subject's left cheek).
+# plus one localised change (fuller soft tissue, target_volume at the top of its range, in a
+# 3 cm ball on the subject's left cheek), shown next to the physics under the same change.
 BUNDLE         ?= models/softdeca-default
 DEMO_TAKE      ?= $(TAKES)/S07-001.csv
 DEMO_SEED      ?= 1
 DEMO_START     ?= 360
 DEMO_FRAMES    ?= 240
-DEMO_LOCALISED ?= w_soft_strain=max@0.05,-0.015,0.085,0.03
+DEMO_LOCALISED ?= target_volume=max@0.05,-0.015,0.085,0.03
 
 .PHONY: demo-bundle
 demo-bundle: ## check that BUNDLE exists, else say how to make one
@@ -95,7 +96,8 @@ demo: demo-bundle build ## template, layers, identities, landmarks, then a real 
 	@echo "                 (PC2 point caches: Blender Mesh Cache modifier; docs/runtime.md)"
 	@echo "  preview:       $(OUT)/demo/replay/preview.png"
 	@echo "  timings:       $(OUT)/demo/replay/replay.json"
-	@echo "  lip openings:  $(OUT)/demo/replay/preview.json (linear, physics and the models on the shown frames)"
+	@echo "  lip openings:  $(OUT)/demo/replay/preview.json (linear, physics and the models on the shown frames;"
+	@echo "                 the localised change's reach in the physics and in SoftDECA)"
 
 bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
 	@mkdir -p build/bench

@@ -1,13 +1,14 @@
 """The contact sheet of a replay: chosen frames (rows) of every model the replay wrote (columns:
 linear blendshapes, SoftDECA, SparseSoftDECA, SoftDECA with the localised change), and, when
-asked, the physics φ† itself on those frames (preview_physics.py), rendered with render.py,
-framed on the face.
+asked, the physics φ† itself on those frames (preview_physics.py), with the localised change
+too when the replay has one, rendered with render.py, framed on the face.
 
 A correction of a few millimetres is invisible in a shaded render, so the models' columns are
 coloured by how far each vertex lies from the linear blendshapes of the same frame, and the
-localised column by how far it lies from plain SoftDECA (what the localised change does): white
-0 to dark red at the column's scale (its 99.5th percentile over the shown frames), written in
-the column's labels.
+localised columns by how far they lie from the same model without the change (what the
+localised change does): white 0 to dark red at the column's scale (its 99.5th percentile over
+the shown frames; the physics' and SoftDECA's localised columns share one), written in the
+column's labels.
 """
 
 from __future__ import annotations
@@ -20,10 +21,12 @@ import numpy as np
 
 from softdeca_train.render import Focus, MeshLayer, RenderSettings, TileSettings, render, tile
 from softdeca_train.runtime.files import read_obj, read_pc2
+from softdeca_train.template.model import N_SKIN
 
 LABELS = {
     "linear": "linear blendshapes",
     "physics": "physics (static)",
+    "physics_localised": "physics, localised change",
     "softdeca": "SoftDECA",
     "softdeca_localised": "SoftDECA, localised change",
     "sparse": "SparseSoftDECA (landmarks)",
@@ -51,13 +54,20 @@ def face_focus(neutral: np.ndarray) -> Focus:
 
 
 def _with_physics(
-    caches: dict[str, np.ndarray], chosen: list[int], column: np.ndarray
+    caches: dict[str, np.ndarray], chosen: list[int], columns: dict[str, np.ndarray]
 ) -> dict[str, np.ndarray]:
-    """The physics column after the linear one; only the chosen frames are filled."""
-    physics = np.zeros_like(caches["linear"])
-    physics[chosen] = column
-    out = {"linear": caches["linear"], "physics": physics}
-    return out | {k: v for k, v in caches.items() if k != "linear"}
+    """The physics column after the linear one, the localised physics before the localised
+    SoftDECA; only the chosen frames are filled."""
+    out: dict[str, np.ndarray] = {}
+    for name, cache in caches.items():
+        if name == "softdeca_localised" and "physics_localised" in columns:
+            out["physics_localised"] = np.zeros_like(cache)
+            out["physics_localised"][chosen] = columns["physics_localised"]
+        out[name] = cache
+        if name == "linear":
+            out["physics"] = np.zeros_like(cache)
+            out["physics"][chosen] = columns["physics"]
+    return out
 
 
 def render_preview(
@@ -91,6 +101,7 @@ def render_preview(
         "physics": "linear",
         "softdeca": "linear",
         "sparse": "linear",
+        "physics_localised": "physics",
         "softdeca_localised": "softdeca",
     }
     ref = {k: v for k, v in ref.items() if k in caches and v in caches}
@@ -98,6 +109,10 @@ def render_preview(
         k: float(np.percentile(np.concatenate([distance_mm(k, v, f) for f in chosen]), 99.5))
         for k, v in ref.items()
     }
+    # The localised change's physics and model share one scale: equal colours, equal motion.
+    together = [k for k in ("physics_localised", "softdeca_localised") if k in scale]
+    for k in together:
+        scale[k] = max(scale[j] for j in together)
 
     images, labels = [], []
     for f in chosen:
@@ -126,7 +141,8 @@ def render_preview(
         f"landmarks from {summary['landmarks_from']}; dynamics "
         + ("on" if summary.get("dynamics") else "off"),
         "colour: distance per vertex to the model named in the label, white 0 to dark red at "
-        "the column's scale (99.5th percentile of the shown frames)"
+        "the column's scale (99.5th percentile of the shown frames; the two localised columns "
+        "share theirs)"
         if ref
         else "",
         f"localised change: {localised} ({summary.get('localised_faces', 0)} skin faces)"
@@ -162,8 +178,11 @@ def _add_physics(
 ) -> tuple[dict[str, np.ndarray], list[int], list[str]]:
     """The physics column, the widest-open mouth among the rows (it replaces the row of its
     segment), preview.json with every column's lip opening, and the sheet's notes."""
+    from softdeca_train.models.bundle import read_manifest
+    from softdeca_train.models.parameters import ParameterSpec
     from softdeca_train.runtime.preview_physics import (
         lip_openings_mm,
+        parse_changes,
         simulate_column,
         widest_open_frame,
     )
@@ -174,31 +193,77 @@ def _add_physics(
     wide = widest_open_frame(lin, template)
     segment = int(np.searchsorted(np.linspace(0, len(lin), len(chosen) + 1), wide, "right")) - 1
     chosen = sorted({*chosen[:segment], wide, *chosen[segment + 1 :]})
-    column = simulate_column(Path(summary["take"]), first, chosen, lin, template, seed)
-    caches = _with_physics(caches, chosen, column.heads)
+    base = parse_changes(summary.get("set") or "")
+    settings = {"physics": base}
+    if summary.get("localised") and "softdeca_localised" in caches:
+        settings["physics_localised"] = base + parse_changes(summary["localised"])
+    specs = tuple(
+        ParameterSpec.from_dict(p) for p in read_manifest(summary["bundle"])["parameters"]
+    )
+    simulated = dict(
+        zip(
+            settings,
+            simulate_column(
+                Path(summary["take"]),
+                first,
+                chosen,
+                lin,
+                template,
+                seed,
+                list(settings.values()),
+                specs,
+            ),
+            strict=True,
+        )
+    )
+    caches = _with_physics(caches, chosen, {k: c.heads for k, c in simulated.items()})
     openings = {
         name: [round(float(x), 3) for x in lip_openings_mm(c[chosen], template)]
         for name, c in caches.items()
     }
-    (replay / "preview.json").write_text(
-        json.dumps(
-            {
-                "frames": [first + f for f in chosen],
-                "widest_open_frame": first + wide,
-                "identity_seed": seed,
-                "lip_opening_mm": openings,
-                "physics_failures": column.failures,
-                "physics_seconds": round(column.seconds, 1),
-            },
-            indent=1,
-        )
-    )
+    report: dict[str, object] = {
+        "frames": [first + f for f in chosen],
+        "widest_open_frame": first + wide,
+        "identity_seed": seed,
+        "lip_opening_mm": openings,
+        "physics_failures": {k: c.failures for k, c in simulated.items()},
+        "physics_seconds": {k: round(c.seconds, 1) for k, c in simulated.items()},
+    }
     row = chosen.index(wide)
-    failing = sum(bool(f) for f in column.failures)
+    failing = sum(bool(f) for c in simulated.values() for f in c.failures)
+    described = summary.get("set") or "default parameters"
     notes = [
-        f"physics: the simulation, static, LHM level 3, default parameters, collisions on, "
-        f"ICT identity seed {seed}; {failing} of {len(chosen)} shown frames fail a sanity bound",
+        f"physics: the simulation, static, LHM level 3, {described}, collisions on, "
+        f"ICT identity seed {seed}; {failing} of {len(chosen) * len(simulated)} simulated "
+        "frames fail a sanity bound",
         f"lip opening at frame {first + wide} (the take's widest-open mouth): "
         + ", ".join(f"{LABELS.get(k, k)} {v[row]:.1f} mm" for k, v in openings.items()),
     ]
+    if "physics_localised" in simulated:
+        response = localised_response(caches, chosen)
+        report["localised"] = {"change": summary["localised"], **response}
+        notes.append(
+            "localised change on the shown frames: the physics moves the skin by up to "
+            f"{max(response['physics_max_mm']):.2f} mm, SoftDECA by up to "
+            f"{max(response['softdeca_max_mm']):.2f} mm; response error "
+            f"|dSoftDECA - dphysics| / |dphysics| {np.median(response['response_error']):.2f} "
+            "(median of the frames; SoftDECA as replayed, the physics static)"
+        )
+    (replay / "preview.json").write_text(json.dumps(report, indent=1))
     return caches, chosen, notes
+
+
+def localised_response(caches: dict[str, np.ndarray], chosen: list[int]) -> dict[str, list]:
+    """Per shown frame, over the skin: how far the localised change moves the physics and
+    SoftDECA (largest vertex distance, mm) and the response error |dm - dp| / |dp| (norms over
+    all skin vertices), as the controls gallery measures a control."""
+    out: dict[str, list] = {"physics_max_mm": [], "softdeca_max_mm": [], "response_error": []}
+    for f in chosen:
+        dp = (caches["physics_localised"][f] - caches["physics"][f])[:N_SKIN].astype(np.float64)
+        dm = (caches["softdeca_localised"][f] - caches["softdeca"][f])[:N_SKIN].astype(np.float64)
+        out["physics_max_mm"].append(round(1e3 * float(np.linalg.norm(dp, axis=1).max()), 4))
+        out["softdeca_max_mm"].append(round(1e3 * float(np.linalg.norm(dm, axis=1).max()), 4))
+        out["response_error"].append(
+            round(float(np.linalg.norm(dm - dp) / max(np.linalg.norm(dp), 1e-12)), 4)
+        )
+    return out
