@@ -85,7 +85,9 @@ def test_the_localised_response_is_measured_against_the_physics() -> None:
     caches = {"physics": base, "physics_localised": base + d, "softdeca": base + 1}
     caches["softdeca_localised"] = caches["softdeca"] + d
     same = localised_response(caches, [0, 2])
-    assert same["response_error"] == pytest.approx([0.0, 0.0], abs=1e-3)  # float32 caches
+    assert same["response_error"] == pytest.approx(
+        [0.0, 0.0], abs=1e-3
+    )  # float32 caches
     assert same["physics_max_mm"] == pytest.approx([1.0, 1.0], abs=1e-3)
     assert same["softdeca_max_mm"] == pytest.approx([1.0, 1.0], abs=1e-3)
     caches["softdeca_localised"] = caches["softdeca"]  # the model ignores the change
