@@ -4,6 +4,7 @@ deformation transfer (exactness, symmetry, gradients) and the parameter localisa
 from __future__ import annotations
 
 import json
+import tarfile
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from softdeca_train.models import (
     dt_system,
     export_bundle,
     load_parameter_specs,
+    pack_bundle,
     read_definition,
     read_manifest,
 )
@@ -87,6 +89,18 @@ def test_manifest_of_another_version_is_refused(bundle, tmp_path):
     (tmp_path / "manifest.json").write_text(json.dumps(m))
     with pytest.raises(ValueError, match="version"):
         read_manifest(tmp_path)
+
+
+def test_the_manifest_is_read_from_a_packed_bundle_too(bundle, tmp_path):
+    folder, _ = bundle
+    packed = tmp_path / "bundle.tar"
+    packed.write_bytes(pack_bundle(folder))
+    assert read_manifest(packed) == read_manifest(folder)
+    other = tmp_path / "other.tar"
+    with tarfile.open(other, "w") as tar:
+        tar.add(folder / "skin_triangles.i32", arcname="skin_triangles.i32")
+    with pytest.raises(ValueError, match="not a bundle"):
+        read_manifest(other)
 
 
 def test_dynamics_networks_stay_in_the_stable_equilibrium_set(bundle, head):

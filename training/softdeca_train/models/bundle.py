@@ -449,7 +449,16 @@ def pack_bundle(folder: str | Path) -> bytes:
 
 
 def read_manifest(folder: str | Path) -> dict[str, Any]:
-    m = json.loads((Path(folder) / MANIFEST).read_text())
+    """The manifest of a bundle folder or of its packed archive (pack_bundle)."""
+    path = Path(folder)
+    if path.is_file():
+        with tarfile.open(path) as tar:
+            member = tar.extractfile(MANIFEST) if MANIFEST in tar.getnames() else None
+            if member is None:
+                raise ValueError(f"{path}: an archive without {MANIFEST}: not a bundle")
+            m = json.loads(member.read())
+    else:
+        m = json.loads((path / MANIFEST).read_text())
     if m.get("format") != FORMAT or m.get("format_version") not in FORMAT_VERSIONS:
         raise ValueError(
             f"{folder}: not a {FORMAT} bundle of version "
