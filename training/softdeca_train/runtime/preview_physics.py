@@ -162,8 +162,9 @@ def simulate_column(
         )
     columns = []
     for changes in settings:
-        sim = hs.simulator(threads=1)
-        for name, value in parameter_fields(hs, specs, changes).items() if changes else ():
+        sim = hs.simulator(threads=1)  # the physics' own defaults, unless changed
+        fields = parameter_fields(hs, specs, changes) if changes else {}
+        for name, value in fields.items():
             if isinstance(value, float):
                 sim.set_parameter(name, value)
             else:
