@@ -63,6 +63,26 @@ def region_labels(template: Template) -> np.ndarray:
     return labels
 
 
+def nearest_skin_vertices(
+    vertices: np.ndarray, tets: np.ndarray, neutral_skin: np.ndarray
+) -> np.ndarray:
+    """Per tet, the vertex of S nearest its centroid at rest: the vertex whose region and
+    per-vertex parameter values the tet takes (the data, the gallery and the runtime alike)."""
+    from scipy.spatial import cKDTree
+
+    centroids = np.asarray(vertices)[np.asarray(tets)].mean(axis=1)
+    return cKDTree(neutral_skin).query(centroids)[1]
+
+
+def mesh_tet_skin_vertices(mesh: object, neutral_skin: np.ndarray) -> dict[str, np.ndarray]:
+    """`nearest_skin_vertices` of both tet domains of a softdeca_native.SimulationMesh."""
+    rest = np.asarray(mesh.rest)  # type: ignore[attr-defined]
+    return {
+        "soft_tet": nearest_skin_vertices(rest, mesh.soft_tets, neutral_skin),  # type: ignore[attr-defined]
+        "muscle_tet": nearest_skin_vertices(rest, mesh.muscle_tets, neutral_skin),  # type: ignore[attr-defined]
+    }
+
+
 def element_regions(
     labels: np.ndarray, mesh: object, neutral_skin: np.ndarray, domain: str
 ) -> np.ndarray:
@@ -71,11 +91,8 @@ def element_regions(
     skin triangles by their first corner, skin points by their own label. `labels`: (N_SKIN,)
     from `region_labels`; `neutral_skin`: the identity's S at rest (N_SKIN, 3)."""
     if domain in ("soft_tet", "muscle_tet"):
-        from scipy.spatial import cKDTree
-
-        rest = np.asarray(mesh.rest)  # type: ignore[attr-defined]
-        tets = np.asarray(mesh.soft_tets if domain == "soft_tet" else mesh.muscle_tets)  # type: ignore[attr-defined]
-        return labels[cKDTree(neutral_skin).query(rest[tets].mean(axis=1))[1]]
+        tets = mesh.soft_tets if domain == "soft_tet" else mesh.muscle_tets  # type: ignore[attr-defined]
+        return labels[nearest_skin_vertices(np.asarray(mesh.rest), tets, neutral_skin)]  # type: ignore[attr-defined]
     if domain == "skin_triangle":
         return labels[np.asarray(mesh.skin_triangles)[:, 0]]  # type: ignore[attr-defined]
     if domain == "skin_point":

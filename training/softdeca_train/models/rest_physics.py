@@ -57,14 +57,14 @@ class RestSolver:
         self, head: RestHead, neutral_head: np.ndarray, skin_triangles: np.ndarray
     ) -> None:
         import softdeca_native as native
-        from scipy.spatial import cKDTree
+
+        from softdeca_train.data.regions import nearest_skin_vertices
 
         self.head = head
         self.neutral_skin = np.asarray(neutral_head, np.float64)[: head.skin_count]
         self.mesh, fill = head.simulation_mesh(neutral_head, skin_triangles)
-        tree = cKDTree(self.neutral_skin)
         self.tet_vertex = {
-            domain: tree.query(fill[tets].mean(axis=1))[1]
+            domain: nearest_skin_vertices(fill, tets, self.neutral_skin)
             for domain, tets in (("soft_tet", head.soft_tets), ("muscle_tet", head.muscle_tets))
         }
         self.sim = native.Simulator(

@@ -246,24 +246,30 @@ def _add_physics(
             "localised change on the shown frames: the physics moves the skin by up to "
             f"{max(response['physics_max_mm']):.2f} mm, SoftDECA by up to "
             f"{max(response['softdeca_max_mm']):.2f} mm; response error "
-            f"|dSoftDECA - dphysics| / |dphysics| {np.median(response['response_error']):.2f} "
+            f"|dSoftDECA - dphysics| / |dphysics| {_median(response['response_error'])} "
             "(median of the frames; SoftDECA as replayed, the physics static)"
         )
     (replay / "preview.json").write_text(json.dumps(report, indent=1))
     return caches, chosen, notes
 
 
+def _median(values: list[float | None]) -> str:
+    known = [v for v in values if v is not None]
+    return f"{np.median(known):.2f}" if known else "undefined (the physics does not move)"
+
+
 def localised_response(caches: dict[str, np.ndarray], chosen: list[int]) -> dict[str, list]:
     """Per shown frame, over the skin: how far the localised change moves the physics and
-    SoftDECA (largest vertex distance, mm) and the response error |dm - dp| / |dp| (norms over
-    all skin vertices), as the controls gallery measures a control."""
+    SoftDECA (largest vertex distance, mm) and the response error |dm - dp| / |dp| as the
+    controls gallery measures a control (None where the physics does not move)."""
+    from softdeca_train.controls.metrics import response_error
+
     out: dict[str, list] = {"physics_max_mm": [], "softdeca_max_mm": [], "response_error": []}
     for f in chosen:
         dp = (caches["physics_localised"][f] - caches["physics"][f])[:N_SKIN].astype(np.float64)
         dm = (caches["softdeca_localised"][f] - caches["softdeca"][f])[:N_SKIN].astype(np.float64)
         out["physics_max_mm"].append(round(1e3 * float(np.linalg.norm(dp, axis=1).max()), 4))
         out["softdeca_max_mm"].append(round(1e3 * float(np.linalg.norm(dm, axis=1).max()), 4))
-        out["response_error"].append(
-            round(float(np.linalg.norm(dm - dp) / max(np.linalg.norm(dp), 1e-12)), 4)
-        )
+        error = response_error(dm, dp)
+        out["response_error"].append(None if error is None else round(error, 4))
     return out

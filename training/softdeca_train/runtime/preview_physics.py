@@ -75,8 +75,7 @@ def parameter_fields(
 ) -> dict[str, float | np.ndarray]:
     """Every parameter's value for `hs`'s simulator after `changes` (applied in order on top of
     the defaults): a number, or one value per element of the parameter's domain."""
-    from scipy.spatial import cKDTree
-
+    from softdeca_train.data.regions import mesh_tet_skin_vertices
     from softdeca_train.models.dt import face_geometry
     from softdeca_train.models.parameters import ParameterState
     from softdeca_train.models.rest_physics import element_values
@@ -94,12 +93,7 @@ def parameter_fields(
         current = params.face_matrix([c.name])[:, 0]
         inside = np.linalg.norm(centroids - np.asarray(c.ball[:3]), axis=1) <= c.ball[3]
         params.set_faces(c.name, np.where(inside, value, current))
-    rest = np.asarray(hs.mesh.rest)
-    tree = cKDTree(skin)
-    tet_vertex = {
-        domain: tree.query(rest[np.asarray(tets)].mean(axis=1))[1]
-        for domain, tets in (("soft_tet", hs.mesh.soft_tets), ("muscle_tet", hs.mesh.muscle_tets))
-    }
+    tet_vertex = mesh_tet_skin_vertices(hs.mesh, skin)
     out: dict[str, float | np.ndarray] = {}
     for spec in specs:
         values = element_values(tet_vertex, params, spec.name, spec.domain)
