@@ -61,10 +61,36 @@ test-native: build build-asan ## ctest on both builds
 	@echo "== native tests (ASan+UBSan)"; ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
 
-test-python: build ## pytest
-	@echo "== Python tests"; $(PY) -m pytest -q tests/python
+test-python: build ## pytest (the numerical bounds' margins -> build/bounds/native.json)
+	@echo "== Python tests"; SOFTDECA_BOUNDS_REPORT=$(CURDIR)/build/bounds/native.json $(PY) -m pytest -q tests/python
 
-test: lint test-native test-fuzz test-python test-swift test-unity ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, Swift, Unity
+test: lint test-native test-fuzz test-python test-kernels test-swift test-unity ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, other CPUs' kernels, Swift, Unity
+
+# ---- Kernel families: the numerics another x86-64 CPU computes -----------------------------
+# tests/cpu/run-as.sh caps every numerical library (this one, numpy, OpenBLAS, torch) at one
+# kernel family (docs/platforms.md, "Kernel families"). test-kernels runs the native kernel and
+# runtime suites and a replay check per precision under avx2 and portable, then the
+# numerics-sensitive Python tests under avx2 (what a CPU without AVX-512 computes), reduced to
+# those that run in minutes; test-kernels-full runs every Python test so.
+KERNEL_PYTESTS := tests/python/test_lhm_eyes.py tests/python/test_lhm_mouth.py tests/python/test_lhm_conforming.py \
+                  tests/python/test_sim_native.py tests/python/test_rest_physics.py tests/python/test_runtime_parity.py \
+                  tests/python/test_residual_stage.py tests/python/test_local_fit.py tests/python/test_linear_baseline.py
+KCHECK := build/kernel-check
+.PHONY: test-kernels test-kernels-full kernel-check-inputs
+kernel-check-inputs: build ## the avatar and take of the kernel families' replay check -> build/kernel-check
+	@mkdir -p $(KCHECK)
+	@[ -f $(KCHECK)/avatar/neutral.obj ] || $(PY) -m softdeca_train avatar --seed 1 --out $(KCHECK)/avatar > /dev/null
+	@[ -f $(KCHECK)/take.sdrec ] || $(BUILD)/plugin/cli/softdeca convert $(CHECK_TAKE) $(KCHECK)/take.sdrec > /dev/null
+
+test-kernels: kernel-check-inputs ## the numerics again on other CPUs' kernel families (avx2, portable)
+	@echo "== numerics on other kernel families (tests/cpu/run-as.sh)"
+	@tests/cpu/check-kernels.sh $(BUILD) $(KCHECK)/avatar $(KCHECK)/take.sdrec $(CHECK_START)
+	@echo "== numerics-sensitive Python tests, kernel family avx2"
+	@SOFTDECA_BOUNDS_REPORT=$(CURDIR)/build/bounds/avx2.json tests/cpu/run-as.sh avx2 $(PY) -m pytest -q $(KERNEL_PYTESTS)
+
+test-kernels-full: kernel-check-inputs ## test-kernels with every Python test under avx2
+	@tests/cpu/check-kernels.sh $(BUILD) $(KCHECK)/avatar $(KCHECK)/take.sdrec $(CHECK_START)
+	@SOFTDECA_BOUNDS_REPORT=$(CURDIR)/build/bounds/avx2-full.json tests/cpu/run-as.sh avx2 $(PY) -m pytest -q tests/python
 
 # The demo's replay: frames DEMO_START.. of a real Live Link Face take through linear
 # blendshapes, SoftDECA and SparseSoftDECA on the ICT identity of DEMO_SEED, default parameters,

@@ -3,9 +3,11 @@
 // bundle, avatar and frames (tests/platforms/windows_replay_check.sh). Uses nothing but
 // softdeca.h, so it builds wherever the library does.
 //
-// usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES
+// usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES [PRECISION]
 //   AVATAR_DIR: neutral.obj and blendshapes/<ARKit name>.obj (as `softdeca replay --avatar` reads)
 //   EXPECTED.pc2: `softdeca replay TAKE.sdrec --models softdeca --start FIRST_FRAME ...`
+//   PRECISION: half (default, as softdeca replay), float or int8: the replay's --precision
+// Also run on one machine under another kernel family (tests/cpu/run-as.sh, make test-kernels).
 // Prints the largest vertex difference; exit status 0 when within the tolerance.
 #include <algorithm>
 #include <cmath>
@@ -81,8 +83,18 @@ Pc2 read_pc2(const std::string& path) {
 }
 
 int run(int argc, char** argv) {
-  if (argc != 7) {
-    std::fprintf(stderr, "usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES\n");
+  if (argc != 7 && argc != 8) {
+    std::fprintf(stderr,
+                 "usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES [half|float|int8]\n");
+    return 2;
+  }
+  const std::string precision_name = argc == 8 ? argv[7] : "half";
+  const int32_t precision = precision_name == "float"  ? SOFTDECA_PRECISION_FLOAT
+                            : precision_name == "int8" ? SOFTDECA_PRECISION_INT8
+                            : precision_name == "half" ? SOFTDECA_PRECISION_HALF
+                                                       : -1;
+  if (precision < 0) {
+    std::fprintf(stderr, "replay_check: precision must be half, float or int8, not '%s'\n", precision_name.c_str());
     return 2;
   }
   const std::string bundle = argv[1], avatar_dir = argv[2], take = argv[3], expected_path = argv[5];
@@ -115,6 +127,7 @@ int run(int argc, char** argv) {
   desc.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
   desc.blendshapes = deltas.data();
   desc.blendshape_count = SOFTDECA_BLENDSHAPE_COUNT;
+  desc.precision = precision;
   softdeca_avatar* avatar = nullptr;
   check(softdeca_avatar_create(model, &desc, &avatar), "creating the avatar");
   check(softdeca_avatar_prepare(avatar), "prepare");
@@ -155,9 +168,10 @@ int run(int argc, char** argv) {
   // The largest motion off the neutral shows the frames animate (a comparison of two rest poses
   // would pass trivially).
   const bool ok = worst <= tolerance && motion > 10 * tolerance;
-  std::printf("replay_check (softdeca %s): %u frames x %u vertices, largest difference %.3g m (tolerance %.3g m), "
+  std::printf("replay_check (softdeca %s, %s): %u frames x %u vertices, largest difference %.3g m (tolerance %.3g m), "
               "largest motion %.3g m: %s\n",
-              softdeca_version(), expected.frames, expected.points, worst, tolerance, motion, ok ? "OK" : "FAILED");
+              softdeca_version(), precision_name.c_str(), expected.frames, expected.points, worst, tolerance, motion,
+              ok ? "OK" : "FAILED");
   return ok ? 0 : 1;
 }
 

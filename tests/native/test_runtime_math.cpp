@@ -191,6 +191,39 @@ TEST(HyperTensor, VertexOffsetsMatchTheDirectProduct) {
   }
 }
 
+// A large term that cancels against another (collinear columns of a fitted table) must not
+// set the rounding of the small ones: every kernel matches the stored values' exact contraction
+// to float rounding of the large term, on every family (tests/cpu/run-as.sh).
+TEST(HyperTensor, Int8KernelsKeepSmallTermsBesideALargeOne) {
+  const std::size_t n = 24;
+  const int K = 32;
+  std::mt19937 rng(11);
+  std::normal_distribution<float> nd;
+  std::vector<float> L(n * K * 3), z(K), base(3 * n, 0.0f);
+  for (std::size_t v = 0; v < n; ++v)
+    for (int c = 0; c < 3; ++c) {
+      const float big = nd(rng);  // latents 0 and 1: +big and -big with z = 1 each: they cancel
+      for (int k = 0; k < K; ++k) L[(v * K + k) * 3 + c] = k == 0 ? big : k == 1 ? -big : 1e-3f * nd(rng);
+    }
+  for (int k = 0; k < K; ++k) z[k] = k < 2 ? 1.0f : nd(rng);
+  const HyperTensor t(L.data(), n, K, 3, Precision::Int8);
+  for (const Kernel kernel : {Kernel::Portable, Kernel::Avx2, Kernel::Avx512Vnni}) {
+    if (!kernel_available(kernel)) continue;
+    std::vector<float> out(3 * n);
+    vertex_offsets(t, z.data(), base.data(), 0, t.blocks(), out.data(), kernel);
+    double worst = 0;
+    for (std::size_t v = 0; v < n; ++v)
+      for (int c = 0; c < 3; ++c) {
+        double want = 0;  // the stored (int8) values, contracted exactly
+        for (int k = 0; k < K; ++k) want += double(z[k]) * t.at(v, k, c);
+        worst = std::max(worst, std::fabs(out[3 * v + c] - want));
+      }
+    // float rounding of the unit-sized terms (2^-24 each, a few of them); the small terms are
+    // ~1e-3 each, so one step of 1/32767 of the large term (3e-5) per term would fail this.
+    EXPECT_LT(worst, 2e-6) << "kernel " << static_cast<int>(kernel);
+  }
+}
+
 TEST(SparseLdlt, RefusesAMatrixThatIsNotPositiveDefinite) {
   Eigen::SparseMatrix<double> K(3, 3);
   K.insert(0, 0) = 1;

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import json
+import os
+from pathlib import Path
+
+import bounds
 import pytest
 from softdeca_train.data.config import GenerateConfig, RunSettings
 from softdeca_train.data.generate import generate
@@ -35,3 +40,18 @@ def small(tmp_path_factory) -> tuple:
     out = tmp_path_factory.mktemp("small")
     summary = generate(SMALL, RunSettings(out=out, workers=2, progress=False))
     return out, summary
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """The numerical bounds that came closest to their values (bounds.py), and the whole list
+    in $SOFTDECA_BOUNDS_REPORT when it is set."""
+    if not bounds.RECORDED:
+        return
+    terminalreporter.section("numerical bounds")
+    for line in bounds.summary_lines():
+        terminalreporter.write_line(line)
+    out = os.environ.get("SOFTDECA_BOUNDS_REPORT")
+    if out:
+        Path(out).parent.mkdir(parents=True, exist_ok=True)
+        Path(out).write_text(json.dumps(bounds.report(), indent=1, default=str))
+        terminalreporter.write_line(f"every bound with its margin: {out}")

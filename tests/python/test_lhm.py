@@ -7,6 +7,7 @@ import itertools
 import numpy as np
 import pytest
 import softdeca_native as native
+from bounds import below
 from softdeca_train.lhm import LhmConfig, check_lhm, fit_lhm
 from softdeca_train.lhm.model import CRANIUM, JAW, LayeredHeadModel
 from softdeca_train.lhm.sphere import icosphere, zoom
@@ -38,7 +39,13 @@ def test_sampled_identity_gives_a_valid_model(template: Template, seed: int) -> 
     assert report.outside_max_mm == 0.0
     assert SOFT_VOLUME_L[0] < report.soft_volume_l < SOFT_VOLUME_L[1]
     assert 0.1 < report.muscle_volume_l < report.soft_volume_l
-    assert report.skin_wrap_to_s_mean_mm < 5.0  # the skin wrap hugs S
+    # the skin wrap hugs S
+    below(
+        report.skin_wrap_to_s_mean_mm,
+        5.0,
+        "a wrap 1-2 mm under S; 5 mm: off the face",
+        what="mm",
+    )
 
 
 def test_embedding_reproduces_skin_exactly(

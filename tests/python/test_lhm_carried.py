@@ -9,6 +9,7 @@ import dataclasses
 import numpy as np
 import pytest
 import softdeca_native as native
+from bounds import above, below
 from softdeca_train.lhm import LhmConfig, fit_lhm
 from softdeca_train.lhm.carried import (
     carry_basis,
@@ -78,7 +79,7 @@ def test_a_sampled_head_is_carried_and_holds_the_floor(template: Template) -> No
     assert q.shortfall(CONFIG) == ""
     # the carried head is the template's deformed: it moved, as its S did
     moved = np.linalg.norm(mesh.vertices - basis.mesh.vertices, axis=1)
-    assert moved.max() > 1e-3
+    above(moved.max(), 1e-3, "another identity's head differs by millimetres", what="m")
 
 
 def test_a_head_below_the_floor_gets_its_own_fill(template: Template) -> None:
@@ -116,8 +117,14 @@ def test_the_physics_varies_smoothly_with_the_head(template: Template) -> None:
     a, b = _correction(template, h0, w), _correction(template, h1, w)
     size = np.linalg.norm(a, axis=1).mean()
     change = np.linalg.norm(a - b, axis=1).mean()
-    assert size > 1e-4
-    assert change < 0.05 * size
+    above(size, 1e-4, "the physics corrects this expression by 0.22 mm", what="m")
+    # own fills changed it by 0.43 of its size; carried meshes by 0.01
+    below(
+        change / size,
+        0.05,
+        "carried meshes: 0.01 of the correction (own fills 0.43); solver noise at 1e-5 ~ 0.01",
+        what="change/size",
+    )
 
 
 def test_the_carried_heads_bones(template: Template) -> None:

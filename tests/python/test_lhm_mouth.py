@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from bounds import above, below
 from softdeca_train.lhm import LhmConfig, fit_lhm
 from softdeca_train.lhm.checks import check_lhm, mouth_quality
 from softdeca_train.lhm.model import CRANIUM, JAW, LayeredHeadModel
@@ -128,11 +129,24 @@ def test_element_quality_is_bounded_around_the_mouth(
     19.8 (before: 41.7 / 27.2), muscle tets 7.2 / 9.0 degrees and 8.7 / 9.0 (before: 24.3 /
     18.6)."""
     q = mouth_quality(head.lhm)
-    assert q.muscle.min_dihedral_deg > 6.0 and q.muscle.max_aspect_ratio < 10.0
-    assert q.mouth_soft.min_dihedral_deg > 2.5 and q.mouth_soft.max_aspect_ratio < 25.0
-    assert (
-        q.mouth_muscle.min_dihedral_deg > 6.0 and q.mouth_muscle.max_aspect_ratio < 10.0
-    )
+    # the wraps' slope limit; without it 3.1 deg and 57.6
+    for name, part, lo, hi in (
+        ("muscle", q.muscle, 6.0, 10.0),
+        ("mouth soft", q.mouth_soft, 2.5, 25.0),
+        ("mouth muscle", q.mouth_muscle, 6.0, 10.0),
+    ):
+        above(
+            part.min_dihedral_deg,
+            lo,
+            "the slope limit's floor, measured above",
+            what=name,
+        )
+        below(
+            part.max_aspect_ratio,
+            hi,
+            "the slope limit's cap, measured under",
+            what=name,
+        )
     report = check_lhm(head.lhm, head.head[:N_SKIN], template.skin_triangles)
     assert report.failures() == []
     assert report.tets_spanning_both_lips == 0
@@ -160,8 +174,10 @@ def test_an_open_mouth_stays_open_in_the_volumetric_solve(head: HeadSimulation) 
     jaw = head.jaw_transforms(blended[None])[0]
     _, skin, _ = sim.solve_static(blended[:N_SKIN].astype(np.float64), jaw=jaw)
     linear = lip_opening_mm(head, blended[:N_SKIN])
-    assert linear > 10.0
-    assert 0.9 <= lip_opening_mm(head, skin) / linear <= 1.1
+    above(linear, 10.0, "jawOpen 0.5 opens the blend 19.7 mm", what="mm")
+    ratio = lip_opening_mm(head, skin) / linear
+    above(ratio, 0.9, "the slit keeps the opening (without it 0.07)", what="ratio")
+    below(ratio, 1.1, "the slit keeps the opening (without it 0.07)", what="ratio")
 
 
 def test_the_default_resolution_has_a_slit_too(template: Template) -> None:
@@ -170,7 +186,18 @@ def test_the_default_resolution_has_a_slit_too(template: Template) -> None:
     m = fit_lhm(template)
     assert len(m.slit_copy_of) > 2
     q = mouth_quality(m)
-    assert q.muscle.max_aspect_ratio < 20.0 and q.mouth_muscle.max_aspect_ratio < 15.0
+    below(
+        q.muscle.max_aspect_ratio,
+        20.0,
+        "15.4 measured (149.6 without the limit)",
+        what="muscle",
+    )
+    below(
+        q.mouth_muscle.max_aspect_ratio,
+        15.0,
+        "11.8 measured (32.4)",
+        what="mouth muscle",
+    )
     assert (
         check_lhm(m, template.neutral[:N_SKIN], template.skin_triangles).failures()
         == []

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import torch
+from bounds import above, below
 from softdeca_train.models import load_parameter_specs
 from softdeca_train.models.networks import region_means
 from softdeca_train.models.residual import ResidualFit, ResidualSizes, ResidualStage
@@ -87,8 +88,18 @@ def test_the_fit_learns_a_residual_nonlinear_in_the_weights():
     out = s.fit(w, features, residual, ResidualFit(steps=800, batch=64), progress=False)
     # the mean alone (the stage with its coefficients at zero) leaves most of it
     mean_only = float((residual - residual.mean(0)).norm(dim=-1).mean()) * 1e3
-    assert mean_only > 0.95 * out["residual_mm"]
-    assert out["after_mm"] < 0.4 * out["residual_mm"], out
+    above(
+        mean_only / out["residual_mm"],
+        0.95,
+        "the coefficients hold all of it",
+        what="ratio",
+    )
+    below(
+        out["after_mm"] / out["residual_mm"],
+        0.4,
+        "800 Adam steps from a fixed seed on a smooth target",
+        what="after/residual",
+    )
     s.eval()
     with torch.no_grad():
         got = s(w[:50], defaults())
@@ -142,9 +153,16 @@ def test_contrast_modes_span_a_response_the_residual_modes_miss():
         return float((fit[:, 0] - r).norm() / r.norm())
 
     s.set_modes(residual)
-    assert unexplained(s.table) > 0.5
+    above(
+        unexplained(s.table),
+        0.5,
+        "the response lies outside the residual's modes",
+        what="",
+    )
     s.set_modes(residual, contrasts, extra=1)
-    assert unexplained(s.table) < 1e-3
+    below(
+        unexplained(s.table), 1e-3, "an SVD of the contrasts holds it: float32 rounding"
+    )
 
 
 def test_pairs_teach_a_response_that_differences_between_heads_hide():
@@ -181,5 +199,7 @@ def test_pairs_teach_a_response_that_differences_between_heads_hide():
         return float((got - response).norm() / (response.norm() * 8**0.5))
 
     paired, alone = learned(True), learned(False)
-    assert alone > 2.0  # the heads' offsets swamp the response...
-    assert paired < 0.9 and paired < 0.25 * alone  # ...which the pairs bring out
+    # the heads' offsets swamp the response, which the pairs bring out
+    above(alone, 2.0, "offsets 10x the response, no pairs", what="alone")
+    below(paired, 0.9, "600 Adam steps with the pairs' contrast", what="paired")
+    below(paired / alone, 0.25, "the pairs' contrast against none", what="paired/alone")

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from bounds import above, below
 from softdeca_train.sim.expressions import (
     COMBINATIONS,
     SNARL,
@@ -257,7 +258,19 @@ def test_snarl_frame_does_not_explode(template: Template) -> None:
     c = frame.check
     assert c.max_displacement_mm <= BOUNDS.exploded_mm + c.explained_mm, c.as_dict()
     assert c.penetrating_physics <= c.penetrating_linear, c.as_dict()
-    assert 0.9 <= c.open_ratio <= 1.1, c.as_dict()  # 27 mm open in the linear blend
+    # 27 mm open in the linear blend
+    above(
+        c.open_ratio,
+        0.9,
+        "the physics keeps the opening within 10 %",
+        what="open ratio",
+    )
+    below(
+        c.open_ratio,
+        1.1,
+        "the physics keeps the opening within 10 %",
+        what="open ratio",
+    )
     assert np.isfinite(c.max_target_distance_mm)
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from bounds import below
 from softdeca_train.data.ranges import DEFAULT_PROFILE, profile_ranges
 from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.networks import BETA_MAX
@@ -31,8 +32,15 @@ def _check_export_deviation(manifest: dict) -> None:
     variance, and their first layers sum hundreds of inputs, so float32 summation order shows;
     measured up to 1.3e-4)."""
     dev = dict(manifest["export_check_max_abs"])
-    assert max(dev.pop(k) for k in ("identity_encoder", "sparse.f_l")) < 1e-3
-    assert max(dev.values()) < 1e-4
+    below(
+        max(dev.pop(k) for k in ("identity_encoder", "sparse.f_l")),
+        1e-3,
+        "float32 sums of hundreds of unit-variance inputs, in two runtimes' orders",
+        what="codes",
+    )
+    below(
+        max(dev.values()), 1e-4, "float32 DG entries (metres) in two runtimes", what="m"
+    )
 
 
 @pytest.fixture(scope="module")
@@ -61,8 +69,11 @@ def test_static_models_learn(run: Run, name: str) -> None:
     before = _train_error(run, run.build(name))
     run.train(name, LoopConfig(steps=40, lr=3e-3, lr_end=1e-3, seed=1), progress=False)
     after = _train_error(run, run.load(name))
-    assert after < 0.9 * before, (
-        f"{name}: {before * 1e3:.3f} mm -> {after * 1e3:.3f} mm"
+    below(
+        after / before,
+        0.9,
+        "40 steps from a fixed seed learn 20-80 % on every kernel family",
+        what=f"{name} after/before",
     )
 
 
@@ -245,8 +256,14 @@ def test_identity_encoder_recovers_identities_exactly(template) -> None:
     _, errors = train_identity_encoder(
         template, FULL_SIZES, IdentityConfig(steps=0), False
     )
-    assert errors["coefficients_rms"] < 1e-3  # h has unit variance
-    assert errors["neutral_mm"] < 1e-3
+    # h has unit variance; the closed form recovers it to float32 rounding
+    below(
+        errors["coefficients_rms"],
+        1e-3,
+        "closed-form least squares in float32",
+        what="rms",
+    )
+    below(errors["neutral_mm"], 1e-3, "closed-form least squares in float32", what="mm")
 
 
 def test_contrast_pairs_join_each_frame_to_its_base() -> None:

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/cpu_features.h"
 #include "core/error.h"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -207,10 +208,7 @@ __attribute__((target("avx2,fma"))) void scatter_avx2(const std::int32_t* cols, 
   }
 }
 
-bool cpu_has_avx2_fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-}
+bool cpu_has_avx2_fma() { return core::cpu_features().avx2; }
 #endif
 
 template <class Index>
