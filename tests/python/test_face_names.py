@@ -11,6 +11,7 @@ import subprocess
 from pathlib import Path
 
 from softdeca_train.face_names import ARKIT_BLENDSHAPES, DEFINITION, LIVELINKFACE_VALUES
+from softdeca_train.runtime.native import blendshape_index
 from softdeca_train.streaming.livelinkface import CANONICAL, VALUE_NAMES
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -61,3 +62,18 @@ def test_the_swift_copies_are_the_ones_its_tests_check() -> None:
         assert any(rx.search(text) for rx in LIST_MARKERS.values()), name
     swift_test = ROOT / "ios_capture/Tests/SoftDecaCaptureTests/FaceNamesTests.swift"
     assert "plugin/data/face_names.json" in swift_test.read_text()
+
+
+def test_rig_names_map_as_the_librarys_table_says() -> None:
+    """The library's rule for rigs' names, through the C ABI, on the table the native and C#
+    tests read too."""
+    table = ROOT / "tests" / "golden" / "names" / "rig_blendshape_names.tsv"
+    rows = [
+        line.split("\t")
+        for line in table.read_text().splitlines()
+        if "\t" in line and not line.startswith("#")
+    ]
+    assert len(rows) > 30
+    for name, want in rows:
+        expected = -1 if want == "-" else ARKIT_BLENDSHAPES.index(want)
+        assert blendshape_index(name) == expected, name

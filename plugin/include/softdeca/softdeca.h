@@ -525,6 +525,13 @@ SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, floa
  * index >= 52. Static strings. */
 SOFTDECA_API const char* softdeca_blendshape_name(uint32_t index);
 
+/* The canonical index of the ARKit blendshape a rig's own shape name denotes, or -1 in
+ * *out_index: ARKit's names in any case, behind a prefix or namespace ("blendShape1.eyeBlinkLeft",
+ * "AK_07_EyeBlinkLeft"), with the side as a suffix ("eyeBlink_L", "eyeBlink.R", "eyeBlinkL"),
+ * in snake case ("mouth_smile_l"); a word after the name ("eyeBlinkLeft_corrective") means no
+ * match. The one rule of the product for rigs' names (docs/avatars.md). */
+SOFTDECA_API softdeca_status softdeca_blendshape_index(const char* name, int32_t* out_index);
+
 typedef enum softdeca_tracking {
   SOFTDECA_TRACKING_LOST = 0,
   SOFTDECA_TRACKING_TRACKED = 1,

@@ -7,6 +7,7 @@
 #include "api/handles.h"
 #include "live/receiver.h"
 #include "stream/arkit_names.h"
+#include "stream/rig_names.h"
 
 struct softdeca_receiver {
   std::unique_ptr<softdeca::live::Receiver> impl;
@@ -33,6 +34,14 @@ void frame_out(softdeca_frame* out, softdeca_bool* out_received, bool got, const
 extern "C" {
 
 SOFTDECA_API const char* softdeca_blendshape_name(uint32_t index) { return stream::blendshape_name(index); }
+
+SOFTDECA_API softdeca_status softdeca_blendshape_index(const char* name, int32_t* out_index) {
+  return guarded(__func__, [&] {
+    require_not_null(name, "name");
+    require_not_null(out_index, "out_index");
+    *out_index = stream::rig_blendshape_index(name);
+  });
+}
 
 SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_config* config) {
   return guarded(__func__, [&] {

@@ -169,6 +169,14 @@ def check(status: int) -> None:
         raise NativeError(status, lib().softdeca_last_error().decode())
 
 
+def blendshape_index(name: str) -> int:
+    """The canonical index (0..51) of the ARKit shape a rig's name denotes, or -1: the library's
+    one rule for rigs' names (softdeca_blendshape_index; "eyeBlink_L", "AK_07_EyeBlinkLeft")."""
+    index = C.c_int32(-1)
+    check(lib().softdeca_blendshape_index(name.encode(), C.byref(index)))
+    return index.value
+
+
 def _f32(a: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float32)
 

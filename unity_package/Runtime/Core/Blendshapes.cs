@@ -6,8 +6,9 @@ namespace SoftDeca
     /// <summary>
     /// The library's canonical blendshape order and a name-based map from any source's order
     /// (AR Foundation's ARKitBlendShapeLocation, Live Link Face, a rig) into it. Sources never
-    /// match by position: each source name is matched to a canonical name, ignoring case
-    /// ("EyeBlinkLeft" and "eyeBlinkLeft" are the same shape).
+    /// match by position: each source name is matched to a canonical name by the library's rule
+    /// for rigs' names (CanonicalIndex: "EyeBlinkLeft", "eyeBlink_L" and
+    /// "blendShape1.eyeBlinkLeft" are the same shape).
     /// </summary>
     public sealed class BlendshapeMap
     {
@@ -33,14 +34,22 @@ namespace SoftDeca
             }
         }
 
-        /// <summary>The canonical index of a name (any case), or -1.</summary>
-        public static int CanonicalIndex(string name)
+        /// <summary>
+        /// The canonical index of the ARKit shape a name denotes, or -1: ARKit's names in any case,
+        /// behind a prefix or namespace ("blendShape1.eyeBlinkLeft", "AK_07_EyeBlinkLeft"), with
+        /// the side as a suffix ("eyeBlink_L", "eyeBlink.R"). The library's rule
+        /// (softdeca_blendshape_index), the same for every part of the product.
+        /// </summary>
+        public static unsafe int CanonicalIndex(string name)
         {
             if (name == null) throw new ArgumentNullException("name");
-            string[] names = CanonicalNames;
-            for (int i = 0; i < names.Length; ++i)
-                if (string.Equals(names[i], name, StringComparison.OrdinalIgnoreCase)) return i;
-            return -1;
+            Library.EnsureCompatible();
+            byte[] text = Utf8.ToNative(name, "name");
+            int index;
+            Status s;
+            fixed (byte* p = text) s = NativeMethods.softdeca_blendshape_index(p, out index);
+            Library.Check(s);
+            return index;
         }
 
         /// <summary>

@@ -25,6 +25,7 @@ namespace SoftDeca
         [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_last_error();
         [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_status_name(Status status);
         [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_blendshape_name(uint index);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_blendshape_index(byte* name, out int index);
 
         // ---- model ----
         [DllImport(Library, CallingConvention = Cdecl)]

@@ -106,6 +106,24 @@ namespace SoftDeca.Tests
         }
 
         [Test]
+        public void RigNamesMapAsTheLibrarysTableSays()
+        {
+            int rows = 0;
+            foreach (string line in File.ReadAllLines(TestData.Require("SOFTDECA_RIG_NAMES")))
+            {
+                if (line.StartsWith("#", StringComparison.Ordinal) || line.IndexOf('\t') < 0) continue;
+                string[] f = line.Split('\t');
+                int want = f[1] == "-" ? -1 : Array.IndexOf(BlendshapeMap.CanonicalNames, f[1]);
+                Assert.AreEqual(want, BlendshapeMap.CanonicalIndex(f[0]), "'" + f[0] + "'");
+                ++rows;
+            }
+            Assert.Greater(rows, 30);
+            var map = new BlendshapeMap(new[] { "Basis", "blendShape1.eyeBlink_L", "AK_25_JawOpen" });
+            CollectionAssert.AreEqual(new[] { "Basis" }, map.Unmatched);
+            Assert.AreEqual(BlendshapeMap.CanonicalIndex("jawOpen"), map.ToCanonical(2));
+        }
+
+        [Test]
         public void UnknownNamesAreReportedAndDuplicatesRefused()
         {
             var map = new BlendshapeMap(new[] { "EyeBlinkLeft", "HeadYaw", null });
