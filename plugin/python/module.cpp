@@ -14,6 +14,7 @@ namespace nb = nanobind;
 using namespace softdeca::geometry;
 
 void bind_sim(nb::module_& m);  // sim_bindings.cpp: the physics simulator
+void bind_fit(nb::module_& m);  // fit_bindings.cpp: fitting a user's avatar
 
 NB_MODULE(softdeca_native, m) {
   m.doc() = "SoftDECA native geometry (C++), used by the training pipeline";
@@ -42,4 +43,5 @@ NB_MODULE(softdeca_native, m) {
         nb::arg("vertices_b"), nb::arg("triangles_b"), nb::arg("max_pairs") = 1000,
         "Pairs (triangle of A, triangle of B) that intersect.");
   bind_sim(m);
+  bind_fit(m);
 }

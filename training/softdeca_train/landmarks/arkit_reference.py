@@ -18,6 +18,7 @@ import numpy as np
 
 from softdeca_train.landmarks.topology import boundary_loops, edge_graph, graph_nearest
 from softdeca_train.paths import cache_dir, default_arkit_reference_path
+from softdeca_train.runtime.native import blendshape_index
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 
 CACHE_FORMAT = 1
@@ -33,28 +34,19 @@ EYE_LEFT_68 = tuple(range(42, 48))
 LIP_INNER_68 = tuple(range(60, 68))
 NEUTRAL_NAMES = ("neutral", "basis", "base", "rest")
 
-_SIDE = re.compile(r"^(?P<base>.*?)(?:[_\-. ](?P<s>[lr])|(?P<w>left|right))$", re.IGNORECASE)
-
 
 def _key(text: str) -> str:
     return re.sub(r"[^a-z0-9]", "", text.lower())
 
 
-_CANONICAL = {_key(n): n for n in ARKIT_BLENDSHAPES}
-
-
 def canonical_shape_name(stem: str) -> str | None:
     """The canonical ARKit name of a file stem ("eyeBlink_L", "EyeBlinkLeft", "eye_blink_left"
-    all give "eyeBlinkLeft"), "neutral" for a rest shape, None if it is not an ARKit shape."""
+    all give "eyeBlinkLeft"; the library's rule for rigs' names, softdeca_blendshape_index),
+    "neutral" for a rest shape, None if it is not an ARKit shape."""
     if _key(stem) in NEUTRAL_NAMES:
         return "neutral"
-    m = _SIDE.match(stem)
-    if m and (m["s"] or m["w"]):
-        side = (m["s"] or m["w"]).lower()
-        key = _key(m["base"]) + ("left" if side in ("l", "left") else "right")
-        if key in _CANONICAL:
-            return _CANONICAL[key]
-    return _CANONICAL.get(_key(stem))
+    index = blendshape_index(stem)
+    return ARKIT_BLENDSHAPES[index] if index >= 0 else None
 
 
 def _parse_obj(data: bytes) -> tuple[np.ndarray, np.ndarray]:

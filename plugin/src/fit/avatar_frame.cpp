@@ -1,0 +1,185 @@
+#include "fit/avatar_frame.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+#include "stream/arkit_names.h"
+
+namespace softdeca::fit {
+namespace {
+
+// A shape's motion counts where it exceeds this share of the shape's largest: the rest is an
+// exporter's rounding (bodies carry 1e-7 "motion" in many files).
+constexpr double kMotionShare = 0.002;
+
+// Left/Right pairs whose shapes move one side's part of the face (not "mouthLeft"/"jawLeft",
+// which move the whole mouth or jaw sideways), with the distance between the Left and the Right
+// shape's centres of motion on the ICT template, in metres (tests/python/test_avatar_frame.py
+// measures them again on the template).
+struct SidePair {
+  const char* stem;
+  double template_distance;
+};
+constexpr SidePair kSidePairs[] = {
+    {"browDown", 0.0836},    {"browOuterUp", 0.0939},  {"cheekSquint", 0.0775},   {"eyeBlink", 0.0657},
+    {"eyeLookDown", 0.0679}, {"eyeLookIn", 0.0672},    {"eyeLookOut", 0.0685},    {"eyeLookUp", 0.0663},
+    {"eyeSquint", 0.0709},   {"eyeWide", 0.0676},      {"mouthDimple", 0.0400},   {"mouthFrown", 0.0408},
+    {"mouthLowerDown", 0.0250}, {"mouthPress", 0.0318}, {"mouthSmile", 0.0512},  {"mouthStretch", 0.0426},
+    {"mouthUpperUp", 0.0326}, {"noseSneer", 0.0391},
+};
+
+// Units a measured scale snaps to when within 25 %: mm, cm, inch, dm, m.
+constexpr double kUnits[] = {0.001, 0.01, 0.0254, 0.1, 1.0};
+constexpr double kSnap = 1.25;
+
+struct Motion {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // motion-weighted centre of what moves
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // summed deltas over summed lengths
+  bool moves = false;
+};
+
+// Shapes that move the face forward, out of it, on every rig (the ICT template: 0.63 to 0.94 of
+// their motion along +Z): they tell a mirrored mesh from a right-handed one.
+constexpr const char* kForwardShapes[] = {"jawForward", "mouthPucker", "mouthFunnel", "cheekPuff"};
+
+int index_of(const std::string& name) { return stream::blendshape_index(name); }
+
+bool starts_with(const char* s, const char* prefix) { return std::string(s).rfind(prefix, 0) == 0; }
+
+void check_finite(const float* p, std::size_t n, const std::string& what) {
+  for (std::size_t i = 0; i < n; ++i)
+    require(std::isfinite(p[i]), what + " has a non-finite value at vertex " + std::to_string(i / 3));
+}
+
+// The motion-weighted centre of one shape's moving vertices; marks them in `face`.
+Motion shape_motion(const AvatarShapes& s, const float* d, std::vector<uint8_t>& face) {
+  const std::size_t n = s.vertex_count;
+  double peak = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    peak = std::max(peak, Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm());
+  Motion m;
+  if (!(peak > 0)) return m;
+  double total = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const double w = Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm();
+    if (w <= kMotionShare * peak) continue;
+    face[v] = 1;
+    total += w;
+    m.centre += w * Eigen::Vector3d(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
+    m.direction += Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]);
+  }
+  m.centre /= total;
+  m.direction /= total;
+  m.moves = true;
+  return m;
+}
+
+double median(std::vector<double> x) {
+  std::sort(x.begin(), x.end());
+  const std::size_t h = x.size() / 2;
+  return x.size() % 2 ? x[h] : 0.5 * (x[h - 1] + x[h]);
+}
+
+std::string axis_name(const Eigen::Vector3d& up) {
+  Eigen::Index k = 0;
+  up.cwiseAbs().maxCoeff(&k);
+  return std::string(up[k] < 0 ? "-" : "+") + "XYZ"[k];
+}
+
+// Area-weighted normals of the triangles whose corners all move: a face's sum points out of it.
+Eigen::Vector3d face_normal_sum(const AvatarShapes& s, const std::vector<uint8_t>& face) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  const auto at = [&](int32_t i) { return Eigen::Vector3d(s.neutral[3 * i], s.neutral[3 * i + 1], s.neutral[3 * i + 2]); };
+  for (std::size_t t = 0; t < s.triangle_count; ++t) {
+    const int32_t* c = s.triangles + 3 * t;
+    if (face[static_cast<std::size_t>(c[0])] && face[static_cast<std::size_t>(c[1])] && face[static_cast<std::size_t>(c[2])])
+      sum += (at(c[1]) - at(c[0])).cross(at(c[2]) - at(c[0]));
+  }
+  return sum;
+}
+
+}  // namespace
+
+AvatarFrame avatar_frame(const AvatarShapes& s) {
+  require(s.neutral != nullptr && s.vertex_count > 0, "the avatar has no vertices");
+  check_finite(s.neutral, 3 * s.vertex_count, "the neutral mesh");
+  require(s.triangles != nullptr || s.triangle_count == 0, "triangle_count without triangles");
+  for (std::size_t i = 0; i < 3 * s.triangle_count; ++i)
+    require(s.triangles[i] >= 0 && static_cast<std::size_t>(s.triangles[i]) < s.vertex_count,
+            "triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh");
+  AvatarFrame f;
+  f.face.assign(s.vertex_count, 0);
+  std::array<Motion, kShapes> motion{};
+  for (std::size_t i = 0; i < kShapes; ++i) {
+    if (s.deltas[i] == nullptr) continue;
+    check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
+    motion[i] = shape_motion(s, s.deltas[i], f.face);
+    f.shapes_used += motion[i].moves;
+  }
+  f.face_vertices = static_cast<std::size_t>(std::count(f.face.begin(), f.face.end(), uint8_t{1}));
+  require(f.shapes_used > 0, "none of the avatar's ARKit blendshapes moves a vertex: no face to fit");
+
+  // The subject's left: the Left shapes' centres minus the Right ones', summed (far-apart pairs
+  // weigh most); the unit: the template's distances over the avatar's, pair by pair.
+  Eigen::Vector3d left = Eigen::Vector3d::Zero();
+  std::vector<double> scales;
+  Eigen::Vector3d eyes = Eigen::Vector3d::Zero();
+  int eye_pairs = 0;
+  double eye_distance = 0;
+  for (const SidePair& p : kSidePairs) {
+    const Motion& l = motion[static_cast<std::size_t>(index_of(std::string(p.stem) + "Left"))];
+    const Motion& r = motion[static_cast<std::size_t>(index_of(std::string(p.stem) + "Right"))];
+    if (!l.moves || !r.moves) continue;
+    const Eigen::Vector3d d = l.centre - r.centre;
+    left += d;
+    if (d.norm() > 0) scales.push_back(p.template_distance / d.norm());
+    if (starts_with(p.stem, "eye")) {
+      eyes += 0.5 * (l.centre + r.centre);
+      eye_distance += d.norm();
+      ++eye_pairs;
+    }
+  }
+  require(left.norm() > 0 && !scales.empty(),
+          "the avatar needs a Left/Right pair of ARKit shapes that move one side of the face (eyeBlink, "
+          "browDown, mouthSmile, ...) to tell its left from its right; it has none");
+  f.left = left.normalized();
+
+  // Up: the eye and brow shapes' centres above the mouth and jaw shapes'.
+  Eigen::Vector3d upper = Eigen::Vector3d::Zero(), lower = Eigen::Vector3d::Zero();
+  int n_upper = 0, n_lower = 0;
+  for (std::size_t i = 0; i < kShapes; ++i) {
+    if (!motion[i].moves) continue;
+    const char* name = stream::blendshape_name(i);
+    if (starts_with(name, "eye") || starts_with(name, "brow")) upper += motion[i].centre, ++n_upper;
+    if (starts_with(name, "mouth") || starts_with(name, "jaw")) lower += motion[i].centre, ++n_lower;
+  }
+  require(n_upper > 0 && n_lower > 0,
+          "the avatar needs eye or brow shapes and mouth or jaw shapes to tell up from down; it has " +
+              std::string(n_upper ? "no mouth or jaw shape" : "no eye or brow shape"));
+  Eigen::Vector3d up = upper / n_upper - lower / n_lower;
+  up -= up.dot(f.left) * f.left;
+  require(up.norm() > 0, "the avatar's eye and mouth shapes move the same place: no up direction");
+  f.up = up.normalized();
+  f.forward = f.left.cross(f.up);
+  f.up_axis = axis_name(f.up);
+
+  f.metres_per_unit_measured = median(scales);
+  f.metres_per_unit = f.metres_per_unit_measured;
+  for (const double unit : kUnits)
+    if (std::fabs(std::log(f.metres_per_unit_measured / unit)) < std::log(kSnap)) f.metres_per_unit = unit;
+  f.eye_distance = eye_pairs ? eye_distance / eye_pairs : 0.066 / f.metres_per_unit;
+  if (eye_pairs) f.eyes = eyes / eye_pairs;
+  // Which way is out of the face: the forward shapes' motion; without them the face's normals
+  // (outward for a consistently wound mesh). Either disagreeing with left x up: a mirrored mesh.
+  Eigen::Vector3d ahead = Eigen::Vector3d::Zero();
+  for (const char* name : kForwardShapes) ahead += motion[static_cast<std::size_t>(index_of(name))].direction;
+  if (ahead.norm() == 0 && s.triangles != nullptr) ahead = face_normal_sum(s, f.face);
+  f.mirrored = ahead.dot(f.forward) < 0;
+  if (f.mirrored) f.forward = -f.forward;
+  return f;
+}
+
+}  // namespace softdeca::fit
