@@ -11,7 +11,8 @@ namespace softdeca::cli {
 
 int run_info(const Args& args) {
   Options o("info", "Describe a recording: its header, frames, duration and rate, landmark profile, and the\n"
-                    "damage recovered from (skipped stretches, a cut-off last record).");
+                    "damage recovered from (skipped stretches, a cut-off last record) and the frames whose values\n"
+                    "were left out or clamped (docs/recording.md, \"Values\").");
   o.positional("RECORDING", "a .sdrec file").flag("--json", "print JSON instead of text");
   if (!o.parse(args)) return 0;
   const recording::Recording rec = recording::read_recording(o.arg(0));
@@ -36,6 +37,8 @@ int run_info(const Args& args) {
   j.number("skipped_bytes", double(rec.recovery.skipped_bytes));
   j.number("truncated_bytes", double(rec.recovery.truncated_bytes));
   j.number("unknown_records", double(rec.recovery.unknown_records));
+  j.number("invalid_frames", double(rec.recovery.invalid_frames));
+  j.number("clamped_frames", double(rec.recovery.clamped_frames));
   if (o.on("--json")) {
     std::printf("%s\n", j.str(true).c_str());
     return 0;
@@ -52,6 +55,8 @@ int run_info(const Args& args) {
   std::printf("  %zu records; damage: %zu regions (%zu bytes) skipped, %zu bytes cut off at the end\n",
               rec.recovery.records, rec.recovery.damaged_regions, rec.recovery.skipped_bytes,
               rec.recovery.truncated_bytes);
+  std::printf("  values: %zu frames left out (not finite, not a rotation), %zu with weights clamped to [0, 1]\n",
+              rec.recovery.invalid_frames, rec.recovery.clamped_frames);
   return 0;
 }
 

@@ -19,10 +19,13 @@ Take read_take(const std::string& path, std::size_t max_frames) {
     take.rows = t.rows;
     take.face_lost = t.face_lost_rows;
     take.invalid = t.malformed_rows;
+    take.clamped = t.clamped_rows;
     frames = std::move(t.frames);
   } else {
     recording::Recording r = recording::read_recording(path);
-    take.rows = r.frames.size();
+    take.rows = r.frames.size() + r.recovery.invalid_frames;
+    take.invalid = r.recovery.invalid_frames;
+    take.clamped = r.recovery.clamped_frames;
     frames = std::move(r.frames);
   }
   std::vector<double> times;
@@ -32,7 +35,7 @@ Take read_take(const std::string& path, std::size_t max_frames) {
       continue;
     }
     std::array<float, 52> w{};
-    for (std::size_t i = 0; i < 52; ++i) w[i] = std::min(1.0f, std::max(0.0f, f.weights[i]));
+    std::copy(f.weights.begin(), f.weights.end(), w.begin());  // in [0, 1]: the frame rule
     take.weights.push_back(w);
     times.push_back(f.capture_time);
     if (max_frames && take.weights.size() >= max_frames) break;

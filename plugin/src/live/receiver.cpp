@@ -330,7 +330,11 @@ bool Receiver::request_neutral() {
 }
 
 void Receiver::start_recording(const std::string& path, const recording::Header& header) {
-  auto writer = std::make_unique<recording::RecordingWriter>(path, header);  // may throw: no lock held
+  start_recording(std::make_unique<recording::RecordingWriter>(path, header), header);  // may throw: no lock held
+}
+
+void Receiver::start_recording(std::unique_ptr<recording::RecordingWriter> writer, const recording::Header& header) {
+  require(writer != nullptr, "no writer to record into");
   auto recorder = std::make_unique<recording::BackgroundRecorder>(std::move(writer), config_.recording_queue);
   std::unique_ptr<recording::BackgroundRecorder> previous;
   {

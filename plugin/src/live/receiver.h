@@ -66,6 +66,8 @@ class Receiver {
   bool request_neutral();
   // Records every frame delivered from now on (and profiles and neutral meshes as they come).
   void start_recording(const std::string& path, const recording::Header& header);
+  // The same into a writer the caller opened (`header` is the one it was opened with).
+  void start_recording(std::unique_ptr<recording::RecordingWriter> writer, const recording::Header& header);
   // Stops recording; returns the error that stopped it early, "" if none.
   std::string stop_recording();
   // Frames written by the current or last recording.

@@ -29,7 +29,7 @@ ConversionReport csv_to_recording(const std::string& csv_path, const std::string
   h.clock = "timecode seconds since midnight";
   RecordingWriter writer(recording_path, h);
   for (const stream::Frame& f : take.frames) writer.write(f);
-  return {writer.frames_written(), take.rows, take.face_lost_rows, take.malformed_rows};
+  return {writer.frames_written(), take.rows, take.face_lost_rows, take.malformed_rows, take.clamped_rows};
 }
 
 ConversionReport recording_to_csv(const std::string& recording_path, const std::string& csv_path,

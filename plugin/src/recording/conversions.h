@@ -11,6 +11,7 @@ struct ConversionReport {
   std::size_t rows = 0;
   std::size_t face_lost_rows = 0;
   std::size_t malformed_rows = 0;
+  std::size_t clamped_rows = 0;
 };
 
 // timecode_rate <= 0: the app's default (60).

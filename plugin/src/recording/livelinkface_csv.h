@@ -19,7 +19,9 @@ struct CsvTake {
   std::vector<stream::Frame> frames;  // capture_time: timecode seconds since midnight
   std::size_t rows = 0;
   std::size_t face_lost_rows = 0;  // skipped: the app had no face
-  std::size_t malformed_rows = 0;  // skipped: wrong field count, bad number or timecode
+  std::size_t malformed_rows = 0;  // skipped: wrong field count, bad number or timecode, or
+                                   // values the frame rule refuses (frame_rule.h)
+  std::size_t clamped_rows = 0;    // kept with weights clamped to [0, 1] (the frame rule)
 };
 
 // Throws softdeca::Error (FORMAT) when the header lacks Timecode or a blendshape column.

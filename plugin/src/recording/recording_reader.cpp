@@ -1,10 +1,10 @@
 #include "recording/recording_reader.h"
 
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "core/error.h"
+#include "core/regular_file.h"
+#include "recording/frame_rule.h"
 #include "recording/record_codec.h"
 #include "stream/crc32.h"
 
@@ -126,7 +126,14 @@ void apply_record(const uint8_t* payload, std::size_t length, const std::vector<
     case RecordType::frame: {
       stream::Frame f;
       ok = decode_frame_record(r, order, f);
-      if (ok) rec.frames.push_back(f);
+      if (!ok) break;
+      const FrameVerdict verdict = apply_frame_rule(f);
+      if (verdict == FrameVerdict::refused) {
+        ++rec.recovery.invalid_frames;
+        break;
+      }
+      rec.recovery.clamped_frames += verdict == FrameVerdict::clamped;
+      rec.frames.push_back(f);
       break;
     }
     case RecordType::profile: {
@@ -188,10 +195,10 @@ Recording parse_recording(const uint8_t* data, std::size_t size) {
 }
 
 Recording read_recording(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(SOFTDECA_ERROR_IO, "cannot open " + path);
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(SOFTDECA_ERROR_IO, "cannot read " + path);
+  const FilePtr file = open_regular_file(path, FileAccess::read);
+  std::vector<uint8_t> bytes(static_cast<std::size_t>(file_size(file.get())));
+  if (std::fread(bytes.data(), 1, bytes.size(), file.get()) != bytes.size())
+    throw Error(SOFTDECA_ERROR_IO, "cannot read " + path);
   return parse_recording(bytes.data(), bytes.size());
 }
 

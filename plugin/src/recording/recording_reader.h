@@ -21,11 +21,15 @@ struct Recovery {
   std::size_t truncated_bytes = 0;   // end of file after the last good record: a cut-off record
   std::size_t unknown_records = 0;   // good records of a type this version does not know
   std::size_t checksum_bytes = 0;    // bytes run through CRC-32: at most the file's size
+  // Frames whose values break the frame rule (frame_rule.h): left out, or kept with their
+  // weights clamped to [0, 1].
+  std::size_t invalid_frames = 0;
+  std::size_t clamped_frames = 0;
 };
 
 struct Recording {
   Header header;
-  std::vector<stream::Frame> frames;                // in file order
+  std::vector<stream::Frame> frames;                // in file order, each within the frame rule
   std::vector<stream::wire::Profile> profiles;      // the header's, then any recorded later
   std::vector<float> neutral;                       // the last neutral mesh in the file, if any
   Recovery recovery;
