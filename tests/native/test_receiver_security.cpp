@@ -120,6 +120,24 @@ TEST(ReceiverSecurity, EachSourceIsRateLimited) {
   EXPECT_EQ(small.sources(), 16u);
 }
 
+// Datagrams the rate limit drops are counted there, not again as lost: the holder's sequence
+// numbers they leave out are no loss on the network.
+TEST(ReceiverSecurity, RateLimitedDatagramsAreNotCountedAsLost) {
+  ReceiverConfig c = loopback();
+  c.source_rate_limit = 40;  // burst of 10
+  Receiver r(c);
+  FrameSender s(make_endpoint("127.0.0.1", r.port()), Format::softdeca, 9);
+  for (uint32_t i = 0; i < 100; ++i) ASSERT_TRUE(s.send(make_frame(i)));
+  ASSERT_TRUE(eventually([&] { return r.stats().datagrams == 100; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // a few tokens back
+  ASSERT_TRUE(s.send(make_frame(100)));                         // after the gap the limit left
+  ASSERT_TRUE(eventually([&] { return r.stats().datagrams == 101; }));
+  const ReceiverStats st = r.stats();
+  EXPECT_GE(st.rate_limited, 80u);
+  EXPECT_EQ(st.lost, 0u);
+  EXPECT_EQ(st.expected, 101u);
+}
+
 // The flood of the review: iFacialMocap datagrams from 200 source ports on loopback while
 // recording. Bounded: 200 senders x 25 datagrams, sent as fast as the socket takes them.
 TEST(ReceiverSecurity, FloodFromManyPortsKeepsTheSessionAndBoundsTheRecording) {

@@ -80,6 +80,8 @@ class Receiver {
   void handle(const uint8_t* data, std::size_t size, const stream::Endpoint& from, double now);
   void count_drop(stream::DropReason reason);
   void start_session(uint32_t session);
+  // Sequence numbers of this session never received, less those the rate limit dropped.
+  uint64_t session_lost() const;
   void on_frame(stream::Frame frame, const stream::Datagram& datagram, double now);
   void release_due(double now);
   void deliver(const stream::Frame& frame, double now);
@@ -100,6 +102,9 @@ class Receiver {
   stream::Format session_format_ = stream::Format::softdeca;
   stream::SequenceTracker sequence_;
   uint64_t lost_before_ = 0;      // earlier sessions' losses
+  // The holder's datagrams this session that the rate limit dropped: the sequence numbers they
+  // leave out are counted in rate_limited, not lost.
+  uint64_t holder_rate_limited_ = 0;
   uint64_t expected_before_ = 0;
   stream::JitterBuffer jitter_;
   std::array<float, stream::kBlendshapeCount> previous_weights_{};  // for sources that omit weights
