@@ -27,9 +27,9 @@ int run_convert(const Args& args) {
   if (o.given("--fps") && !(fps > 0 && fps <= 1000)) throw UsageError("--fps must be in (0, 1000]");
   if (ends_with(in, ".csv") && ends_with(out, ".sdrec")) {
     const auto r = recording::csv_to_recording(in, out, fps);
-    std::printf("%s: %zu rows, %zu frames written (%zu with weights clamped to [0, 1]), %zu face-lost rows skipped, "
-                "%zu malformed rows skipped\n",
-                out.c_str(), r.rows, r.frames, r.clamped_rows, r.face_lost_rows, r.malformed_rows);
+    std::printf("%s: %zu rows, %zu frames written, %zu face-lost rows skipped, %zu malformed rows skipped, %zu rows "
+                "with weights clamped to [0, 1]\n",
+                out.c_str(), r.rows, r.frames, r.face_lost_rows, r.malformed_rows, r.clamped_rows);
     return 0;
   }
   if (ends_with(in, ".sdrec") && ends_with(out, ".csv")) {
