@@ -21,6 +21,7 @@
 
 #include "bench_fifo.h"
 #include "bench_figures.h"
+#include "bench_recording_memory.h"
 #include "command.h"
 #include "json.h"
 #include "live/receiver.h"
@@ -181,7 +182,8 @@ int run_bench_reliability(const Args& args) {
             "iFacialMocap flood from many source ports on 127.0.0.1 while recording (session changes,\n"
             "recording growth), the reader on a crafted damaged recording (seconds per MiB), and the\n"
             "consumer's poll while the recording's disk cannot keep up (p99 poll time), and how long every\n"
-            "path that opens a recording or CSV take takes to refuse a FIFO.");
+            "path that opens a recording or CSV take takes to refuse a FIFO, and the memory an opened\n"
+            "recording holds per frame.");
   declare_output_options(o, "reliability", "where the runs write their files");
   o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
@@ -205,6 +207,8 @@ int run_bench_reliability(const Args& args) {
   load = std::max(load, load_average());
   std::fprintf(stderr, "bench-reliability: FIFOs\n");
   const FifoRefusal fifo = fifo_refusal_run(scratch);
+  std::fprintf(stderr, "bench-reliability: recording memory\n");
+  const RecordingMemory memory = recording_memory_run(scratch + "/bench-reliability-memory.sdrec", 20000);
 
   char load_text[80];
   std::snprintf(load_text, sizeof load_text, " (machine load average up to %.1f during the runs)", load);
@@ -236,6 +240,13 @@ int run_bench_reliability(const Args& args) {
           figure(fifo.worst_ms, "ms", "100", "lower",
                  how + "the slowest of " + std::to_string(fifo.paths) + " paths that open a recording or CSV take ("
                        + fifo.worst + ") to refuse a FIFO nobody writes"));
+  char memory_text[300];
+  std::snprintf(memory_text, sizeof memory_text,
+                "a recording of %zu frames with 149 landmarks (%.0f bytes a frame on disk) opened for playing; the "
+                "heap it holds (glibc mallinfo2), per frame",
+                memory.frames, memory.file_bytes_per_frame);
+  out.raw("reliability.recording_bytes_per_frame_in_memory",
+          figure(memory.heap_bytes_per_frame, "bytes/frame", "64", "lower", how + memory_text));
   write_text_file(o.text("--out"), out.str(true) + "\n");
   std::printf("%s\n", out.str(true).c_str());
   return 0;

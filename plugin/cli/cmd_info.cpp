@@ -5,7 +5,8 @@
 #include "command.h"
 #include "json.h"
 #include "options.h"
-#include "recording/recording_reader.h"
+#include "read_limits_arg.h"
+#include "recording/recording_index.h"
 
 namespace softdeca::cli {
 
@@ -14,16 +15,15 @@ int run_info(const Args& args) {
                     "damage recovered from (skipped stretches, a cut-off last record) and the frames whose values\n"
                     "were left out or clamped (docs/recording.md, \"Values\").");
   o.positional("RECORDING", "a .sdrec file").flag("--json", "print JSON instead of text");
+  declare_read_limits(o);
   if (!o.parse(args)) return 0;
-  const recording::Recording rec = recording::read_recording(o.arg(0));
+  // One pass over the file; frames stay on disk (memory grows with the frame count only).
+  const recording::RecordingIndex index = recording::RecordingIndex::open(o.arg(0), read_limits(o));
+  const recording::RecordingMeta& rec = index.meta();
   const auto& h = rec.header;
-  const std::size_t n = rec.frames.size();
-  const double duration = n > 1 ? rec.frames.back().capture_time - rec.frames.front().capture_time : 0;
-  std::size_t tracked = 0, with_landmarks = 0;
-  for (const auto& f : rec.frames) {
-    tracked += f.tracking == stream::Tracking::tracked;
-    with_landmarks += f.landmark_count > 0;
-  }
+  const std::size_t n = index.frame_count();
+  const double duration = n > 1 ? index.capture_time(n - 1) - index.capture_time(0) : 0;
+  const std::size_t tracked = index.tracked_frames(), with_landmarks = index.frames_with_landmarks();
   JsonObject j;
   j.text("device", h.device).text("subject", h.subject).text("source", h.source).text("clock", h.clock);
   j.number("start_unix_time", h.start_unix_time).number("timecode_rate", h.timecode_rate).text("units", h.units);

@@ -31,4 +31,7 @@ FilePtr open_regular_file(const std::string& path, FileAccess access);
 // The size in bytes of an open regular file.
 std::uint64_t file_size(std::FILE* file);
 
+// Exactly `n` bytes at `offset` (64-bit on every platform); false on an error or a short file.
+bool read_at(std::FILE* file, std::uint64_t offset, void* data, std::size_t n);
+
 }  // namespace softdeca

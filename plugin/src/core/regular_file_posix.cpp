@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <limits>
 
 #include "core/error.h"
 #include "core/regular_file.h"
@@ -65,6 +66,11 @@ std::uint64_t file_size(std::FILE* file) {
   struct stat st {};
   if (!file || ::fstat(::fileno(file), &st) != 0 || st.st_size < 0) return 0;
   return static_cast<std::uint64_t>(st.st_size);
+}
+
+bool read_at(std::FILE* file, std::uint64_t offset, void* data, std::size_t n) {
+  if (!file || offset > static_cast<std::uint64_t>(std::numeric_limits<off_t>::max())) return false;
+  return ::fseeko(file, static_cast<off_t>(offset), SEEK_SET) == 0 && std::fread(data, 1, n, file) == n;
 }
 
 }  // namespace softdeca

@@ -68,4 +68,9 @@ std::uint64_t file_size(std::FILE* file) {
   return static_cast<std::uint64_t>(size.QuadPart);
 }
 
+bool read_at(std::FILE* file, std::uint64_t offset, void* data, std::size_t n) {
+  if (!file || offset > static_cast<std::uint64_t>(INT64_MAX)) return false;
+  return _fseeki64(file, static_cast<__int64>(offset), SEEK_SET) == 0 && std::fread(data, 1, n, file) == n;
+}
+
 }  // namespace softdeca

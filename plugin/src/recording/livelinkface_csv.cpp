@@ -54,9 +54,11 @@ std::array<std::size_t, llf::kValueCount> csv_order() {
   return order;
 }
 
-std::string read_file(const std::string& path) {
+std::string read_file(const std::string& path, const ReadLimits& limits) {
   const FilePtr file = open_regular_file(path, FileAccess::read);
-  std::string text(static_cast<std::size_t>(file_size(file.get())), '\0');
+  const std::uint64_t size = file_size(file.get());
+  require_within(path, size, limits, "a CSV take");
+  std::string text(static_cast<std::size_t>(size), '\0');
   if (std::fread(text.data(), 1, text.size(), file.get()) != text.size())
     throw Error(SOFTDECA_ERROR_IO, "cannot read " + path);
   return text;
@@ -124,35 +126,60 @@ CsvTake parse_livelinkface_csv(std::string_view text, double rate) {
   return take;
 }
 
-CsvTake read_livelinkface_csv(const std::string& path, double rate) {
-  return parse_livelinkface_csv(read_file(path), rate);
+CsvTake read_livelinkface_csv(const std::string& path, double rate, const ReadLimits& limits) {
+  return parse_livelinkface_csv(read_file(path, limits), rate);
 }
 
 std::string format_livelinkface_csv(const std::vector<stream::Frame>& frames, int rate) {
-  require(rate > 0 && rate <= 1000, "timecode rate must be an integer in [1, 1000]");
-  const auto order = csv_order();
-  std::string out = "Timecode,BlendShapeCount";
-  for (std::size_t i : order) out += std::string(",") + llf::value_name(i);
-  out += '\n';
-  for (const stream::Frame& f : frames) {
-    if (f.tracking != stream::Tracking::tracked) continue;
-    require(std::isfinite(f.capture_time) && f.capture_time >= 0, "capture time not a time of day");
-    out += format_timecode(f.capture_time, rate) + ",61";
-    const llf::Values values = llf::frame_to_values(f);
-    for (std::size_t i : order) {
-      out += ',';
-      append_float(out, values[i]);
-    }
-    out += '\n';
-  }
+  std::string out = csv_header(rate);
+  for (const stream::Frame& f : frames) append_csv_row(out, f, rate);
   return out;
 }
 
+std::string csv_header(int rate) {
+  require(rate > 0 && rate <= 1000, "timecode rate must be an integer in [1, 1000]");
+  std::string out = "Timecode,BlendShapeCount";
+  for (std::size_t i : csv_order()) out += std::string(",") + llf::value_name(i);
+  return out + '\n';
+}
+
+bool append_csv_row(std::string& out, const stream::Frame& f, int rate) {
+  if (f.tracking != stream::Tracking::tracked) return false;
+  require(std::isfinite(f.capture_time) && f.capture_time >= 0, "capture time not a time of day");
+  out += format_timecode(f.capture_time, rate) + ",61";
+  const llf::Values values = llf::frame_to_values(f);
+  for (std::size_t i : csv_order()) {
+    out += ',';
+    append_float(out, values[i]);
+  }
+  out += '\n';
+  return true;
+}
+
+CsvWriter::CsvWriter(const std::string& path, int rate) : path_(path), rate_(rate), text_(csv_header(rate)) {
+  file_ = open_regular_file(path, FileAccess::create);
+}
+
+void CsvWriter::write(const stream::Frame& frame) {
+  rows_ += append_csv_row(text_, frame, rate_);
+  if (text_.size() >= kFlushBytes) flush();
+}
+
+void CsvWriter::finish() {
+  flush();
+  if (std::fflush(file_.get()) != 0) throw Error(SOFTDECA_ERROR_IO, "cannot write " + path_);
+}
+
+void CsvWriter::flush() {
+  if (std::fwrite(text_.data(), 1, text_.size(), file_.get()) != text_.size())
+    throw Error(SOFTDECA_ERROR_IO, "cannot write " + path_);
+  text_.clear();
+}
+
 void write_livelinkface_csv(const std::string& path, const std::vector<stream::Frame>& frames, int rate) {
-  const std::string text = format_livelinkface_csv(frames, rate);
-  const FilePtr out = open_regular_file(path, FileAccess::create);
-  if (std::fwrite(text.data(), 1, text.size(), out.get()) != text.size() || std::fflush(out.get()) != 0)
-    throw Error(SOFTDECA_ERROR_IO, "cannot write " + path);
+  CsvWriter out(path, rate);
+  for (const stream::Frame& f : frames) out.write(f);
+  out.finish();
 }
 
 }  // namespace softdeca::recording
