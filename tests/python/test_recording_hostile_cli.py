@@ -92,6 +92,15 @@ def test_out_of_range_values_are_counted_by_info_and_never_played(
     recording.write_recording(path, recording.Header(), frames)
     info = json.loads(run("info", str(path), "--json").stdout)
     assert (info["frames"], info["invalid_frames"], info["clamped_frames"]) == (2, 2, 1)
+    # The Python reader follows the same rule.
+    python = recording.read_recording(path)
+    assert (
+        len(python.frames),
+        python.recovery.invalid_frames,
+        python.recovery.clamped_frames,
+        python.recovery.damaged_regions,
+    ) == (2, 2, 1, 0)
+    assert python.frames[1].weights[:2].tolist() == [1.0, 0.0]
     played = run("play", str(path), "--speed", "1000")
     assert played.returncode == 0, played.stderr
     lines = [json.loads(line) for line in played.stdout.splitlines()]
