@@ -1,5 +1,7 @@
 #include "recording/recording_reader.h"
 
+#include "recording/recording_index.h"
+
 namespace softdeca::recording {
 
 Recording parse_recording(const uint8_t* data, std::size_t size) {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "recording/read_limits.h"
 #include "recording/record_scan.h"
-#include "recording/recording_index.h"
 
 namespace softdeca::recording {
 
