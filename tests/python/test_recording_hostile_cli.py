@@ -54,6 +54,7 @@ def good_recording(path: Path) -> Path:
             "1",
             "--quiet",
         ],
+        ["receive", "--port", "0", "--duration", "0.2", "--stats-json", "{fifo}.csv"],
     ],
 )
 def test_a_fifo_is_refused_at_once(tmp_path: Path, command: list[str]) -> None:
