@@ -19,7 +19,9 @@
 #include <thread>
 #include <vector>
 
+#include "bench_fifo.h"
 #include "bench_figures.h"
+#include "bench_recording_memory.h"
 #include "command.h"
 #include "json.h"
 #include "live/receiver.h"
@@ -115,13 +117,13 @@ struct SlowDisk {
   std::size_t recorded = 0;
 };
 
-// The recording goes into a FIFO drained at `drain_bytes_per_s` (a disk far slower than the
+// The recording goes into a pipe drained at `drain_bytes_per_s` (a disk far slower than the
 // stream); frames arrive at `rate` Hz; a consumer polls latest() and next(0) every millisecond.
-SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, double drain_bytes_per_s) {
-  std::filesystem::remove(fifo);
-  if (::mkfifo(fifo.c_str(), 0600) != 0) throw std::runtime_error("cannot make a FIFO at " + fifo);
-  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
-  if (reader < 0) throw std::runtime_error("cannot open " + fifo);
+SlowDisk slow_disk_run(double seconds, double rate, double drain_bytes_per_s) {
+  int ends[2];
+  if (::pipe(ends) != 0) throw std::runtime_error("cannot make a pipe");
+  const int reader = ends[0];
+  ::fcntl(reader, F_SETFL, O_NONBLOCK);
   std::atomic<bool> done{false}, draining_all{false};
   std::thread drain([&] {
     char buf[4096];
@@ -134,7 +136,9 @@ SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, dou
   live::ReceiverConfig c = loopback(stream::Format::softdeca);
   c.source_rate_limit = 0;
   live::Receiver r(c);
-  r.start_recording(fifo, recording::Header{});
+  r.start_recording(std::make_unique<recording::RecordingWriter>(FilePtr(::fdopen(ends[1], "wb")), "pipe",
+                                                                  recording::Header{}),
+                    recording::Header{});
   stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.port()), stream::Format::softdeca, 3);
   std::vector<double> polls;
   stream::Frame f;
@@ -165,7 +169,6 @@ SlowDisk slow_disk_run(const std::string& fifo, double seconds, double rate, dou
   done.store(true);
   drain.join();
   ::close(reader);
-  std::filesystem::remove(fifo);
   out.poll_p99_ms = 1000 * stream::percentile(polls, 0.99);
   out.poll_max_ms = 1000 * *std::max_element(polls.begin(), polls.end());
   return out;
@@ -178,7 +181,9 @@ int run_bench_reliability(const Args& args) {
             "Measure the receiver and the recording reader under hostile input (docs/security.md): an\n"
             "iFacialMocap flood from many source ports on 127.0.0.1 while recording (session changes,\n"
             "recording growth), the reader on a crafted damaged recording (seconds per MiB), and the\n"
-            "consumer's poll while the recording's disk cannot keep up (p99 poll time).");
+            "consumer's poll while the recording's disk cannot keep up (p99 poll time), and how long every\n"
+            "path that opens a recording or CSV take takes to refuse a FIFO, and the memory an opened\n"
+            "recording holds per frame.");
   declare_output_options(o, "reliability", "where the runs write their files");
   o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
@@ -198,8 +203,12 @@ int run_bench_reliability(const Args& args) {
   std::fprintf(stderr, ", resync");
   const double resync = resync_run(scratch + "/bench-reliability-resync.sdrec", static_cast<std::size_t>(mib));
   std::fprintf(stderr, ", slow disk\n");
-  const SlowDisk slow = slow_disk_run(scratch + "/bench-reliability-slow.fifo", slow_s, 240, 16384);
+  const SlowDisk slow = slow_disk_run(slow_s, 240, 16384);
   load = std::max(load, load_average());
+  std::fprintf(stderr, "bench-reliability: FIFOs\n");
+  const FifoRefusal fifo = fifo_refusal_run(scratch);
+  std::fprintf(stderr, "bench-reliability: recording memory\n");
+  const RecordingMemory memory = recording_memory_run(scratch + "/bench-reliability-memory.sdrec", 20000);
 
   char load_text[80];
   std::snprintf(load_text, sizeof load_text, " (machine load average up to %.1f during the runs)", load);
@@ -213,7 +222,7 @@ int run_bench_reliability(const Args& args) {
                 static_cast<unsigned long long>(flood.foreign), static_cast<unsigned long long>(flood.rate_limited));
   char slow_text[400];
   std::snprintf(slow_text, sizeof slow_text,
-                "frames with 149 landmarks at 240 Hz for %.0f s recorded into a FIFO drained at 16 KiB/s; the "
+                "frames with 149 landmarks at 240 Hz for %.0f s recorded into a pipe drained at 16 KiB/s; the "
                 "consumer polled latest() and next(0) every ms; %llu delivered, %zu recorded, %llu recording drops; "
                 "worst poll %.3f ms",
                 slow_s, static_cast<unsigned long long>(slow.delivered), slow.recorded,
@@ -227,6 +236,17 @@ int run_bench_reliability(const Args& args) {
                  how + std::to_string(mib) + " MiB of record headers claiming 64 KiB with wrong checksums, one "
                        "every 12 bytes, parsed in memory"));
   out.raw("reliability.poll_p99_ms_slow_disk", figure(slow.poll_p99_ms, "ms", "1", "lower", how + slow_text));
+  out.raw("reliability.fifo_open_ms",
+          figure(fifo.worst_ms, "ms", "100", "lower",
+                 how + "the slowest of " + std::to_string(fifo.paths) + " paths that open a recording or CSV take ("
+                       + fifo.worst + ") to refuse a FIFO nobody writes"));
+  char memory_text[300];
+  std::snprintf(memory_text, sizeof memory_text,
+                "a recording of %zu frames with 149 landmarks (%.0f bytes a frame on disk) opened for playing; the "
+                "heap it holds (glibc mallinfo2), per frame",
+                memory.frames, memory.file_bytes_per_frame);
+  out.raw("reliability.recording_bytes_per_frame_in_memory",
+          figure(memory.heap_bytes_per_frame, "bytes/frame", "64", "lower", how + memory_text));
   write_text_file(o.text("--out"), out.str(true) + "\n");
   std::printf("%s\n", out.str(true).c_str());
   return 0;

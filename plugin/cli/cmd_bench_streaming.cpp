@@ -23,6 +23,7 @@
 #include "stream/frame_sender.h"
 #include "stream/percentile.h"
 #include "stream/steady_clock.h"
+#include "stream/udp_socket.h"
 
 namespace softdeca::cli {
 namespace {
@@ -76,13 +77,16 @@ struct Receiving {
   }
 };
 
-live::ReceiverConfig loopback() {
+// The receiver's own throughput is measured with the per-source rate limit off (it would
+// otherwise measure the limit: 1,000 datagrams a second); flood_run measures the limit.
+live::ReceiverConfig loopback(double source_rate_limit = 0) {
   live::ReceiverConfig c;
   c.bind_address = "127.0.0.1";
   c.port = 0;
   c.format = stream::Format::softdeca;
   c.delay = 0;
   c.queue_capacity = 65536;
+  c.source_rate_limit = source_rate_limit;
   return c;
 }
 
@@ -121,6 +125,44 @@ Throughput throughput_run(std::size_t frames) {
   // The 0.2 s of polling at the end costs next to no CPU: the figure is the streaming work.
   const double cpu = process_cpu_seconds() - cpu_start;
   return {double(r.popped) / (r.last_pop - start), double(r.popped) / double(frames), 1e6 * cpu / double(r.popped)};
+}
+
+struct Flood {
+  double cpu_us_per_datagram;  // process CPU time per datagram the receiver read
+  double dropped_ratio;        // of those, the share the rate limit dropped
+};
+
+// CPU time per frame of the sending side alone (encoding and the send call), into a socket
+// nobody reads: what the throughput and flood runs' process CPU holds besides the receiver's.
+double sender_cpu_us(std::size_t frames) {
+  stream::UdpSocket sink("127.0.0.1", 0);
+  stream::FrameSender sender(stream::make_endpoint("127.0.0.1", sink.local_port()), stream::Format::softdeca, 13);
+  const double cpu_start = process_cpu_seconds();
+  for (std::size_t i = 0; i < frames; ++i) sender.send(sample_frame(i));
+  return 1e6 * (process_cpu_seconds() - cpu_start) / double(frames);
+}
+
+// One sender floods a receiver that keeps the default rate limit: what each datagram costs
+// when nearly all are dropped before decoding.
+Flood flood_run(std::size_t frames) {
+  const double cpu_start = process_cpu_seconds();
+  Receiving r(loopback(1000));
+  stream::FrameSender sender(stream::make_endpoint("127.0.0.1", r.receiver.port()), stream::Format::softdeca, 11);
+  for (std::size_t i = 0; i < frames; ++i) sender.send(sample_frame(i));
+  uint64_t seen = 0;
+  for (double quiet_since = steady_seconds(); steady_seconds() - quiet_since < 0.2;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const uint64_t now_seen = r.receiver.stats().datagrams;
+    if (now_seen != seen) {
+      seen = now_seen;
+      quiet_since = steady_seconds();
+    }
+  }
+  r.finish();
+  const live::ReceiverStats s = r.receiver.stats();
+  if (s.datagrams == 0) throw std::runtime_error("the flood run received nothing");
+  const double cpu = process_cpu_seconds() - cpu_start;
+  return {1e6 * cpu / double(s.datagrams), double(s.rate_limited) / double(s.datagrams)};
 }
 
 // Frames paced at `rate`; send -> available latencies of every frame.
@@ -181,7 +223,8 @@ RecordingRates recording_run(const std::string& path, std::size_t frames) {
 int run_bench_streaming(const Args& args) {
   Options o("bench-streaming",
             "Measure the streaming path on this machine: receiver throughput on 127.0.0.1 (frames blasted\n"
-            "as fast as the socket takes them), latency from send to frame available (frames paced),\n"
+            "as fast as the socket takes them, the per-source rate limit off), what the rate limit costs\n"
+            "per datagram under a flood, latency from send to frame available (frames paced),\n"
             "decoder cost, recording write and read rates. Medians over --runs runs; writes the figures\n"
             "as JSON (the benchmark format of docs/ARCHITECTURE.md, Conventions).");
   declare_output_options(o, "streaming", "where the recording runs write their file");
@@ -200,7 +243,8 @@ int run_bench_streaming(const Args& args) {
   std::vector<uint8_t> probe;
   stream::wire::encode_frame(sample_frame(0), probe);
 
-  std::vector<double> tput, delivered, cpu_us, p50, p99, decode_ns, write_fps, read_fps;
+  std::vector<double> tput, delivered, cpu_us, p50, p99, decode_ns, write_fps, read_fps, flood_us, flood_dropped,
+      sender_us;
   double load = load_average();
   double bytes_per_frame = 0;
   for (long run = 0; run < runs; ++run) {
@@ -209,6 +253,11 @@ int run_bench_streaming(const Args& args) {
     tput.push_back(t.per_second);
     delivered.push_back(t.delivered_ratio);
     cpu_us.push_back(t.cpu_us);
+    std::fprintf(stderr, ", flood");
+    const Flood fl = flood_run(static_cast<std::size_t>(tp));
+    flood_us.push_back(fl.cpu_us_per_datagram);
+    flood_dropped.push_back(fl.dropped_ratio);
+    sender_us.push_back(sender_cpu_us(static_cast<std::size_t>(tp)));
     std::fprintf(stderr, ", latency");
     const auto l = latency_run(static_cast<std::size_t>(lat), lat_rate);
     if (l.size() < static_cast<std::size_t>(lat) / 2) throw std::runtime_error("most latency frames were lost");
@@ -232,19 +281,33 @@ int run_bench_streaming(const Args& args) {
                             std::to_string(kLandmarks) + " landmarks)";
   JsonObject out;
   out.raw("streaming.datagrams_per_s",
-          figure(median(tput), "datagrams/s", "1000", "higher",
+          figure(median(tput), "datagrams/s", "20000", "higher",
                  cmd + ": median of " + std::to_string(runs) + " runs; " + std::to_string(tp) + " " + frame +
-                     " sent as fast as possible to a receiver on 127.0.0.1 (no jitter delay); frames delivered per "
-                     "second from the first send to the last delivery"));
+                     " sent as fast as possible to a receiver on 127.0.0.1 (no jitter delay, per-source rate "
+                     "limit off); frames delivered per second from the first send to the last delivery"));
   out.raw("streaming.cpu_us_per_datagram",
           figure(median(cpu_us), "us", "null", "lower",
                  cmd + ": in the throughput runs, the process's CPU time (sender, receiver and consumer "
                        "threads, user + system) per frame delivered; unlike the rate, it does not depend on "
                        "what else the machine runs"));
   out.raw("streaming.blast_delivered_ratio",
-          figure(median(delivered), "ratio", "null", "higher",
+          figure(median(delivered), "ratio", "1.0", "higher",
                  cmd + ": in the throughput runs, the share of frames delivered (the rest overflowed the "
                        "socket's receive buffer while the receiver was behind)"));
+  const double sender = median(sender_us);
+  const std::string sender_text = "; less the sending side's " + json_number(sender) +
+                                  " us per frame (encoding and sending into a socket nobody reads)";
+  out.raw("streaming.receive_cpu_us_per_datagram",
+          figure(std::max(0.0, median(cpu_us) - sender), "us", "null", "lower",
+                 cmd + ": streaming.cpu_us_per_datagram (every datagram decoded and delivered, rate limit off)" +
+                     sender_text));
+  out.raw("streaming.rate_limited_cpu_us_per_datagram",
+          figure(std::max(0.0, median(flood_us) - sender), "us", "null", "lower",
+                 cmd + ": one sender blasting " + std::to_string(tp) + " " + frame + " at a receiver with the "
+                       "default per-source rate limit (1,000/s), a median share of " +
+                       json_number(median(flood_dropped)) + " dropped by the limit before decoding: the process's "
+                       "CPU time per datagram read" + sender_text +
+                       "; what the receiver spends on a datagram the limit drops"));
   const std::string lat_how = cmd + ": median over " + std::to_string(runs) + " runs of the percentile over " +
                               std::to_string(lat) + " " + frame + " sent at " + json_number(lat_rate) +
                               " Hz to 127.0.0.1; from the sender's clock reading before encoding to the consumer "

@@ -4,6 +4,7 @@
 
 #include "command.h"
 #include "options.h"
+#include "read_limits_arg.h"
 #include "recording/conversions.h"
 
 namespace softdeca::cli {
@@ -21,18 +22,21 @@ int run_convert(const Args& args) {
   o.positional("INPUT", "a .csv take or a .sdrec recording")
       .positional("OUTPUT", "a .sdrec recording or a .csv take")
       .option("--fps", "RATE", "timecode frames per second (default: the recording's, else 60)");
+  declare_read_limits(o);
   if (!o.parse(args)) return 0;
+  const recording::ReadLimits limits = read_limits(o);
   const std::string in = o.arg(0), out = o.arg(1);
   const double fps = o.given("--fps") ? o.number("--fps") : 0;
   if (o.given("--fps") && !(fps > 0 && fps <= 1000)) throw UsageError("--fps must be in (0, 1000]");
   if (ends_with(in, ".csv") && ends_with(out, ".sdrec")) {
-    const auto r = recording::csv_to_recording(in, out, fps);
-    std::printf("%s: %zu rows, %zu frames written, %zu face-lost rows skipped, %zu malformed rows skipped\n",
-                out.c_str(), r.rows, r.frames, r.face_lost_rows, r.malformed_rows);
+    const auto r = recording::csv_to_recording(in, out, fps, limits);
+    std::printf("%s: %zu rows, %zu frames written, %zu face-lost rows skipped, %zu malformed rows skipped, %zu rows "
+                "with weights clamped to [0, 1]\n",
+                out.c_str(), r.rows, r.frames, r.face_lost_rows, r.malformed_rows, r.clamped_rows);
     return 0;
   }
   if (ends_with(in, ".sdrec") && ends_with(out, ".csv")) {
-    const auto r = recording::recording_to_csv(in, out, fps);
+    const auto r = recording::recording_to_csv(in, out, fps, limits);
     std::printf("%s: %zu frames written\n", out.c_str(), r.frames);
     return 0;
   }

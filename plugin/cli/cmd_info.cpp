@@ -5,24 +5,25 @@
 #include "command.h"
 #include "json.h"
 #include "options.h"
-#include "recording/recording_reader.h"
+#include "read_limits_arg.h"
+#include "recording/recording_index.h"
 
 namespace softdeca::cli {
 
 int run_info(const Args& args) {
   Options o("info", "Describe a recording: its header, frames, duration and rate, landmark profile, and the\n"
-                    "damage recovered from (skipped stretches, a cut-off last record).");
+                    "damage recovered from (skipped stretches, a cut-off last record) and the frames whose values\n"
+                    "were left out or clamped (docs/recording.md, \"Values\").");
   o.positional("RECORDING", "a .sdrec file").flag("--json", "print JSON instead of text");
+  declare_read_limits(o);
   if (!o.parse(args)) return 0;
-  const recording::Recording rec = recording::read_recording(o.arg(0));
+  // One pass over the file; frames stay on disk (memory grows with the frame count only).
+  const recording::RecordingIndex index = recording::RecordingIndex::open(o.arg(0), read_limits(o));
+  const recording::RecordingMeta& rec = index.meta();
   const auto& h = rec.header;
-  const std::size_t n = rec.frames.size();
-  const double duration = n > 1 ? rec.frames.back().capture_time - rec.frames.front().capture_time : 0;
-  std::size_t tracked = 0, with_landmarks = 0;
-  for (const auto& f : rec.frames) {
-    tracked += f.tracking == stream::Tracking::tracked;
-    with_landmarks += f.landmark_count > 0;
-  }
+  const std::size_t n = index.frame_count();
+  const double duration = n > 1 ? index.capture_time(n - 1) - index.capture_time(0) : 0;
+  const std::size_t tracked = index.tracked_frames(), with_landmarks = index.frames_with_landmarks();
   JsonObject j;
   j.text("device", h.device).text("subject", h.subject).text("source", h.source).text("clock", h.clock);
   j.number("start_unix_time", h.start_unix_time).number("timecode_rate", h.timecode_rate).text("units", h.units);
@@ -36,6 +37,8 @@ int run_info(const Args& args) {
   j.number("skipped_bytes", double(rec.recovery.skipped_bytes));
   j.number("truncated_bytes", double(rec.recovery.truncated_bytes));
   j.number("unknown_records", double(rec.recovery.unknown_records));
+  j.number("invalid_frames", double(rec.recovery.invalid_frames));
+  j.number("clamped_frames", double(rec.recovery.clamped_frames));
   if (o.on("--json")) {
     std::printf("%s\n", j.str(true).c_str());
     return 0;
@@ -52,6 +55,8 @@ int run_info(const Args& args) {
   std::printf("  %zu records; damage: %zu regions (%zu bytes) skipped, %zu bytes cut off at the end\n",
               rec.recovery.records, rec.recovery.damaged_regions, rec.recovery.skipped_bytes,
               rec.recovery.truncated_bytes);
+  std::printf("  values: %zu frames left out (not finite, not a rotation), %zu with weights clamped to [0, 1]\n",
+              rec.recovery.invalid_frames, rec.recovery.clamped_frames);
   return 0;
 }
 

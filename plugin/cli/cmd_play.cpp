@@ -9,8 +9,8 @@
 #include "command.h"
 #include "json.h"
 #include "options.h"
+#include "read_limits_arg.h"
 #include "recording/player.h"
-#include "recording/recording_reader.h"
 #include "stop_limits.h"
 #include "stream/frame_sender.h"
 #include "stream/steady_clock.h"
@@ -51,9 +51,10 @@ int run_play(const Args& args) {
       .option("--send", "HOST:PORT", "stream over UDP to this numeric address instead of printing")
       .option("--format", "NAME", "what --send sends: softdeca or livelinkface", "softdeca");
   StopLimits::declare(o, "frames");
+  declare_read_limits(o);
   o.flag("--quiet", "print nothing but errors");
   if (!o.parse(args)) return 0;
-  recording::Player player(recording::read_recording(o.arg(0)));
+  recording::Player player(recording::RecordingIndex::open(o.arg(0), read_limits(o)));
   const double speed = o.number("--speed");
   if (!(speed > 0)) throw UsageError("--speed must be > 0");
   player.set_speed(speed);
@@ -130,7 +131,7 @@ int run_play(const Args& args) {
       }
       const double t = double(k) * cycle + player.frame_time(i);
       sleep_for(wall_start + (t - start) / speed - stream::steady_seconds());
-      emit(rec.frames[i], player.frame_time(i));
+      emit(player.frame(i), player.frame_time(i));
       ++i;
     }
   }

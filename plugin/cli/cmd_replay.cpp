@@ -152,8 +152,9 @@ Take read_replay_take(const std::string& path, long start, long max_frames) {
   if (static_cast<std::size_t>(start) >= take.weights.size())
     throw UsageError("--start " + std::to_string(start) + " is past the take's " + std::to_string(take.weights.size()) + " frames");
   take.weights.erase(take.weights.begin(), take.weights.begin() + start);
-  std::fprintf(stderr, "take %s: %zu rows, %zu face-lost rows skipped, %zu unreadable; frames %ld to %zu\n", take.path.c_str(),
-               take.rows, take.face_lost, take.invalid, start, static_cast<std::size_t>(start) + take.weights.size() - 1);
+  std::fprintf(stderr, "take %s: %zu rows, %zu face-lost rows skipped, %zu unreadable, %zu with weights clamped to [0, 1]; "
+               "frames %ld to %zu\n", take.path.c_str(), take.rows, take.face_lost, take.invalid, take.clamped, start,
+               static_cast<std::size_t>(start) + take.weights.size() - 1);
   return take;
 }
 
@@ -314,6 +315,7 @@ int run_replay(const Args& args) {
       .number("frames", static_cast<double>(take.weights.size()))
       .number("face_lost_rows_skipped", static_cast<double>(take.face_lost))
       .number("unreadable_rows_skipped", static_cast<double>(take.invalid))
+      .number("clamped_rows", static_cast<double>(take.clamped))
       .number("take_median_frame_s", take.median_frame_s)
       .text("bundle", o.text("--bundle"))
       .raw("untrained", model.info.untrained ? "true" : "false")

@@ -2,8 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <stdexcept>
+
+#include "core/regular_file.h"
 
 namespace softdeca::cli {
 
@@ -57,9 +58,11 @@ std::string JsonObject::str(bool pretty) const {
   return out + (pretty ? "\n}" : "}");
 }
 
+// Through the library's one way of opening files (a FIFO given to --stats-json is refused, not
+// waited on).
 void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out || !out.write(text.data(), static_cast<std::streamsize>(text.size())))
+  const FilePtr out = open_regular_file(path, FileAccess::create);
+  if (std::fwrite(text.data(), 1, text.size(), out.get()) != text.size() || std::fflush(out.get()) != 0)
     throw std::runtime_error("cannot write " + path);
 }
 

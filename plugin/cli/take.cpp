@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "recording/livelinkface_csv.h"
-#include "recording/recording_reader.h"
+#include "recording/recording_index.h"
 
 namespace softdeca::cli {
 
@@ -19,20 +20,28 @@ Take read_take(const std::string& path, std::size_t max_frames) {
     take.rows = t.rows;
     take.face_lost = t.face_lost_rows;
     take.invalid = t.malformed_rows;
+    take.clamped = t.clamped_rows;
     frames = std::move(t.frames);
-  } else {
-    recording::Recording r = recording::read_recording(path);
-    take.rows = r.frames.size();
-    frames = std::move(r.frames);
+  }
+  // A recording's frames are decoded one at a time from its index (recording_index.h).
+  std::unique_ptr<recording::RecordingIndex> index;
+  if (!csv) {
+    index = std::make_unique<recording::RecordingIndex>(recording::RecordingIndex::open(path));
+    const recording::Recovery& r = index->meta().recovery;
+    take.rows = index->frame_count() + r.invalid_frames;
+    take.invalid = r.invalid_frames;
+    take.clamped = r.clamped_frames;
   }
   std::vector<double> times;
-  for (const stream::Frame& f : frames) {
+  const std::size_t count = csv ? frames.size() : index->frame_count();
+  for (std::size_t k = 0; k < count; ++k) {
+    const stream::Frame f = csv ? frames[k] : index->frame(k);
     if (f.tracking == stream::Tracking::lost) {
       ++take.face_lost;
       continue;
     }
     std::array<float, 52> w{};
-    for (std::size_t i = 0; i < 52; ++i) w[i] = std::min(1.0f, std::max(0.0f, f.weights[i]));
+    std::copy(f.weights.begin(), f.weights.end(), w.begin());  // in [0, 1]: the frame rule
     take.weights.push_back(w);
     times.push_back(f.capture_time);
     if (max_frames && take.weights.size() >= max_frames) break;

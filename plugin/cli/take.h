@@ -1,6 +1,7 @@
 // Takes for the runtime tools: a Live Link Face CSV (read by the streaming side's reader:
 // columns by name, face-lost rows skipped and counted) or a recording of the streaming format
-// (frames the tracker lost are skipped too). Weights in canonical ARKit order.
+// (frames the tracker lost are skipped too). Weights in canonical ARKit order, within the frame
+// rule both readers apply (recording/frame_rule.h): rows it refuses are counted in `invalid`.
 #pragma once
 
 #include <array>
@@ -14,6 +15,7 @@ struct Take {
   std::string path;
   std::vector<std::array<float, 52>> weights;
   std::size_t rows = 0, face_lost = 0, invalid = 0;
+  std::size_t clamped = 0;  // kept with weights clamped to [0, 1] (recording/frame_rule.h)
   double median_frame_s = 0;  // median time between kept frames
 };
 

@@ -97,6 +97,15 @@ TEST_F(BundleFolder, MissingPathIsAnInputOutputError) {
   EXPECT_EQ(failure([] { BundleFiles::from_path("no-such-bundle"); }).first, SOFTDECA_ERROR_IO);
 }
 
+// A NUL in a name the manifest gives: the message shows the whole name, the NUL escaped (a C
+// string would end there and hide the rest).
+TEST_F(BundleFolder, ANulInAFileNameIsShownEscaped) {
+  const BundleFiles files = BundleFiles::from_path(relative());
+  const auto [code, message] = failure([&] { files.get(std::string("weights\0/../../secret", 21)); });
+  EXPECT_EQ(code, SOFTDECA_ERROR_FORMAT);
+  EXPECT_EQ(message, "bundle file name 'weights\\x00/../../secret' is not a plain relative path");
+}
+
 TEST_F(BundleFolder, FolderInPlaceOfAFileIsRefused) {
   fs::create_directories(bundle() / "weights.bin");
   const BundleFiles files = BundleFiles::from_path(relative());

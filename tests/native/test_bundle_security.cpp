@@ -17,6 +17,7 @@
 #include "api/error.h"
 #include "runtime/bundle_files.h"
 #include "runtime/model.h"
+#include "onnx_test_support.h"
 #include "runtime/onnx_model_scan.h"
 #include "runtime/sha256.h"
 #include "runtime_fixture.h"
@@ -28,20 +29,7 @@ using namespace softdeca::runtime;
 
 namespace {
 
-// ---- a few protobuf fields, enough to write hostile ONNX graphs ----
-std::string varint(std::uint64_t v) {
-  std::string out;
-  do {
-    std::uint8_t b = v & 0x7F;
-    v >>= 7;
-    out += static_cast<char>(v ? b | 0x80 : b);
-  } while (v);
-  return out;
-}
-std::string field(int number, std::uint64_t value) { return varint(std::uint64_t(number) << 3) + varint(value); }
-std::string field(int number, const std::string& bytes) {
-  return varint(std::uint64_t(number) << 3 | 2) + varint(bytes.size()) + bytes;
-}
+using softdeca::test::field;
 
 // TensorProto: a float tensor of 4 elements whose data lives at `location`.
 std::string external_tensor(const std::string& name, const std::string& location) {

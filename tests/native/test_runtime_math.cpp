@@ -103,6 +103,32 @@ TEST(DeformationTransfer, IdentityGradientsReturnTheInputAndTheSolveMatchesEigen
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[3 * v + c], x(static_cast<Eigen::Index>(v), c), 1e-5 * x.cwiseAbs().maxCoeff());
 }
 
+// A neutral vertex far outside any head is named as such, not reported as a triangle of area 0;
+// a truly degenerate triangle's message gives its area's magnitude.
+TEST(DeformationTransfer, AWildNeutralVertexIsNamed) {
+  const Grid g;
+  std::vector<float> v = g.v;
+  v[3 * 5 + 1] = 1e30f;
+  try {
+    SkinGeometry::measure(v.data(), g.n, g.t);
+    ADD_FAILURE() << "accepted a vertex at 1e30 m";
+  } catch (const softdeca::Error& e) {
+    EXPECT_EQ(std::string(e.what()), "vertex 5 of the neutral is not within 100 m of the origin (coordinate 1e+30)");
+  }
+  std::vector<float> flat = g.v;
+  const auto at = [&](int corner, int c) -> float& { return flat[3 * static_cast<std::size_t>(g.t[static_cast<std::size_t>(corner)]) + static_cast<std::size_t>(c)]; };
+  for (int c = 0; c < 3; ++c) at(1, c) = at(2, c) = at(0, c);
+  at(1, 0) += 1e-6f;  // a triangle of 5e-13 m^2
+  at(2, 1) += 1e-6f;
+  try {
+    SkinGeometry::measure(flat.data(), g.n, g.t);
+    ADD_FAILURE() << "accepted a degenerate triangle";
+  } catch (const softdeca::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is degenerate (area "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("e-13 m^2"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
   const Grid g;
   const SkinGeometry geo = SkinGeometry::measure(g.v.data(), g.n, g.t);

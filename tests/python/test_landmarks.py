@@ -280,11 +280,15 @@ def test_barycentric_points_on_s(tmpl, arkit, definition, registration):
     assert (lms.triangle >= 0).all() and (lms.triangle < len(st)).all()
     np.testing.assert_array_equal(st[lms.triangle], lms.corners)
     assert lms.corners.max() < N_SKIN
-    # The cached points are those of a fresh registration, within 0.5 mm of it.
-    np.testing.assert_allclose(
-        lms.evaluate(tmpl.neutral),
-        registration.landmarks.evaluate(tmpl.neutral),
-        atol=1e-9,
+    # The cached points are those of a fresh registration: the same on one CPU, a few um apart
+    # where the cache was made on other kernels (the registration's iterative fit).
+    below(
+        np.abs(
+            lms.evaluate(tmpl.neutral) - registration.landmarks.evaluate(tmpl.neutral)
+        ).max(),
+        1e-5,
+        "the registration's fit on another kernel family: 4.1e-6 m (AVX2 against AVX-512)",
+        what="cached vs fresh m",
     )
     pts = registration.registration.registered[definition.vertices]
     below(

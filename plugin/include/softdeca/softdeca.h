@@ -678,7 +678,8 @@ typedef struct softdeca_recording_header {
 } softdeca_recording_header;
 
 /* Records every frame the receiver delivers from now on into a new file at `path`, with the
- * profiles and neutral meshes the stream carries. */
+ * profiles and neutral meshes the stream carries. `path` must be a regular file (or not exist):
+ * a FIFO or a folder is SOFTDECA_ERROR_INVALID_ARGUMENT at once. */
 SOFTDECA_API softdeca_status softdeca_receiver_start_recording(
     softdeca_receiver* receiver, const char* path, const softdeca_recording_header* header);
 /* Ends the recording; *out_frames (may be NULL) gets the frames written. SOFTDECA_ERROR_IO when
@@ -688,7 +689,8 @@ SOFTDECA_API softdeca_status softdeca_receiver_stop_recording(softdeca_receiver*
 
 typedef struct softdeca_recorder softdeca_recorder;
 
-/* Creates (replaces) a recording file and writes its header. */
+/* Creates (replaces) a recording file and writes its header; SOFTDECA_ERROR_INVALID_ARGUMENT
+ * when `path` names something other than a regular file (a FIFO, a folder). */
 SOFTDECA_API softdeca_status softdeca_recorder_create(const char* path,
                                                       const softdeca_recording_header* header,
                                                       softdeca_recorder** out_recorder);
@@ -721,8 +723,11 @@ typedef struct softdeca_recording_info {
 
 typedef struct softdeca_player softdeca_player;
 
-/* Reads a recording, recovering what a damaged file still holds (info tells what was lost);
- * SOFTDECA_ERROR_FORMAT when its header is unreadable or it has no frame. */
+/* Opens a recording, recovering what a damaged file still holds (info tells what was lost).
+ * Frames stay in the file and are read as they are asked for; weights come out in [0, 1]
+ * (docs/recording.md, "Values"). SOFTDECA_ERROR_FORMAT when its header is unreadable, it has
+ * no frame or it is over 1 GiB; SOFTDECA_ERROR_INVALID_ARGUMENT when `path` is not a regular
+ * file (a FIFO, a folder: refused without blocking). */
 SOFTDECA_API softdeca_status softdeca_player_open(const char* path, softdeca_player** out_player);
 /* NULL is ignored. */
 SOFTDECA_API void softdeca_player_destroy(softdeca_player* player);

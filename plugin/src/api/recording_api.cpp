@@ -10,7 +10,7 @@
 #include "api/handles.h"
 #include "recording/conversions.h"
 #include "recording/player.h"
-#include "recording/recording_reader.h"
+#include "recording/recording_index.h"
 #include "recording/recording_writer.h"
 
 struct softdeca_recorder {
@@ -63,7 +63,7 @@ void convert_file(const char* from, const char* from_name, const char* to, const
   require_not_null(to, to_name);
   require(std::isfinite(timecode_rate) && timecode_rate >= 0 && timecode_rate <= 1000, "timecode_rate must be in [0, 1000]");
   if (out_report) require_struct(out_report, "out_report");
-  report_out(convert(from, to, timecode_rate), out_report);
+  report_out(convert(from, to, timecode_rate, recording::ReadLimits{}), out_report);
 }
 }  // namespace
 
@@ -127,7 +127,7 @@ SOFTDECA_API softdeca_status softdeca_player_open(const char* path, softdeca_pla
   return guarded(__func__, [&] {
     require_not_null(path, "path");
     create_handle(out_player, "out_player", [&](softdeca_player& p) {
-      p.impl = std::make_unique<recording::Player>(recording::read_recording(path));
+      p.impl = std::make_unique<recording::Player>(recording::RecordingIndex::open(path));
     });
   });
 }
@@ -163,7 +163,7 @@ SOFTDECA_API softdeca_status softdeca_player_frame(const softdeca_player* player
     require_struct(out_frame, "out_frame");
     require(index < p.frame_count(), "index " + std::to_string(index) + " is not below the frame count " +
                                          std::to_string(p.frame_count()));
-    abi::frame_to_abi(p.recording().frames[index], out_frame);
+    abi::frame_to_abi(p.frame(index), out_frame);
   });
 }
 

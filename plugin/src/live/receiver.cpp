@@ -124,6 +124,7 @@ bool Receiver::admit(const Endpoint& from, double now) {
   ++stats_.datagrams;
   if (!rate_limit_.allow(from, now)) {
     ++stats_.rate_limited;
+    if (have_holder_ && endpoint_key(from) == holder_) ++holder_rate_limited_;
     return false;
   }
   if (have_holder_ && !config_.follow_newest && now - holder_heard_ < config_.session_hold &&
@@ -205,9 +206,10 @@ void Receiver::start_session(uint32_t session) {
     Frame f;
     while (jitter_.pop_any(f)) deliver(f, steady_seconds());
   }
-  lost_before_ += sequence_.lost();
+  lost_before_ += session_lost();
   expected_before_ += sequence_.expected();
   sequence_ = SequenceTracker();
+  holder_rate_limited_ = 0;
   jitter_ = JitterBuffer(config_.delay);
   previous_weights_.fill(0);
   have_session_ = true;
@@ -278,6 +280,11 @@ bool Receiver::next(double timeout, Frame& out) {
   return true;
 }
 
+uint64_t Receiver::session_lost() const {
+  const uint64_t gaps = sequence_.lost();
+  return gaps - std::min(gaps, holder_rate_limited_);
+}
+
 bool Receiver::latest(Frame& out) const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (have_latest_) out = latest_;
@@ -287,7 +294,7 @@ bool Receiver::latest(Frame& out) const {
 ReceiverStats Receiver::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
   ReceiverStats s = stats_;
-  s.lost = lost_before_ + sequence_.lost();
+  s.lost = lost_before_ + session_lost();
   s.expected = expected_before_ + sequence_.expected();
   s.loss_ratio = s.expected ? double(s.lost) / double(s.expected) : 0.0;
   const double now = steady_seconds();
@@ -330,7 +337,11 @@ bool Receiver::request_neutral() {
 }
 
 void Receiver::start_recording(const std::string& path, const recording::Header& header) {
-  auto writer = std::make_unique<recording::RecordingWriter>(path, header);  // may throw: no lock held
+  start_recording(std::make_unique<recording::RecordingWriter>(path, header), header);  // may throw: no lock held
+}
+
+void Receiver::start_recording(std::unique_ptr<recording::RecordingWriter> writer, const recording::Header& header) {
+  require(writer != nullptr, "no writer to record into");
   auto recorder = std::make_unique<recording::BackgroundRecorder>(std::move(writer), config_.recording_queue);
   std::unique_ptr<recording::BackgroundRecorder> previous;
   {

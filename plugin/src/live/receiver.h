@@ -66,6 +66,8 @@ class Receiver {
   bool request_neutral();
   // Records every frame delivered from now on (and profiles and neutral meshes as they come).
   void start_recording(const std::string& path, const recording::Header& header);
+  // The same into a writer the caller opened (`header` is the one it was opened with).
+  void start_recording(std::unique_ptr<recording::RecordingWriter> writer, const recording::Header& header);
   // Stops recording; returns the error that stopped it early, "" if none.
   std::string stop_recording();
   // Frames written by the current or last recording.
@@ -78,6 +80,8 @@ class Receiver {
   void handle(const uint8_t* data, std::size_t size, const stream::Endpoint& from, double now);
   void count_drop(stream::DropReason reason);
   void start_session(uint32_t session);
+  // Sequence numbers of this session never received, less those the rate limit dropped.
+  uint64_t session_lost() const;
   void on_frame(stream::Frame frame, const stream::Datagram& datagram, double now);
   void release_due(double now);
   void deliver(const stream::Frame& frame, double now);
@@ -98,6 +102,9 @@ class Receiver {
   stream::Format session_format_ = stream::Format::softdeca;
   stream::SequenceTracker sequence_;
   uint64_t lost_before_ = 0;      // earlier sessions' losses
+  // The holder's datagrams this session that the rate limit dropped: the sequence numbers they
+  // leave out are counted in rate_limited, not lost.
+  uint64_t holder_rate_limited_ = 0;
   uint64_t expected_before_ = 0;
   stream::JitterBuffer jitter_;
   std::array<float, stream::kBlendshapeCount> previous_weights_{};  // for sources that omit weights

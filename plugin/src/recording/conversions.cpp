@@ -4,7 +4,7 @@
 
 #include "core/error.h"
 #include "recording/livelinkface_csv.h"
-#include "recording/recording_reader.h"
+#include "recording/recording_index.h"
 #include "recording/recording_writer.h"
 
 namespace softdeca::recording {
@@ -18,9 +18,9 @@ std::string stem(const std::string& path) {
 }  // namespace
 
 ConversionReport csv_to_recording(const std::string& csv_path, const std::string& recording_path,
-                                  double rate) {
+                                  double rate, const ReadLimits& limits) {
   if (rate <= 0) rate = kLiveLinkFaceTimecodeRate;
-  const CsvTake take = read_livelinkface_csv(csv_path, rate);
+  const CsvTake take = read_livelinkface_csv(csv_path, rate, limits);
   Header h;
   h.device = "Live Link Face";
   h.subject = stem(csv_path);
@@ -29,17 +29,20 @@ ConversionReport csv_to_recording(const std::string& csv_path, const std::string
   h.clock = "timecode seconds since midnight";
   RecordingWriter writer(recording_path, h);
   for (const stream::Frame& f : take.frames) writer.write(f);
-  return {writer.frames_written(), take.rows, take.face_lost_rows, take.malformed_rows};
+  return {writer.frames_written(), take.rows, take.face_lost_rows, take.malformed_rows, take.clamped_rows};
 }
 
 ConversionReport recording_to_csv(const std::string& recording_path, const std::string& csv_path,
-                                  double rate) {
-  const Recording rec = read_recording(recording_path);
-  if (rate <= 0) rate = rec.header.timecode_rate > 0 ? rec.header.timecode_rate : kLiveLinkFaceTimecodeRate;
+                                  double rate, const ReadLimits& limits) {
+  const RecordingIndex index = RecordingIndex::open(recording_path, limits);
+  const Header& header = index.meta().header;
+  if (rate <= 0) rate = header.timecode_rate > 0 ? header.timecode_rate : kLiveLinkFaceTimecodeRate;
   require(rate == std::floor(rate), "a CSV timecode rate must be a whole number of frames per second");
-  write_livelinkface_csv(csv_path, rec.frames, static_cast<int>(rate));
+  CsvWriter out(csv_path, static_cast<int>(rate));
+  for (std::size_t i = 0; i < index.frame_count(); ++i) out.write(index.frame(i));  // one frame in memory at a time
+  out.finish();
   ConversionReport report;
-  for (const stream::Frame& f : rec.frames) report.frames += f.tracking == stream::Tracking::tracked;
+  report.frames = out.rows();
   return report;
 }
 

@@ -2,32 +2,37 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/error.h"
 #include "recording/frame_interpolation.h"
 
 namespace softdeca::recording {
 
-Player::Player(Recording recording) : rec_(std::move(recording)) {
-  require(!rec_.frames.empty(), "the recording has no frames", SOFTDECA_ERROR_FORMAT);
-  // Recorders write in capture order; a converted or hand-made file might not be.
-  std::stable_sort(rec_.frames.begin(), rec_.frames.end(),
-                   [](const stream::Frame& a, const stream::Frame& b) { return a.capture_time < b.capture_time; });
-  start_ = rec_.frames.front().capture_time;
-  duration_ = rec_.frames.back().capture_time - start_;
+Player::Player(RecordingIndex index) : index_(std::move(index)) {
+  require(index_.frame_count() > 0, "the recording has no frames", SOFTDECA_ERROR_FORMAT);
+  index_.sort_by_capture_time();  // recorders write in capture order; a converted or hand-made file might not be
+  start_ = index_.capture_time(0);
+  duration_ = index_.capture_time(index_.frame_count() - 1) - start_;
 }
 
-double Player::frame_time(std::size_t i) const { return rec_.frames.at(i).capture_time - start_; }
+Player::Player(const Recording& recording) : Player(RecordingIndex::from_frames(recording, recording.frames)) {}
+
+double Player::frame_time(std::size_t i) const { return index_.capture_time(i) - start_; }
 
 stream::Frame Player::frame_at(double time) const {
   const double t = start_ + std::clamp(time, 0.0, duration_);
-  const auto& frames = rec_.frames;
-  const auto after = std::upper_bound(frames.begin(), frames.end(), t,
-                                      [](double v, const stream::Frame& f) { return v < f.capture_time; });
-  if (after == frames.begin()) return frames.front();
-  if (after == frames.end()) return frames.back();
-  const stream::Frame& a = *(after - 1);
-  const stream::Frame& b = *after;
+  // The first frame after t: times are sorted.
+  std::size_t lo = 0, hi = index_.frame_count();
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (t < index_.capture_time(mid)) hi = mid;
+    else lo = mid + 1;
+  }
+  if (lo == 0) return index_.frame(0);
+  if (lo == index_.frame_count()) return index_.frame(lo - 1);
+  const stream::Frame a = index_.frame(lo - 1);
+  const stream::Frame b = index_.frame(lo);
   const double span = b.capture_time - a.capture_time;
   return span > 0 ? interpolate(a, b, (t - a.capture_time) / span) : a;
 }

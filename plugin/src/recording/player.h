@@ -1,10 +1,12 @@
 // Plays a recording: a playhead in seconds from the first frame, moved by the host's clock
 // times a speed, wrapping when looping; the frame at any time is interpolated (frame_interpolation.h).
+// Frames stay in the file (recording_index.h) and are decoded as they are played.
 #pragma once
 
 #include <cstddef>
 #include <vector>
 
+#include "recording/recording_index.h"
 #include "recording/recording_reader.h"
 
 namespace softdeca::recording {
@@ -12,10 +14,13 @@ namespace softdeca::recording {
 class Player {
  public:
   // Throws softdeca::Error (FORMAT) when the recording has no frames.
-  explicit Player(Recording recording);
+  explicit Player(RecordingIndex index);
+  explicit Player(const Recording& recording);  // frames already in memory
 
-  const Recording& recording() const { return rec_; }
-  std::size_t frame_count() const { return rec_.frames.size(); }
+  const RecordingMeta& recording() const { return index_.meta(); }
+  std::size_t frame_count() const { return index_.frame_count(); }
+  // Frame i in capture-time order.
+  stream::Frame frame(std::size_t i) const { return index_.frame(i); }
   double duration() const { return duration_; }  // seconds from the first to the last frame
   double frame_time(std::size_t i) const;        // seconds from the first frame
   // The frame at `time` seconds from the first (clamped to [0, duration]), interpolated.
@@ -32,7 +37,7 @@ class Player {
   bool advance(double dt);
 
  private:
-  Recording rec_;
+  RecordingIndex index_;
   double start_ = 0;
   double duration_ = 0;
   double position_ = 0;

@@ -146,25 +146,26 @@ bool decode_frame_record(ByteReader& r, const std::vector<int>& weight_order, Fr
       !r.f64le(f.send_time) || !r.f64le(f.receive_time) || !r.u16le(weight_count) ||
       !r.u16le(landmark_count))
     return false;
-  if (tracking > static_cast<uint8_t>(stream::Tracking::limited) || !std::isfinite(f.capture_time) ||
-      !std::isfinite(f.send_time) || !std::isfinite(f.receive_time) ||
-      weight_count != weight_order.size() || landmark_count > stream::kMaxLandmarks)
+  if (tracking > static_cast<uint8_t>(stream::Tracking::limited) || weight_count != weight_order.size() ||
+      landmark_count > stream::kMaxLandmarks)
     return false;
   f.tracking = static_cast<stream::Tracking>(tracking);
   f.has_sequence = flags & kHasSequence;
+  // Values are taken as written; whether they are usable is the frame rule's (frame_rule.h).
   for (std::size_t i = 0; i < weight_count; ++i) {
     float v = 0;
-    if (!r.f32le(v) || !std::isfinite(v)) return false;
+    if (!r.f32le(v)) return false;
     if (weight_order[i] >= 0) f.weights[static_cast<std::size_t>(weight_order[i])] = v;
   }
   f.has_head = flags & kHasHead;
   f.has_eyes = flags & kHasEyes;
   using stream::PoseRead;
-  if (f.has_head && stream::read_pose(r, f.head) != PoseRead::ok) return false;
-  if (f.has_eyes && (stream::read_pose(r, f.left_eye) != PoseRead::ok || stream::read_pose(r, f.right_eye) != PoseRead::ok))
+  if (f.has_head && stream::read_pose(r, f.head) == PoseRead::short_input) return false;
+  if (f.has_eyes && (stream::read_pose(r, f.left_eye) == PoseRead::short_input ||
+                     stream::read_pose(r, f.right_eye) == PoseRead::short_input))
     return false;
   for (std::size_t i = 0; i < 3u * landmark_count; ++i)
-    if (!r.f32le(f.landmarks[i]) || !std::isfinite(f.landmarks[i])) return false;
+    if (!r.f32le(f.landmarks[i])) return false;
   f.landmark_count = landmark_count;
   return true;  // bytes after this belong to a newer minor version
 }

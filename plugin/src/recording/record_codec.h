@@ -22,6 +22,7 @@ void encode_profile_record(const stream::wire::Profile& profile, std::vector<uin
 void encode_neutral_record(const std::vector<float>& xyz, std::vector<uint8_t>& out);
 
 // Record bodies after the type byte (a profile body is stream::wire::read_profile_body's).
+// A frame's values come as written: false only when the record's layout is broken.
 bool decode_frame_record(stream::ByteReader& r, const std::vector<int>& weight_order,
                          stream::Frame& frame);
 bool decode_neutral_body(stream::ByteReader& r, std::vector<float>& xyz);

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include "core/error.h"
 #include "recording/record_codec.h"
@@ -13,6 +14,19 @@ namespace softdeca::recording {
 RecordingWriter::RecordingWriter(const std::string& path, const Header& header) : path_(path) {
   std::vector<uint8_t> fields;
   encode_header_fields(header, fields);  // throws on an invalid profile before touching the file
+  file_ = open_regular_file(path, FileAccess::create);
+  write_header(header);
+}
+
+RecordingWriter::RecordingWriter(FilePtr file, const std::string& name, const Header& header)
+    : path_(name), file_(std::move(file)) {
+  require(file_ != nullptr, "no file to record into");
+  write_header(header);
+}
+
+void RecordingWriter::write_header(const Header& header) {
+  std::vector<uint8_t> fields;
+  encode_header_fields(header, fields);
   std::vector<uint8_t> block;
   stream::ByteWriter w(block);
   w.bytes(kFileMagic.data(), kFileMagic.size());
@@ -21,13 +35,7 @@ RecordingWriter::RecordingWriter(const std::string& path, const Header& header) 
   w.u32le(static_cast<uint32_t>(fields.size()));
   w.bytes(fields.data(), fields.size());
   w.u32le(stream::crc32(block.data() + kFileMagic.size(), block.size() - kFileMagic.size()));
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) throw Error(SOFTDECA_ERROR_IO, "cannot create " + path + ": " + std::strerror(errno));
   put(block.data(), block.size());
-}
-
-RecordingWriter::~RecordingWriter() {
-  if (file_) std::fclose(file_);
 }
 
 void RecordingWriter::write(const stream::Frame& frame) {
@@ -57,7 +65,7 @@ void RecordingWriter::append_record(const std::vector<uint8_t>& payload) {
 }
 
 void RecordingWriter::put(const void* data, std::size_t size) {
-  if (std::fwrite(data, 1, size, file_) != size || std::fflush(file_) != 0)
+  if (std::fwrite(data, 1, size, file_.get()) != size || std::fflush(file_.get()) != 0)
     throw Error(SOFTDECA_ERROR_IO, "cannot write " + path_ + ": " + std::strerror(errno));
 }
 

@@ -7,15 +7,19 @@
 #include <string>
 #include <vector>
 
+#include "core/regular_file.h"
 #include "recording/recording_format.h"
 
 namespace softdeca::recording {
 
 class RecordingWriter {
  public:
-  // Creates (or replaces) the file and writes the header. Throws softdeca::Error.
+  // Creates (or replaces) the file and writes the header. Throws softdeca::Error; a path that
+  // is not a regular file (a FIFO, a folder) is refused without blocking (core/regular_file.h).
   RecordingWriter(const std::string& path, const Header& header);
-  ~RecordingWriter();
+  // Writes into a stream the caller opened (`name` for messages): a pipe standing for a slow
+  // disk in tests and benchmarks.
+  RecordingWriter(FilePtr file, const std::string& name, const Header& header);
   RecordingWriter(const RecordingWriter&) = delete;
   RecordingWriter& operator=(const RecordingWriter&) = delete;
 
@@ -26,11 +30,12 @@ class RecordingWriter {
   const std::string& path() const { return path_; }
 
  private:
+  void write_header(const Header& header);
   void append_record(const std::vector<uint8_t>& payload);
   void put(const void* data, std::size_t size);
 
   std::string path_;
-  std::FILE* file_ = nullptr;
+  FilePtr file_;
   std::vector<uint8_t> payload_;  // reused between records
   std::vector<uint8_t> record_;
   std::size_t frames_ = 0;

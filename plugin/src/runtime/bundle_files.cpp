@@ -60,9 +60,26 @@ std::string field_text(const std::uint8_t* field, std::size_t n) {
   return std::string(reinterpret_cast<const char*>(field), len);
 }
 
+// A name as messages show it: control bytes (a NUL would end the C ABI's message) as \xNN.
+std::string printable(const std::string& name) {
+  std::string out;
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u != 0x7f) {
+      out += c;
+      continue;
+    }
+    static const char kHex[] = "0123456789abcdef";
+    out += "\\x";
+    out += kHex[u >> 4];
+    out += kHex[u & 15];
+  }
+  return out;
+}
+
 void check_name(const std::string& name) {
   if (name.empty() || name.find("..") != std::string::npos || name[0] == '/' || name.find('\0') != std::string::npos)
-    throw Error(SOFTDECA_ERROR_FORMAT, "bundle file name '" + name + "' is not a plain relative path");
+    throw Error(SOFTDECA_ERROR_FORMAT, "bundle file name '" + printable(name) + "' is not a plain relative path");
 }
 }  // namespace
 

@@ -11,21 +11,12 @@
 
 #include <vector>
 
+#include "core/wide_path.h"
 #include "runtime/bundle_folder_io.h"
 
 namespace softdeca::runtime {
 
 namespace {
-// Empty when `text` is empty or not valid UTF-8 (which then names no file).
-std::wstring wide(const std::string& text) {
-  if (text.empty() || text.size() > 0x7fffffff) return {};
-  const int n = MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, text.data(), static_cast<int>(text.size()), nullptr, 0);
-  if (n <= 0) return {};
-  std::wstring out(static_cast<std::size_t>(n), L'\0');
-  MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, text.data(), static_cast<int>(text.size()), out.data(), n);
-  return out;
-}
-
 std::string narrow(const wchar_t* text, std::size_t size) {
   if (size == 0 || size > 0x7fffffff) return {};
   const int n = WideCharToMultiByte(CP_UTF8, WC_ERR_INVALID_CHARS, text, static_cast<int>(size), nullptr, 0, nullptr, nullptr);
@@ -40,7 +31,7 @@ HANDLE native(std::intptr_t handle) { return reinterpret_cast<HANDLE>(handle); }
 // Opens `path` for `access`; FILE_FLAG_BACKUP_SEMANTICS lets folders open too. Sharing
 // everything: looking at a file never stands in the way of whoever else uses it.
 HANDLE open_entry(const std::string& path, DWORD access, bool follow_links) {
-  const std::wstring w = wide(path);
+  const std::wstring w = wide_path(path);
   if (w.empty()) return INVALID_HANDLE_VALUE;
   const DWORD flags = FILE_FLAG_BACKUP_SEMANTICS | (follow_links ? 0 : FILE_FLAG_OPEN_REPARSE_POINT);
   return CreateFileW(w.c_str(), access, FILE_SHARE_READ | FILE_SHARE_WRITE | FILE_SHARE_DELETE, nullptr,
@@ -106,7 +97,7 @@ bool path_inside(const std::string& root, const std::string& path) {
 }
 
 ReadOnlyFile::ReadOnlyFile(const std::string& path) {
-  const std::wstring w = wide(path);
+  const std::wstring w = wide_path(path);
   if (w.empty()) return;
   // Without FILE_FLAG_BACKUP_SEMANTICS a folder does not open; a pipe or device opens without
   // waiting and is refused by is_regular before any read.

@@ -1,6 +1,7 @@
 #include "runtime/deformation_transfer.h"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/error.h"
@@ -9,6 +10,14 @@ namespace softdeca::runtime {
 
 namespace {
 constexpr double kMinFaceArea = 1e-12;  // m^2, as dt.py
+constexpr double kMaxVertexMetres = 100;  // a neutral face mesh lies within this of its origin
+
+// Numbers in messages with their magnitude (std::to_string would print 1e-20 as 0.000000).
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
 
 Eigen::SparseMatrix<double> assemble(const SkinGeometry& g, std::size_t n, const std::vector<std::int32_t>& t,
                                      double regularisation) {
@@ -61,6 +70,12 @@ SkinGeometry SkinGeometry::measure(const float* skin, std::size_t n, const std::
   g.face_area.resize(nf);
   g.metric.resize(3 * nf);
   g.vertex_mass.assign(n, 0.0);
+  // A vertex far outside any head (1e30) would otherwise surface as a triangle of "area 0".
+  for (std::size_t i = 0; i < 3 * n; ++i)
+    expect(std::isfinite(skin[i]) && std::fabs(skin[i]) <= kMaxVertexMetres, [&] {
+      return "vertex " + std::to_string(i / 3) + " of the neutral is not within " + format_number(kMaxVertexMetres) +
+             " m of the origin (coordinate " + format_number(skin[i]) + ")";
+    });
   for (std::size_t f = 0; f < nf; ++f) {
     const float* a = skin + 3 * static_cast<std::size_t>(t[3 * f]);
     const float* b = skin + 3 * static_cast<std::size_t>(t[3 * f + 1]);
@@ -72,8 +87,9 @@ SkinGeometry SkinGeometry::measure(const float* skin, std::size_t n, const std::
     }
     const double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
     const double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-    require(area >= kMinFaceArea, "skin triangle " + std::to_string(f) + " of the neutral is degenerate (area " +
-                                      std::to_string(area) + " m^2)");
+    expect(area >= kMinFaceArea, [&] {
+      return "skin triangle " + std::to_string(f) + " of the neutral is degenerate (area " + format_number(area) + " m^2)";
+    });
     const double g00 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
     const double g01 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
     const double g11 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];

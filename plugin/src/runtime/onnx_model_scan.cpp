@@ -1,9 +1,12 @@
 #include "runtime/onnx_model_scan.h"
 
+#include <algorithm>
+#include <cstring>
 #include <limits>
 #include <map>
 
 #include "core/error.h"
+#include "runtime/onnx_constant_sizes.h"
 
 namespace softdeca::runtime {
 namespace {
@@ -120,15 +123,35 @@ struct Tensor {
   std::string name;
   std::uint64_t dtype = 1;
   std::uint64_t elements = 1;
+  std::vector<std::uint64_t> dims;
   bool external = false;
-  std::vector<std::int64_t> int64_values;  // short int64 tensors: possible shapes
+  std::vector<double> values;  // short numeric tensors (float, double, int32, int64): possible shapes
 };
 
-struct ShapeUse {
-  std::string shape_input;
-  std::string output;
-  std::uint64_t element_bytes = 4;
-};
+// Little-endian numbers of `width` bytes as the tensor's type says (raw_data, packed fields).
+void little_endian_values(const std::uint8_t* p, std::size_t size, std::uint64_t dtype, std::vector<double>& out) {
+  const std::size_t width = dtype == 7 || dtype == 11 ? 8 : 4;
+  if (size % width != 0 || size / width > kMaxShapeValues) return;
+  out.clear();
+  for (std::size_t i = 0; i < size; i += width) {
+    std::uint64_t v = 0;
+    for (std::size_t k = 0; k < width; ++k) v |= std::uint64_t{p[i + k]} << (8 * k);
+    if (dtype == 1) {
+      float f;
+      const auto u = static_cast<std::uint32_t>(v);
+      std::memcpy(&f, &u, 4);
+      out.push_back(f);
+    } else if (dtype == 11) {
+      double d;
+      std::memcpy(&d, &v, 8);
+      out.push_back(d);
+    } else if (dtype == 6) {
+      out.push_back(static_cast<double>(static_cast<std::int32_t>(static_cast<std::uint32_t>(v))));
+    } else {
+      out.push_back(static_cast<double>(static_cast<std::int64_t>(v)));
+    }
+  }
+}
 
 class Scanner {
  public:
@@ -143,20 +166,16 @@ class Scanner {
       else if (f.number == 20) training_info(f, 1);
       else if (f.number == 25) function(f, 1);
     }
-    for (const ShapeUse& u : shape_uses_) {
-      const auto it = constants_.find(u.shape_input);
-      if (it == constants_.end()) continue;  // computed at run time: ONNX Runtime's own checks
-      std::uint64_t n = 1;
-      for (const std::int64_t d : it->second) n = mul_sat(n, d < 0 ? 1 : static_cast<std::uint64_t>(d));
-      const std::uint64_t bytes = mul_sat(n, u.element_bytes);
+    // Outputs whose size follows from constants (computed at run time otherwise: ONNX
+    // Runtime's own checks).
+    folding_.evaluate([&](const std::string& name, std::uint64_t bytes) {
       result.shaped_bytes = add_sat(result.shaped_bytes, bytes);
-      note(u.output, bytes);
-    }
+      note(name, bytes);
+    });
   }
 
  private:
-  std::map<std::string, std::vector<std::int64_t>> constants_;
-  std::vector<ShapeUse> shape_uses_;
+  ConstantSizes folding_;
 
   static void depth_check(int depth) {
     if (depth > kMaxDepth) bad("messages nested deeper than " + std::to_string(kMaxDepth));
@@ -206,7 +225,9 @@ class Scanner {
     const std::uint64_t bytes = mul_sat(t.elements, element_size(t.dtype));
     result.initializer_bytes = add_sat(result.initializer_bytes, bytes);
     note(t.name, bytes);
-    if (!t.int64_values.empty() && !t.name.empty()) constants_[t.name] = t.int64_values;
+    if (t.name.empty()) return;
+    if (!t.values.empty()) folding_.values(t.name, t.values);
+    folding_.shape(t.name, t.dims, element_size(t.dtype));
   }
 
   void sparse_tensor(const Field& f, int depth) {
@@ -221,7 +242,8 @@ class Scanner {
     depth_check(depth);
     Tensor t;
     bool has_dims = false;
-    std::vector<std::int64_t> raw_int64;
+    std::vector<double> numbers;
+    Field raw;
     Message m(f.data, f.size);
     Field x;
     while (m.next(x)) {
@@ -231,24 +253,22 @@ class Scanner {
           repeated_varints(x, [&](std::uint64_t d) {
             if (static_cast<std::int64_t>(d) < 0) bad("tensor with a negative dimension");
             t.elements = mul_sat(t.elements, d);
+            if (t.dims.size() < kMaxShapeValues) t.dims.push_back(d);
           });
           break;
         case 2: if (x.wire == 0) t.dtype = x.varint; break;
-        case 7:
+        case 5: case 7:  // int32_data, int64_data: varints
           repeated_varints(x, [&](std::uint64_t v) {
-            if (raw_int64.size() <= kMaxShapeValues) raw_int64.push_back(static_cast<std::int64_t>(v));
+            if (numbers.size() <= kMaxShapeValues)
+              numbers.push_back(x.number == 5 ? double(static_cast<std::int32_t>(v)) : double(static_cast<std::int64_t>(v)));
           });
+          break;
+        case 4: case 10:  // float_data, double_data: packed fixed-width
+          if (x.wire == 2) little_endian_values(x.data, x.size, x.number == 4 ? 1 : 11, numbers);
           break;
         case 8: t.name = text(x); break;
         case 9:
-          if (x.wire == 2 && x.size % 8 == 0 && x.size / 8 <= kMaxShapeValues) {
-            raw_int64.clear();
-            for (std::size_t i = 0; i < x.size; i += 8) {
-              std::uint64_t v = 0;
-              for (int k = 0; k < 8; ++k) v |= std::uint64_t{x.data[i + k]} << (8 * k);
-              raw_int64.push_back(static_cast<std::int64_t>(v));
-            }
-          }
+          if (x.wire == 2) raw = x;  // decoded once the type is known
           break;
         case 13: t.external = true; break;                      // external_data entries
         case 14: if (x.varint == 1) t.external = true; break;   // data_location = EXTERNAL
@@ -256,7 +276,9 @@ class Scanner {
       }
     }
     if (!has_dims) t.elements = 1;  // a scalar
-    if (t.dtype == 7 && raw_int64.size() <= kMaxShapeValues) t.int64_values = std::move(raw_int64);
+    if (raw.data) little_endian_values(raw.data, raw.size, t.dtype, numbers);
+    const bool numeric = t.dtype == 1 || t.dtype == 6 || t.dtype == 7 || t.dtype == 11;
+    if (numeric && numbers.size() <= kMaxShapeValues && numbers.size() == t.elements) t.values = std::move(numbers);
     return t;
   }
 
@@ -264,18 +286,26 @@ class Scanner {
     depth_check(depth);
     std::string name;
     std::uint64_t bytes = 0;
+    StaticShape shape;
     Message m(f.data, f.size);
     Field v;
     while (m.next(v)) {
       if (v.number == 1) name = text(v);
-      else if (v.number == 2 && v.wire == 2) bytes = type_bytes(v, depth + 1);
+      else if (v.number == 2 && v.wire == 2) bytes = type_bytes(v, depth + 1, shape);
     }
     result.declared_bytes = add_sat(result.declared_bytes, bytes);
     note(name, bytes);
+    if (shape.is_static && !name.empty()) folding_.shape(name, shape.dims, shape.element_bytes);
   }
 
+  struct StaticShape {
+    bool is_static = false;  // a tensor type whose every dimension is a number
+    std::vector<std::uint64_t> dims;
+    std::uint64_t element_bytes = 4;
+  };
+
   // TypeProto: tensor_type (1) and sparse_tensor_type (8) have elem_type (1) and shape (2).
-  std::uint64_t type_bytes(const Field& f, int depth) {
+  std::uint64_t type_bytes(const Field& f, int depth, StaticShape& static_shape) {
     depth_check(depth);
     Message m(f.data, f.size);
     Field t;
@@ -283,76 +313,96 @@ class Scanner {
     while (m.next(t)) {
       if (t.wire != 2 || (t.number != 1 && t.number != 8)) continue;
       std::uint64_t dtype = 1, elements = 1;
+      bool has_shape = false, all_numbers = true;
+      std::vector<std::uint64_t> dims;
       Message tensor_type(t.data, t.size);
       Field x;
       while (tensor_type.next(x)) {
         if (x.number == 1 && x.wire == 0) dtype = x.varint;
         if (x.number != 2 || x.wire != 2) continue;
+        has_shape = true;
         Message shape(x.data, x.size);
         Field dim;
         while (shape.next(dim)) {
           if (dim.number != 1 || dim.wire != 2) continue;
           std::uint64_t value = 1;  // dim_param (a named free dimension): counted as 1
+          bool number = false;
           Message d(dim.data, dim.size);
           Field dv;
           while (d.next(dv))
-            if (dv.number == 1 && dv.wire == 0 && static_cast<std::int64_t>(dv.varint) > 0) value = dv.varint;
+            if (dv.number == 1 && dv.wire == 0 && static_cast<std::int64_t>(dv.varint) >= 0) {
+              value = std::max<std::uint64_t>(dv.varint, 1);
+              number = true;
+            }
+          all_numbers = all_numbers && number;
           elements = mul_sat(elements, value);
+          if (dims.size() < kMaxShapeValues) dims.push_back(value);
+          else all_numbers = false;
         }
       }
       bytes = add_sat(bytes, mul_sat(elements, element_size(dtype)));
+      if (t.number == 1 && has_shape && all_numbers) static_shape = {true, std::move(dims), element_size(dtype)};
     }
     return bytes;
   }
 
+  // Nodes go to the constant folding (onnx_constant_sizes.h), evaluated in order at the end.
   void node(const Field& f, int depth) {
     depth_check(depth);
-    std::vector<std::string> inputs, outputs;
-    std::string op;
-    std::uint64_t value_dtype = 1;
-    std::vector<std::int64_t> value_ints;
-    Tensor value;
-    bool has_value = false;
+    FoldNode n;
     Message m(f.data, f.size);
     Field x;
     while (m.next(x)) {
       switch (x.number) {
-        case 1: inputs.push_back(text(x)); break;
-        case 2: outputs.push_back(text(x)); break;
-        case 4: op = text(x); break;
+        case 1: n.inputs.push_back(text(x)); break;
+        case 2: n.outputs.push_back(text(x)); break;
+        case 4: n.op = text(x); break;
         case 5:
-          if (x.wire == 2) attribute(x, depth + 1, value, has_value, value_ints);
+          if (x.wire == 2) attribute(x, depth + 1, n);
           break;
         default: break;
       }
     }
-    if (has_value) value_dtype = value.dtype;
-    if (op == "Constant" && !outputs.empty()) {
-      if (has_value && !value.int64_values.empty()) constants_[outputs[0]] = value.int64_values;
-      else if (!value_ints.empty()) constants_[outputs[0]] = value_ints;
-    } else if (op == "ConstantOfShape" && !inputs.empty() && !outputs.empty()) {
-      shape_uses_.push_back({inputs[0], outputs[0], element_size(value_dtype)});
-    } else if (op == "Expand" && inputs.size() >= 2 && !outputs.empty()) {
-      shape_uses_.push_back({inputs[1], outputs[0], 4});
-    }
+    folding_.node(std::move(n));
   }
 
   // AttributeProto: name (1), ints (8), t (5), g (6), tensors (10), graphs (11),
   // sparse_tensor (22), sparse_tensors (23). Every tensor counts as an initializer.
-  void attribute(const Field& f, int depth, Tensor& value, bool& has_value, std::vector<std::int64_t>& value_ints) {
+  // A node's integer attributes (i: 3), and a Constant's value however it is given: value
+  // (a tensor), value_int(s), value_float(s) (f: 2, floats: 7).
+  void attribute(const Field& f, int depth, FoldNode& node) {
     depth_check(depth);
     std::string name;
-    std::vector<std::int64_t> ints;
-    bool value_tensor = false;
+    std::vector<double> ints, floats;
+    bool value_tensor = false, has_int = false, has_float = false;
+    std::int64_t i = 0;
     Tensor t;
     Message m(f.data, f.size);
     Field x;
     while (m.next(x)) {
       switch (x.number) {
         case 1: name = text(x); break;
+        case 2:
+          if (x.wire == 5) {
+            const auto u = static_cast<std::uint32_t>(x.varint);
+            float v;
+            std::memcpy(&v, &u, 4);
+            floats.assign(1, v);
+            has_float = true;
+          }
+          break;
+        case 3:
+          if (x.wire == 0) {
+            i = static_cast<std::int64_t>(x.varint);
+            has_int = true;
+          }
+          break;
+        case 7:
+          if (x.wire == 2) little_endian_values(x.data, x.size, 1, floats);
+          break;
         case 8:
           repeated_varints(x, [&](std::uint64_t v) {
-            if (ints.size() <= kMaxShapeValues) ints.push_back(static_cast<std::int64_t>(v));
+            if (ints.size() <= kMaxShapeValues) ints.push_back(double(static_cast<std::int64_t>(v)));
           });
           break;
         case 5:
@@ -368,11 +418,22 @@ class Scanner {
         default: break;
       }
     }
+    if (has_int) node.ints[name] = i;
+    const auto constant = [&](std::vector<double> v, std::vector<std::uint64_t> dims, std::uint64_t bytes) {
+      node.has_value = v.size() <= kMaxShapeValues;
+      node.value = std::move(v);
+      node.value_dims = std::move(dims);
+      node.value_element_bytes = bytes;
+    };
     if (name == "value" && value_tensor) {
-      value = std::move(t);
-      has_value = true;
+      node.value_element_bytes = element_size(t.dtype);
+      node.value_dims = t.dims;
+      if (!t.values.empty()) constant(t.values, t.dims, element_size(t.dtype));
     }
-    if (name == "value_ints" && ints.size() <= kMaxShapeValues) value_ints = std::move(ints);
+    if (name == "value_int" && has_int) constant({double(i)}, {}, 8);
+    if (name == "value_ints" && ints.size() <= kMaxShapeValues) constant(ints, {ints.size()}, 8);
+    if (name == "value_float" && has_float) constant(floats, {}, 4);
+    if (name == "value_floats" && !floats.empty()) constant(floats, {floats.size()}, 4);
   }
 };
 

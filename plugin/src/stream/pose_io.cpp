@@ -18,9 +18,13 @@ PoseRead read_pose(ByteReader& r, Pose& p) {
     if (!r.f32le(x)) return PoseRead::short_input;
   std::copy(v, v + 3, p.position.begin());
   std::copy(v + 3, v + 7, p.rotation.begin());
+  return check_pose(p) ? PoseRead::ok : PoseRead::invalid;
+}
+
+bool check_pose(Pose& p) {
   for (float x : p.position)
-    if (!std::isfinite(x) || std::fabs(x) > 1e3f) return PoseRead::invalid;
-  return normalize_rotation(p.rotation) ? PoseRead::ok : PoseRead::invalid;
+    if (!std::isfinite(x) || std::fabs(x) > 1e3f) return false;
+  return normalize_rotation(p.rotation);
 }
 
 }  // namespace softdeca::stream

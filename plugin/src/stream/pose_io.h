@@ -9,9 +9,12 @@ namespace softdeca::stream {
 
 void write_pose(ByteWriter& w, const Pose& pose);
 
+// Whether a pose is one a tracker can report: every value finite, the position within 1 km,
+// the quaternion near enough to unit length to be a rotation (it is then renormalised).
+bool check_pose(Pose& pose);
+
 enum class PoseRead { ok, short_input, invalid };
-// Reads a pose; `invalid` when a value is not finite, the position is beyond 1 km, or the
-// quaternion is too far from unit length to be a rotation (it is renormalised otherwise).
+// Reads a pose; `invalid` when check_pose refuses it (the values read are kept as they were).
 PoseRead read_pose(ByteReader& r, Pose& pose);
 
 }  // namespace softdeca::stream

@@ -236,6 +236,21 @@ def read_csv(path: str | Path, rate: float = TIMECODE_RATE) -> CsvTake:
     return parse_csv(Path(path).read_text(encoding="utf-8"), rate)
 
 
+def shortest_float32(v: float) -> str:
+    """The shortest text that reads back as the same 32-bit float, as C++'s std::to_chars
+    writes it: fixed or scientific, whichever is shorter (fixed on a tie); -0 as 0."""
+    x = np.float32(float(v) + 0.0)
+    # A whole number is written with all its digits in fixed form (161682407424, not
+    # 161682400000); its length is the same either way.
+    fixed = (
+        str(int(x))
+        if float(x).is_integer()
+        else np.format_float_positional(x, unique=True, trim="-")
+    )
+    scientific = np.format_float_scientific(x, unique=True, trim="-", exp_digits=2)
+    return scientific if len(scientific) < len(fixed) else fixed
+
+
 def format_csv(frames: list[Frame], rate: int = int(TIMECODE_RATE)) -> str:
     out = ["Timecode,BlendShapeCount," + ",".join(VALUE_NAMES[i] for i in CSV_ORDER)]
     for f in frames:
@@ -245,6 +260,6 @@ def format_csv(frames: list[Frame], rate: int = int(TIMECODE_RATE)) -> str:
         out.append(
             format_timecode(f.capture_time, rate)
             + ",61,"
-            + ",".join(f"{float(v[i]) + 0.0:.10f}" for i in CSV_ORDER)
+            + ",".join(shortest_float32(v[i]) for i in CSV_ORDER)
         )
     return "\n".join(out) + "\n"

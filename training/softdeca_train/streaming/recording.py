@@ -77,6 +77,10 @@ class Recovery:
     skipped_bytes: int = 0
     truncated_bytes: int = 0
     unknown_records: int = 0
+    # Frames the frame rule left out (values not finite, impossible poses or landmarks) or
+    # kept with weights clamped to [0, 1], as the native reader (recording/frame_rule.h).
+    invalid_frames: int = 0
+    clamped_frames: int = 0
 
 
 @dataclass
@@ -253,29 +257,27 @@ def _decode_neutral_body(body: bytes) -> np.ndarray | None:
     return xyz if np.isfinite(xyz).all() else None
 
 
-def _decode_frame_record(body: bytes, order: list[int]) -> Frame | None:
+# What became of a frame record: its layout broken (damage), its values refused by the frame
+# rule, or kept (with weights clamped, or as written).
+BROKEN, INVALID, CLAMPED, KEPT = "broken", "invalid", "clamped", "kept"
+
+
+def _decode_frame_record(body: bytes, order: list[int]) -> tuple[str, Frame | None]:
     if len(body) < _FRAME_FIXED.size:
-        return None
+        return BROKEN, None
     (_, tracking, flags, _, session, seq, profile_id, capture, send, receive, nw, nl) = (
         _FRAME_FIXED.unpack_from(body)
     )
-    if (
-        tracking > Tracking.LIMITED
-        or not all(map(math.isfinite, (capture, send, receive)))
-        or nw != len(order)
-        or nl > MAX_LANDMARKS
-    ):
-        return None
+    if tracking > Tracking.LIMITED or nw != len(order) or nl > MAX_LANDMARKS:
+        return BROKEN, None
     head, eyes = bool(flags & _HAS_HEAD), bool(flags & _HAS_EYES)
     need = _FRAME_FIXED.size + 4 * (nw + 7 * head + 14 * eyes + 3 * nl)
     if len(body) < need:
-        return None
+        return BROKEN, None
     v = np.frombuffer(
         body, dtype="<f4", count=(need - _FRAME_FIXED.size) // 4, offset=_FRAME_FIXED.size
     ).astype(np.float32)
     weights = np.zeros(len(ARKIT_BLENDSHAPES), dtype=np.float32)
-    if not np.isfinite(v[:nw]).all():
-        return None
     for i, k in enumerate(order):
         if k >= 0:
             weights[k] = v[i]
@@ -290,22 +292,28 @@ def _decode_frame_record(body: bytes, order: list[int]) -> Frame | None:
         weights=weights,
         profile_id=profile_id,
     )
+    # The frame rule: every value finite, poses the stream decoder accepts, landmarks within
+    # 1 km; then weights clamped to [0, 1].
+    if not all(map(math.isfinite, (capture, send, receive))) or not np.isfinite(weights).all():
+        return INVALID, None
     at = nw
     if head:
         f.head = _read_pose(v[at : at + 7])
         if f.head is None:
-            return None
+            return INVALID, None
         at += 7
     if eyes:
         f.left_eye, f.right_eye = _read_pose(v[at : at + 7]), _read_pose(v[at + 7 : at + 14])
         if f.left_eye is None or f.right_eye is None:
-            return None
+            return INVALID, None
         at += 14
     lm = v[at : at + 3 * nl]
-    if not np.isfinite(lm).all():
-        return None
+    if not np.isfinite(lm).all() or (nl and np.abs(lm).max() > 1e3):
+        return INVALID, None
     f.landmarks = lm.reshape(nl, 3)
-    return f
+    clamped = bool(((weights < 0) | (weights > 1)).any())
+    f.weights = np.clip(weights, 0, 1).astype(np.float32)
+    return (CLAMPED if clamped else KEPT), f
 
 
 def _good_record(data: bytes, at: int) -> int:
@@ -367,8 +375,10 @@ def _apply(payload: bytes, order: list[int], rec: Recording) -> None:
     kind = payload[0]
     ok = True
     if kind == RecordType.FRAME:
-        f = _decode_frame_record(payload, order)
-        ok = f is not None
+        verdict, f = _decode_frame_record(payload, order)
+        ok = verdict != BROKEN
+        rec.recovery.invalid_frames += verdict == INVALID
+        rec.recovery.clamped_frames += verdict == CLAMPED
         if f is not None:
             rec.frames.append(f)
     elif kind == RecordType.PROFILE:
