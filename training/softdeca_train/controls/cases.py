@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 
 from softdeca_train.controls.definitions import Setting
-from softdeca_train.data.regions import REGIONS, element_regions, region_labels
 from softdeca_train.template import Template
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import REGIONS, element_regions, region_labels
 
 # Identity seeds of the gallery: datasets derive theirs from a SeedSequence of (dataset seed,
 # 1, identity id), a 32-bit hash, so these small seeds name identities no dataset holds.

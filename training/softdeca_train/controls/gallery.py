@@ -23,9 +23,9 @@ from softdeca_train.controls.definitions import (
 )
 from softdeca_train.controls.metrics import control_response, identity_spread
 from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
-from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.paths import REPO_ROOT, default_takes_path
+from softdeca_train.template.regions import REGIONS, region_labels
 
 RANGES = ("control", "physics")
 

@@ -133,7 +133,7 @@ def _set_regional(
     domains). Returns the pattern stored with the instances (p in every region without one)
     and the soft tissue's requested volume: p's target_volume, or its field with each tet's
     region where the pattern varies it (the volume bound judges each region on its own)."""
-    from softdeca_train.data.regions import REGIONS, element_regions, region_labels
+    from softdeca_train.template.regions import REGIONS, element_regions, region_labels
 
     tv = names.index("target_volume")
     if g.p_regions is None:

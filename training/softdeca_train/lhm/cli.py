@@ -19,7 +19,8 @@ def _bench_args(p: argparse.ArgumentParser) -> None:
 def _bench_run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from softdeca_train.bench import bench_lhm, report_area
+    from softdeca_train.bench import report_area
+    from softdeca_train.lhm.bench import bench_lhm
 
     report_area(Path(args.out), "lhm", bench_lhm(args.ict, heads=args.heads))
     return 0
@@ -57,7 +58,7 @@ def _lhm_run(args: argparse.Namespace) -> int:
     report = checked.as_dict()
     if cfg.tet_mesh in ("carried", "conforming"):
         from softdeca_train.lhm.carried import tissue_mesh
-        from softdeca_train.lhm.checks import conforming_quality
+        from softdeca_train.lhm.conforming import conforming_quality
 
         mesh, _ = tissue_mesh(t, h, model)
         report["tet_source"] = mesh.source

@@ -23,7 +23,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from softdeca_train.models.networks import (
+from softdeca_train.models.blocks import (
     NetworkSizes,
     Normalise,
     gravity_columns,

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from softdeca_train.mesh_files import read_obj, read_pc2
 from softdeca_train.render import Focus, MeshLayer, RenderSettings, TileSettings, render, tile
-from softdeca_train.runtime.files import read_obj, read_pc2
 from softdeca_train.template.model import N_SKIN
 
 LABELS = {

@@ -75,10 +75,10 @@ def parameter_fields(
 ) -> dict[str, float | np.ndarray]:
     """Every parameter's value for `hs`'s simulator after `changes` (applied in order on top of
     the defaults): a number, or one value per element of the parameter's domain."""
-    from softdeca_train.data.regions import mesh_tet_skin_vertices
     from softdeca_train.models.dt import face_geometry
     from softdeca_train.models.parameters import ParameterState
     from softdeca_train.models.rest_physics import element_values
+    from softdeca_train.template.regions import mesh_tet_skin_vertices
 
     skin = np.asarray(hs.head[:N_SKIN], np.float64)
     faces = np.asarray(hs.mesh.skin_triangles, np.int64)

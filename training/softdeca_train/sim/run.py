@@ -99,8 +99,8 @@ def reference_distances(
 ) -> dict[str, Any]:
     """How far `result`'s skin S lies from a `reference` run of the same frames (solved to
     `tolerance`): per frame the mean and largest vertex distance (mm), the vertex of S with the
-    largest and its region (data/regions.py, `labels` per vertex of S)."""
-    from softdeca_train.data.regions import REGIONS
+    largest and its region (template/regions.py, `labels` per vertex of S)."""
+    from softdeca_train.template.regions import REGIONS
 
     frames = []
     for a, b in zip(result.physics, reference.physics, strict=True):

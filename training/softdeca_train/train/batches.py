@@ -61,7 +61,7 @@ class Batch:
     prev_T: torch.Tensor | None = None
     prev_weights: torch.Tensor | None = None  # dynamic: (2, 52)
     source_take: np.ndarray | None = None  # (B,) take index or -1 (coverage)
-    # static/sparse: (len(REGIONS), P) the group's values per region of S (data/regions.py),
+    # static/sparse: (len(REGIONS), P) the group's values per region of S (template/regions.py),
     # p in every region without a regional pattern; None in datasets written without them
     p_regions: torch.Tensor | None = None
     p_faces: torch.Tensor | None = None  # (F, P) p_regions on the skin triangles
@@ -128,7 +128,7 @@ class Dataset:
         unknown = set(parameters or ()) - set(names)
         if unknown:
             raise ValueError(f"unknown parameters {sorted(unknown)}")
-        from softdeca_train.data.regions import region_labels
+        from softdeca_train.template.regions import region_labels
 
         self.labels = region_labels(self.template)  # regional patterns -> triangles, vertices
         self.columns = (

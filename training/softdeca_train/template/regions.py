@@ -22,6 +22,9 @@ REGIONS = (
     "mouth_socket",
     "eye_sockets",
 )
+# The regions on the outer skin (the mouth and eye sockets are inside the head): the ones a
+# region control acts on and a regional pattern of the data varies.
+CONTROL_REGIONS = tuple(r for r in REGIONS if r not in ("mouth_socket", "eye_sockets"))
 
 
 # Parameter domains whose elements have a region (element_regions); a landmark's weight
