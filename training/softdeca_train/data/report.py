@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from softdeca_train.data.blend import SkinBlend
-from softdeca_train.data.config import KINDS, GenerateConfig
+from softdeca_train.data.config import KINDS, GenerateConfig, default_takes_path
 from softdeca_train.data.expressions import expression_sources, load_takes
 from softdeca_train.data.offset_structure import RIDGE, offset_structure
 from softdeca_train.data.ranges import sampling_parameters
@@ -546,8 +546,6 @@ def _distribution_lines(n_identities: int, spread: np.ndarray) -> list[str]:
 def write_report(
     folder: Path, out: Path, ict: str | None = None, takes_dir: Path | None = None
 ) -> Path:
-    from softdeca_train.data.config import default_takes_path
-
     folder, out = Path(folder), Path(out)
     manifest = json.loads((folder / "manifest.json").read_text())
     template = Template.load(ict)

@@ -27,6 +27,7 @@ import numpy as np
 
 from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_head import RestHead
+from softdeca_train.template.regions import nearest_skin_vertices
 
 # The physics' element kinds a parameter map is carried to (plugin/data/parameters.json).
 MAPPED_DOMAINS = ("soft_tet", "muscle_tet", "skin_triangle", "skin_point")
@@ -56,9 +57,8 @@ class RestSolver:
     def __init__(
         self, head: RestHead, neutral_head: np.ndarray, skin_triangles: np.ndarray
     ) -> None:
+        # compiled with the plugin: reading and running a bundle does not need it
         import softdeca_native as native
-
-        from softdeca_train.template.regions import nearest_skin_vertices
 
         self.head = head
         self.neutral_skin = np.asarray(neutral_head, np.float64)[: head.skin_count]

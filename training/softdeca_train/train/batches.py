@@ -19,8 +19,10 @@ import torch
 from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import TEST, TRAIN
 from softdeca_train.models.dt import DtSystem, dt_system
+from softdeca_train.parameters import load_parameters
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import region_labels
 
 # max_error that keeps every frame: evaluation judges a model on the whole test split.
 EVERY_FRAME = math.inf
@@ -122,13 +124,11 @@ class Dataset:
         self.blend = SkinBlend.of(self.template)
         self.cache = IdentityCache(self.template, self.template.skin_triangles)
         self.tolerance = float(self.manifest["header"]["config"]["tolerance"])
-        from softdeca_train.parameters import load_parameters
 
         names = load_parameters().names
         unknown = set(parameters or ()) - set(names)
         if unknown:
             raise ValueError(f"unknown parameters {sorted(unknown)}")
-        from softdeca_train.template.regions import region_labels
 
         self.labels = region_labels(self.template)  # regional patterns -> triangles, vertices
         self.columns = (

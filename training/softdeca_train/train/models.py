@@ -12,6 +12,7 @@ from dataclasses import replace
 import numpy as np
 import torch
 from torch import nn
+from tqdm import tqdm
 
 from softdeca_train.data.plan import FIXED
 from softdeca_train.models.dt import deformation_transfer
@@ -297,8 +298,6 @@ class SoftDecaHybrid(Trainable):
         and of `more`: its w part (rank latent - 1, reduced-rank regression) in f_w's linear
         path and L_v's base, its constant and parameter parts in L_v's local map; every MLP's
         output and the DT stage start at zero."""
-        from tqdm import tqdm
-
         fit: LocalRidge | None = None
         moment = torch.zeros(self.n_weights, self.n_weights, dtype=torch.float64)
         sources = [data, *more]
@@ -357,8 +356,6 @@ class SoftDecaHybrid(Trainable):
         """With z's codes fixed by the first fit, the vertex stage again as a per-vertex ridge
         fit on `code_features`: its code part in L_v's base, the local features' in the
         constant slot's table, the products in the slot table. One more pass over the data."""
-        from tqdm import tqdm
-
         hyper = self.f_ph_v
         assert hyper.base is not None and hyper.local is not None
         assert hyper.local.slot_table is not None
@@ -393,8 +390,6 @@ class SoftDecaHybrid(Trainable):
         their coefficients (models/residual.py). `contrasts`: a dataset generated with
         contrasts (data/plan.py contrast), whose static train frames join the fit with their
         pairs."""
-        from tqdm import tqdm
-
         assert self.f_r is not None
         with torch.no_grad():
             self.f_r.table.zero_()  # the model without the stage
