@@ -70,7 +70,7 @@ PYTHON_LAYERS: tuple[tuple[str, ...], ...] = (
     # benchmark figures, geometry, mesh files, pictures
     ("paths", "commands", "bench", "geometry", "mesh_files", "render"),
     # the definitions the plugin shares (plugin/data) and the third-party data
-    ("face_names", "parameters", "third_party_data"),
+    ("face_names", "parameters", "contact_rules", "third_party_data"),
     # the head template and its regions; the landmarks on it; the layered head model
     ("template",),
     ("landmarks",),

@@ -21,6 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from softdeca_train.contact_rules import CONTACT_RULES
 from softdeca_train.lhm import LhmConfig, eyes
 from softdeca_train.lhm.eyes import EYE_ZONE_SHARE
 from softdeca_train.sim.collision_spec import CollisionSpec, collision_sets
@@ -36,11 +37,11 @@ class ContactRules:
 
     landmarks68: np.ndarray  # (68,) skin vertex indices of the 68 Multi-PIE landmarks
     lid_candidates: np.ndarray  # skin vertices that may belong to a lid
-    lip_radius: float = 0.012
-    lip_corner_radius: float = 0.008
-    lid_reach: float = 0.008
-    lid_corner_radius: float = 0.004
-    eye_zone_share: float = 0.75
+    lip_radius: float = CONTACT_RULES.lip_radius
+    lip_corner_radius: float = CONTACT_RULES.lip_corner_radius
+    lid_reach: float = CONTACT_RULES.lid_reach
+    lid_corner_radius: float = CONTACT_RULES.lid_corner_radius
+    eye_zone_share: float = CONTACT_RULES.eye_zone_share
 
     def sets(
         self,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from softdeca_train.contact_rules import CONTACT_RULES
 from softdeca_train.template.components import N_SKIN
 
 # Adult anthropometric ranges in mm, about mean +- 3 SD of Farkas (1994, "Anthropometry of the
@@ -25,7 +26,9 @@ def face_measures(head: np.ndarray, lm68: np.ndarray) -> dict[str, float]:
     }
 
 
-def lip_contact_zone(head: np.ndarray, lm68: np.ndarray, radius: float = 0.012) -> np.ndarray:
+def lip_contact_zone(
+    head: np.ndarray, lm68: np.ndarray, radius: float = CONTACT_RULES.lip_radius
+) -> np.ndarray:
     """S vertices within `radius` of the inner lip contour. ICT's own neutral has its lips
     pressed into each other there; the simulation's collision step resolves that contact."""
     mouth = head[lm68[60:68]]
