@@ -14,7 +14,7 @@ from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.landmarks.definition import load_definition
 from softdeca_train.streaming.protocol import Profile
 
-# "softdeca149": SparseSoftDECA's contour landmarks (landmarks/definition.json);
+# "softdeca149": SparseSoftDECA's contour landmarks (plugin/data/landmarks.json);
 # "arkit68": the standard 68-point scheme's vertices; "none": no landmarks.
 PROFILES = ("softdeca149", "arkit68", "none")
 
