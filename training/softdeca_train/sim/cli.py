@@ -233,8 +233,6 @@ def _bench_physics_args(p: argparse.ArgumentParser) -> None:
 
 
 def _bench_physics_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from softdeca_train.bench import report_area
     from softdeca_train.sim.bench import DEFAULT_TAKE, bench_physics_lhm
 
