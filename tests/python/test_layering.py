@@ -1,5 +1,7 @@
 """The native library's layers: core/ below everything, the C ABI (api/) on top, nothing below
-api/ including it, and the streaming areas (stream/, recording/, live/) in one order."""
+api/ including it, and the streaming areas (stream/, recording/, live/) in one order. The
+training package's layers (PYTHON_LAYERS): no import cycle, areas importing only downwards,
+and imports at module top but for a few explained ones."""
 
 from __future__ import annotations
 
