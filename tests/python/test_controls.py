@@ -29,8 +29,8 @@ from softdeca_train.controls.report import (
     merge_into_report,
     validate_report,
 )
-from softdeca_train.data.regions import REGIONS
 from softdeca_train.parameters import load_parameters
+from softdeca_train.template.regions import REGIONS
 
 REPO = Path(__file__).resolve().parents[2]
 # A tiny "face": 6 vertices, the first two in the lips.
@@ -224,8 +224,8 @@ def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:
     from softdeca_train.data.expressions import expression_sources, load_takes
     from softdeca_train.data.plan import FIXED, make_plan
     from softdeca_train.data.ranges import sampling_parameters
-    from softdeca_train.data.regions import REGIONAL_DOMAINS
     from softdeca_train.paths import default_takes_path
+    from softdeca_train.template.regions import REGIONAL_DOMAINS
 
     cfg = GenerateConfig(static=24, dynamic=0, sparse=8, region_share=0.5, seed=3)
     assert cfg.frames_per_params == 1 and cfg.ranges == "controls"

@@ -23,11 +23,11 @@ from softdeca_train.data.loader import ShardDataset
 from softdeca_train.data.personalise import add_noise, personalise
 from softdeca_train.data.plan import FIXED, make_plan
 from softdeca_train.data.ranges import fixed_outside_profile
-from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.data.shards import iter_shards, verify
 from softdeca_train.landmarks import template_landmarks
 from softdeca_train.parameters import load_parameters
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import REGIONS, region_labels
 
 
 def _all(folder, kind: str) -> dict[str, np.ndarray]:

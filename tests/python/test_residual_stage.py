@@ -8,7 +8,7 @@ import numpy as np
 import torch
 from bounds import above, below
 from softdeca_train.models import load_parameter_specs
-from softdeca_train.models.networks import region_means
+from softdeca_train.models.blocks import region_means
 from softdeca_train.models.residual import ResidualFit, ResidualSizes, ResidualStage
 from softdeca_train.models.synthetic import TEST_PARAMETERS
 

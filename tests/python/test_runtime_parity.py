@@ -367,9 +367,9 @@ def test_parity_on_the_template_topology(tmp_path, template):
 def test_rest_physics_parity_on_the_template_topology(tmp_path, template):
     """The physics at prepare on the real head: the tissue fill carried to an ICT identity, its
     lip and lid sets and each tet's skin vertex found on it, natively as in the reference."""
-    from softdeca_train.data.regions import REGIONS, region_labels
     from softdeca_train.models.rest_head import rest_head_from_template
     from softdeca_train.models.topology import from_template
+    from softdeca_train.template.regions import REGIONS, region_labels
 
     d = from_template(template)
     nets = build_random(d, load_parameter_specs(TEST_PARAMETERS), TEST_SIZES, seed=3)

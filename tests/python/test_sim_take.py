@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from bounds import above, below
 from softdeca_train.lhm import LhmConfig
-from softdeca_train.runtime.files import read_obj, read_pc2
+from softdeca_train.mesh_files import read_obj, read_pc2
 from softdeca_train.sim import HeadSimulation, build_head_simulation
 from softdeca_train.sim.measures import penetrating_points
 from softdeca_train.sim.take import read_take
@@ -283,8 +283,8 @@ def test_steps_parse_without_the_native_module(tmp_path: Path) -> None:
 
 
 def test_reference_distances_name_the_largest_and_its_region() -> None:
-    from softdeca_train.data.regions import REGIONS
     from softdeca_train.sim.run import SimulatedTake, reference_distances
+    from softdeca_train.template.regions import REGIONS
 
     rng = np.random.default_rng(0)
     heads = [rng.normal(size=(N_SKIN + 5, 3)).astype(np.float32) for _ in range(2)]

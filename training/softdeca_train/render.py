@@ -35,7 +35,7 @@ def _pyvista():  # -> the pyvista module
     if importlib.util.find_spec("triton") is not None:
         with contextlib.suppress(ImportError):
             import triton  # noqa: F401
-    import pyvista as pv
+    import pyvista as pv  # VTK loads slowly: only pictures pay for it
 
     return pv
 
@@ -321,7 +321,7 @@ def _font(size: int) -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
     # DejaVu Sans (shipped with matplotlib) has the Greek labels use (σ of the identities);
     # Pillow's own default font draws them as boxes.
     try:
-        from matplotlib import font_manager
+        from matplotlib import font_manager  # only for its font file
 
         return ImageFont.truetype(font_manager.findfont("DejaVu Sans"), size)
     except (ImportError, OSError, ValueError):

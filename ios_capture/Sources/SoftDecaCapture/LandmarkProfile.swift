@@ -35,22 +35,22 @@ public struct LandmarkProfile: Equatable, Sendable {
         self.id = CRC32.checksum(bytes.bytes)
     }
 
-    /// Where the landmark file is found: the app's resources (`definition.json`, added to the
+    /// Where the landmark file is found: the app's resources (`landmarks.json`, added to the
     /// app target from the repository), else the repository this source file is in.
     public static func definitionURL() -> URL? {
-        if let url = Bundle.main.url(forResource: "definition", withExtension: "json") { return url }
+        if let url = Bundle.main.url(forResource: "landmarks", withExtension: "json") { return url }
         let repo = URL(fileURLWithPath: #filePath).deletingLastPathComponent().deletingLastPathComponent()
             .deletingLastPathComponent().deletingLastPathComponent()
-        let url = repo.appendingPathComponent("training/softdeca_train/landmarks/definition.json")
+        let url = repo.appendingPathComponent("plugin/data/landmarks.json")
         return FileManager.default.fileExists(atPath: url.path) ? url : nil
     }
 
-    /// The landmark file every part of the product reads (training/softdeca_train/landmarks/
-    /// definition.json, whose indices the model bundle carries too): its
+    /// The landmark file every part of the product reads (plugin/data/landmarks.json, whose
+    /// indices the model bundle carries too): its
     /// `landmarks[].arkit_vertex`, in order.
     public static func softdeca149(definition: URL? = nil) throws -> LandmarkProfile {
         guard let url = definition ?? definitionURL() else {
-            throw CaptureError.profile("the landmark definition is missing: add training/softdeca_train/landmarks/definition.json to the app's resources")
+            throw CaptureError.profile("the landmark definition is missing: add plugin/data/landmarks.json to the app's resources")
         }
         let data: Data
         do { data = try Data(contentsOf: url) } catch {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "runtime/contact_rules_table.h"  // generated from plugin/data/contact_rules.json
 #include "sim/mesh.h"
 
 namespace softdeca::runtime {
@@ -14,8 +15,9 @@ namespace softdeca::runtime {
 struct ContactRules {
   std::vector<std::int32_t> landmarks68;     // skin vertex indices of the 68 Multi-PIE landmarks
   std::vector<std::int32_t> lid_candidates;  // skin vertices that may belong to a lid
-  double lip_radius = 0.012, lip_corner_radius = 0.008;
-  double lid_reach = 0.008, lid_corner_radius = 0.004, eye_zone_share = 0.75;
+  double lip_radius = SOFTDECA_CONTACT_LIP_RADIUS, lip_corner_radius = SOFTDECA_CONTACT_LIP_CORNER_RADIUS;
+  double lid_reach = SOFTDECA_CONTACT_LID_REACH, lid_corner_radius = SOFTDECA_CONTACT_LID_CORNER_RADIUS;
+  double eye_zone_share = SOFTDECA_CONTACT_EYE_ZONE_SHARE;
 };
 
 // upper_teeth / lower_teeth: the teeth's triangles over simulated vertices. `skin_triangles`:

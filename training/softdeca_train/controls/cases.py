@@ -12,10 +12,13 @@ from pathlib import Path
 import numpy as np
 
 from softdeca_train.controls.definitions import Setting
-from softdeca_train.data.regions import REGIONS, element_regions, region_labels
+from softdeca_train.data.expressions import load_takes
+from softdeca_train.models.reference import ReferenceAvatar
+from softdeca_train.models.topology import from_template
 from softdeca_train.template import Template
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import REGIONS, element_regions, region_labels
 
 # Identity seeds of the gallery: datasets derive theirs from a SeedSequence of (dataset seed,
 # 1, identity id), a 32-bit hash, so these small seeds name identities no dataset holds.
@@ -25,8 +28,6 @@ IDENTITY_SEEDS = (101, 202, 303)
 def expressions(takes_folder: Path, take: str = "facial", count: int = 3) -> np.ndarray:
     """(count, 52) ARKit frames of a held-out take: the frame that opens the jaw most, the
     broadest smile and the strongest pucker (in that order, the first `count`)."""
-    from softdeca_train.data.expressions import load_takes
-
     takes = {t.name: t for t in load_takes(takes_folder)}
     if take not in takes:
         raise ValueError(f"no take {take!r} in {takes_folder}")
@@ -56,6 +57,7 @@ class PhysicsCase:
 
     @cached_property
     def head(self):  # -> HeadSimulation
+        # the physics needs the compiled softdeca_native; the rest of the gallery does not
         from softdeca_train.lhm import LhmConfig
         from softdeca_train.sim import build_head_simulation
 
@@ -64,7 +66,7 @@ class PhysicsCase:
 
     @cached_property
     def sim(self):  # -> native.Simulator
-        import softdeca_native as native
+        import softdeca_native as native  # compiled with the plugin: see `head`
 
         return native.Simulator(
             self.head.mesh, tolerance=self.tolerance, max_iterations=self.max_iterations
@@ -114,9 +116,6 @@ class ModelCase:
     runtime refuses them); `clamped` records which parameters were."""
 
     def __init__(self, networks, case: PhysicsCase) -> None:  # networks: OnnxNetworks
-        from softdeca_train.models.reference import ReferenceAvatar
-        from softdeca_train.models.topology import from_template
-
         t = case.template
         self.case = case
         self.nets = networks

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 from pathlib import Path
 
 from softdeca_train.commands import Command, add_ict_argument, add_tet_mesh_argument
@@ -157,7 +158,6 @@ def add_report_arguments(p: argparse.ArgumentParser, standalone: bool = True) ->
 
 def report_parts(args: argparse.Namespace, bundle: Path) -> tuple[list[dict], dict | None]:
     """The report's `controls` (measured, or read from --controls-json) and `real_takes`."""
-    import json
 
     from softdeca_train.controls.gallery import GalleryConfig, report_entries, run_gallery
     from softdeca_train.controls.report import RealTakes, real_takes

@@ -7,12 +7,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from softdeca_train.data.regions import REGIONS
 from softdeca_train.parameters import ParameterSet
+from softdeca_train.template.regions import CONTROL_REGIONS, REGIONS
 
-# Regions of S a region control acts on: every region of data/regions.py on the outer skin
-# (the mouth and eye sockets are inside the head).
-CONTROL_REGIONS = tuple(r for r in REGIONS if r not in ("mouth_socket", "eye_sockets"))
 # The parameter region controls set per region by default: the soft tissue's target volume
 # (a fuller or thinner region, "thicker lips").
 REGION_PARAMETERS = ("target_volume",)

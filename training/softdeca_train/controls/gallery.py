@@ -23,9 +23,12 @@ from softdeca_train.controls.definitions import (
 )
 from softdeca_train.controls.metrics import control_response, identity_spread
 from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
-from softdeca_train.data.regions import REGIONS, region_labels
+from softdeca_train.controls.pictures import draw_gallery, markdown
+from softdeca_train.models.bundle import OnnxNetworks
 from softdeca_train.parameters import ParameterSet, load_parameters
-from softdeca_train.paths import REPO_ROOT, default_takes_path
+from softdeca_train.paths import REPO_ROOT, data_dir, default_takes_path
+from softdeca_train.template import Template
+from softdeca_train.template.regions import REGIONS, region_labels
 
 RANGES = ("control", "physics")
 
@@ -117,8 +120,6 @@ def _measure_case(
     cache = open_cache(cfg.physics_cache)
     model = None
     if cfg.bundle is not None:
-        from softdeca_train.models.bundle import OnnxNetworks
-
         model = ModelCase(OnnxNetworks(cfg.bundle), case)
 
     def physics(s: Setting) -> np.ndarray:
@@ -153,8 +154,6 @@ def control_entry(c: Control, acc: Collected, labels: np.ndarray) -> dict:
 
 def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
     """Measure every control (and draw its pictures); returns the gallery's JSON."""
-    from softdeca_train.template import Template
-
     t0 = time.perf_counter()
     controls, defaults = controls_of(cfg)
     template = Template.load(cfg.ict)
@@ -187,8 +186,6 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
         "seconds": round(time.perf_counter() - t0, 1),
     }
     if cfg.pictures:
-        from softdeca_train.controls.pictures import draw_gallery
-
         draw_gallery(
             cfg.out, controls, acc.shown, cases[0], entries, progress, complete=not cfg.only
         )
@@ -198,8 +195,6 @@ def run_gallery(cfg: GalleryConfig, progress: bool = True) -> dict:
 def _shown_path(value: object) -> object:
     """Paths as the report shows them: relative to the repository or the data folder (the
     gallery is committed: no machine's absolute paths)."""
-    from softdeca_train.paths import data_dir
-
     if not isinstance(value, Path):
         return value
     p = value.resolve()
@@ -218,8 +213,6 @@ def report_entries(result: dict) -> list[dict]:
 
 
 def write_gallery(cfg: GalleryConfig, result: dict) -> Path:
-    from softdeca_train.controls.pictures import markdown
-
     cfg.out.mkdir(parents=True, exist_ok=True)
     (cfg.out / "controls.json").write_text(json.dumps(result, indent=1) + "\n")
     path = cfg.out / "README.md"

@@ -36,7 +36,7 @@ PHYSICS_SOURCES = (
     "training/softdeca_train/lhm",
     "training/softdeca_train/template",
     "training/softdeca_train/parameters.py",
-    "training/softdeca_train/data/regions.py",
+    "training/softdeca_train/contact_rules.py",
     "training/softdeca_train/controls/cases.py",
 )
 

@@ -12,6 +12,7 @@ from tqdm import tqdm
 
 from softdeca_train.controls.cases import PhysicsCase
 from softdeca_train.controls.definitions import Control
+from softdeca_train.render import MeshLayer, RenderSettings, TileSettings, render, tile
 
 SIZE = (220, 220)
 
@@ -21,8 +22,6 @@ def _fmt(x: float | None, digits: int = 3) -> str:
 
 
 def _heat(shape: np.ndarray, tris: np.ndarray, mm: np.ndarray, vmax: float) -> np.ndarray:
-    from softdeca_train.render import MeshLayer, RenderSettings, render
-
     layer = MeshLayer(shape, tris, scalars=mm, clim=(0.0, vmax))
     return render([layer], "three_quarter", settings=RenderSettings(size=SIZE))
 
@@ -32,8 +31,6 @@ def control_picture(
 ) -> None:
     """One row per expression: physics change, model change, and at the top of the range
     |model - physics| and |linear - physics| (mm)."""
-    from softdeca_train.render import TileSettings, tile
-
     tris = case.template.skin_triangles
     d_phys = 1e3 * np.linalg.norm(shown["physics"] - shown["lo"], axis=-1)
     has_model = "model" in shown
@@ -74,10 +71,10 @@ def control_picture(
 
 
 def summary_figure(path: Path, entries: list[dict]) -> None:
-    import matplotlib
+    import matplotlib  # loads slowly: only this figure uses it
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # after the backend is chosen
 
     names = [e["name"] for e in entries]
     fig, axes = plt.subplots(3, 1, figsize=(10, 9), sharex=True)

@@ -16,6 +16,10 @@ from tqdm import tqdm
 from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase
 from softdeca_train.controls.definitions import Setting
 from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
+from softdeca_train.models.bundle import OnnxNetworks
+from softdeca_train.parameters import load_parameters
+from softdeca_train.streaming.livelinkface import read_csv
+from softdeca_train.template import Template
 
 CONTROL_KEYS = ("name", "region", "physics_max_mm", "response_error", "leakage")
 REAL_TAKE_KEYS = ("frames", "identities", "softdeca_mm", "linear_mm")
@@ -72,8 +76,6 @@ class RealTakes:
 
 def take_frames(recordings: Path, every: int) -> np.ndarray:
     """(n, 52) every `every`-th tracked frame of every Live Link Face take below `recordings`."""
-    from softdeca_train.streaming.livelinkface import read_csv
-
     paths = sorted(Path(recordings).rglob("*.csv"))
     if not paths:
         raise FileNotFoundError(f"no Live Link Face takes (*.csv) below {recordings}")
@@ -87,10 +89,6 @@ def take_frames(recordings: Path, every: int) -> np.ndarray:
 def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
     """Mean distance (mm) of SoftDECA (the bundle, default parameters) and of the linear
     blendshapes to the physics (default parameters), over every vertex of S and every frame."""
-    from softdeca_train.models.bundle import OnnxNetworks
-    from softdeca_train.parameters import load_parameters
-    from softdeca_train.template import Template
-
     if not 1 <= cfg.identities <= len(IDENTITY_SEEDS) or cfg.every < 1:
         raise ValueError(f"identities must be in 1..{len(IDENTITY_SEEDS)}, every >= 1")
     weights = take_frames(cfg.recordings, cfg.every)

@@ -114,7 +114,7 @@ def run_ray(
     `workers` CPUs; otherwise connect (e.g. "ray://head:10001" or "auto"). Cluster nodes need
     this package, softdeca_native and ICT-FaceKit (the --ict path) installed alike."""
     try:
-        import ray
+        import ray  # optional: only the Ray executor needs it
     except ImportError as e:
         raise ValueError("--ray-address needs the ray package (pip install ray)") from e
     keep = ("PYTHONPATH", "SOFTDECA_ICT", "SOFTDECA_DATA", "SOFTDECA_CACHE")

@@ -42,7 +42,7 @@ REGIONAL = {
     "p_regions": (
         "float64",
         "(n, 10, 25)",
-        "parameters per region of S (data/regions.py REGIONS order): a regional pattern, or p "
+        "parameters per region of S (template/regions.py REGIONS order): a regional pattern, or p "
         "in every region",
     ),
 }

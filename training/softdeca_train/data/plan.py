@@ -21,6 +21,7 @@ from softdeca_train.data.expressions import Draws, ExpressionSource
 from softdeca_train.data.ranges import fixed_outside_profile
 from softdeca_train.parameters import ParameterSet
 from softdeca_train.sim.dynamics import MAX_PEAK_GAIN, peak_gain
+from softdeca_train.template.regions import CONTROL_REGIONS, REGIONAL_DOMAINS, REGIONS
 
 KIND_CODE = {k: i for i, k in enumerate(KINDS)}
 # Parameters that do not act in a kind keep their defaults there (paper 4.2.1: static
@@ -101,9 +102,6 @@ def regional_pattern(
     the physics defines per element of a place on S, REGIONAL_DOMAINS) that is not fixed
     gets, with probability 1/2, its own value in every region of the face a control can set
     (drawn from its range like p), the others keep p's value everywhere. None: p everywhere."""
-    from softdeca_train.controls.definitions import CONTROL_REGIONS
-    from softdeca_train.data.regions import REGIONAL_DOMAINS, REGIONS
-
     if rng.random() >= share:
         return None
     pattern = np.repeat(p[None], len(REGIONS), axis=0)
@@ -126,9 +124,6 @@ def contrast(
     """(p, pattern) with one factor drawn again: one parameter that is not fixed, everywhere,
     or (with probability `region_share`, for a localisable one) its value in one region of
     the face a control can set. Everything else stays as it was."""
-    from softdeca_train.controls.definitions import CONTROL_REGIONS
-    from softdeca_train.data.regions import REGIONAL_DOMAINS, REGIONS
-
     free = [k for k, s in enumerate(params.specs) if s.name not in fixed]
     if not free:
         raise ValueError("contrasts need a parameter that is not fixed")

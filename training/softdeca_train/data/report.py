@@ -22,16 +22,16 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from softdeca_train.data.blend import SkinBlend
-from softdeca_train.data.config import KINDS, GenerateConfig
+from softdeca_train.data.config import KINDS, GenerateConfig, default_takes_path
 from softdeca_train.data.expressions import expression_sources, load_takes
 from softdeca_train.data.offset_structure import RIDGE, offset_structure
 from softdeca_train.data.ranges import sampling_parameters
-from softdeca_train.data.regions import REGIONS, region_labels
 from softdeca_train.data.shards import iter_shards
 from softdeca_train.landmarks import SurfaceLandmarks, template_landmarks
 from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.template import ARKIT_BLENDSHAPES, Template
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import REGIONS, region_labels
 
 BIN_MM = 0.01
 MAX_MM = 200.0
@@ -445,7 +445,7 @@ def _displacement_lines(st: _Stats, tables: dict, tables_all: dict) -> list[str]
     lines = [
         "## How much the physics moves S: |T - S| in mm",
         "",
-        "Per vertex and frame (dynamic: all sequence frames). Regions: data/regions.py. "
+        "Per vertex and frame (dynamic: all sequence frames). Regions: template/regions.py. "
         "This is the yardstick for the networks' errors.",
         "",
     ]
@@ -546,8 +546,6 @@ def _distribution_lines(n_identities: int, spread: np.ndarray) -> list[str]:
 def write_report(
     folder: Path, out: Path, ict: str | None = None, takes_dir: Path | None = None
 ) -> Path:
-    from softdeca_train.data.config import default_takes_path
-
     folder, out = Path(folder), Path(out)
     manifest = json.loads((folder / "manifest.json").read_text())
     template = Template.load(ict)

@@ -22,6 +22,7 @@ from softdeca_train.sim.measures import SoftVolume
 from softdeca_train.sim.sanity import REASONS, VolumeField, check_frame
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import REGIONS, element_regions, region_labels
 
 F16_MAX = 65504.0
 
@@ -133,8 +134,6 @@ def _set_regional(
     domains). Returns the pattern stored with the instances (p in every region without one)
     and the soft tissue's requested volume: p's target_volume, or its field with each tet's
     region where the pattern varies it (the volume bound judges each region on its own)."""
-    from softdeca_train.data.regions import REGIONS, element_regions, region_labels
-
     tv = names.index("target_volume")
     if g.p_regions is None:
         return np.repeat(g.p[None], len(REGIONS), axis=0), float(g.p[tv])

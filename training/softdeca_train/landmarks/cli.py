@@ -71,7 +71,7 @@ def add_landmarks_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--write-definition",
         action="store_true",
-        help="regenerate the committed landmark definition (definition.json) from "
+        help="regenerate the committed landmark definition (plugin/data/landmarks.json) from "
         "its rules before registering",
     )
 

@@ -5,8 +5,8 @@ a hand-typed vertex list: eye rings and the inner-lip ring are boundary loops, t
 the arc of the outer rim through the 68 jaw points, and brows, nose and outer lips are shortest
 edge paths between consecutive 68-point anchors. Chains longer than wanted are subsampled evenly
 by arc length, always keeping their anchors. `generate_definition()` applies the rules;
-definition.json (committed) is its output and what later stages read (`load_definition()`); a
-test checks that the two agree.
+plugin/data/landmarks.json (committed) is its output and what later stages read
+(`load_definition()`); a test checks that the two agree.
 """
 
 from __future__ import annotations
@@ -27,9 +27,12 @@ from softdeca_train.landmarks.topology import (
     loop_arc,
     subsample_chain,
 )
+from softdeca_train.paths import REPO_ROOT
 
 DEFINITION_FORMAT = 1
-DEFINITION_PATH = Path(__file__).with_name("definition.json")
+# The one landmark file of the product, beside the plugin's other shared definitions: the
+# training, the iOS app and (through each bundle's manifest) the runtime read it.
+DEFINITION_PATH = REPO_ROOT / "plugin" / "data" / "landmarks.json"
 # +x is the subject's own left (docs/ARCHITECTURE.md, Conventions)
 SIDE_REGIONS = {"left": +1, "right": -1}
 

@@ -60,8 +60,8 @@ def _mesh_quality(r: LandmarkRegistration) -> dict[str, Any]:
     )
     out: dict[str, Any] = {"inverted_triangles": flips}
     try:
-        import softdeca_native as native
-    except ImportError:  # the native module is optional here; the count is informative
+        import softdeca_native as native  # optional here: the count is informative
+    except ImportError:
         return out
     t32 = tri.astype(np.int32)
     out["self_intersections_arkit_neutral"] = len(native.self_intersections(r.arkit.neutral, t32))

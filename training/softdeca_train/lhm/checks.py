@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import TYPE_CHECKING
 
 import igl
 import numpy as np
@@ -11,9 +10,6 @@ import softdeca_native as native
 
 from softdeca_train.lhm.model import LayeredHeadModel
 from softdeca_train.lhm.quality import QualityReport, mouth_columns, quality_report
-
-if TYPE_CHECKING:  # conforming.py imports this module
-    from softdeca_train.lhm.conforming import TetMesh
 
 
 @dataclass(frozen=True)
@@ -89,7 +85,7 @@ def tets_spanning_both_lips(
     return int(((side > 0).any(axis=1) & (side < 0).any(axis=1)).sum())
 
 
-def _slit_middle(model: LayeredHeadModel) -> np.ndarray:
+def slit_middle(model: LayeredHeadModel) -> np.ndarray:
     """Middle of the slit's inner part on the skin wrap: the mouth region's centre."""
     middle = model.mouth_copies if len(model.slit_copy_of) else model.slit_path
     return model.skin_wrap[middle].mean(axis=0)
@@ -97,26 +93,9 @@ def _slit_middle(model: LayeredHeadModel) -> np.ndarray:
 
 def mouth_quality(model: LayeredHeadModel) -> QualityReport:
     """Element quality of the model, overall and in the mouth region around the slit."""
-    center = _slit_middle(model)
+    center = slit_middle(model)
     mouth = mouth_columns(model.skin_wrap, center, model.n_layers)
     return quality_report(model.vertices, model.soft_tets, model.muscle_tets, mouth)
-
-
-def conforming_quality(model: LayeredHeadModel, tm: TetMesh) -> QualityReport:
-    """Element quality of `model`'s conforming tet mesh (its fill, lhm/conforming.py, or the
-    template's carried, lhm/carried.py), overall and in the mouth region (vertices within the
-    region's radius of the slit's middle)."""
-    from softdeca_train.lhm.quality import MOUTH_REGION_RADIUS
-
-    center = _slit_middle(model)
-    # the mouth's columns: directions from the head centre within the region's radius of the
-    # slit's middle on the skin wrap (as for the prisms, from the skin to the skull)
-    axis = center - model.center
-    r = np.linalg.norm(axis)
-    d = tm.vertices - model.center
-    cos = d @ axis / np.maximum(np.linalg.norm(d, axis=1) * r, 1e-12)
-    mouth = cos > np.cos(np.arctan(MOUTH_REGION_RADIUS / r))
-    return quality_report(tm.vertices, tm.soft_tets, tm.muscle_tets, mouth)
 
 
 def tet_quality(points: np.ndarray, tets: np.ndarray) -> np.ndarray:

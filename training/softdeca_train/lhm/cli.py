@@ -6,6 +6,8 @@ resolution)."""
 from __future__ import annotations
 
 import argparse
+import json
+from pathlib import Path
 
 from softdeca_train.commands import Command, add_ict_argument, add_tet_mesh_argument
 
@@ -17,9 +19,8 @@ def _bench_args(p: argparse.ArgumentParser) -> None:
 
 
 def _bench_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from softdeca_train.bench import bench_lhm, report_area
+    from softdeca_train.bench import report_area
+    from softdeca_train.lhm.bench import bench_lhm
 
     report_area(Path(args.out), "lhm", bench_lhm(args.ict, heads=args.heads))
     return 0
@@ -36,9 +37,6 @@ def _lhm_args(p: argparse.ArgumentParser) -> None:
 
 
 def _lhm_run(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
-
     from softdeca_train.lhm import LhmConfig, check_lhm, fit_lhm
     from softdeca_train.lhm.figures import render_layers
     from softdeca_train.template import Template
@@ -57,7 +55,7 @@ def _lhm_run(args: argparse.Namespace) -> int:
     report = checked.as_dict()
     if cfg.tet_mesh in ("carried", "conforming"):
         from softdeca_train.lhm.carried import tissue_mesh
-        from softdeca_train.lhm.checks import conforming_quality
+        from softdeca_train.lhm.conforming import conforming_quality
 
         mesh, _ = tissue_mesh(t, h, model)
         report["tet_source"] = mesh.source
@@ -83,9 +81,6 @@ def _carry_args(p: argparse.ArgumentParser) -> None:
 
 
 def _carry_run(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
-
     import numpy as np
     from tqdm import tqdm
 
@@ -142,9 +137,6 @@ def _demo_args(p: argparse.ArgumentParser) -> None:
 
 
 def _demo_run(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
-
     from tqdm import tqdm
 
     from softdeca_train.landmarks.figure import render_registration

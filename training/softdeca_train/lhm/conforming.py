@@ -33,8 +33,9 @@ import numpy as np
 import softdeca_native as native
 from scipy.spatial import cKDTree
 
-from softdeca_train.lhm.checks import closed_wrap_triangles
+from softdeca_train.lhm.checks import closed_wrap_triangles, slit_middle
 from softdeca_train.lhm.model import LayeredHeadModel
+from softdeca_train.lhm.quality import MOUTH_REGION_RADIUS, QualityReport, quality_report
 from softdeca_train.lhm.tetfill import run_fill
 from softdeca_train.paths import cache_dir
 
@@ -159,3 +160,18 @@ def conforming_mesh(
         bone_vertices=bone.astype(np.int32),
         bone_wrap_vertex=np.asarray(nearest, np.int32),
     )
+
+
+def conforming_quality(model: LayeredHeadModel, tm: TetMesh) -> QualityReport:
+    """Element quality of `model`'s conforming tet mesh (its fill, this module's, or the
+    template's carried, lhm/carried.py), overall and in the mouth region (vertices within the
+    region's radius of the slit's middle)."""
+    center = slit_middle(model)
+    # the mouth's columns: directions from the head centre within the region's radius of the
+    # slit's middle on the skin wrap (as for the prisms, from the skin to the skull)
+    axis = center - model.center
+    r = np.linalg.norm(axis)
+    d = tm.vertices - model.center
+    cos = d @ axis / np.maximum(np.linalg.norm(d, axis=1) * r, 1e-12)
+    mouth = cos > np.cos(np.arctan(MOUTH_REGION_RADIUS / r))
+    return quality_report(tm.vertices, tm.soft_tets, tm.muscle_tets, mouth)

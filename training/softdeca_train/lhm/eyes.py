@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from softdeca_train.contact_rules import CONTACT_RULES
 from softdeca_train.lhm.mouth import closest_on_polyline
 
 # ICT 68-landmark ids per eye: one corner, the upper lid's two, the other corner, and the
@@ -20,7 +21,7 @@ EYES = {
     "left": (42, (43, 44), 45, (47, 46)),
 }
 # S points within this share of the eye's width from the fissure's middle take a lid side.
-EYE_ZONE_SHARE = 0.75
+EYE_ZONE_SHARE = CONTACT_RULES.eye_zone_share
 
 
 def fissure_line(skin: np.ndarray, lm68: np.ndarray, eye: str) -> np.ndarray:

@@ -9,7 +9,15 @@ import numpy as np
 
 from softdeca_train.lhm.fit import fit_lhm
 from softdeca_train.lhm.model import JAW, LayeredHeadModel
-from softdeca_train.render import ClipPlane, Focus, MeshLayer, RenderSettings, render, tile
+from softdeca_train.render import (
+    ClipPlane,
+    Focus,
+    MeshLayer,
+    RenderSettings,
+    TileSettings,
+    render,
+    tile,
+)
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.template.plausibility import face_measures
@@ -98,7 +106,6 @@ def render_layers(
         "cut at eye height (from above)",
         "skull (cranium/jaw) and muscle wrap",
     ]
-    from softdeca_train.render import TileSettings
 
     footer = [
         f"skin: S (tan), skin wrap (blue), muscle wrap (red), skull wrap (ivory, jaw "
@@ -129,7 +136,6 @@ def render_identities(template: Template, seeds: list[int], path: str | Path) ->
         m = face_measures(head, template.landmarks68)
         text = f"seed {seed}: eyes {m['biocular']:.0f} mm, face {m['nasion_menton']:.0f} mm"
         labels += [text, f"seed {seed}: layers"]
-    from softdeca_train.render import TileSettings
 
     tile(images, labels, path, TileSettings(columns=2 * min(len(seeds), 3)))
     return Path(path)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -150,8 +151,6 @@ class LayeredHeadModel:
 
     @classmethod
     def load(cls, path: str | Path) -> LayeredHeadModel:
-        import ast
-
         with np.load(path) as z:
             cfg = {
                 str(k): ast.literal_eval(str(v))

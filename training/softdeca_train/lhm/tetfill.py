@@ -23,7 +23,7 @@ SEED_LIBRARY = "libsoftdeca_fixed_seed.so"
 
 def seed_library() -> Path:
     """The preload library, built next to the softdeca_native extension."""
-    import softdeca_native
+    import softdeca_native  # compiled with the plugin; only its folder is needed here
 
     path = Path(softdeca_native.__file__).parent / SEED_LIBRARY
     if not path.exists():
@@ -68,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("surface", type=Path, help="npz with vertices, faces, edge_length, envelope")
     ap.add_argument("out", type=Path, help="npz to write with vertices and tets")
     args = ap.parse_args(argv)
-    import pytetwild
+    import pytetwild  # only the fill's own process loads TetWild
 
     with np.load(args.surface) as z:
         v, t = pytetwild.tetrahedralize(

@@ -4,6 +4,7 @@ onnxruntime). The format is specified in docs/bundle.md; the native runtime read
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import io
 import json
@@ -194,6 +195,7 @@ def _name_constant_outputs(data: bytes, names: list[str]) -> bytes:
     """An output the exporter folded into a constant (the residual stage's mode table) keeps
     the constant's generated name; give it its contract name through an Identity, and the
     constant a table name, so that _store_half stores it in float16 like the other tables."""
+    # onnx only where a bundle is exported
     import onnx
     from onnx import helper
 
@@ -215,7 +217,7 @@ def _name_constant_outputs(data: bytes, names: list[str]) -> bytes:
 def _store_half(data: bytes) -> tuple[bytes, list[str]]:
     """Store the per-element tables (HALF_TABLES) as float16, each read through a Cast node
     (torch's exporter folds such a Cast away, so it is done here)."""
-    import onnx
+    import onnx  # only where a bundle is exported
     from onnx import TensorProto, helper, numpy_helper
 
     model = onnx.load_from_string(data)
@@ -251,8 +253,6 @@ def _round_tables(module: nn.Module) -> None:
 def as_stored(nets: BundleNetworks) -> BundleNetworks:
     """A copy of `nets` as an exported bundle holds them (per-element tables in float16): the
     torch reference a runtime running the bundle should reproduce."""
-    import copy
-
     out = copy.deepcopy(nets)
     for m in out.modules():
         _round_tables(m)
@@ -420,7 +420,7 @@ def _residual_sizes(nets: BundleNetworks) -> dict[str, Any]:
 def _check_onnx(
     data: bytes, module: nn.Module, spec: dict[str, Any], example: tuple[torch.Tensor, ...]
 ) -> float:
-    import onnxruntime as ort
+    import onnxruntime as ort  # only where a bundle is run
 
     so = ort.SessionOptions()
     so.log_severity_level = 3
@@ -498,7 +498,7 @@ class OnnxNetworks:
     """A bundle's networks run by onnxruntime (the reference for trained bundles)."""
 
     def __init__(self, folder: str | Path) -> None:
-        import onnxruntime as ort
+        import onnxruntime as ort  # only where a bundle is run
 
         folder = Path(folder)
         self.manifest = read_manifest(folder)

@@ -16,45 +16,28 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
 from torch import nn
 
+from softdeca_train.models.blocks import (
+    NetworkSizes,
+    Normalise,
+    gravity_columns,
+    gravity_load,
+    region_means,
+)
 from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.models.residual import ResidualSizes, ResidualStage
 from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
-
-if TYPE_CHECKING:
-    from softdeca_train.models.residual import ResidualStage
 
 # The stable, equilibrium-preserving dynamics set (eq. 21 with gamma + 2 alpha - beta = 1):
 # beta in [0, BETA_MAX], gamma in [GAMMA_MIN, GAMMA_MAX] keep both roots of
 # r^2 - 2 alpha r + beta inside the unit circle, and a constant input stays constant.
 BETA_MAX = 0.99
 GAMMA_MIN, GAMMA_MAX = 0.01, 1.99
-
-
-@dataclass(frozen=True)
-class NetworkSizes:
-    """Layer widths. `latent` is the 32 of the paper; the rest are ours (Appendix D is lost)."""
-
-    latent: int = 32
-    identity: int = 100
-    f_w_hidden: tuple[int, ...] = (128, 128)
-    f_l_hidden: tuple[int, ...] = (256, 256)
-    hyper_hidden: tuple[int, ...] = (128, 128)
-    dynamics_hidden: tuple[int, ...] = (32,)
-    positional: int = 32
-    encoder_points: int = 1024
-    encoder_hidden: tuple[int, ...] = (256,)
-    # SoftDECA's residual stage (models/residual.py): modes besides the mean, the members'
-    # width and count, and the steps each member trains
-    residual_modes: int = 31
-    residual_hidden: int = 256
-    residual_members: int = 5
-    residual_steps: int = 3000
 
 
 FULL_SIZES = NetworkSizes()
@@ -73,23 +56,6 @@ TEST_SIZES = NetworkSizes(
     residual_members=2,
     residual_steps=100,
 )
-
-
-class Normalise(nn.Module):
-    """Raw parameter values -> [-1, 1] (log scale where the spec says so)."""
-
-    def __init__(self, specs: Sequence[ParameterSpec]) -> None:
-        super().__init__()
-        log = torch.tensor([s.scale == "log" for s in specs])
-        lo = torch.tensor([np.log(s.min) if s.scale == "log" else s.min for s in specs])
-        hi = torch.tensor([np.log(s.max) if s.scale == "log" else s.max for s in specs])
-        self.register_buffer("log", log)
-        self.register_buffer("lo", lo.float())
-        self.register_buffer("span", (hi - lo).float())
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        x = torch.where(self.log, torch.log(torch.clamp(x, min=1e-30)), x)
-        return 2.0 * (x - self.lo) / self.span - 1.0
 
 
 def mlp(sizes: Sequence[int], out_scale: float = 1.0) -> nn.Sequential:
@@ -175,45 +141,6 @@ class ElementMLP(nn.Module):
             + self.from_identity(identity)
         )
         return self.rest(x)
-
-
-# The gravity load of a parameter vector: s d - d0 in g, d the direction of the strength s,
-# tilt and azimuth (degrees), d0 the capture's own load (1 g along -Y); the simulator's
-# gravity_forces and linear_baseline.ParameterScaling.gravity_load use the same.
-GRAVITY_COLUMNS = ("gravity_strength", "gravity_tilt", "gravity_azimuth")
-
-
-def gravity_columns(specs: Sequence[ParameterSpec]) -> list[int] | None:
-    """The indices of GRAVITY_COLUMNS among `specs`, or None where gravity is no input."""
-    names = [s.name for s in specs]
-    return (
-        [names.index(c) for c in GRAVITY_COLUMNS]
-        if all(c in names for c in GRAVITY_COLUMNS)
-        else None
-    )
-
-
-def gravity_load(parameters: torch.Tensor, columns: list[int] | None) -> torch.Tensor:
-    """(n, P) raw parameters -> (n, 3) gravity load in g (zero without gravity columns)."""
-    if columns is None:
-        return torch.zeros_like(parameters[:, :3])
-    s, tilt, azimuth = (parameters[:, i] for i in columns)
-    # degrees by a constant factor: ONNX opset 17 has no deg2rad
-    t, a = tilt * (np.pi / 180.0), azimuth * (np.pi / 180.0)
-    d = torch.stack([torch.sin(t) * torch.cos(a), -torch.cos(t), torch.sin(t) * torch.sin(a)], 1)
-    return s[:, None] * d + torch.tensor([0.0, 1.0, 0.0], dtype=d.dtype)
-
-
-def region_means(labels: np.ndarray, n_regions: int) -> np.ndarray:
-    """(R, V) rows averaging a per-vertex field over each region's vertices (a region without
-    vertices gets a zero row; a vertex labelled -1 is in none)."""
-    labels = np.asarray(labels, np.int64)
-    m = np.zeros((n_regions, len(labels)), np.float32)
-    for r in range(n_regions):
-        idx = np.nonzero(labels == r)[0]
-        if len(idx):
-            m[r, idx] = 1.0 / len(idx)
-    return m
 
 
 # The parameters whose response depends on the expression: a tissue's strain and volume
@@ -510,8 +437,6 @@ def build_random(
             f_dyn=DynamicsNetwork(nv, specs, sizes, gamma0=0.6, beta0=0.25),
         )
     if sd is not None and residual_stage:
-        from softdeca_train.models.residual import ResidualSizes, ResidualStage
-
         regions = definition.skin_regions
         labels = np.zeros(nv, np.int64) if regions is None else regions
         sd.f_r = ResidualStage(labels, specs, ResidualSizes.of(sizes))

@@ -8,6 +8,7 @@ from __future__ import annotations
 import copy
 import json
 import os
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,6 +16,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from softdeca_train.models.synthetic import TEST_PARAMETERS
 from softdeca_train.paths import REPO_ROOT
 
 # The one list of parameters (the physics'). The exporter reads it when present.
@@ -117,10 +119,6 @@ def specs_or_test_list(source: str | None) -> tuple[ParameterSpec, ...]:
     """For tools that must run before the physics' list exists: `source`, else the controls
     of plugin/data/parameters.json, else (with a note on stderr) the 5-parameter test list."""
     if source is None and not PARAMETERS_JSON.is_file():
-        import sys
-
-        from softdeca_train.models.synthetic import TEST_PARAMETERS
-
         print(
             f"note: {PARAMETERS_JSON} is missing: using the 5-parameter test list", file=sys.stderr
         )

@@ -22,8 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 from torch import nn
+from tqdm import tqdm
 
-from softdeca_train.models.networks import (
+from softdeca_train.models.blocks import (
     NetworkSizes,
     Normalise,
     gravity_columns,
@@ -205,8 +206,6 @@ class ResidualStage(nn.Module):
         `pairs` (M, 2): frames of one identity and expression whose p differs in one factor;
         the members then also learn their coefficients' differences (ResidualFit).
         Returns the fit's train errors (mm, mean per-vertex distance)."""
-        from tqdm import tqdm
-
         x = torch.cat([weights, parameter_features], dim=1).float()
         with torch.no_grad():
             self.input_mean.copy_(x.mean(0))

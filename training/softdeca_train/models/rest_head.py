@@ -21,7 +21,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from softdeca_train.sim.collision_spec import CollisionSpec
+from softdeca_train.contact_rules import CONTACT_RULES
+from softdeca_train.lhm import LhmConfig, eyes
+from softdeca_train.lhm.eyes import EYE_ZONE_SHARE
+from softdeca_train.sim.collision_spec import CollisionSpec, collision_sets
+from softdeca_train.sim.lids import lid_candidates, lid_sets_of
+from softdeca_train.sim.lips import lip_sets_of
 
 REST_HEAD_FILE = "rest_head.bin"
 
@@ -32,11 +37,11 @@ class ContactRules:
 
     landmarks68: np.ndarray  # (68,) skin vertex indices of the 68 Multi-PIE landmarks
     lid_candidates: np.ndarray  # skin vertices that may belong to a lid
-    lip_radius: float = 0.012
-    lip_corner_radius: float = 0.008
-    lid_reach: float = 0.008
-    lid_corner_radius: float = 0.004
-    eye_zone_share: float = 0.75
+    lip_radius: float = CONTACT_RULES.lip_radius
+    lip_corner_radius: float = CONTACT_RULES.lip_corner_radius
+    lid_reach: float = CONTACT_RULES.lid_reach
+    lid_corner_radius: float = CONTACT_RULES.lid_corner_radius
+    eye_zone_share: float = CONTACT_RULES.eye_zone_share
 
     def sets(
         self,
@@ -45,11 +50,6 @@ class ContactRules:
         upper_teeth: np.ndarray,
         lower_teeth: np.ndarray,
     ) -> list[CollisionSpec]:
-        from softdeca_train.lhm import eyes
-        from softdeca_train.sim.collision_spec import collision_sets
-        from softdeca_train.sim.lids import lid_sets_of
-        from softdeca_train.sim.lips import lip_sets_of
-
         if self.eye_zone_share != eyes.EYE_ZONE_SHARE:
             raise ValueError("the bundle's eye_zone_share differs from the physics'")
         lm = self.landmarks68
@@ -96,6 +96,7 @@ class RestHead:
 
     def carried_vertices(self, neutral_skin: np.ndarray) -> np.ndarray:
         """The fill's vertices carried to an avatar's neutral skin (N_SKIN, 3)."""
+        # the carried fill needs the compiled softdeca_native; reading a bundle does not
         from softdeca_train.lhm.carried import stiffness_matrix
 
         s = np.asarray(neutral_skin, np.float64)
@@ -113,7 +114,7 @@ class RestHead:
         self, neutral_head: np.ndarray, skin_triangles: np.ndarray
     ) -> tuple[Any, np.ndarray]:
         """The avatar's simulation mesh (native.SimulationMesh) and its fill's vertices."""
-        import softdeca_native as native
+        import softdeca_native as native  # compiled with the plugin: see carried_vertices
 
         head = np.asarray(neutral_head, np.float64)
         skin = head[: self.skin_count]
@@ -175,11 +176,9 @@ def rest_head_for_bundle(template: Any, specs: Any, config: Any = None) -> RestH
 def rest_head_from_template(template: Any, config: Any = None) -> RestHead:
     """The template's rest head as data generation builds it (the carried fill at identity
     zero, LHM level 3 unless `config` says otherwise)."""
-    from softdeca_train.lhm import LhmConfig
+    # the physics needs the compiled softdeca_native; reading a bundle does not
     from softdeca_train.lhm.carried import carry_basis
-    from softdeca_train.lhm.eyes import EYE_ZONE_SHARE
     from softdeca_train.sim import build_head_simulation
-    from softdeca_train.sim.lids import lid_candidates
 
     cfg = config or LhmConfig(level=3, tet_mesh="carried")
     head_sim = build_head_simulation(template, None, cfg)
@@ -307,7 +306,7 @@ def inert_parameters(
     is under the physics (under 0.1 µm at either end of their range, solved on `neutral_head`
     with the others at their defaults). Global parameters never count: gravity's direction
     moves nothing at rest only while its tilt is zero."""
-    import softdeca_native as native
+    import softdeca_native as native  # compiled with the plugin: see carried_vertices
 
     mesh, _ = head.simulation_mesh(neutral_head, skin_triangles)
     sim = native.Simulator(mesh, tolerance=head.tolerance, max_iterations=head.max_iterations)

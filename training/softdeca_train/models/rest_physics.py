@@ -17,7 +17,7 @@ with a load (softer tissue sagging more under heavier gravity) is the physics'. 
 defaults c = 0; a frame costs one add.
 
 The head is the bundle's (rest_head.py) carried to the avatar. Parameter maps reach the
-physics' elements as the data's regions do (data/regions.py, element_regions): a tet takes the
+physics' elements as the data's regions do (template/regions.py, element_regions): a tet takes the
 values of the skin vertex nearest its centroid on the avatar, a skin triangle its face value,
 a skin point its vertex value."""
 
@@ -27,6 +27,7 @@ import numpy as np
 
 from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_head import RestHead
+from softdeca_train.template.regions import nearest_skin_vertices
 
 # The physics' element kinds a parameter map is carried to (plugin/data/parameters.json).
 MAPPED_DOMAINS = ("soft_tet", "muscle_tet", "skin_triangle", "skin_point")
@@ -56,9 +57,8 @@ class RestSolver:
     def __init__(
         self, head: RestHead, neutral_head: np.ndarray, skin_triangles: np.ndarray
     ) -> None:
+        # compiled with the plugin: reading and running a bundle does not need it
         import softdeca_native as native
-
-        from softdeca_train.data.regions import nearest_skin_vertices
 
         self.head = head
         self.neutral_skin = np.asarray(neutral_head, np.float64)[: head.skin_count]

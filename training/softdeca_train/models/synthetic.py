@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdeca_train.models.rest_head import RestHead
 from softdeca_train.models.topology import CRANIUM, JAW, LandmarkSet, TemplateDefinition
 
 JAW_OPEN = 24  # canonical ARKit index of jawOpen
@@ -153,8 +154,6 @@ def synthetic_rest_head(head: SyntheticHead, shells: tuple[float, ...] = (1.0, 0
     """A rest head for the synthetic skin (rest_physics.RestHead): shells of S scaled about its
     centre, soft tissue between the first two, muscle between the last two, the innermost the
     pinned cranium; S is the outer shell itself."""
-    from softdeca_train.models.rest_head import RestHead
-
     d = head.definition
     vs = d.skin_vertices
     skin = head.neutral[:vs]

@@ -8,7 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdeca_train.landmarks import template_landmarks
+from softdeca_train.landmarks.definition import load_definition
+from softdeca_train.lhm.model import JAW as LHM_JAW
+from softdeca_train.template import Template
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
+from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import region_labels
 
 CRANIUM, JAW = 0, 1  # non-skin bone labels (the layered head model's convention)
 
@@ -49,7 +55,7 @@ class TemplateDefinition:
     # (skin_vertices, 3) S at rest, metres: where the vertex stage's smoothing tables come
     # from (models/smoothing.py); None (a bundle read back) builds no smoothing
     skin_rest: np.ndarray | None = None
-    # (skin_vertices,) region index of every skin vertex (data/regions.py): where the residual
+    # (skin_vertices,) region index of every skin vertex (template/regions.py): where the residual
     # stage reads each region's parameters; None (a bundle read back) builds no residual stage
     skin_regions: np.ndarray | None = None
 
@@ -88,13 +94,8 @@ class TemplateDefinition:
 def from_template(template: object | None = None) -> TemplateDefinition:
     """The definition of the ICT-based template: S, the 149 landmarks registered to S, and the
     bone labels of the layered head model (JAW where jawOpen moves a vertex like the teeth)."""
-    from softdeca_train.data.regions import region_labels
-    from softdeca_train.landmarks import template_landmarks
-    from softdeca_train.landmarks.definition import load_definition
+    # the head model's fit needs the compiled softdeca_native; a bundle's definition does not
     from softdeca_train.lhm.fit import bone_labels
-    from softdeca_train.lhm.model import JAW as LHM_JAW
-    from softdeca_train.template import Template
-    from softdeca_train.template.model import N_SKIN
 
     t = template if isinstance(template, Template) else Template.load()
     definition = load_definition()

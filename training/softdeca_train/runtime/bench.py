@@ -11,7 +11,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+from softdeca_train.models import FULL_SIZES, BundleInfo, build_random, export_bundle
+from softdeca_train.models.parameters import specs_or_test_list
+from softdeca_train.models.rest_head import rest_head_for_bundle
+from softdeca_train.models.topology import from_template
 from softdeca_train.paths import REPO_ROOT, default_takes_path
+from softdeca_train.runtime.files import write_identity_avatar
+from softdeca_train.template import Template
 
 DEFAULT_TAKE = default_takes_path() / "S07-001.csv"
 CLI = REPO_ROOT / "build" / "release" / "plugin" / "cli" / "softdeca"
@@ -24,12 +30,6 @@ def bench_runtime(
     frames: int = 600,
     parameters: str | None = None,
 ) -> Path:
-    from softdeca_train.models import FULL_SIZES, BundleInfo, build_random, export_bundle
-    from softdeca_train.models.parameters import specs_or_test_list
-    from softdeca_train.models.topology import from_template
-    from softdeca_train.runtime.files import write_identity_avatar
-    from softdeca_train.template import Template
-
     work = out / "runtime-inputs"
     specs = specs_or_test_list(parameters)
     definition = from_template(Template.load(ict))
@@ -37,7 +37,6 @@ def bench_runtime(
         definition, specs, FULL_SIZES, seed=0, vertex_stage=True, residual_stage=True
     )
     info = BundleInfo(True, "UNTRAINED full-size random networks for the runtime benchmark")
-    from softdeca_train.models.rest_head import rest_head_for_bundle
 
     template = Template.load(ict)
     rest = rest_head_for_bundle(template, specs)  # the physics at prepare, as trained bundles

@@ -4,6 +4,8 @@ tests' inputs and the runtime benchmark."""
 from __future__ import annotations
 
 import argparse
+import json
+from pathlib import Path
 
 from softdeca_train.commands import Command, add_ict_argument
 
@@ -24,8 +26,6 @@ def _runtime_bundle_args(p: argparse.ArgumentParser) -> None:
 
 
 def _runtime_bundle_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from softdeca_train.models import (
         FULL_SIZES,
         TEST_SIZES,
@@ -66,9 +66,6 @@ def _rest_physics_args(p: argparse.ArgumentParser) -> None:
 
 
 def _rest_physics_run(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
-
     from softdeca_train.lhm import LhmConfig
     from softdeca_train.models.bundle import add_rest_physics, read_manifest
     from softdeca_train.models.parameters import ParameterSpec
@@ -98,8 +95,6 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
 
 
 def _avatar_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from softdeca_train.runtime.files import write_identity_avatar
 
     out = write_identity_avatar(args.seed, Path(args.out), args.ict)
@@ -135,8 +130,6 @@ def _runtime_test_data_args(p: argparse.ArgumentParser) -> None:
 
 
 def _runtime_test_data_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from softdeca_train.runtime.testdata import write_test_data
 
     print(f"wrote {write_test_data(Path(args.out))}")
@@ -152,8 +145,6 @@ def _runtime_bench_args(p: argparse.ArgumentParser) -> None:
 
 
 def _runtime_bench_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from softdeca_train.runtime.bench import DEFAULT_TAKE, bench_runtime
 
     take = Path(args.take) if args.take else DEFAULT_TAKE

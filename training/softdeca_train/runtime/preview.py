@@ -19,8 +19,12 @@ from pathlib import Path
 
 import numpy as np
 
+from softdeca_train.controls.metrics import response_error
+from softdeca_train.mesh_files import read_obj, read_pc2
+from softdeca_train.models.bundle import read_manifest
+from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.render import Focus, MeshLayer, RenderSettings, TileSettings, render, tile
-from softdeca_train.runtime.files import read_obj, read_pc2
+from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
 LABELS = {
@@ -178,15 +182,13 @@ def _add_physics(
 ) -> tuple[dict[str, np.ndarray], list[int], list[str]]:
     """The physics column, the widest-open mouth among the rows (it replaces the row of its
     segment), preview.json with every column's lip opening, and the sheet's notes."""
-    from softdeca_train.models.bundle import read_manifest
-    from softdeca_train.models.parameters import ParameterSpec
+    # the physics needs the compiled softdeca_native; the sheet without it does not
     from softdeca_train.runtime.preview_physics import (
         lip_openings_mm,
         parse_changes,
         simulate_column,
         widest_open_frame,
     )
-    from softdeca_train.template import Template
 
     template = Template.load(ict)
     lin = caches["linear"]
@@ -262,8 +264,6 @@ def localised_response(caches: dict[str, np.ndarray], chosen: list[int]) -> dict
     """Per shown frame, over the skin: how far the localised change moves the physics and
     SoftDECA (largest vertex distance, mm) and the response error |dm - dp| / |dp| as the
     controls gallery measures a control (None where the physics does not move)."""
-    from softdeca_train.controls.metrics import response_error
-
     out: dict[str, list] = {"physics_max_mm": [], "softdeca_max_mm": [], "response_error": []}
     for f in chosen:
         dp = (caches["physics_localised"][f] - caches["physics"][f])[:N_SKIN].astype(np.float64)

@@ -15,6 +15,7 @@ is measured against."""
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,10 +23,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.lhm import LhmConfig
+from softdeca_train.models.dt import face_geometry
+from softdeca_train.models.parameters import ParameterSpec, ParameterState
+from softdeca_train.models.rest_physics import element_values
 from softdeca_train.sim import sanity
+from softdeca_train.sim.head import build_head_simulation
+from softdeca_train.sim.run import simulate_frames
+from softdeca_train.sim.take import read_take
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import mesh_tet_skin_vertices
 
 if TYPE_CHECKING:
     from softdeca_train.sim.head import HeadSimulation
@@ -75,11 +83,6 @@ def parameter_fields(
 ) -> dict[str, float | np.ndarray]:
     """Every parameter's value for `hs`'s simulator after `changes` (applied in order on top of
     the defaults): a number, or one value per element of the parameter's domain."""
-    from softdeca_train.data.regions import mesh_tet_skin_vertices
-    from softdeca_train.models.dt import face_geometry
-    from softdeca_train.models.parameters import ParameterState
-    from softdeca_train.models.rest_physics import element_values
-
     skin = np.asarray(hs.head[:N_SKIN], np.float64)
     faces = np.asarray(hs.mesh.skin_triangles, np.int64)
     params = ParameterState(specs, faces, face_geometry(skin, faces)[0])
@@ -132,12 +135,6 @@ def simulate_column(
     frame `first_frame`) for ICT identity `seed`, one column per entry of `settings` (the
     changes on top of the defaults of `specs`, the bundle's parameters); `linear` is the
     replay's linear cache, the check that the avatar is that identity."""
-    import time
-
-    from softdeca_train.lhm import LhmConfig
-    from softdeca_train.sim.head import build_head_simulation
-    from softdeca_train.sim.run import simulate_frames
-    from softdeca_train.sim.take import read_take
 
     t0 = time.perf_counter()
     weights = np.stack([read_take(take, first_frame + f, 1).weights[0] for f in frames])

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from softdeca_train.mesh_files import write_obj
 from softdeca_train.models import (
     TEST_SIZES,
     BundleInfo,
@@ -18,7 +19,7 @@ from softdeca_train.models import (
     pack_bundle,
 )
 from softdeca_train.models.synthetic import TEST_PARAMETERS, synthetic_head, synthetic_rest_head
-from softdeca_train.runtime.files import write_obj, write_rig
+from softdeca_train.runtime.files import write_rig
 from softdeca_train.streaming.livelinkface import CSV_ORDER, VALUE_NAMES
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 

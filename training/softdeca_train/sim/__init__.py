@@ -17,7 +17,7 @@ __all__ = ["HeadSimulation", "build_head_simulation"]
 
 def __getattr__(name: str) -> Any:
     if name in __all__:
-        from softdeca_train.sim import head
+        from softdeca_train.sim import head  # needs the native module: loaded on first use
 
         return getattr(head, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

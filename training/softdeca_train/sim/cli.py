@@ -104,7 +104,6 @@ def _set_parameters(sim: native.Simulator, values: dict[str, float]) -> None:
 
 
 def run_simulate(args: argparse.Namespace) -> int:
-    from softdeca_train.data.regions import region_labels
     from softdeca_train.lhm import LhmConfig
     from softdeca_train.sim.figure import render_comparison
     from softdeca_train.sim.head import build_head_simulation
@@ -119,6 +118,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     )
     from softdeca_train.sim.take import read_take
     from softdeca_train.template import Template
+    from softdeca_train.template.regions import region_labels
 
     t0 = time.perf_counter()
     if args.threads < 1 or args.level < 1 or args.obj_every < 0 or args.render_frames < 0:
@@ -233,8 +233,6 @@ def _bench_physics_args(p: argparse.ArgumentParser) -> None:
 
 
 def _bench_physics_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from softdeca_train.bench import report_area
     from softdeca_train.sim.bench import DEFAULT_TAKE, bench_physics_lhm
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdeca_train.contact_rules import CONTACT_RULES
 from softdeca_train.lhm.eyes import EYES, fissure_line, lid_side_of_points
 from softdeca_train.lhm.mouth import closest_on_polyline
 from softdeca_train.template import Template
@@ -43,7 +44,10 @@ def lid_candidates(template: Template) -> np.ndarray:
 
 
 def lid_sets(
-    template: Template, head: np.ndarray, reach: float = 0.008, corner_radius: float = 0.004
+    template: Template,
+    head: np.ndarray,
+    reach: float = CONTACT_RULES.lid_reach,
+    corner_radius: float = CONTACT_RULES.lid_corner_radius,
 ) -> LidSets:
     """The lid sets of a head of the template (lid_sets_of)."""
     skin = np.asarray(head)[:N_SKIN]
@@ -54,8 +58,8 @@ def lid_sets_of(
     skin: np.ndarray,
     lm68: np.ndarray,
     candidates: np.ndarray,
-    reach: float = 0.008,
-    corner_radius: float = 0.004,
+    reach: float = CONTACT_RULES.lid_reach,
+    corner_radius: float = CONTACT_RULES.lid_corner_radius,
 ) -> LidSets:
     """`lm68`: the 68 landmarks' skin vertex indices; `candidates`: lid_candidates."""
     side = lid_side_of_points(skin, lm68)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdeca_train.contact_rules import CONTACT_RULES
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.template.plausibility import lip_contact_zone
@@ -29,7 +30,10 @@ class LipSets:
 
 
 def lip_sets(
-    template: Template, head: np.ndarray, radius: float = 0.012, corner_radius: float = 0.008
+    template: Template,
+    head: np.ndarray,
+    radius: float = CONTACT_RULES.lip_radius,
+    corner_radius: float = CONTACT_RULES.lip_corner_radius,
 ) -> LipSets:
     """The lip sets of a head of the template (lip_sets_of)."""
     skin = np.asarray(head)[:N_SKIN]
@@ -40,8 +44,8 @@ def lip_sets_of(
     skin: np.ndarray,
     lm68: np.ndarray,
     skin_triangles: np.ndarray,
-    radius: float = 0.012,
-    corner_radius: float = 0.008,
+    radius: float = CONTACT_RULES.lip_radius,
+    corner_radius: float = CONTACT_RULES.lip_corner_radius,
 ) -> LipSets:
     """Split the lip contact zone (S points within `radius` of the inner lip contour) into
     upper and lower lip by the mouth line: the segment between the inner mouth corners (ICT

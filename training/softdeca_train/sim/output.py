@@ -5,25 +5,11 @@ Unity, which imports OBJ but not point caches."""
 
 from __future__ import annotations
 
-import struct
 from pathlib import Path
 
 import numpy as np
 
-from softdeca_train.runtime.files import write_obj
-
-
-def write_pc2(path: Path, frames: list[np.ndarray], sample_rate: float = 1.0) -> Path:
-    """PC2: "POINTCACHE2\\0", version 1, point count, start frame 0, sample rate, frame
-    count, then float32 xyz per point per frame (as plugin/cli/mesh_io.h writes it)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    data = np.stack([np.asarray(f, np.float32) for f in frames])
-    header = struct.pack(
-        "<12siiffi", b"POINTCACHE2\0", 1, data.shape[1], 0.0, sample_rate, len(data)
-    )
-    path.write_bytes(header + data.astype("<f4").tobytes())
-    return path
+from softdeca_train.mesh_files import write_obj, write_pc2
 
 
 def write_sequences(

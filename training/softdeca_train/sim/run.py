@@ -16,6 +16,7 @@ from softdeca_train.sim.head import HeadSimulation
 from softdeca_train.sim.measures import SoftVolume, mean_distance_mm
 from softdeca_train.sim.sanity import FrameCheck, check_frame, failure_counts
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import REGIONS
 
 STAT_KEYS = ("iterations", "converged", "estimated_error", "collision_rounds", "total_seconds")
 
@@ -99,9 +100,7 @@ def reference_distances(
 ) -> dict[str, Any]:
     """How far `result`'s skin S lies from a `reference` run of the same frames (solved to
     `tolerance`): per frame the mean and largest vertex distance (mm), the vertex of S with the
-    largest and its region (data/regions.py, `labels` per vertex of S)."""
-    from softdeca_train.data.regions import REGIONS
-
+    largest and its region (template/regions.py, `labels` per vertex of S)."""
     frames = []
     for a, b in zip(result.physics, reference.physics, strict=True):
         d = 1e3 * np.linalg.norm(a[:N_SKIN].astype(np.float64) - b[:N_SKIN], axis=1)

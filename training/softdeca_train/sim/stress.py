@@ -8,7 +8,10 @@ from __future__ import annotations
 import heapq
 import json
 import math
+import multiprocessing
+import time
 from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -19,6 +22,7 @@ from tqdm import tqdm
 from softdeca_train.lhm import LhmConfig
 from softdeca_train.parameters import load_parameters
 from softdeca_train.sim.expressions import all_expressions, combinations
+from softdeca_train.sim.figure import render_rows
 from softdeca_train.sim.head import HeadSimulation, build_head_simulation
 from softdeca_train.sim.measures import SoftVolume
 from softdeca_train.sim.sanity import FrameCheck, bench_figures, check_frame, failure_counts
@@ -208,8 +212,6 @@ def run_stress(
     **settings: Any,
 ) -> StressResult:
     """Every case's frames through φ† and the sanity bounds; `settings` go to the Simulator."""
-    import time
-
     t0 = time.perf_counter()
     out = StressResult()
     heap: list[tuple[float, int, WorstFrame]] = []
@@ -284,10 +286,6 @@ def run_stress_parallel(
 ) -> StressResult:
     """run_stress over `workers` processes, one head simulation (identity, level) per task,
     the largest first; the frames come back in the order run_stress gives them."""
-    import multiprocessing
-    import time
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
     t0 = time.perf_counter()
     groups = _case_groups(cases)
     size = [sum(len(c.frames) for c in g) for g in groups]
@@ -367,8 +365,6 @@ def write_report(
     out: Path, result: StressResult, template: Template, command: str
 ) -> dict[str, dict[str, Any]]:
     """stress.json, stress.md and the contact sheet stress_worst.png in `out`."""
-    from softdeca_train.sim.figure import render_rows
-
     out.mkdir(parents=True, exist_ok=True)
     summary = group_summary(result.frames)
     doc = {

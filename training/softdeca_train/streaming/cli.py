@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import argparse
+import json
+from pathlib import Path
 
 from softdeca_train.commands import Command
 
@@ -43,9 +45,6 @@ def _virtual_device_args(p: argparse.ArgumentParser) -> None:
 
 
 def _virtual_device_run(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
-
     from softdeca_train.streaming.impairments import Impairments
     from softdeca_train.streaming.virtual_device import VirtualDeviceConfig, run
 
@@ -98,8 +97,6 @@ def _golden_args(p: argparse.ArgumentParser) -> None:
 
 
 def _golden_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from softdeca_train.streaming.golden import generate
 
     for path in generate(Path(args.out)):

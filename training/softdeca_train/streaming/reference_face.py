@@ -11,9 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from softdeca_train.landmarks.arkit_reference import ArkitFace
+from softdeca_train.landmarks.definition import load_definition
 from softdeca_train.streaming.protocol import Profile
 
-# "softdeca149": SparseSoftDECA's contour landmarks (landmarks/definition.json);
+# "softdeca149": SparseSoftDECA's contour landmarks (plugin/data/landmarks.json);
 # "arkit68": the standard 68-point scheme's vertices; "none": no landmarks.
 PROFILES = ("softdeca149", "arkit68", "none")
 
@@ -37,8 +38,6 @@ class ReferenceFace(ArkitFace):
     def profile(self, name: str) -> Profile | None:
         """A landmark profile by name (see PROFILES)."""
         if name == "softdeca149":
-            from softdeca_train.landmarks.definition import load_definition
-
             return Profile("softdeca149", tuple(int(i) for i in load_definition().vertices))
         if name == "arkit68":
             return Profile("arkit68", tuple(int(i) for i in self.landmarks68))

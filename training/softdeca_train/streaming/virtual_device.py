@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from softdeca_train.streaming import livelinkface, protocol
 from softdeca_train.streaming.frame import Frame
@@ -221,7 +222,6 @@ def run(config: VirtualDeviceConfig) -> SendLog:
 def _progress(enabled: bool, total: int) -> Callable[[int], None]:
     if not enabled:
         return lambda n: None
-    from tqdm import tqdm
 
     bar = tqdm(total=total, unit="frame", desc="virtual device")
 

@@ -9,42 +9,10 @@ from functools import cached_property
 import numpy as np
 
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES, arkit_to_ict_matrix
+from softdeca_train.template.components import COMPONENTS, N_SKIN, Component
 from softdeca_train.template.ict_source import load_ict
+from softdeca_train.template.plausibility import implausibilities
 
-
-@dataclass(frozen=True)
-class Component:
-    """A contiguous vertex range of the ICT mesh [start, stop)."""
-
-    name: str
-    start: int
-    stop: int
-
-    @property
-    def slice(self) -> slice:
-        return slice(self.start, self.stop)
-
-
-# Vertex ranges from ICT-FaceKit's README (stop exclusive).
-COMPONENTS: tuple[Component, ...] = (
-    Component("face", 0, 9409),
-    Component("head_neck", 9409, 11248),
-    Component("mouth_socket", 11248, 13294),
-    Component("eye_socket_left", 13294, 13678),
-    Component("eye_socket_right", 13678, 14062),
-    Component("gums_tongue", 14062, 17039),
-    Component("teeth_upper", 17039, 19247),
-    Component("teeth_lower", 19247, 21451),
-    Component("eyeball_left", 21451, 23021),
-    Component("eyeball_right", 23021, 24591),
-    Component("lacrimal_fluid", 24591, 24999),
-    Component("eye_blend", 24999, 25047),
-    Component("eye_occlusion", 25047, 25351),
-    Component("eyelashes", 25351, 26719),
-)
-# S: face, head and neck, mouth socket and eye sockets. They are contiguous in ICT's order.
-SKIN_COMPONENTS = ("face", "head_neck", "mouth_socket", "eye_socket_left", "eye_socket_right")
-N_SKIN = 14062
 # Identity coefficients: ICT's modes are principal components already scaled by their standard
 # deviation (the largest displacement at weight 1 falls from 13 mm for mode 0 to 0.3 mm for
 # mode 99, like a PCA spectrum), so h ~ N(0, I) samples the population; truncated at 3 sigma.
@@ -157,8 +125,6 @@ class Template:
         the human range; see plausibility.py). Draws are rejected and redrawn from the same
         seeded stream: at scale 1 about a third of raw draws fold at the inner eye corners or
         the columella (14 of 40 seeds, measured with the tests' check)."""
-        from softdeca_train.template.plausibility import implausibilities
-
         rng = np.random.default_rng(seed)
         for _ in range(max_draws):
             h = (

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
-import softdeca_native as native
 
-from softdeca_train.template.model import N_SKIN
+from softdeca_train.contact_rules import CONTACT_RULES
+from softdeca_train.template.components import N_SKIN
 
 # Adult anthropometric ranges in mm, about mean +- 3 SD of Farkas (1994, "Anthropometry of the
 # Head and Face") and later tables: biocular width ex-ex, mouth width ch-ch, nasion-menton.
@@ -26,7 +26,9 @@ def face_measures(head: np.ndarray, lm68: np.ndarray) -> dict[str, float]:
     }
 
 
-def lip_contact_zone(head: np.ndarray, lm68: np.ndarray, radius: float = 0.012) -> np.ndarray:
+def lip_contact_zone(
+    head: np.ndarray, lm68: np.ndarray, radius: float = CONTACT_RULES.lip_radius
+) -> np.ndarray:
     """S vertices within `radius` of the inner lip contour. ICT's own neutral has its lips
     pressed into each other there; the simulation's collision step resolves that contact."""
     mouth = head[lm68[60:68]]
@@ -38,6 +40,10 @@ def skin_self_intersections(
     head: np.ndarray, skin_tris: np.ndarray, lm68: np.ndarray, limit: int = 100000
 ) -> list[tuple[int, int]]:
     """Intersecting triangle pairs of S, ignoring those where both lie in the lip contact."""
+    # The compiled module is built with the plugin; the template loads without it (streaming and
+    # landmark tools read the template on machines that never build the plugin).
+    import softdeca_native as native
+
     lips = lip_contact_zone(head, lm68)
     pairs = native.self_intersections(head[:N_SKIN], skin_tris, limit)
     return [(a, b) for a, b in pairs if not (lips[skin_tris[a]].all() and lips[skin_tris[b]].all())]

@@ -19,8 +19,10 @@ import torch
 from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import TEST, TRAIN
 from softdeca_train.models.dt import DtSystem, dt_system
+from softdeca_train.parameters import load_parameters
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
+from softdeca_train.template.regions import region_labels
 
 # max_error that keeps every frame: evaluation judges a model on the whole test split.
 EVERY_FRAME = math.inf
@@ -61,7 +63,7 @@ class Batch:
     prev_T: torch.Tensor | None = None
     prev_weights: torch.Tensor | None = None  # dynamic: (2, 52)
     source_take: np.ndarray | None = None  # (B,) take index or -1 (coverage)
-    # static/sparse: (len(REGIONS), P) the group's values per region of S (data/regions.py),
+    # static/sparse: (len(REGIONS), P) the group's values per region of S (template/regions.py),
     # p in every region without a regional pattern; None in datasets written without them
     p_regions: torch.Tensor | None = None
     p_faces: torch.Tensor | None = None  # (F, P) p_regions on the skin triangles
@@ -122,13 +124,11 @@ class Dataset:
         self.blend = SkinBlend.of(self.template)
         self.cache = IdentityCache(self.template, self.template.skin_triangles)
         self.tolerance = float(self.manifest["header"]["config"]["tolerance"])
-        from softdeca_train.parameters import load_parameters
 
         names = load_parameters().names
         unknown = set(parameters or ()) - set(names)
         if unknown:
             raise ValueError(f"unknown parameters {sorted(unknown)}")
-        from softdeca_train.data.regions import region_labels
 
         self.labels = region_labels(self.template)  # regional patterns -> triangles, vertices
         self.columns = (

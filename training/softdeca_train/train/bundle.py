@@ -16,6 +16,7 @@ from pathlib import Path
 from softdeca_train.data.generate import code_version
 from softdeca_train.models.bundle import BundleInfo, export_bundle
 from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, SparseNetworks
+from softdeca_train.models.rest_head import rest_head_for_bundle
 from softdeca_train.train.batches import Dataset
 from softdeca_train.train.evaluate import test_errors
 from softdeca_train.train.identity import IdentityConfig
@@ -114,7 +115,6 @@ def train_bundle(
         },
         errors=errors,
     )
-    from softdeca_train.models.rest_head import rest_head_for_bundle
 
     if progress:
         print("physics at prepare: the template's tissue fill and its rest-inert parameters")

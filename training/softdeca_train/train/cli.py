@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 from pathlib import Path
 
 from softdeca_train.commands import Command
@@ -213,8 +214,6 @@ def add_linear_args(p: argparse.ArgumentParser) -> None:
 
 
 def run_linear(args: argparse.Namespace) -> int:
-    import json
-
     from softdeca_train.train.linear_baseline import (
         LinearBaselineConfig,
         format_table,

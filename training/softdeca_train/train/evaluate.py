@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import torch
@@ -71,8 +71,6 @@ class ErrorSum:
 
 
 def _with_landmarks(batch: Batch, which: str, model: SparseSoftDeca) -> Batch:
-    from dataclasses import replace
-
     if which == "same_head":
         own = model.landmarks_on(batch.S)
         return replace(batch, landmarks=own, landmarks_clean=own)

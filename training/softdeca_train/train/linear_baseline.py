@@ -24,7 +24,7 @@ import numpy as np
 from tqdm import tqdm
 
 from softdeca_train.data.shards import iter_shards
-from softdeca_train.models.networks import GRAVITY_COLUMNS
+from softdeca_train.models.blocks import GRAVITY_COLUMNS
 from softdeca_train.parameters import ParameterSet, load_parameters
 from softdeca_train.train.batches import EVERY_FRAME, training_mask
 

@@ -31,8 +31,8 @@ from tqdm import tqdm
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.train.batches import EVERY_FRAME, Batch, Dataset
+from softdeca_train.train.gradients import GRADIENT_CLAMP, frame_gradients
 from softdeca_train.train.linear_baseline import ParameterScaling
-from softdeca_train.train.models import GRADIENT_CLAMP, frame_gradients
 
 
 def _own(p: np.ndarray, scaling: ParameterScaling) -> np.ndarray:

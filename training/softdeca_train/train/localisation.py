@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from softdeca_train.data.config import GenerateConfig
 from softdeca_train.render import MeshLayer, RenderSettings, render, tile
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.batches import Batch
@@ -58,9 +59,9 @@ def _first_frame(
 
 
 def _physics(run: Run, batch: Batch, change: LocalChange | None) -> np.ndarray:
+    # the physics needs the compiled softdeca_native; training and its other reports do not
     import softdeca_native as native
 
-    from softdeca_train.data.config import GenerateConfig
     from softdeca_train.data.simulate import without_collisions
     from softdeca_train.lhm import LhmConfig
     from softdeca_train.sim import build_head_simulation

@@ -12,10 +12,9 @@ from dataclasses import replace
 import numpy as np
 import torch
 from torch import nn
+from tqdm import tqdm
 
-from softdeca_train.controls.definitions import CONTROL_REGIONS
 from softdeca_train.data.plan import FIXED
-from softdeca_train.data.regions import REGIONS
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.models.networks import (
     EXPRESSION_SLOTS,
@@ -32,7 +31,10 @@ from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.residual import ResidualFit, ResidualSizes, ResidualStage
 from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
+from softdeca_train.template.regions import CONTROL_REGIONS, REGIONS
 from softdeca_train.train.batches import Batch, Dataset
+from softdeca_train.train.gradients import GRADIENT_CLAMP, frame_gradients
+from softdeca_train.train.local_fit import LocalRidge
 
 EPS = 1e-12
 CM = 0.01  # vertex offsets are learned in centimetres (HyperNetwork.unit)
@@ -94,27 +96,6 @@ class Trainable(nn.Module):
         # moves S, so progress reads better as the ratio of the two
         base = float(vertex_error(batch.S, batch.T).mean()) * 1e3
         return err.mean(), {"error_mm": mm, "no_correction_mm": base}
-
-
-# |G - I| bound of the per-face gradients taken from data (init_from_data, local_fit.py): a few
-# sliver faces reach 30 and would own the leading modes.
-GRADIENT_CLAMP = 0.3
-
-
-def frame_gradients(s: torch.Tensor, t: torch.Tensor, triangles: torch.Tensor) -> torch.Tensor:
-    """Per frame and face the 3x3 G with G [e1, e2, n](S) = [e1, e2, n](T), n the normal
-    scaled by 1/sqrt(|e1 x e2|) (Sumner and Popovic): (B, F, 3, 3)."""
-
-    def frames(x: torch.Tensor) -> torch.Tensor:
-        x = x.double()
-        e1 = x[:, triangles[:, 1]] - x[:, triangles[:, 0]]
-        e2 = x[:, triangles[:, 2]] - x[:, triangles[:, 0]]
-        n = torch.linalg.cross(e1, e2)
-        n = n / torch.sqrt(n.norm(dim=-1, keepdim=True).clamp_min(1e-20))
-        return torch.stack([e1, e2, n], dim=-1)  # columns
-
-    vs, vt = frames(s), frames(t)
-    return torch.linalg.solve(vs.transpose(-1, -2), vt.transpose(-1, -2)).transpose(-1, -2).float()
 
 
 @torch.no_grad()
@@ -214,7 +195,7 @@ def static_inputs(specs: Sequence[ParameterSpec]) -> tuple[str, ...]:
 
 
 def varied_region_labels(labels: np.ndarray) -> np.ndarray:
-    """Region labels (data/regions.py REGIONS) renumbered over the regions a regional pattern
+    """Region labels (template/regions.py REGIONS) renumbered over the regions a regional pattern
     sets (controls/definitions.py CONTROL_REGIONS); -1 for the others, which keep the group's
     p and so add no input of their own."""
     number = np.full(len(REGIONS), -1, np.int64)
@@ -317,10 +298,6 @@ class SoftDecaHybrid(Trainable):
         and of `more`: its w part (rank latent - 1, reduced-rank regression) in f_w's linear
         path and L_v's base, its constant and parameter parts in L_v's local map; every MLP's
         output and the DT stage start at zero."""
-        from tqdm import tqdm
-
-        from softdeca_train.train.local_fit import LocalRidge
-
         fit: LocalRidge | None = None
         moment = torch.zeros(self.n_weights, self.n_weights, dtype=torch.float64)
         sources = [data, *more]
@@ -379,10 +356,6 @@ class SoftDecaHybrid(Trainable):
         """With z's codes fixed by the first fit, the vertex stage again as a per-vertex ridge
         fit on `code_features`: its code part in L_v's base, the local features' in the
         constant slot's table, the products in the slot table. One more pass over the data."""
-        from tqdm import tqdm
-
-        from softdeca_train.train.local_fit import LocalRidge
-
         hyper = self.f_ph_v
         assert hyper.base is not None and hyper.local is not None
         assert hyper.local.slot_table is not None
@@ -417,8 +390,6 @@ class SoftDecaHybrid(Trainable):
         their coefficients (models/residual.py). `contrasts`: a dataset generated with
         contrasts (data/plan.py contrast), whose static train frames join the fit with their
         pairs."""
-        from tqdm import tqdm
-
         assert self.f_r is not None
         with torch.no_grad():
             self.f_r.table.zero_()  # the model without the stage

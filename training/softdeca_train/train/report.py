@@ -16,6 +16,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from softdeca_train.bench import write_area
 from softdeca_train.models.bundle import OnnxNetworks
 from softdeca_train.models.reference import ReferenceAvatar
 from softdeca_train.render import MeshLayer, RenderSettings, render, tile
@@ -25,10 +26,13 @@ from softdeca_train.train.evaluate import (
     SPARSE_INPUTS,
     ErrorSum,
     GroupOffsetOracle,
+    _AsDynamic,
     _test_take,
     measure,
+    no_correction,
     time_per_frame,
 )
+from softdeca_train.train.localisation import localisation_figure
 from softdeca_train.train.models import (
     NoCorrection,
     SparseSoftDeca,
@@ -188,12 +192,9 @@ def write_report(
             if vertex_mm is not None:
                 maps[name] = vertex_mm
             if name == "softdeca":
-                from softdeca_train.train.evaluate import _AsDynamic
-
                 errors["softdeca/dynamic"] = measure(run, name, _AsDynamic(m)).summary()
         else:
             errors[name] = measure(run, name, m).summary()
-    from softdeca_train.train.evaluate import no_correction
 
     errors["no-correction/dynamic"] = measure(run, "nc", no_correction("dynamic")).summary()
     oracle = measure(run, "oracle", GroupOffsetOracle())
@@ -221,7 +222,6 @@ def write_report(
     _heatmaps(
         run, {f"{k}: mean error": v for k, v in shown.items()}, out / "error_heatmaps.png", vmax
     )
-    from softdeca_train.train.localisation import localisation_figure
 
     local = localisation_figure(run, models["softdeca"], out / "localisation.png")
     left_out = left_out_counts(run)
@@ -427,8 +427,6 @@ def _where_the_error_is(e: dict) -> list[str]:
 
 
 def _write_bench(folder: Path, r: dict, run: Run) -> None:
-    from softdeca_train.bench import write_area
-
     e, ms = r["errors"], r["ms_per_frame"]
     how = f"python -m softdeca_train evaluate --run {run.folder} (test split, mean per-vertex mm)"
     figs = {}

@@ -13,10 +13,11 @@ import numpy as np
 import torch
 
 from softdeca_train.data.config import GenerateConfig
-from softdeca_train.models.networks import FULL_SIZES, TEST_SIZES, NetworkSizes
+from softdeca_train.models.networks import FULL_SIZES, TEST_SIZES, IdentityEncoder, NetworkSizes
 from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.topology import TemplateDefinition, from_template
 from softdeca_train.template import Template
+from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.batches import Dataset
 from softdeca_train.train.identity import IdentityConfig, train_identity_encoder
 from softdeca_train.train.loop import LoopConfig, train
@@ -178,8 +179,6 @@ class Run:
     def identity_encoder(self, cfg: IdentityConfig, progress: bool = True) -> tuple:
         """The trained identity encoder (trained now if the run has none) and its errors."""
         path, info = self.folder / "identity.pt", self.folder / "identity.json"
-        from softdeca_train.models.networks import IdentityEncoder
-        from softdeca_train.template.model import N_SKIN
 
         if path.is_file() and info.is_file():
             enc = IdentityEncoder(N_SKIN, self.sizes, cfg.seed)

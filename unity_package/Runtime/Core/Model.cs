@@ -51,8 +51,8 @@ namespace SoftDeca
                     Domain = Utf8.FromNative(p.Domain),
                     Description = Utf8.FromNative(p.Description),
                     DefaultValue = p.DefaultValue,
-                    Min = p.Min,
-                    Max = p.Max,
+                    Min = p.Lo,
+                    Max = p.Hi,
                     LogScale = p.LogScale != 0,
                 };
             }

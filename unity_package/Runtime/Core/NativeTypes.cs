@@ -97,8 +97,8 @@ namespace SoftDeca
         public IntPtr Domain;
         public IntPtr Description;
         public double DefaultValue;
-        public double Min;
-        public double Max;
+        public double Lo;
+        public double Hi;
         public int LogScale;
 
         public static NativeParameterInfo Create()

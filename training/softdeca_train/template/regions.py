@@ -6,6 +6,7 @@ one region; the first matching rule wins, in the order of REGIONS."""
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
@@ -22,6 +23,9 @@ REGIONS = (
     "mouth_socket",
     "eye_sockets",
 )
+# The regions on the outer skin (the mouth and eye sockets are inside the head): the ones a
+# region control acts on and a regional pattern of the data varies.
+CONTROL_REGIONS = tuple(r for r in REGIONS if r not in ("mouth_socket", "eye_sockets"))
 
 
 # Parameter domains whose elements have a region (element_regions); a landmark's weight
@@ -68,8 +72,6 @@ def nearest_skin_vertices(
 ) -> np.ndarray:
     """Per tet, the vertex of S nearest its centroid at rest: the vertex whose region and
     per-vertex parameter values the tet takes (the data, the gallery and the runtime alike)."""
-    from scipy.spatial import cKDTree
-
     centroids = np.asarray(vertices)[np.asarray(tets)].mean(axis=1)
     return cKDTree(neutral_skin).query(centroids)[1]
 

@@ -1,0 +1,36 @@
+"""The numbers of the lip and lid contact rules, read from their one definition
+plugin/data/contact_rules.json (the same file the C++ library embeds at build time)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, fields
+
+from softdeca_train.paths import REPO_ROOT
+
+DEFINITION = REPO_ROOT / "plugin" / "data" / "contact_rules.json"
+
+
+@dataclass(frozen=True)
+class ContactDistances:
+    """Lengths in metres; eye_zone_share is a share of an eye's width."""
+
+    lip_radius: float
+    lip_corner_radius: float
+    lid_reach: float
+    lid_corner_radius: float
+    eye_zone_share: float
+
+
+def _load() -> ContactDistances:
+    data = json.loads(DEFINITION.read_text())
+    if data.get("format") != "softdeca-contact-rules":
+        raise ValueError(f"{DEFINITION}: not a softdeca-contact-rules file")
+    rules = data["rules"]
+    names = [f.name for f in fields(ContactDistances)]
+    if sorted(rules) != sorted(names):
+        raise ValueError(f"{DEFINITION}: rules must be exactly {', '.join(names)}")
+    return ContactDistances(**{n: float(rules[n]["value"]) for n in names})
+
+
+CONTACT_RULES = _load()
