@@ -4,11 +4,13 @@
 #include <nanobind/eigen/sparse.h>
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
 #include "geometry/cotan.h"
 #include "geometry/intersections.h"
 #include "geometry/tet_mesh.h"
+#include "stream/rig_names.h"
 
 namespace nb = nanobind;
 using namespace softdeca::geometry;
@@ -19,6 +21,8 @@ void bind_fit(nb::module_& m);  // fit_bindings.cpp: fitting a user's avatar
 NB_MODULE(softdeca_native, m) {
   m.doc() = "SoftDECA native geometry (C++), used by the training pipeline";
   m.def("version", [] { return std::string(SOFTDECA_VERSION_STRING); });
+  m.def("rig_blendshape_index", [](const std::string& name) { return softdeca::stream::rig_blendshape_index(name); },
+        nb::arg("name"), "The canonical ARKit index a rig's blendshape name denotes, or -1 (docs/avatars.md).");
   m.def("tet_signed_volumes", &tet_signed_volumes, nb::arg("vertices"), nb::arg("tets"),
         "Signed tet volumes (b-a).((c-a)x(d-a))/6.");
   m.def(

@@ -18,7 +18,6 @@ import numpy as np
 
 from softdeca_train.landmarks.topology import boundary_loops, edge_graph, graph_nearest
 from softdeca_train.paths import cache_dir, default_arkit_reference_path
-from softdeca_train.runtime.native import blendshape_index
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 
 CACHE_FORMAT = 1
@@ -45,7 +44,10 @@ def canonical_shape_name(stem: str) -> str | None:
     "neutral" for a rest shape, None if it is not an ARKit shape."""
     if _key(stem) in NEUTRAL_NAMES:
         return "neutral"
-    index = blendshape_index(stem)
+    # the compiled library, imported where it is needed: this package's readers load without it
+    from softdeca_native import rig_blendshape_index
+
+    index = rig_blendshape_index(stem)
     return ARKIT_BLENDSHAPES[index] if index >= 0 else None
 
 
