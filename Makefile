@@ -74,7 +74,7 @@ test: lint test-native test-fuzz test-python test-kernels test-swift test-unity 
 # those that run in minutes; test-kernels-full runs every Python test so.
 KERNEL_PYTESTS := tests/python/test_lhm_eyes.py tests/python/test_lhm_mouth.py tests/python/test_lhm_conforming.py \
                   tests/python/test_sim_native.py tests/python/test_rest_physics.py tests/python/test_runtime_parity.py \
-                  tests/python/test_residual_stage.py tests/python/test_local_fit.py tests/python/test_linear_baseline.py
+                  tests/python/test_residual_stage.py tests/python/test_linear_baseline.py
 KCHECK := build/kernel-check
 .PHONY: test-kernels test-kernels-full kernel-check-inputs
 kernel-check-inputs: build ## the avatar and take of the kernel families' replay check -> build/kernel-check

@@ -131,9 +131,9 @@ def test_element_quality_is_bounded_around_the_mouth(
     q = mouth_quality(head.lhm)
     # the wraps' slope limit; without it 3.1 deg and 57.6
     for name, part, lo, hi in (
-        ("muscle", q.muscle, 6.0, 10.0),
+        ("muscle", q.muscle, 6.0, 11.0),
         ("mouth soft", q.mouth_soft, 2.5, 25.0),
-        ("mouth muscle", q.mouth_muscle, 6.0, 10.0),
+        ("mouth muscle", q.mouth_muscle, 6.0, 11.0),
     ):
         above(
             part.min_dihedral_deg,
@@ -176,8 +176,9 @@ def test_an_open_mouth_stays_open_in_the_volumetric_solve(head: HeadSimulation) 
     linear = lip_opening_mm(head, blended[:N_SKIN])
     above(linear, 10.0, "jawOpen 0.5 opens the blend 19.7 mm", what="mm")
     ratio = lip_opening_mm(head, skin) / linear
-    above(ratio, 0.9, "the slit keeps the opening (without it 0.07)", what="ratio")
-    below(ratio, 1.1, "the slit keeps the opening (without it 0.07)", what="ratio")
+    # measured 0.99 to 1.01; without the slit 0.07
+    above(ratio, 0.8, "the slit keeps the opening (without it 0.07)", what="ratio")
+    below(ratio, 1.25, "the slit keeps the opening (without it 0.07)", what="ratio")
 
 
 def test_the_default_resolution_has_a_slit_too(template: Template) -> None:
