@@ -146,7 +146,7 @@ clean: ## remove build/ and out/ (OUT)
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
 FUZZ         := build/fuzz
 FUZZ_TARGETS := softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
-                bundle_tar bundle_folder manifest onnx_model
+                bundle_tar bundle_folder manifest onnx_model onnx_graph
 FUZZ_SECONDS ?= 620
 
 .PHONY: fuzz-build test-fuzz fuzz-long
