@@ -128,7 +128,8 @@ demo: demo-bundle build ## template, layers, identities, landmarks, then a real 
 bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/bench/<area>.json (docs/benchmarks.md)
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
-	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json
+	@$(PY) -m softdeca_train runtime-test-data --out build/bench/runtime_test_data > /dev/null
+	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json --bundle build/bench/runtime_test_data/bundle
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
 	@$(PY) -m softdeca_train bench-physics --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
@@ -146,7 +147,7 @@ clean: ## remove build/ and out/ (OUT)
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
 FUZZ         := build/fuzz
 FUZZ_TARGETS := softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
-                bundle_tar bundle_folder manifest onnx_model
+                bundle_tar bundle_folder manifest onnx_model onnx_graph
 FUZZ_SECONDS ?= 620
 
 .PHONY: fuzz-build test-fuzz fuzz-long

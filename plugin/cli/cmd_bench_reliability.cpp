@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_bundle_memory.h"
 #include "bench_fifo.h"
 #include "bench_figures.h"
 #include "bench_recording_memory.h"
@@ -183,18 +184,23 @@ int run_bench_reliability(const Args& args) {
             "recording growth), the reader on a crafted damaged recording (seconds per MiB), and the\n"
             "consumer's poll while the recording's disk cannot keep up (p99 poll time), and how long every\n"
             "path that opens a recording or CSV take takes to refuse a FIFO, and the memory an opened\n"
-            "recording holds per frame.");
+            "recording holds per frame; with --bundle, the peak memory of loading copies of that bundle\n"
+            "grown by one constant-foldable producer each, just under, just over and far over a budget.");
   declare_output_options(o, "reliability", "where the runs write their files");
   o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
       .option("--resync-mib", "N", "MiB of crafted damage", "16")
-      .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3");
+      .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
+      .option("--bundle", "DIR", "a small bundle folder to grow (the runtime test data's bundle)", "")
+      .option("--bundle-budget-mib", "N", "the memory budget of the bundle runs", "256");
   if (!o.parse(args)) return 0;
   const std::string scratch = create_output_folders(o);
   const long ports = o.integer("--ports"), mib = o.integer("--resync-mib");
   const double flood_s = o.number("--flood-seconds"), slow_s = o.number("--slow-seconds");
-  if (ports < 2 || ports > 1000 || mib < 1 || mib > 1024 || !(flood_s > 0) || !(slow_s > 0))
-    throw UsageError("2 to 1000 ports, 1 to 1024 MiB and positive durations, please");
+  const long budget_mib = o.integer("--bundle-budget-mib");
+  if (ports < 2 || ports > 1000 || mib < 1 || mib > 1024 || !(flood_s > 0) || !(slow_s > 0) || budget_mib < 16 ||
+      budget_mib > 4096)
+    throw UsageError("2 to 1000 ports, 1 to 1024 MiB, positive durations and a 16 to 4096 MiB budget, please");
   double load = load_average();
 
   std::fprintf(stderr, "bench-reliability: flood");
@@ -209,6 +215,11 @@ int run_bench_reliability(const Args& args) {
   const FifoRefusal fifo = fifo_refusal_run(scratch);
   std::fprintf(stderr, "bench-reliability: recording memory\n");
   const RecordingMemory memory = recording_memory_run(scratch + "/bench-reliability-memory.sdrec", 20000);
+  BundleMemory bundles;
+  if (!o.text("--bundle").empty()) {
+    std::fprintf(stderr, "bench-reliability: bundle memory\n");
+    bundles = bundle_memory_run(o.text("--bundle"), scratch, std::uint64_t(budget_mib) << 20);
+  }
 
   char load_text[80];
   std::snprintf(load_text, sizeof load_text, " (machine load average up to %.1f during the runs)", load);
@@ -247,6 +258,23 @@ int run_bench_reliability(const Args& args) {
                 memory.frames, memory.file_bytes_per_frame);
   out.raw("reliability.recording_bytes_per_frame_in_memory",
           figure(memory.heap_bytes_per_frame, "bytes/frame", "64", "lower", how + memory_text));
+  if (bundles.bundles > 0) {
+    char bundle_text[700];
+    std::snprintf(bundle_text, sizeof bundle_text,
+                  "%d copies of %s, each grown by one Range, Tile, ConstantOfShape, Expand, Resize or Shape-derived "
+                  "ConstantOfShape of constant inputs sized just under, just over and 64 times over a %ld MiB budget, "
+                  "loaded in a child process each (%d loaded, %d refused) after the unchanged bundle warmed ONNX "
+                  "Runtime up; the worst peak RSS increase while loading (VmHWM, reset before, over VmRSS before) "
+                  "over the budget: %s",
+                  bundles.bundles, o.text("--bundle").c_str(), budget_mib, bundles.loaded, bundles.refused,
+                  bundles.worst.c_str());
+    out.raw("reliability.bundle_peak_rss_over_budget",
+            figure(bundles.worst_ratio, "ratio", "1.0", "lower", how + bundle_text));
+    out.raw("reliability.runtime_start_rss_mib",
+            figure(double(bundles.runtime_start_bytes) / double(1 << 20), "MiB", "null", "lower",
+                   how + "the peak RSS increase of the first Model::load of " + o.text("--bundle") +
+                       " in a fresh process: ONNX Runtime's start, once a process, outside the memory budget"));
+  }
   write_text_file(o.text("--out"), out.str(true) + "\n");
   std::printf("%s\n", out.str(true).c_str());
   return 0;
