@@ -64,18 +64,15 @@ def test_the_template_faces_plus_z_in_metres(head) -> None:
     )  # between the eyes, in front
 
 
-@pytest.mark.parametrize(
-    "stem",
-    [
-        "eyeBlink",
-        "eyeWide",
-        "browDown",
-        "browOuterUp",
-        "cheekSquint",
-        "mouthSmile",
-        "noseSneer",
-    ],
-)
+# Every pair of the library's table (fit/avatar_frame.cpp, kSidePairs).
+SIDE_PAIRS = [
+    "browDown", "browOuterUp", "cheekSquint", "eyeBlink", "eyeLookDown", "eyeLookIn",
+    "eyeLookOut", "eyeLookUp", "eyeSquint", "eyeWide", "mouthDimple", "mouthFrown",
+    "mouthLowerDown", "mouthPress", "mouthSmile", "mouthStretch", "mouthUpperUp", "noseSneer",
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("stem", SIDE_PAIRS)
 def test_each_side_pair_alone_gives_the_unit(head, stem: str) -> None:
     """One Left/Right pair, one eye and one mouth shape: the table's distance for that pair is
     the template's (so any subset of shapes measures the unit)."""

@@ -170,8 +170,10 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   f.metres_per_unit = f.metres_per_unit_measured;
   for (const double unit : kUnits)
     if (std::fabs(std::log(f.metres_per_unit_measured / unit)) < std::log(kSnap)) f.metres_per_unit = unit;
-  f.eye_distance = eye_pairs ? eye_distance / eye_pairs : 0.066 / f.metres_per_unit;
-  if (eye_pairs) f.eyes = eyes / eye_pairs;
+  if (eye_pairs) {
+    f.eye_distance = eye_distance / eye_pairs;
+    f.eyes = eyes / eye_pairs;
+  }
   // Which way is out of the face: the forward shapes' motion; without them the face's normals
   // (outward for a consistently wound mesh). Either disagreeing with left x up: a mirrored mesh.
   Eigen::Vector3d ahead = Eigen::Vector3d::Zero();
