@@ -318,6 +318,86 @@ typedef struct softdeca_stats {
 
 SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* avatar, softdeca_stats* out_stats);
 
+/* ---- A user's own avatar: fitting and the fitted avatar -------------------------------
+ * Any ARKit-rigged mesh (any topology, a head or a whole body, any unit and axis convention)
+ * is fitted once to the bundle's template: the face, its axes and unit are read off its own
+ * ARKit shapes, the template's skin is registered to the face, and every avatar vertex that
+ * follows the face is embedded on the registered template. A fitted avatar then runs
+ * SoftDECA and SparseSoftDECA on the registered template and returns the avatar's own
+ * vertices: its own linear blend plus the physics' correction carried through the embedding
+ * (docs/avatars.md). Vertices away from the face move exactly as the avatar's rig moves them.
+ * Needs a bundle with the template head (format version 5). */
+
+typedef struct softdeca_avatar_fit softdeca_avatar_fit;
+
+/* An avatar mesh in its own coordinates (right-handed: a left-handed host mirrors one axis)
+ * and its own units. The mesh may be several parts (head, eyes, teeth, body) concatenated. */
+typedef struct softdeca_avatar_mesh {
+  uint32_t struct_size;      /* sizeof(softdeca_avatar_mesh) */
+  const float* neutral;      /* vertex_count * 3 floats */
+  uint32_t vertex_count;     /* 3 .. SOFTDECA_MAX_AVATAR_VERTICES */
+  const int32_t* triangles;  /* triangle_count * 3 vertex indices */
+  uint32_t triangle_count;
+  const float* blendshapes;  /* 52 * vertex_count * 3 floats: the rig's ARKit shapes as deltas in
+                                canonical order; a shape the rig lacks is all zeros (found by
+                                softdeca_blendshape_index from the rig's own names) */
+  uint32_t blendshape_count; /* 52 */
+  const float* landmarks;    /* NULL, or landmark_count * 3 floats: the bundle's landmarks on the
+                                avatar's neutral, in the bundle's order (optional guides; needed
+                                only for a rig without ARKit shapes) */
+  uint32_t landmark_count;   /* 0 or the bundle's landmark_count */
+} softdeca_avatar_mesh;
+
+#define SOFTDECA_MAX_AVATAR_VERTICES 4000000u
+
+typedef struct softdeca_fit_options {
+  uint32_t struct_size;     /* sizeof(softdeca_fit_options) */
+  double metres_per_unit;   /* 0: read off the shapes (snapped to mm, cm, inch, dm, m) */
+  uint32_t iterations;      /* registration iterations; 0: the default */
+  uint32_t reserved;
+} softdeca_fit_options;
+
+/* Fills *options with the defaults (struct_size must be set). */
+SOFTDECA_API softdeca_status softdeca_fit_options_init(softdeca_fit_options* options);
+
+/* Fits an avatar to the model's template (seconds for a 20k-vertex body). Errors name the
+ * problem: no ARKit shape moves a vertex, no face found, NaN vertices, degenerate triangles,
+ * shapes of the wrong size. options may be NULL (the defaults). */
+SOFTDECA_API softdeca_status softdeca_avatar_fit_create(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
+                                                        const softdeca_fit_options* options,
+                                                        softdeca_avatar_fit** out_fit);
+/* NULL is a no-op. */
+SOFTDECA_API void softdeca_avatar_fit_destroy(softdeca_avatar_fit* fit);
+
+/* Saves a fit (written to a temporary file and renamed into place: never half-written). */
+SOFTDECA_API softdeca_status softdeca_avatar_fit_save(const softdeca_avatar_fit* fit, const char* path);
+
+/* Loads a saved fit for this model; refuses a fit of another bundle (SOFTDECA_ERROR_FORMAT). */
+SOFTDECA_API softdeca_status softdeca_avatar_fit_load(const softdeca_model* model, const char* path,
+                                                      softdeca_avatar_fit** out_fit);
+
+/* The fit's report as JSON (metres_per_unit, up_axis, shapes_matched, shapes_carried,
+ * face_vertices, face_residual_mm_mean / _max, seconds, ...): NUL-terminated into buffer when
+ * capacity suffices; *out_length (may be NULL) receives the length without the NUL either way
+ * (SOFTDECA_ERROR_BUFFER_TOO_SMALL when it does not fit). */
+SOFTDECA_API softdeca_status softdeca_avatar_fit_report(const softdeca_avatar_fit* fit, char* buffer,
+                                                        uint32_t capacity, uint32_t* out_length);
+
+/* The registered template skin (skin_vertex_count points) in the avatar's units and axes, and
+ * the vertex count of the avatar the fit was made for; either output may be NULL. */
+SOFTDECA_API softdeca_status softdeca_avatar_fit_get_registered(const softdeca_avatar_fit* fit, float* out_points,
+                                                                uint32_t point_capacity, uint32_t* out_vertex_count);
+
+/* An avatar on the user's own mesh: `mesh` is the mesh the fit was made for (checked by a hash
+ * of its neutral and triangles: a changed mesh is refused with SOFTDECA_ERROR_FORMAT). Every
+ * softdeca_avatar_* call then works in the avatar's own vertices (outputs hold vertex_count
+ * vertices; parameter maps are given per avatar triangle or vertex and reach the template
+ * through the fit), except evaluate_surface, which needs the template's topology.
+ * threads and precision as in softdeca_avatar_desc. */
+SOFTDECA_API softdeca_status softdeca_avatar_create_fitted(const softdeca_model* model, const softdeca_avatar_fit* fit,
+                                                           const softdeca_avatar_mesh* mesh, uint32_t threads,
+                                                           int32_t precision, softdeca_avatar** out_avatar);
+
 /* ---- Geometry -------------------------------------------------------------------------- */
 
 /* Embeds points in a tetrahedral mesh: for every point, the tetrahedron that contains it and
