@@ -6,17 +6,8 @@
 
 #include "api/error.h"
 #include "api/handles.h"
-#include "runtime/avatar.h"
+#include "api/runtime_handles.h"
 #include "runtime/bundle_files.h"
-#include "runtime/model.h"
-
-struct softdeca_model {
-  std::shared_ptr<const softdeca::runtime::Model> model;
-};
-
-struct softdeca_avatar {
-  std::unique_ptr<softdeca::runtime::Avatar> avatar;
-};
 
 namespace {
 using namespace softdeca;
@@ -25,19 +16,21 @@ using runtime::Model;
 
 constexpr std::size_t kMaxThreads = 8;
 
-const Model& model_of(const softdeca_model* m) {
-  require_not_null(m, "model");
-  return *m->model;
-}
-
+// The avatar that holds parameters, identity, preparation and dynamics: for a fitted avatar,
+// the registered template's.
 Avatar& avatar_of(softdeca_avatar* a) {
   require_not_null(a, "avatar");
-  return *a->avatar;
+  return a->fitted ? a->fitted->core() : *a->avatar;
 }
 
 const Avatar& avatar_of(const softdeca_avatar* a) {
   require_not_null(a, "avatar");
-  return *a->avatar;
+  return a->fitted ? a->fitted->core() : *a->avatar;
+}
+
+runtime::FittedAvatar* fitted_of(softdeca_avatar* a) {
+  require_not_null(a, "avatar");
+  return a->fitted.get();
 }
 
 runtime::Output output_of(const softdeca_output* o) {
@@ -217,8 +210,6 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
       require_finite(desc->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->blendshapes");
     }
     require(desc->threads <= kMaxThreads, "desc->threads must be at most " + std::to_string(kMaxThreads));
-    require(desc->precision >= SOFTDECA_PRECISION_HALF && desc->precision <= SOFTDECA_PRECISION_INT8,
-            "desc->precision is not a softdeca_precision");
     runtime::AvatarDesc d;
     d.neutral = desc->neutral;
     d.vertex_count = vh;
@@ -227,9 +218,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
     d.blendshapes = desc->blendshape_count ? desc->blendshapes : nullptr;
     d.blendshape_count = desc->blendshape_count;
     d.threads = desc->threads == 0 ? 1 : desc->threads;
-    d.precision = desc->precision == SOFTDECA_PRECISION_FLOAT  ? runtime::Precision::Float
-                  : desc->precision == SOFTDECA_PRECISION_INT8 ? runtime::Precision::Int8
-                                                               : runtime::Precision::Half;
+    d.precision = precision_of(desc->precision, "desc->precision");
     create_handle(out_avatar, "out_avatar",
                   [&](softdeca_avatar& h) { h.avatar = std::make_unique<Avatar>(model->model, d); });
   });
@@ -250,7 +239,8 @@ SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_faces(softdeca_avatar
                                                                  uint32_t face_count) {
   return guarded(__func__, [&] {
     Avatar& a = avatar_of(avatar);
-    a.set_parameter_faces(parameter_index(a.model(), index), values, face_count);
+    if (auto* f = fitted_of(avatar)) f->set_parameter_faces(parameter_index(a.model(), index), values, face_count);
+    else a.set_parameter_faces(parameter_index(a.model(), index), values, face_count);
   });
 }
 
@@ -258,7 +248,8 @@ SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_vertices(softdeca_ava
                                                                     const float* values, uint32_t vertex_count) {
   return guarded(__func__, [&] {
     Avatar& a = avatar_of(avatar);
-    a.set_parameter_vertices(parameter_index(a.model(), index), values, vertex_count);
+    if (auto* f = fitted_of(avatar)) f->set_parameter_vertices(parameter_index(a.model(), index), values, vertex_count);
+    else a.set_parameter_vertices(parameter_index(a.model(), index), values, vertex_count);
   });
 }
 
@@ -291,13 +282,18 @@ SOFTDECA_API softdeca_status softdeca_avatar_prepare(softdeca_avatar* avatar) {
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* avatar, const float* weights,
                                                               uint32_t weight_count, const softdeca_output* output) {
-  return guarded(__func__, [&] { avatar_of(avatar).evaluate_weights(weights, weight_count, output_of(output)); });
+  return guarded(__func__, [&] {
+    if (auto* f = fitted_of(avatar)) f->evaluate_weights(weights, weight_count, output_of(output));
+    else avatar_of(avatar).evaluate_weights(weights, weight_count, output_of(output));
+  });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_surface(softdeca_avatar* avatar, const float* weights,
                                                               uint32_t weight_count, const float* surface, uint32_t vertex_count,
                                                               const softdeca_output* output) {
   return guarded(__func__, [&] {
+    require(fitted_of(avatar) == nullptr,
+            "evaluate_surface takes a surface in the template's topology: a fitted avatar takes weights or landmarks");
     avatar_of(avatar).evaluate_surface(weights, weight_count, surface, vertex_count, output_of(output));
   });
 }
@@ -309,12 +305,18 @@ SOFTDECA_API softdeca_status softdeca_avatar_calibrate_landmarks(softdeca_avatar
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_landmarks(softdeca_avatar* avatar, const float* points,
                                                                 uint32_t point_count, const softdeca_output* output) {
-  return guarded(__func__, [&] { avatar_of(avatar).evaluate_landmarks(points, point_count, output_of(output)); });
+  return guarded(__func__, [&] {
+    if (auto* f = fitted_of(avatar)) f->evaluate_landmarks(points, point_count, output_of(output));
+    else avatar_of(avatar).evaluate_landmarks(points, point_count, output_of(output));
+  });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_linear(softdeca_avatar* avatar, const float* weights, uint32_t weight_count,
                                                              const softdeca_output* output) {
-  return guarded(__func__, [&] { avatar_of(avatar).evaluate_linear(weights, weight_count, output_of(output)); });
+  return guarded(__func__, [&] {
+    if (auto* f = fitted_of(avatar)) f->evaluate_linear(weights, weight_count, output_of(output));
+    else avatar_of(avatar).evaluate_linear(weights, weight_count, output_of(output));
+  });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_set_dynamics(softdeca_avatar* avatar, softdeca_bool enabled) {
@@ -345,7 +347,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* av
     out_stats->prepare_ms = s.prepare_ms;
     out_stats->prepare_networks_ms = s.prepare_networks_ms;
     out_stats->factorisation_ms = s.factorisation_ms;
-    out_stats->memory_bytes = s.memory_bytes;
+    out_stats->memory_bytes = s.memory_bytes + (avatar->fitted ? avatar->fitted->bytes() : 0);
     out_stats->prepare_physics_ms = s.prepare_physics_ms;
     out_stats->physics_iterations = static_cast<uint32_t>(s.physics_iterations);
     out_stats->reserved = 0;

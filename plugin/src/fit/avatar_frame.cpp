@@ -118,6 +118,8 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
     check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
     motion[i] = shape_motion(s, s.deltas[i], f.face);
     f.shapes_used += motion[i].moves;
+    f.moves[i] = motion[i].moves;
+    f.centres[i] = motion[i].centre;
   }
   f.face_vertices = static_cast<std::size_t>(std::count(f.face.begin(), f.face.end(), uint8_t{1}));
   require(f.shapes_used > 0, "none of the avatar's ARKit blendshapes moves a vertex: no face to fit");

@@ -42,6 +42,9 @@ struct AvatarFrame {
   // mouthFunnel, cheekPuff), else the face's normals, point along -(left x up).
   bool mirrored = false;
   std::vector<uint8_t> face;  // per vertex: 1 where some ARKit shape moves it
+  // Per shape: whether it moves a vertex, and its motion-weighted centre (avatar coordinates).
+  std::array<bool, kShapes> moves{};
+  std::array<Eigen::Vector3d, kShapes> centres{};
   std::size_t face_vertices = 0;
   std::size_t shapes_used = 0;
 };

@@ -1,5 +1,7 @@
 #include "runtime/avatar.h"
 
+#include "runtime/frame_guard.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -48,20 +50,6 @@ std::size_t Preparation::bytes() const {
          residual_condition.size() * 4 + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4 +
          rest_offset.size() * 4;
 }
-
-class Avatar::FrameGuard {
- public:
-  explicit FrameGuard(std::atomic<bool>& busy) : busy_(busy) {
-    if (busy_.exchange(true, std::memory_order_acquire))
-      throw Error(SOFTDECA_ERROR_BUSY, "the avatar is in use by a frame on another thread (one frame thread at a time)");
-  }
-  ~FrameGuard() { busy_.store(false, std::memory_order_release); }
-  FrameGuard(const FrameGuard&) = delete;
-  FrameGuard& operator=(const FrameGuard&) = delete;
-
- private:
-  std::atomic<bool>& busy_;
-};
 
 Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
     : model_(std::move(model)),

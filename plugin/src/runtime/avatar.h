@@ -108,8 +108,13 @@ class Avatar {
 
   AvatarStats stats() const;
 
+  // S_t of the last evaluate_weights (skin_vertices x 3): the linear blend the model corrected.
+  // Frame thread only, valid until its next frame.
+  const float* linear_skin() const { return head_.data(); }
+  // The avatar's neutral head (head_vertices x 3).
+  const std::vector<float>& neutral() const { return neutral_; }
+
  private:
-  class FrameGuard;
   std::shared_ptr<const Preparation> current() const;
   HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                            const std::vector<float>& identity, std::size_t n, std::size_t width) const;

@@ -369,6 +369,29 @@ void parse_rest_physics(const Json& doc, Manifest& m) {
 }
 }  // namespace
 
+namespace {
+void parse_template_head(const Json& doc, Manifest& m) {
+  if (!doc.has("template_head")) return;
+  const std::string what = "template_head";
+  check(m.format_version >= 5, "template_head (fitting users' avatars) needs bundle format version 5");
+  const Json& t = doc.at(what.c_str(), "manifest");
+  m.template_head_file = t.at("file", what).string(what + ".file");
+  m.template_head_sha256 = sha256_of(t, what);
+  const auto shape = [&](const char* key, const char* dtype, std::vector<long long> expected) {
+    const Json& e = t.at(key, what);
+    check(e.at("dtype", what).string(what + "." + key + ".dtype") == dtype, what + "." + key + ".dtype must be " + dtype);
+    const auto& dims = e.at("shape", what).array(what + "." + key + ".shape");
+    check(dims.size() == expected.size(), what + "." + key + ".shape has the wrong rank");
+    for (std::size_t i = 0; i < dims.size(); ++i)
+      check(dims[i].integer(what + "." + key + ".shape") == expected[i],
+            what + "." + key + ".shape does not match the template's sizes");
+  };
+  shape("neutral", "float32", {m.head_vertices, 3});
+  shape("shapes", "float16", {kBlendshapeCount, m.skin_vertices, 3});
+  m.has_template_head = true;
+}
+}  // namespace
+
 Manifest parse_manifest(const std::string& text) {
   const Json doc = Json::parse(text);
   Manifest m;
@@ -379,6 +402,7 @@ Manifest parse_manifest(const std::string& text) {
   parse_deformation_and_dynamics(doc, m);
   parse_networks(doc, m);
   parse_rest_physics(doc, m);
+  parse_template_head(doc, m);
   return m;
 }
 

@@ -12,8 +12,9 @@
 namespace softdeca::runtime {
 
 // Versions this runtime reads: 1, 2 (adds SoftDECA's optional vertex stage), 3 (adds its
-// optional residual stage) and 4 (adds the optional physics at prepare, `rest_physics`).
-constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 4;
+// optional residual stage), 4 (adds the optional physics at prepare, `rest_physics`) and 5
+// (adds the optional template head for fitting users' avatars, `template_head`).
+constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 5;
 constexpr const char* kBundleFormat = "softdeca-bundle";
 constexpr const char* kDtFormulation = "cotangent-poisson-1";
 // The 52 ARKit shapes in canonical order: names from the one definition, stream/arkit_names.h.
@@ -84,6 +85,10 @@ struct Manifest {
   int residual_modes = 0, residual_condition = 0;
   bool has_rest_physics = false;  // format version 4
   RestPhysicsSpec rest_physics;
+  // The template head (format version 5): the neutral head (float32) and the 52 ARKit shapes
+  // over the skin (float16) in one file; sizes are the template's.
+  bool has_template_head = false;
+  std::string template_head_file, template_head_sha256;
 
   const NetworkSpec& network(const std::string& key) const;
   int find_parameter(const std::string& name) const;  // -1 when absent

@@ -66,6 +66,7 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
   std::shared_ptr<Model> m(new Model());
   const Bytes& manifest_bytes = files.get("manifest.json");
   m->manifest_ = parse_manifest(std::string(manifest_bytes.begin(), manifest_bytes.end()));
+  m->manifest_sha256_ = sha256_hex(manifest_bytes.data(), manifest_bytes.size());
   const Manifest& mf = m->manifest_;
 
   const Bytes& tri = verified(files, mf.skin_triangles_file, mf.skin_triangles_sha256);
@@ -114,6 +115,10 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
     const Bytes& data = verified(files, mf.rest_physics.file, mf.rest_physics.sha256);
     m->rest_head_ = std::make_unique<const RestHead>(parse_rest_head(mf, data));
   }
+
+  if (mf.has_template_head)
+    m->template_head_ = std::make_unique<const TemplateHead>(
+        parse_template_head(mf, verified(files, mf.template_head_file, mf.template_head_sha256)));
 
   // Every network is verified and scanned before the first session exists: nothing a bundle
   // declares is allocated until the whole bundle fits the budget.

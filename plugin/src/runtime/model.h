@@ -14,6 +14,7 @@
 #include "runtime/manifest.h"
 #include "runtime/onnx_network.h"
 #include "runtime/rest_head.h"
+#include "runtime/template_head.h"
 
 namespace softdeca::runtime {
 
@@ -58,6 +59,10 @@ class Model {
   const OnnxNetwork* residual_coefficients() const { return networks_.at(9).get(); }
   // The physics at prepare's head (format version 4), or null.
   const RestHead* rest_head() const { return rest_head_.get(); }
+  // The template head for fitting users' avatars (format version 5), or null.
+  const TemplateHead* template_head() const { return template_head_.get(); }
+  // SHA-256 of the manifest as loaded: a saved fit names the bundle it was made for.
+  const std::string& manifest_sha256() const { return manifest_sha256_; }
 
  private:
   Model() = default;
@@ -65,6 +70,8 @@ class Model {
   std::vector<std::int32_t> skin_triangles_;
   std::vector<std::uint8_t> non_skin_bones_;
   std::unique_ptr<const RestHead> rest_head_;
+  std::unique_ptr<const TemplateHead> template_head_;
+  std::string manifest_sha256_;
   std::unique_ptr<Ort::Env> env_;  // before the sessions: they must go first
   std::vector<std::unique_ptr<OnnxNetwork>> networks_;
 };

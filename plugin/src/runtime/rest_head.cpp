@@ -4,42 +4,13 @@
 #include <cstring>
 #include <string>
 
+#include "core/binary_reader.h"
 #include "core/error.h"
 
 namespace softdeca::runtime {
 
 namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, message); }
-
-// Reads the file's arrays in order; every read is bounds-checked against the bytes left.
-class Reader {
- public:
-  Reader(const Bytes& data, std::string name) : data_(data), name_(std::move(name)) {}
-
-  template <class T>
-  void read(T* out, std::size_t count, const char* what) {
-    const std::size_t size = count * sizeof(T);
-    if (size / sizeof(T) != count || size > data_.size() - at_)
-      fail(name_ + ": shorter than its manifest says (reading " + what + ")");
-    if (size == 0) return;  // an empty array: no bytes, and `out` may be null
-    std::memcpy(out, data_.data() + at_, size);  // little-endian hosts only, like every bundle file
-    at_ += size;
-  }
-  template <class T>
-  std::vector<T> vector(std::size_t count, const char* what) {
-    std::vector<T> v(count);
-    read(v.data(), count, what);
-    return v;
-  }
-  void finish() const {
-    if (at_ != data_.size()) fail(name_ + ": " + std::to_string(data_.size() - at_) + " bytes more than its manifest says");
-  }
-
- private:
-  const Bytes& data_;
-  std::string name_;
-  std::size_t at_ = 0;
-};
 
 void indices_below(const std::int32_t* v, std::size_t count, std::int64_t bound, const std::string& what) {
   for (std::size_t i = 0; i < count; ++i)
@@ -66,7 +37,7 @@ std::size_t RestHead::bytes() const {
 RestHead parse_rest_head(const Manifest& m, const Bytes& data) {
   const RestPhysicsSpec& s = m.rest_physics;
   const std::string& f = s.file;
-  Reader in(data, f);
+  BinaryReader in(data.data(), data.size(), f);
   RestHead h;
   const auto n = static_cast<Eigen::Index>(s.fill_vertices);
   const auto ns = static_cast<Eigen::Index>(m.skin_vertices);

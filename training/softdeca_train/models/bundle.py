@@ -34,15 +34,21 @@ from softdeca_train.models.rest_head import (
     read_rest_head,
     rest_head_file,
 )
+from softdeca_train.models.template_head import (
+    TemplateHead,
+    read_template_head,
+    template_head_file,
+)
 from softdeca_train.models.topology import LandmarkSet, TemplateDefinition
 
 FORMAT = "softdeca-bundle"
 # Version 2 adds SoftDECA's optional vertex stage (softdeca.f_ph_v), version 3 its optional
 # residual stage (softdeca.f_r_ph, softdeca.f_r_w), version 4 the physics at prepare
-# (rest_physics, rest_head.bin); a bundle is written with the lowest
+# (rest_physics, rest_head.bin), version 5 the template head for fitting users' avatars
+# (template_head, template_head.bin); a bundle is written with the lowest
 # version that holds it, so runtimes that read only older versions still run what they can.
-FORMAT_VERSION = 4
-FORMAT_VERSIONS = (1, 2, 3, 4)
+FORMAT_VERSION = 5
+FORMAT_VERSIONS = (1, 2, 3, 4, 5)
 OPSET = 17
 MANIFEST = "manifest.json"
 SKIN_TRIANGLES_FILE = "skin_triangles.i32"
@@ -270,10 +276,12 @@ def export_bundle(
     info: BundleInfo,
     check: bool = True,
     rest_head: RestHead | None = None,
+    template_head: TemplateHead | None = None,
 ) -> Path:
     """Write a bundle folder: manifest.json, the skin triangulation, the non-skin bone labels
     and one ONNX file per network, and with `rest_head` the physics at prepare
-    (rest_physics.py). With `check`, every ONNX file is run in onnxruntime against its torch
+    (rest_physics.py), with `template_head` what fitting users' avatars needs
+    (template_head.py). With `check`, every ONNX file is run in onnxruntime against its torch
     module and the largest deviation is recorded in the manifest."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -372,7 +380,35 @@ def export_bundle(
     (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
     if rest_head is not None:
         add_rest_physics(folder, rest_head)
+    if template_head is not None:
+        add_template_head(folder, template_head)
     return folder
+
+
+def add_template_head(folder: str | Path, head: TemplateHead) -> None:
+    """Add (or replace) a bundle's template head: template_head.bin and the manifest's
+    `template_head` entry; the format version becomes 5."""
+    folder = Path(folder)
+    manifest = read_manifest(folder)
+    t = manifest["template"]
+    if head.neutral.shape[0] != t["head_vertices"] or head.shapes.shape[1] != t["skin_vertices"]:
+        raise ValueError("the template head does not match the bundle's template sizes")
+    data, entry = template_head_file(head)
+    (folder / entry["file"]).write_bytes(data)
+    manifest["template_head"] = {**entry, "sha256": hashlib.sha256(data).hexdigest()}
+    manifest["format_version"] = 5
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+
+
+def read_bundle_template_head(folder: str | Path, manifest: dict[str, Any]) -> TemplateHead | None:
+    """A bundle's template head, or None when it has none."""
+    entry = manifest.get("template_head")
+    if entry is None:
+        return None
+    data = (Path(folder) / entry["file"]).read_bytes()
+    if hashlib.sha256(data).hexdigest() != entry["sha256"]:
+        raise ValueError(f"{entry['file']}: sha256 does not match the manifest")
+    return read_template_head(entry, data)
 
 
 def add_rest_physics(folder: str | Path, head: RestHead) -> None:

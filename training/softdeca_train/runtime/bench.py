@@ -14,6 +14,7 @@ from pathlib import Path
 from softdeca_train.models import FULL_SIZES, BundleInfo, build_random, export_bundle
 from softdeca_train.models.parameters import specs_or_test_list
 from softdeca_train.models.rest_head import rest_head_for_bundle
+from softdeca_train.models.template_head import template_head_from
 from softdeca_train.models.topology import from_template
 from softdeca_train.paths import REPO_ROOT, default_takes_path
 from softdeca_train.runtime.files import write_identity_avatar
@@ -40,7 +41,15 @@ def bench_runtime(
 
     template = Template.load(ict)
     rest = rest_head_for_bundle(template, specs)  # the physics at prepare, as trained bundles
-    bundle = export_bundle(work / "bundle", definition, nets, info, check=False, rest_head=rest)
+    bundle = export_bundle(
+        work / "bundle",
+        definition,
+        nets,
+        info,
+        check=False,
+        rest_head=rest,
+        template_head=template_head_from(template),
+    )
     avatar = work / "avatar-seed1"
     if not (avatar / "neutral.obj").is_file():
         write_identity_avatar(1, avatar, ict)

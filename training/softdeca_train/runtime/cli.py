@@ -35,24 +35,29 @@ def _runtime_bundle_run(args: argparse.Namespace) -> int:
         pack_bundle,
     )
     from softdeca_train.models.parameters import specs_or_test_list
+    from softdeca_train.models.template_head import template_head_from, template_head_of
 
     specs = specs_or_test_list(args.parameters)
     if args.synthetic:
         from softdeca_train.models.synthetic import synthetic_head
 
-        definition, sizes = synthetic_head().definition, TEST_SIZES
+        head = synthetic_head()
+        definition, sizes = head.definition, TEST_SIZES
+        template_head = template_head_of(head.neutral, head.blendshapes, definition.skin_vertices)
     else:
         from softdeca_train.models.topology import from_template
         from softdeca_train.template import Template
 
-        definition, sizes = from_template(Template.load(args.ict)), FULL_SIZES
+        template = Template.load(args.ict)
+        definition, sizes = from_template(template), FULL_SIZES
+        template_head = template_head_from(template)
     nets = build_random(definition, specs, sizes, seed=args.seed)
     info = BundleInfo(
         untrained=True,
         description="UNTRAINED: random-weight networks of the contract's shapes, for tests, "
         "benchmarks and replays that must not depend on a trained bundle",
     )
-    out = export_bundle(Path(args.out), definition, nets, info)
+    out = export_bundle(Path(args.out), definition, nets, info, template_head=template_head)
     if args.tar:
         Path(str(out) + ".tar").write_bytes(pack_bundle(out))
     print(f"wrote untrained bundle {out} ({definition.name}, {len(specs)} parameters)")
@@ -85,6 +90,23 @@ def _rest_physics_run(args: argparse.Namespace) -> int:
         f"vertices, {entry['soft_tets'] + entry['muscle_tets']} tets); rest-inert: "
         f"{', '.join(head.inert) or 'none'}"
     )
+    return 0
+
+
+def _template_head_args(p: argparse.ArgumentParser) -> None:
+    add_ict_argument(p)
+    p.add_argument("bundle", help="bundle folder in the ICT template's topology")
+
+
+def _template_head_run(args: argparse.Namespace) -> int:
+    from softdeca_train.models.bundle import add_template_head
+    from softdeca_train.models.template_head import TEMPLATE_HEAD_FILE, template_head_from
+    from softdeca_train.template import Template
+
+    folder = Path(args.bundle)
+    add_template_head(folder, template_head_from(Template.load(args.ict)))
+    size = (folder / TEMPLATE_HEAD_FILE).stat().st_size
+    print(f"{folder}: {TEMPLATE_HEAD_FILE} ({size / 2**20:.1f} MiB), format version 5")
     return 0
 
 
@@ -165,6 +187,13 @@ COMMANDS = [
         "and its rest-inert parameters (format version 4).",
         _rest_physics_args,
         _rest_physics_run,
+    ),
+    Command(
+        "bundle-template-head",
+        "Add the template head that fitting users' avatars needs to a bundle "
+        "(template_head.bin, format version 5).",
+        _template_head_args,
+        _template_head_run,
     ),
     Command(
         "avatar",

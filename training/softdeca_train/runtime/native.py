@@ -5,6 +5,7 @@ Every call checks its status and raises NativeError with the library's message."
 from __future__ import annotations
 
 import ctypes as C
+import json
 import os
 from pathlib import Path
 
@@ -94,6 +95,29 @@ class AvatarDesc(C.Structure):
     ]
 
 
+class AvatarMesh(C.Structure):
+    _fields_ = [
+        ("struct_size", C.c_uint32),
+        ("neutral", C.POINTER(C.c_float)),
+        ("vertex_count", C.c_uint32),
+        ("triangles", C.POINTER(C.c_int32)),
+        ("triangle_count", C.c_uint32),
+        ("blendshapes", C.POINTER(C.c_float)),
+        ("blendshape_count", C.c_uint32),
+        ("landmarks", C.POINTER(C.c_float)),
+        ("landmark_count", C.c_uint32),
+    ]
+
+
+class FitOptions(C.Structure):
+    _fields_ = [
+        ("struct_size", C.c_uint32),
+        ("metres_per_unit", C.c_double),
+        ("iterations", C.c_uint32),
+        ("reserved", C.c_uint32),
+    ]
+
+
 class Output(C.Structure):
     _fields_ = [
         ("struct_size", C.c_uint32),
@@ -155,6 +179,7 @@ def lib() -> C.CDLL:
         loaded.softdeca_abi_version.restype = C.c_uint32
         loaded.softdeca_model_destroy.restype = None
         loaded.softdeca_avatar_destroy.restype = None
+        loaded.softdeca_avatar_fit_destroy.restype = None
         found = loaded.softdeca_abi_version()
         if found != ABI_VERSION:
             raise RuntimeError(
@@ -256,6 +281,93 @@ class NativeModel:
         return out
 
 
+class AvatarArrays:
+    """A user's avatar mesh kept alive for the C ABI: neutral (N, 3), triangles (T, 3), the 52
+    ARKit shapes as deltas (52, N, 3; zeros where the rig lacks one), optional landmarks."""
+
+    def __init__(
+        self,
+        neutral: np.ndarray,
+        triangles: np.ndarray,
+        deltas: np.ndarray,
+        landmarks: np.ndarray | None = None,
+    ) -> None:
+        self.neutral = _f32(neutral)
+        self.triangles = np.ascontiguousarray(triangles, dtype=np.int32)
+        self.deltas = _f32(deltas)
+        self.landmarks = None if landmarks is None else _f32(landmarks)
+        self.desc = AvatarMesh(
+            C.sizeof(AvatarMesh),
+            _ptr(self.neutral),
+            len(self.neutral),
+            _ptr(self.triangles, C.c_int32),
+            len(self.triangles),
+            _ptr(self.deltas),
+            len(self.deltas),
+            _ptr(self.landmarks),
+            0 if self.landmarks is None else len(self.landmarks),
+        )
+
+
+class NativeFit:
+    """softdeca_avatar_fit: a user's avatar fitted to a model's template."""
+
+    def __init__(self, handle: C.c_void_p) -> None:
+        self.handle = handle
+
+    @classmethod
+    def create(
+        cls,
+        model: NativeModel,
+        mesh: AvatarArrays,
+        metres_per_unit: float = 0.0,
+        iterations: int = 0,
+    ) -> NativeFit:
+        opts = FitOptions(C.sizeof(FitOptions), metres_per_unit, iterations, 0)
+        handle = C.c_void_p()
+        check(
+            lib().softdeca_avatar_fit_create(
+                model.handle, C.byref(mesh.desc), C.byref(opts), C.byref(handle)
+            )
+        )
+        return cls(handle)
+
+    @classmethod
+    def load(cls, model: NativeModel, path: str | os.PathLike[str]) -> NativeFit:
+        handle = C.c_void_p()
+        check(lib().softdeca_avatar_fit_load(model.handle, str(path).encode(), C.byref(handle)))
+        return cls(handle)
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        check(lib().softdeca_avatar_fit_save(self.handle, str(path).encode()))
+
+    def report(self) -> dict:
+        length = C.c_uint32()
+        lib().softdeca_avatar_fit_report(self.handle, None, 0, C.byref(length))
+        buf = C.create_string_buffer(length.value + 1)
+        check(lib().softdeca_avatar_fit_report(self.handle, buf, len(buf), C.byref(length)))
+        return json.loads(buf.value.decode())
+
+    def registered(self, skin_vertices: int) -> np.ndarray:
+        """The registered template skin in the avatar's units and axes."""
+        out = np.zeros((skin_vertices, 3), dtype=np.float32)
+        check(
+            lib().softdeca_avatar_fit_get_registered(
+                self.handle, _ptr(out), C.c_uint32(len(out)), None
+            )
+        )
+        return out
+
+    def close(self) -> None:
+        if self.handle:
+            lib().softdeca_avatar_fit_destroy(self.handle)
+            self.handle = C.c_void_p()
+
+    def __del__(self) -> None:
+        if getattr(self, "handle", None):
+            lib().softdeca_avatar_fit_destroy(self.handle)
+
+
 class NativeAvatar:
     """softdeca_avatar: one head and its per-frame state."""
 
@@ -286,11 +398,39 @@ class NativeAvatar:
         )
         self.handle = C.c_void_p()
         check(lib().softdeca_avatar_create(model.handle, C.byref(desc), C.byref(self.handle)))
-        self.vertices = np.zeros((self.vh, 3), dtype=np.float32)
-        self.normals = np.zeros((self.vh, 3), dtype=np.float32)
-        self._out = Output(
-            C.sizeof(Output), _ptr(self.vertices), self.vh, _ptr(self.normals), self.vh
+        self._buffers(self.vh)
+
+    @classmethod
+    def fitted(
+        cls,
+        model: NativeModel,
+        fit: NativeFit,
+        mesh: AvatarArrays,
+        threads: int = 1,
+        precision: str = "half",
+    ) -> NativeAvatar:
+        """An avatar on the user's own mesh: outputs hold the mesh's own vertices."""
+        self = cls.__new__(cls)
+        self.model, self.fit, self.mesh = model, fit, mesh
+        self.handle = C.c_void_p()
+        check(
+            lib().softdeca_avatar_create_fitted(
+                model.handle,
+                fit.handle,
+                C.byref(mesh.desc),
+                C.c_uint32(threads),
+                C.c_int32(PRECISIONS[precision]),
+                C.byref(self.handle),
+            )
         )
+        self.vh = len(mesh.neutral)
+        self._buffers(self.vh)
+        return self
+
+    def _buffers(self, n: int) -> None:
+        self.vertices = np.zeros((n, 3), dtype=np.float32)
+        self.normals = np.zeros((n, 3), dtype=np.float32)
+        self._out = Output(C.sizeof(Output), _ptr(self.vertices), n, _ptr(self.normals), n)
 
     def close(self) -> None:
         if self.handle:

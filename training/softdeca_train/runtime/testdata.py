@@ -19,6 +19,7 @@ from softdeca_train.models import (
     pack_bundle,
 )
 from softdeca_train.models.synthetic import TEST_PARAMETERS, synthetic_head, synthetic_rest_head
+from softdeca_train.models.template_head import template_head_of
 from softdeca_train.runtime.files import write_rig
 from softdeca_train.streaming.livelinkface import CSV_ORDER, VALUE_NAMES
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
@@ -50,7 +51,16 @@ def write_test_data(out: Path) -> Path:
     nets = build_random(head.definition, specs, TEST_SIZES, seed=1)
     info = BundleInfo(untrained=True, description="native test bundle: synthetic head, random")
     # with the physics at prepare (format version 4) on a shell head under the synthetic skin
-    export_bundle(out / "bundle", head.definition, nets, info, rest_head=synthetic_rest_head(head))
+    export_bundle(
+        out / "bundle",
+        head.definition,
+        nets,
+        info,
+        rest_head=synthetic_rest_head(head),
+        template_head=template_head_of(
+            head.neutral, head.blendshapes, head.definition.skin_vertices
+        ),
+    )
     (out / "bundle.tar").write_bytes(pack_bundle(out / "bundle"))
     only = build_random(head.definition, specs, TEST_SIZES, seed=2, sparse=False)
     export_bundle(out / "bundle_softdeca_only", head.definition, only, info)

@@ -17,6 +17,7 @@ from softdeca_train.data.generate import code_version
 from softdeca_train.models.bundle import BundleInfo, export_bundle
 from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, SparseNetworks
 from softdeca_train.models.rest_head import rest_head_for_bundle
+from softdeca_train.models.template_head import template_head_from
 from softdeca_train.train.batches import Dataset
 from softdeca_train.train.evaluate import test_errors
 from softdeca_train.train.identity import IdentityConfig
@@ -119,7 +120,14 @@ def train_bundle(
     if progress:
         print("physics at prepare: the template's tissue fill and its rest-inert parameters")
     rest = rest_head_for_bundle(run.template, run.specs)
-    return export_bundle(bundle, run.definition, nets, info, rest_head=rest)
+    return export_bundle(
+        bundle,
+        run.definition,
+        nets,
+        info,
+        rest_head=rest,
+        template_head=template_head_from(run.template),
+    )
 
 
 def _dataset_summary(data: Dataset | None) -> dict | None:

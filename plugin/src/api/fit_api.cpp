@@ -1,0 +1,200 @@
+// The fit part of the C ABI: fitting a user's avatar, saving and loading the fit, and the
+// avatar made on it (fit/avatar_fit.h, runtime/fitted_avatar.h).
+#include <Eigen/LU>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "api/error.h"
+#include "api/handles.h"
+#include "api/runtime_handles.h"
+#include "core/regular_file.h"
+#include "fit/fit_file.h"
+#include "fit/limits.h"
+#include "runtime/frame_guard.h"
+
+namespace {
+using namespace softdeca;
+
+// A saved fit holds about 30 bytes per avatar vertex and 30 per template skin vertex.
+constexpr std::uint64_t kMaxFitFileBytes = std::uint64_t{1} << 30;
+
+const softdeca_avatar_fit& fit_of(const softdeca_avatar_fit* f) {
+  require_not_null(f, "fit");
+  return *f;
+}
+
+// The caller's mesh as the fit reads it: a shape that is all zeros is one the rig lacks.
+fit::AvatarMesh mesh_of(const softdeca_avatar_mesh* m, const runtime::Model& model) {
+  require_struct(m, "mesh");
+  require_not_null(m->neutral, "mesh->neutral");
+  require(m->vertex_count >= 3 && m->vertex_count <= fit::kMaxAvatarVertices,
+          "mesh->vertex_count is " + std::to_string(m->vertex_count) + "; an avatar has 3 to " +
+              std::to_string(fit::kMaxAvatarVertices) + " vertices");
+  require_not_null(m->triangles, "mesh->triangles");
+  require(m->triangle_count >= 1 && m->triangle_count <= fit::kMaxAvatarTriangles, "mesh->triangle_count is out of range");
+  require(m->blendshape_count == SOFTDECA_BLENDSHAPE_COUNT,
+          "mesh->blendshape_count must be 52 (zeros for a shape the rig lacks), got " + std::to_string(m->blendshape_count));
+  require_not_null(m->blendshapes, "mesh->blendshapes");
+  const std::size_t n = m->vertex_count;
+  fit::AvatarMesh a;
+  a.neutral = m->neutral;
+  a.vertex_count = n;
+  a.triangles = m->triangles;
+  a.triangle_count = m->triangle_count;
+  for (std::size_t k = 0; k < fit::kShapes; ++k) {
+    const float* d = m->blendshapes + k * n * 3;
+    for (std::size_t i = 0; i < n * 3; ++i)
+      if (d[i] != 0) {
+        a.deltas[k] = d;
+        break;
+      }
+  }
+  if (m->landmarks) {
+    require(m->landmark_count == model.manifest().landmarks.size(),
+            "mesh->landmark_count must be the bundle's " + std::to_string(model.manifest().landmarks.size()) + " landmarks");
+    require_finite(m->landmarks, std::size_t{m->landmark_count} * 3, "mesh->landmarks");
+    a.landmarks = m->landmarks;
+    a.landmark_count = m->landmark_count;
+  }
+  return a;
+}
+}  // namespace
+
+extern "C" {
+
+SOFTDECA_API softdeca_status softdeca_fit_options_init(softdeca_fit_options* options) {
+  return guarded(__func__, [&] {
+    require_struct(options, "options");
+    const uint32_t size = options->struct_size;
+    *options = softdeca_fit_options{};
+    options->struct_size = size;
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_avatar_fit_create(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
+                                                        const softdeca_fit_options* options, softdeca_avatar_fit** out_fit) {
+  return guarded(__func__, [&] {
+    const runtime::Model& m = model_of(model);
+    require_not_null(out_fit, "out_fit");
+    const fit::AvatarMesh a = mesh_of(mesh, m);
+    fit::FitOptions o;
+    if (options) {
+      require_struct(options, "options");
+      require(options->metres_per_unit >= 0 && options->metres_per_unit <= 1000,
+              "options->metres_per_unit must be 0 (detect) or a unit of at most 1000 m");
+      require(options->iterations <= 1000, "options->iterations must be at most 1000");
+      o.metres_per_unit = options->metres_per_unit;
+      o.iterations = static_cast<int>(options->iterations);
+    }
+    const fit::TemplateData t = runtime::fit_template(m);
+    create_handle(out_fit, "out_fit", [&](softdeca_avatar_fit& h) {
+      h.fit = fit::fit_avatar(t, a, o);
+      h.bundle_sha256 = m.manifest_sha256();
+    });
+  });
+}
+
+SOFTDECA_API void softdeca_avatar_fit_destroy(softdeca_avatar_fit* fit) { destroy_handle(__func__, fit); }
+
+SOFTDECA_API softdeca_status softdeca_avatar_fit_save(const softdeca_avatar_fit* fit, const char* path) {
+  return guarded(__func__, [&] {
+    const softdeca_avatar_fit& f = fit_of(fit);
+    require_not_null(path, "path");
+    const std::vector<std::uint8_t> bytes =
+        fit::encode_fit(f.fit, f.bundle_sha256, f.fit.source.weight.size());
+    const std::string part = std::string(path) + ".part";
+    {
+      FilePtr file = open_regular_file(part, FileAccess::create);
+      if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size() || std::fflush(file.get()) != 0) {
+        file.reset();
+        std::remove(part.c_str());
+        throw Error(SOFTDECA_ERROR_IO, "could not write " + part);
+      }
+    }
+    std::error_code ec;
+    std::filesystem::rename(std::filesystem::u8path(part), std::filesystem::u8path(path), ec);
+    if (ec) {
+      std::remove(part.c_str());
+      throw Error(SOFTDECA_ERROR_IO, "could not move " + part + " to " + path + ": " + ec.message());
+    }
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_avatar_fit_load(const softdeca_model* model, const char* path,
+                                                      softdeca_avatar_fit** out_fit) {
+  return guarded(__func__, [&] {
+    const runtime::Model& m = model_of(model);
+    require_not_null(path, "path");
+    require_not_null(out_fit, "out_fit");
+    FilePtr file = open_regular_file(path, FileAccess::read);
+    const std::uint64_t size = file_size(file.get());
+    if (size > kMaxFitFileBytes) throw Error(SOFTDECA_ERROR_FORMAT, std::string(path) + " is larger than any fit");
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+    if (!read_at(file.get(), 0, bytes.data(), bytes.size())) throw Error(SOFTDECA_ERROR_IO, std::string("could not read ") + path);
+    const runtime::Manifest& mf = m.manifest();
+    create_handle(out_fit, "out_fit", [&](softdeca_avatar_fit& h) {
+      h.fit = fit::decode_fit(bytes.data(), bytes.size(), path, m.manifest_sha256(),
+                              static_cast<std::size_t>(mf.head_vertices), static_cast<std::size_t>(mf.skin_vertices),
+                              static_cast<std::size_t>(mf.skin_triangles));
+      h.bundle_sha256 = m.manifest_sha256();
+    });
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_avatar_fit_report(const softdeca_avatar_fit* fit, char* buffer, uint32_t capacity,
+                                                        uint32_t* out_length) {
+  return guarded(__func__, [&] {
+    const std::string& r = fit_of(fit).fit.report;
+    if (out_length) *out_length = static_cast<uint32_t>(r.size());
+    if (capacity < r.size() + 1)
+      throw Error(SOFTDECA_ERROR_BUFFER_TOO_SMALL,
+                  "the report needs " + std::to_string(r.size() + 1) + " bytes, the buffer has " + std::to_string(capacity));
+    require_not_null(buffer, "buffer");
+    std::memcpy(buffer, r.c_str(), r.size() + 1);
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_avatar_fit_get_registered(const softdeca_avatar_fit* fit, float* out_points,
+                                                                uint32_t point_capacity, uint32_t* out_vertex_count) {
+  return guarded(__func__, [&] {
+    const fit::AvatarFit& f = fit_of(fit).fit;
+    const std::size_t vs = f.source.weight.size();
+    if (out_points) {
+      expect(point_capacity >= vs, [&] {
+        return "point_capacity " + std::to_string(point_capacity) + " is below the skin's " + std::to_string(vs) + " points";
+      }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+      const Eigen::Matrix3d inv = f.placement.linear.inverse();
+      for (std::size_t v = 0; v < vs; ++v) {
+        const Eigen::Vector3d x(f.registered[3 * v], f.registered[3 * v + 1], f.registered[3 * v + 2]);
+        const Eigen::Vector3d p = inv * (x - f.placement.offset);
+        for (int c = 0; c < 3; ++c) out_points[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(p[c]);
+      }
+    }
+    if (out_vertex_count) *out_vertex_count = static_cast<uint32_t>(f.vertex_count);
+  });
+}
+
+SOFTDECA_API softdeca_status softdeca_avatar_create_fitted(const softdeca_model* model, const softdeca_avatar_fit* fit,
+                                                           const softdeca_avatar_mesh* mesh, uint32_t threads, int32_t precision,
+                                                           softdeca_avatar** out_avatar) {
+  return guarded(__func__, [&] {
+    const runtime::Model& m = model_of(model);
+    const softdeca_avatar_fit& f = fit_of(fit);
+    require_not_null(out_avatar, "out_avatar");
+    require(f.bundle_sha256 == m.manifest_sha256(), "the fit was made for another bundle: fit the avatar again with this one");
+    const fit::AvatarMesh a = mesh_of(mesh, m);
+    require(threads <= 8, "threads must be at most 8");
+    runtime::FittedAvatarDesc d;
+    d.fit = &f.fit;
+    d.mesh = &a;
+    d.threads = threads == 0 ? 1 : threads;
+    d.precision = precision_of(precision, "precision");
+    create_handle(out_avatar, "out_avatar",
+                  [&](softdeca_avatar& h) { h.fitted = std::make_unique<runtime::FittedAvatar>(model->model, d); });
+  });
+}
+
+}  // extern "C"

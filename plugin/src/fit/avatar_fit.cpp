@@ -1,0 +1,370 @@
+#include "fit/avatar_fit.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <unordered_map>
+
+#include "core/error.h"
+#include "fit/mesh_hash.h"
+#include "fit/mesh_topology.h"
+#include "fit/registration.h"
+#include "fit/shape_guides.h"
+#include "geometry/nearest_points.h"
+#include "stream/arkit_names.h"
+
+namespace softdeca::fit {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Shapes that move skin and nothing else on every rig: the parts of a mesh they move are its
+// skin; eyeballs, teeth and tongue (moved by eyeLook, jaw and tongue shapes) are not.
+constexpr const char* kSkinShapes[] = {
+    "browDownLeft",    "browDownRight",    "browInnerUp",      "browOuterUpLeft",  "browOuterUpRight",
+    "eyeBlinkLeft",    "eyeBlinkRight",    "cheekSquintLeft",  "cheekSquintRight", "noseSneerLeft",
+    "noseSneerRight",  "mouthSmileLeft",   "mouthSmileRight",  "mouthDimpleLeft",  "mouthDimpleRight",
+    "mouthStretchLeft", "mouthStretchRight", "cheekPuff",
+};
+
+// Distances of the embedding (metres): an avatar vertex within kNear of the registered skin
+// follows it fully, beyond kFar not at all; the template's face weight falls to zero over
+// kFaceFade away from the vertices its shapes move.
+constexpr double kNear = 0.003, kFar = 0.010, kFaceFade = 0.03;
+// A template vertex takes the avatar's shapes fully within kShapeNear of the avatar's surface,
+// its own beyond kShapeFar.
+constexpr double kShapeNear = 0.004, kShapeFar = 0.015;
+
+double smooth_fall(double d, double near, double far) {
+  if (d <= near) return 1;
+  if (d >= far) return 0;
+  const double t = (d - near) / (far - near);
+  return 1 - t * t * (3 - 2 * t);
+}
+
+Eigen::Vector3d row3(const float* p, std::size_t i) { return {p[3 * i], p[3 * i + 1], p[3 * i + 2]}; }
+
+// Kabsch: the rotation (no reflection) and translation taking src onto dst, weighted.
+void kabsch(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst, Eigen::Matrix3d& r,
+            Eigen::Vector3d& t) {
+  Eigen::Vector3d cs = Eigen::Vector3d::Zero(), cd = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < src.size(); ++i) cs += src[i], cd += dst[i];
+  cs /= static_cast<double>(src.size());
+  cd /= static_cast<double>(src.size());
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < src.size(); ++i) h += (src[i] - cs) * (dst[i] - cd).transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  r = svd.matrixV() * d * svd.matrixU().transpose();
+  t = cd - r * cs;
+}
+
+void check_mesh(const AvatarMesh& a) {
+  require(a.neutral != nullptr && a.vertex_count >= 3, "the avatar has no vertices");
+  require(a.triangles != nullptr && a.triangle_count > 0, "the avatar has no triangles");
+  for (std::size_t i = 0; i < 3 * a.vertex_count; ++i)
+    if (!std::isfinite(a.neutral[i]))
+      throw Error(SOFTDECA_ERROR_NON_FINITE, "the avatar's neutral mesh has a non-finite value at vertex " + std::to_string(i / 3));
+  for (std::size_t i = 0; i < 3 * a.triangle_count; ++i)
+    require(a.triangles[i] >= 0 && static_cast<std::size_t>(a.triangles[i]) < a.vertex_count,
+            "the avatar's triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh");
+  for (std::size_t k = 0; k < kShapes; ++k)
+    if (a.deltas[k])
+      for (std::size_t i = 0; i < 3 * a.vertex_count; ++i)
+        if (!std::isfinite(a.deltas[k][i]))
+          throw Error(SOFTDECA_ERROR_NON_FINITE, std::string("the avatar's blendshape ") + stream::blendshape_name(k) +
+                                                     " has a non-finite value at vertex " + std::to_string(i / 3));
+}
+
+std::string json_string(const std::string& s) {
+  std::string o = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += c;
+  }
+  return o + "\"";
+}
+
+std::string name_list(const std::array<ShapeOrigin, kShapes>& origin, ShapeOrigin which) {
+  std::string o = "[";
+  for (std::size_t k = 0; k < kShapes; ++k)
+    if (origin[k] == which) o += (o.size() > 1 ? ", " : "") + json_string(stream::blendshape_name(k));
+  return o + "]";
+}
+
+}  // namespace
+
+AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOptions& options) {
+  const auto t0 = Clock::now();
+  const auto step = [&](const char* what, double share) {
+    if (options.progress) options.progress(what, share);
+  };
+  check_mesh(a);
+  require(t.head_neutral && t.shapes && t.skin_triangles && t.skin_vertices > 0, "the bundle has no template head");
+  const std::size_t n = a.vertex_count, vs = t.skin_vertices;
+  step("reading the avatar's face", 0.0);
+
+  // 1. The face, its axes and unit, on the avatar and (the same way) on the template.
+  AvatarShapes as;
+  as.neutral = a.neutral;
+  as.vertex_count = n;
+  as.deltas = a.deltas;
+  as.triangles = a.triangles;
+  as.triangle_count = a.triangle_count;
+  const AvatarFrame frame = avatar_frame(as);
+  AvatarShapes ts;
+  ts.neutral = t.head_neutral;
+  ts.vertex_count = vs;
+  for (std::size_t k = 0; k < kShapes; ++k) ts.deltas[k] = t.moves[k] ? t.shapes + k * vs * 3 : nullptr;
+  const AvatarFrame tframe = avatar_frame(ts);
+
+  // 2. The placement: unit and axes, then the rigid motion that best takes the shapes' centres
+  // of motion onto the template's.
+  const double unit = options.metres_per_unit > 0 ? options.metres_per_unit : frame.metres_per_unit;
+  Eigen::Matrix3d axes;
+  axes.row(0) = frame.left.transpose();
+  axes.row(1) = frame.up.transpose();
+  axes.row(2) = frame.forward.transpose();
+  Placement place;
+  place.linear = unit * axes;
+  std::vector<Eigen::Vector3d> src, dst;
+  for (std::size_t k = 0; k < kShapes; ++k)
+    if (frame.moves[k] && tframe.moves[k]) {
+      src.push_back(place.linear * frame.centres[k]);
+      dst.push_back(tframe.centres[k]);
+    }
+  require(src.size() >= 3, "the avatar shares fewer than 3 moving ARKit shapes with the template: too few to place it");
+  {
+    Eigen::Matrix3d r;
+    Eigen::Vector3d tr;
+    kabsch(src, dst, r, tr);
+    place.linear = r * place.linear;
+    place.offset = tr;
+  }
+
+  // 3. The avatar's parts and its skin: the parts the skin-only shapes move.
+  const MeshTopology topo = mesh_topology(a.neutral, n, a.triangles, a.triangle_count);
+  std::vector<uint8_t> skin_part(topo.components, 0);
+  for (const char* name : kSkinShapes) {
+    const float* d = a.deltas[static_cast<std::size_t>(stream::blendshape_index(name))];
+    if (!d) continue;
+    double peak = 0;
+    for (std::size_t v = 0; v < n; ++v) peak = std::max(peak, row3(d, v).norm());
+    for (std::size_t v = 0; v < n; ++v)
+      if (peak > 0 && row3(d, v).norm() > 0.05 * peak) skin_part[static_cast<std::size_t>(topo.component[v])] = 1;
+  }
+  if (std::find(skin_part.begin(), skin_part.end(), 1) == skin_part.end())  // no skin-only shape: every face part
+    for (std::size_t v = 0; v < n; ++v)
+      if (frame.face[v]) skin_part[static_cast<std::size_t>(topo.component[v])] = 1;
+  std::vector<std::int32_t> skin_tris;
+  std::vector<uint8_t> skin_edges;
+  for (std::size_t f = 0; f < a.triangle_count; ++f) {
+    const std::int32_t* c = a.triangles + 3 * f;
+    if (!skin_part[static_cast<std::size_t>(topo.component[static_cast<std::size_t>(c[0])])]) continue;
+    if (topo.weld[static_cast<std::size_t>(c[0])] == topo.weld[static_cast<std::size_t>(c[1])] ||
+        topo.weld[static_cast<std::size_t>(c[1])] == topo.weld[static_cast<std::size_t>(c[2])] ||
+        topo.weld[static_cast<std::size_t>(c[0])] == topo.weld[static_cast<std::size_t>(c[2])])
+      continue;
+    skin_tris.insert(skin_tris.end(), c, c + 3);
+    skin_edges.push_back(topo.boundary_edges[f]);
+  }
+  require(!skin_tris.empty(), "the avatar's face has no triangle with area: nothing to fit to");
+
+  // The avatar in the template's frame.
+  Points y(static_cast<Eigen::Index>(n), 3);
+  const auto place_all = [&] {
+    for (std::size_t v = 0; v < n; ++v) y.row(static_cast<Eigen::Index>(v)) = place.to_template(row3(a.neutral, v)).transpose();
+  };
+  place_all();
+
+  // 4. Guides from the shapes' semantics, and the placement refined on them.
+  Points tskin(static_cast<Eigen::Index>(vs), 3);
+  for (std::size_t v = 0; v < vs; ++v) tskin.row(static_cast<Eigen::Index>(v)) = row3(t.head_neutral, v).transpose();
+  std::vector<uint8_t> avatar_skin(n, 0);
+  for (std::size_t v = 0; v < n; ++v)
+    avatar_skin[v] = skin_part[static_cast<std::size_t>(topo.component[v])] && topo.weld[v] == static_cast<std::int32_t>(v);
+  step("matching the shapes", 0.05);
+  ShapeInputs si{t, a, tframe.face, frame.face, avatar_skin};
+  std::vector<Guide> guides;
+  for (int round = 0; round < 2; ++round) {
+    guides = shape_guides(si, tskin, y, place.linear);
+    if (guides.size() < 8) break;
+    std::vector<Eigen::Vector3d> from, to;
+    for (const Guide& g : guides) {
+      from.push_back(g.target);
+      to.push_back(tskin.row(g.vertex).transpose());
+    }
+    Eigen::Matrix3d r;
+    Eigen::Vector3d tr;
+    kabsch(from, to, r, tr);
+    place.linear = r * place.linear;
+    place.offset = r * place.offset + tr;
+    place_all();
+  }
+  guides = shape_guides(si, tskin, y, place.linear);
+  if (a.landmarks && a.landmark_count == t.landmark_triangle.size())
+    for (std::size_t l = 0; l < a.landmark_count; ++l) {
+      const auto tri = static_cast<Eigen::Index>(t.landmark_triangle[l]);
+      int corner = 0;
+      for (int k = 1; k < 3; ++k)
+        if (t.landmark_bary[l][static_cast<std::size_t>(k)] > t.landmark_bary[l][static_cast<std::size_t>(corner)]) corner = k;
+      guides.push_back({t.skin_triangles[3 * tri + corner], place.to_template(row3(a.landmarks, l)), 2.0});
+    }
+
+  // 5. Registration: the template's face (and, weaker, the rest of its skin) onto the avatar's skin.
+  step("registering the template", 0.15);
+  Triangles ttri(static_cast<Eigen::Index>(t.skin_triangle_count), 3);
+  for (std::size_t f = 0; f < t.skin_triangle_count * 3; ++f) ttri(static_cast<Eigen::Index>(f / 3), static_cast<Eigen::Index>(f % 3)) = t.skin_triangles[f];
+  Triangles atri(static_cast<Eigen::Index>(skin_tris.size() / 3), 3);
+  for (std::size_t f = 0; f < skin_tris.size(); ++f) atri(static_cast<Eigen::Index>(f / 3), static_cast<Eigen::Index>(f % 3)) = skin_tris[f];
+  const geometry::SurfaceQuery avatar_surface(y, atri);
+  RegistrationTarget target{&avatar_surface, skin_edges, topo.boundary_vertex};
+  std::vector<double> data_weight(vs);
+  for (std::size_t v = 0; v < vs; ++v) data_weight[v] = tframe.face[v] ? 1.0 : 0.5;
+  RegistrationSettings settings;
+  if (options.iterations > 0) settings.iterations = options.iterations;
+  const Registration reg = register_skin(tskin, ttri, data_weight, target, guides, settings, [&](int i, int of) {
+    step("registering the template", 0.15 + 0.6 * i / of);
+  });
+
+  AvatarFit fit;
+  fit.mesh_sha256 = mesh_sha256(a.neutral, n, a.triangles, a.triangle_count);
+  fit.vertex_count = n;
+  fit.triangle_count = a.triangle_count;
+  fit.placement = place;
+
+  // The registered head: the skin, and every other vertex moved with its nearest skin vertex.
+  fit.registered.assign(t.head_neutral, t.head_neutral + t.head_vertices * 3);
+  for (std::size_t v = 0; v < vs; ++v)
+    for (int c = 0; c < 3; ++c) fit.registered[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(reg.skin(static_cast<Eigen::Index>(v), c));
+  if (t.head_vertices > vs) {
+    geometry::Sites rest(static_cast<Eigen::Index>(t.head_vertices - vs), 3);
+    for (std::size_t v = vs; v < t.head_vertices; ++v) rest.row(static_cast<Eigen::Index>(v - vs)) = row3(t.head_neutral, v).transpose();
+    const std::vector<std::int32_t> near = geometry::nearest_sites(tskin, rest);
+    for (std::size_t v = vs; v < t.head_vertices; ++v) {
+      const auto s = static_cast<Eigen::Index>(near[v - vs]);
+      for (int c = 0; c < 3; ++c)
+        fit.registered[3 * v + static_cast<std::size_t>(c)] += static_cast<float>(reg.skin(s, c) - tskin(s, c));
+    }
+  }
+
+  // 6. The residual over the template's face, where the avatar has surface.
+  step("measuring the fit", 0.8);
+  double sum = 0, worst = 0;
+  std::size_t counted = 0;
+  for (std::size_t v = 0; v < vs; ++v) {
+    if (!tframe.face[v]) continue;
+    const geometry::SurfacePoint p = avatar_surface.closest(reg.skin.row(static_cast<Eigen::Index>(v)).transpose(), settings.reach_end * 2);
+    if (p.triangle < 0 || target.on_boundary(p)) continue;
+    const double d = std::sqrt(p.squared_distance);
+    sum += d;
+    worst = std::max(worst, d);
+    ++counted;
+  }
+  require(counted > 0, "the template's face found no surface of the avatar near it: is this mesh a face?");
+
+  // 7. Where each template vertex reads the avatar's shapes.
+  fit.source.corners.assign(vs * 3, 0);
+  fit.source.bary.assign(vs * 3, 0.0f);
+  fit.source.weight.assign(vs, 0.0f);
+  for (std::size_t v = 0; v < vs; ++v) {
+    const geometry::SurfacePoint p = avatar_surface.closest(reg.skin.row(static_cast<Eigen::Index>(v)).transpose());
+    if (p.triangle < 0) continue;
+    for (std::size_t k = 0; k < 3; ++k) {
+      fit.source.corners[3 * v + k] = skin_tris[3 * static_cast<std::size_t>(p.triangle) + k];
+      fit.source.bary[3 * v + k] = static_cast<float>(p.bary[static_cast<Eigen::Index>(k)]);
+    }
+    fit.source.weight[v] = static_cast<float>(smooth_fall(std::sqrt(p.squared_distance), kShapeNear, kShapeFar));
+  }
+  for (std::size_t k = 0; k < kShapes; ++k)
+    fit.origin[k] = frame.moves[k] ? ShapeOrigin::Avatar : t.moves[k] ? ShapeOrigin::Template : ShapeOrigin::None;
+
+  // 8. The embedding: every skin-part vertex of the avatar near the registered skin.
+  step("embedding the avatar", 0.85);
+  std::vector<double> face_weight(vs, 1.0);
+  {
+    std::vector<Eigen::Index> in_face;
+    for (std::size_t v = 0; v < vs; ++v)
+      if (tframe.face[v]) in_face.push_back(static_cast<Eigen::Index>(v));
+    geometry::Sites sites(static_cast<Eigen::Index>(in_face.size()), 3), queries(static_cast<Eigen::Index>(vs), 3);
+    for (std::size_t i = 0; i < in_face.size(); ++i) sites.row(static_cast<Eigen::Index>(i)) = tskin.row(in_face[i]);
+    queries = tskin;
+    const std::vector<std::int32_t> near = geometry::nearest_sites(sites, queries);
+    for (std::size_t v = 0; v < vs; ++v)
+      face_weight[v] = smooth_fall((tskin.row(static_cast<Eigen::Index>(v)) - sites.row(near[v])).norm(), 0.0, kFaceFade);
+  }
+  const geometry::SurfaceQuery registered(reg.skin, ttri);
+  const Points tnormals = vertex_normals(reg.skin, ttri);
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!skin_part[static_cast<std::size_t>(topo.component[v])]) continue;
+    const Eigen::Vector3d q = y.row(static_cast<Eigen::Index>(v)).transpose();
+    const geometry::SurfacePoint p = registered.closest(q, kFar);
+    if (p.triangle < 0) continue;
+    double fw = 0;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const auto c = static_cast<std::size_t>(ttri(p.triangle, k));
+      fw += p.bary[k] * face_weight[c];
+      normal += p.bary[k] * tnormals.row(static_cast<Eigen::Index>(c)).transpose();
+    }
+    const double w = fw * smooth_fall(std::sqrt(p.squared_distance), kNear, kFar);
+    if (!(w > 0)) continue;
+    fit.embedding.vertex.push_back(static_cast<std::int32_t>(v));
+    fit.embedding.triangle.push_back(p.triangle);
+    for (int k = 0; k < 3; ++k) fit.embedding.bary.push_back(static_cast<float>(p.bary[k]));
+    fit.embedding.offset.push_back(static_cast<float>((q - p.point).dot(normal.normalized())));
+    fit.embedding.weight.push_back(static_cast<float>(w));
+  }
+  require(!fit.embedding.vertex.empty(), "no vertex of the avatar lies on the registered face");
+
+  // 9. The report.
+  const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  std::size_t full = 0;
+  for (const float w : fit.embedding.weight) full += w >= 1.0f;
+  std::ostringstream r;
+  r.precision(6);
+  r << "{\"metres_per_unit\": " << unit << ", \"metres_per_unit_measured\": " << frame.metres_per_unit_measured
+    << ", \"up_axis\": " << json_string(frame.up_axis) << ", \"mirrored\": " << (frame.mirrored ? "true" : "false")
+    << ", \"vertices\": " << n << ", \"triangles\": " << a.triangle_count << ", \"parts\": " << topo.components
+    << ", \"skin_parts\": " << std::count(skin_part.begin(), skin_part.end(), 1)
+    << ", \"degenerate_triangles\": " << topo.degenerate_triangles << ", \"face_vertices\": " << frame.face_vertices
+    << ", \"embedded_vertices\": " << fit.embedding.size() << ", \"embedded_fully\": " << full
+    << ", \"shapes_matched\": " << name_list(fit.origin, ShapeOrigin::Avatar)
+    << ", \"shapes_carried\": " << name_list(fit.origin, ShapeOrigin::Template)
+    << ", \"shapes_missing\": " << name_list(fit.origin, ShapeOrigin::None) << ", \"guides\": " << guides.size()
+    << ", \"face_residual_mm_mean\": " << 1000 * sum / static_cast<double>(counted)
+    << ", \"face_residual_mm_max\": " << 1000 * worst << ", \"face_residual_points\": " << counted
+    << ", \"seconds\": " << seconds << "}";
+  fit.report = r.str();
+  step("done", 1.0);
+  return fit;
+}
+
+std::vector<float> carried_shapes(const TemplateData& t, const AvatarMesh& a, const AvatarFit& fit) {
+  const std::size_t vs = t.skin_vertices, vh = t.head_vertices;
+  std::vector<float> out(kShapes * vh * 3, 0.0f);
+  const Eigen::Matrix3d& lin = fit.placement.linear;
+  for (std::size_t k = 0; k < kShapes; ++k) {
+    float* dst = out.data() + k * vh * 3;
+    const float* own = t.moves[k] ? t.shapes + k * vs * 3 : nullptr;
+    const float* avatar = fit.origin[k] == ShapeOrigin::Avatar ? a.deltas[k] : nullptr;
+    for (std::size_t v = 0; v < vs; ++v) {
+      Eigen::Vector3d d = own ? row3(own, v) : Eigen::Vector3d::Zero();
+      const double w = fit.source.weight[v];
+      if (avatar && w > 0) {
+        Eigen::Vector3d carried = Eigen::Vector3d::Zero();
+        for (std::size_t c = 0; c < 3; ++c)
+          carried += fit.source.bary[3 * v + c] * row3(avatar, static_cast<std::size_t>(fit.source.corners[3 * v + c]));
+        d = w * (lin * carried) + (1 - w) * d;  // away from the avatar's surface, the template's own
+      }
+      for (int c = 0; c < 3; ++c) dst[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(d[c]);
+    }
+  }
+  return out;
+}
+
+}  // namespace softdeca::fit

@@ -1,0 +1,71 @@
+// A user's own avatar at run time: SoftDECA and SparseSoftDECA run on the registered template
+// (an Avatar in the template's topology, made from the fit), and every frame returns the
+// avatar's own vertices: its own linear blend plus the models' correction carried through the
+// fit's embedding (SparseSoftDECA: its whole deformation). Vertices the embedding does not hold
+// move exactly as the avatar's rig moves them.
+#pragma once
+
+#include <Eigen/Core>
+#include <atomic>
+#include <memory>
+#include <vector>
+
+#include "fit/avatar_fit.h"
+#include "runtime/avatar.h"
+
+namespace softdeca::runtime {
+
+// What a fit needs of a model's bundle; Error(INVALID_ARGUMENT) when it has no template head.
+fit::TemplateData fit_template(const Model& m);
+
+struct FittedAvatarDesc {
+  const fit::AvatarFit* fit = nullptr;
+  const fit::AvatarMesh* mesh = nullptr;  // the mesh the fit was made for (checked by its hash)
+  std::size_t threads = 1;
+  Precision precision = Precision::Half;
+};
+
+class FittedAvatar {
+ public:
+  FittedAvatar(std::shared_ptr<const Model> model, const FittedAvatarDesc& desc);
+
+  // The registered template's avatar: parameters, identity, prepare, dynamics, calibration.
+  Avatar& core() { return *core_; }
+  const Avatar& core() const { return *core_; }
+  std::size_t vertex_count() const { return n_; }
+  std::size_t triangle_count() const { return triangles_.size() / 3; }
+
+  // Maps over the avatar's own triangles or vertices, carried to the template's skin vertices.
+  void set_parameter_faces(int index, const float* values, std::size_t count);
+  void set_parameter_vertices(int index, const float* values, std::size_t count);
+
+  void evaluate_weights(const float* weights, std::size_t count, const Output& out);
+  void evaluate_landmarks(const float* points, std::size_t count, const Output& out);
+  void evaluate_linear(const float* weights, std::size_t count, const Output& out);
+
+  std::size_t bytes() const;
+
+ private:
+  void check_output(const Output& out) const;
+  // out[v] += weight * A^-1 (sum of bary * field[corner]) over the embedding; field: skin x 3.
+  void add_carried(const float* field, float* out) const;
+  void finish(const Output& out);
+
+  std::unique_ptr<Avatar> core_;
+  std::size_t n_ = 0, vs_ = 0, vh_ = 0;
+  std::vector<float> neutral_;  // the avatar's own, n x 3
+  std::vector<std::int32_t> triangles_;
+  Blendshapes blendshapes_;     // the avatar's own shapes
+  std::vector<float> registered_skin_;  // vs x 3
+  fit::Embedding embedding_;
+  std::vector<std::int32_t> skin_triangles_;
+  Eigen::Matrix3f to_avatar_;  // the placement's inverse linear part (template vectors to the avatar's)
+  fit::ShapeSource source_;
+  std::vector<float> template_skin_weight_;  // per template skin vertex: sum of its source weights (for maps)
+
+  std::atomic<bool> busy_{false};
+  std::vector<float> head_out_, field_, weights_;
+  Normals normals_;
+};
+
+}  // namespace softdeca::runtime
