@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <unordered_map>
 
@@ -129,21 +130,34 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   axes.row(0) = frame.left.transpose();
   axes.row(1) = frame.up.transpose();
   axes.row(2) = frame.forward.transpose();
-  Placement place;
-  place.linear = unit * axes;
-  std::vector<Eigen::Vector3d> src, dst;
+  // Both hands are tried: the one whose Left and Right shapes land on the template's wins (the
+  // frame's own guess from the forward shapes or normals can be fooled by an unusual rig).
+  std::vector<std::size_t> shared;
   for (std::size_t k = 0; k < kShapes; ++k)
-    if (frame.moves[k] && tframe.moves[k]) {
-      src.push_back(place.linear * frame.centres[k]);
+    if (frame.moves[k] && tframe.moves[k]) shared.push_back(k);
+  require(shared.size() >= 3, "the avatar shares fewer than 3 moving ARKit shapes with the template: too few to place it");
+  Placement place;
+  double best = std::numeric_limits<double>::infinity();
+  bool mirrored = frame.mirrored;
+  for (const double hand : {1.0, -1.0}) {
+    Eigen::Matrix3d linear = unit * axes;
+    linear.row(2) *= hand;
+    std::vector<Eigen::Vector3d> src, dst;
+    for (const std::size_t k : shared) {
+      src.push_back(linear * frame.centres[k]);
       dst.push_back(tframe.centres[k]);
     }
-  require(src.size() >= 3, "the avatar shares fewer than 3 moving ARKit shapes with the template: too few to place it");
-  {
     Eigen::Matrix3d r;
     Eigen::Vector3d tr;
     kabsch(src, dst, r, tr);
-    place.linear = r * place.linear;
-    place.offset = tr;
+    double rms = 0;
+    for (std::size_t i = 0; i < src.size(); ++i) rms += (r * src[i] + tr - dst[i]).squaredNorm();
+    if (rms < best) {
+      best = rms;
+      place.linear = r * linear;
+      place.offset = tr;
+      mirrored = hand < 0 ? !frame.mirrored : frame.mirrored;
+    }
   }
 
   // 3. The avatar's parts and its skin: the parts the skin-only shapes move.
@@ -328,7 +342,7 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   std::ostringstream r;
   r.precision(6);
   r << "{\"metres_per_unit\": " << unit << ", \"metres_per_unit_measured\": " << frame.metres_per_unit_measured
-    << ", \"up_axis\": " << json_string(frame.up_axis) << ", \"mirrored\": " << (frame.mirrored ? "true" : "false")
+    << ", \"up_axis\": " << json_string(frame.up_axis) << ", \"mirrored\": " << (mirrored ? "true" : "false")
     << ", \"vertices\": " << n << ", \"triangles\": " << a.triangle_count << ", \"parts\": " << topo.components
     << ", \"skin_parts\": " << std::count(skin_part.begin(), skin_part.end(), 1)
     << ", \"degenerate_triangles\": " << topo.degenerate_triangles << ", \"face_vertices\": " << frame.face_vertices
