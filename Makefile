@@ -146,7 +146,7 @@ clean: ## remove build/ and out/ (OUT)
 # test-fuzz: a few seconds each on the committed corpus; fuzz-long: the long runs of
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
 FUZZ         := build/fuzz
-FUZZ_TARGETS := softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
+FUZZ_TARGETS := fit_file softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
                 bundle_tar bundle_folder manifest onnx_model onnx_graph
 FUZZ_SECONDS ?= 620
 
