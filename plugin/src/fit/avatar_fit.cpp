@@ -13,7 +13,7 @@
 #include "fit/mesh_hash.h"
 #include "fit/mesh_topology.h"
 #include "fit/registration.h"
-#include "fit/shape_guides.h"
+#include "fit/shape_matcher.h"
 #include "geometry/nearest_points.h"
 #include "stream/arkit_names.h"
 
@@ -95,6 +95,23 @@ std::string name_list(const std::array<ShapeOrigin, kShapes>& origin, ShapeOrigi
   for (std::size_t k = 0; k < kShapes; ++k)
     if (origin[k] == which) o += (o.size() > 1 ? ", " : "") + json_string(stream::blendshape_name(k));
   return o + "]";
+}
+
+// The shapes both meshes move, with their deltas in the template's frame.
+std::vector<SharedShape> shared_shapes(const TemplateData& t, const AvatarMesh& a, const AvatarFrame& frame,
+                                       const AvatarFrame& tframe, const Eigen::Matrix3d& lin) {
+  const std::size_t n = a.vertex_count, vs = t.skin_vertices;
+  std::vector<SharedShape> shapes;
+  for (std::size_t k = 0; k < kShapes; ++k) {
+    if (!frame.moves[k] || !tframe.moves[k]) continue;
+    SharedShape s;
+    s.avatar.resize(static_cast<Eigen::Index>(n), 3);
+    for (std::size_t v = 0; v < n; ++v) s.avatar.row(static_cast<Eigen::Index>(v)) = (lin * row3(a.deltas[k], v)).transpose();
+    s.template_.resize(static_cast<Eigen::Index>(vs), 3);
+    for (std::size_t v = 0; v < vs; ++v) s.template_.row(static_cast<Eigen::Index>(v)) = row3(t.shapes + k * vs * 3, v).transpose();
+    shapes.push_back(std::move(s));
+  }
+  return shapes;
 }
 
 }  // namespace
@@ -195,31 +212,10 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   };
   place_all();
 
-  // 4. Guides from the shapes' semantics, and the placement refined on them.
+  // 4. Guides: the bundle's landmarks on the avatar, when the host gives them.
   Points tskin(static_cast<Eigen::Index>(vs), 3);
   for (std::size_t v = 0; v < vs; ++v) tskin.row(static_cast<Eigen::Index>(v)) = row3(t.head_neutral, v).transpose();
-  std::vector<uint8_t> avatar_skin(n, 0);
-  for (std::size_t v = 0; v < n; ++v)
-    avatar_skin[v] = skin_part[static_cast<std::size_t>(topo.component[v])] && topo.weld[v] == static_cast<std::int32_t>(v);
-  step("matching the shapes", 0.05);
-  ShapeInputs si{t, a, tframe.face, frame.face, avatar_skin};
   std::vector<Guide> guides;
-  for (int round = 0; round < 2; ++round) {
-    guides = shape_guides(si, tskin, y, place.linear);
-    if (guides.size() < 8) break;
-    std::vector<Eigen::Vector3d> from, to;
-    for (const Guide& g : guides) {
-      from.push_back(g.target);
-      to.push_back(tskin.row(g.vertex).transpose());
-    }
-    Eigen::Matrix3d r;
-    Eigen::Vector3d tr;
-    kabsch(from, to, r, tr);
-    place.linear = r * place.linear;
-    place.offset = r * place.offset + tr;
-    place_all();
-  }
-  guides = shape_guides(si, tskin, y, place.linear);
   if (a.landmarks && a.landmark_count == t.landmark_triangle.size())
     for (std::size_t l = 0; l < a.landmark_count; ++l) {
       const auto tri = static_cast<Eigen::Index>(t.landmark_triangle[l]);
@@ -229,21 +225,23 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
       guides.push_back({t.skin_triangles[3 * tri + corner], place.to_template(row3(a.landmarks, l)), 2.0});
     }
 
-  // 5. Registration: the template's face (and, weaker, the rest of its skin) onto the avatar's skin.
-  step("registering the template", 0.15);
+  // 5. Registration: the template's face (and, weaker, the rest of its skin) onto the avatar's
+  // skin, matched at the neutral and in the rig's strongest shapes together.
+  step("registering the template", 0.1);
   Triangles ttri(static_cast<Eigen::Index>(t.skin_triangle_count), 3);
   for (std::size_t f = 0; f < t.skin_triangle_count * 3; ++f) ttri(static_cast<Eigen::Index>(f / 3), static_cast<Eigen::Index>(f % 3)) = t.skin_triangles[f];
   Triangles atri(static_cast<Eigen::Index>(skin_tris.size() / 3), 3);
   for (std::size_t f = 0; f < skin_tris.size(); ++f) atri(static_cast<Eigen::Index>(f / 3), static_cast<Eigen::Index>(f % 3)) = skin_tris[f];
-  const geometry::SurfaceQuery avatar_surface(y, atri);
-  RegistrationTarget target{&avatar_surface, skin_edges, topo.boundary_vertex};
   std::vector<double> data_weight(vs);
   for (std::size_t v = 0; v < vs; ++v) data_weight[v] = tframe.face[v] ? 1.0 : 0.5;
+  const ShapeMatcher matcher(y, atri, skin_edges, topo.boundary_vertex, data_weight,
+                             shared_shapes(t, a, frame, tframe, place.linear));
   RegistrationSettings settings;
   if (options.iterations > 0) settings.iterations = options.iterations;
-  const Registration reg = register_skin(tskin, ttri, data_weight, target, guides, settings, [&](int i, int of) {
-    step("registering the template", 0.15 + 0.6 * i / of);
+  const Registration reg = register_skin(tskin, ttri, std::cref(matcher), guides, settings, [&](int i, int of) {
+    step("registering the template", 0.1 + 0.65 * i / of);
   });
+  const geometry::SurfaceQuery& avatar_surface = matcher.neutral();
 
   AvatarFit fit;
   fit.mesh_sha256 = mesh_sha256(a.neutral, n, a.triangles, a.triangle_count);
@@ -273,7 +271,7 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   for (std::size_t v = 0; v < vs; ++v) {
     if (!tframe.face[v]) continue;
     const geometry::SurfacePoint p = avatar_surface.closest(reg.skin.row(static_cast<Eigen::Index>(v)).transpose(), settings.reach_end * 2);
-    if (p.triangle < 0 || target.on_boundary(p)) continue;
+    if (p.triangle < 0 || matcher.on_boundary(p)) continue;
     const double d = std::sqrt(p.squared_distance);
     sum += d;
     worst = std::max(worst, d);
@@ -349,7 +347,7 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
     << ", \"embedded_vertices\": " << fit.embedding.size() << ", \"embedded_fully\": " << full
     << ", \"shapes_matched\": " << name_list(fit.origin, ShapeOrigin::Avatar)
     << ", \"shapes_carried\": " << name_list(fit.origin, ShapeOrigin::Template)
-    << ", \"shapes_missing\": " << name_list(fit.origin, ShapeOrigin::None) << ", \"guides\": " << guides.size()
+    << ", \"shapes_missing\": " << name_list(fit.origin, ShapeOrigin::None) << ", \"landmarks\": " << guides.size() << ", \"matched_by_shapes\": " << matcher.described()
     << ", \"face_residual_mm_mean\": " << 1000 * sum / static_cast<double>(counted)
     << ", \"face_residual_mm_max\": " << 1000 * worst << ", \"face_residual_points\": " << counted
     << ", \"seconds\": " << seconds << "}";

@@ -10,21 +10,6 @@
 
 namespace softdeca::fit {
 
-bool RegistrationTarget::on_boundary(const geometry::SurfacePoint& p) const {
-  if (p.triangle < 0) return true;
-  constexpr double kEdge = 1e-9;
-  const auto t = static_cast<std::size_t>(p.triangle);
-  int zero = -1, zeros = 0;
-  for (int k = 0; k < 3; ++k)
-    if (p.bary[k] <= kEdge) zero = k, ++zeros;
-  if (zeros == 0) return false;  // inside the triangle
-  if (zeros == 1) return (boundary_edges[t] >> zero) & 1;
-  for (int k = 0; k < 3; ++k)  // a corner
-    if (p.bary[k] > kEdge)
-      return boundary_vertex[static_cast<std::size_t>(surface->triangles()(p.triangle, k))] != 0;
-  return true;
-}
-
 Points vertex_normals(const Points& v, const Triangles& f) {
   Points n = Points::Zero(v.rows(), 3);
   for (Eigen::Index t = 0; t < f.rows(); ++t) {
@@ -62,11 +47,10 @@ Eigen::SparseMatrix<double> laplacian(Eigen::Index n, const Triangles& f) {
 }
 }  // namespace
 
-Registration register_skin(const Points& start, const Triangles& triangles, const std::vector<double>& data_weight,
-                           const RegistrationTarget& target, const std::vector<Guide>& guides,
-                           const RegistrationSettings& s, const std::function<void(int, int)>& progress) {
+Registration register_skin(const Points& start, const Triangles& triangles, const Matcher& matcher,
+                           const std::vector<Guide>& guides, const RegistrationSettings& s,
+                           const std::function<void(int, int)>& progress) {
   const Eigen::Index n = start.rows();
-  require(static_cast<Eigen::Index>(data_weight.size()) == n, "registration: one data weight per skin vertex");
   const Eigen::SparseMatrix<double> l = laplacian(n, triangles);
   const Eigen::SparseMatrix<double> ltl = Eigen::SparseMatrix<double>(l.transpose()) * l;
   Eigen::SparseMatrix<double> identity(n, n);
@@ -77,6 +61,7 @@ Registration register_skin(const Points& start, const Triangles& triangles, cons
   Registration r;
   r.skin = start;
   r.matched.assign(static_cast<std::size_t>(n), 0);
+  std::vector<Match> matches(static_cast<std::size_t>(n));
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
   bool analysed = false;
   const int iterations = std::max(1, s.iterations);
@@ -89,21 +74,13 @@ Registration register_skin(const Points& start, const Triangles& triangles, cons
 
     Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(n, kAnchor * stiffness);
     Points rhs = (stiffness * (ltl * start)).eval() + kAnchor * stiffness * start;
-    std::fill(r.matched.begin(), r.matched.end(), uint8_t{0});
+    matcher(r.skin, normals, reach, matches);
     for (Eigen::Index i = 0; i < n; ++i) {
-      const double w = data_weight[static_cast<std::size_t>(i)];
-      if (!(w > 0)) continue;
-      const geometry::SurfacePoint p = target.surface->closest(r.skin.row(i).transpose(), reach);
-      if (p.triangle < 0 || target.on_boundary(p)) continue;
-      const auto& tri = target.surface->triangles();
-      const auto& v = target.surface->vertices();
-      const Eigen::Vector3d a = v.row(tri(p.triangle, 0)), b = v.row(tri(p.triangle, 1)), c = v.row(tri(p.triangle, 2));
-      const Eigen::Vector3d fn = (b - a).cross(c - a);
-      const double fl = fn.norm();
-      if (!(fl > 0) || std::fabs(fn.dot(normals.row(i).transpose())) < s.min_normal_cos * fl) continue;
-      diagonal[i] += w;
-      rhs.row(i) += w * p.point.transpose();
-      r.matched[static_cast<std::size_t>(i)] = 1;
+      const Match& m = matches[static_cast<std::size_t>(i)];
+      r.matched[static_cast<std::size_t>(i)] = m.weight > 0;
+      if (!(m.weight > 0)) continue;
+      diagonal[i] += m.weight;
+      rhs.row(i) += m.weight * m.target.transpose();
     }
     for (const Guide& g : guides) {
       diagonal[g.vertex] += guide * g.weight;
