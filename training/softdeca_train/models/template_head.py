@@ -13,6 +13,8 @@ from typing import Any
 
 import numpy as np
 
+from softdeca_train.template.components import N_SKIN
+
 TEMPLATE_HEAD_FILE = "template_head.bin"
 N_SHAPES = 52
 
@@ -75,6 +77,4 @@ def template_head_from(template: Any) -> TemplateHead:
     """The ICT template's head (template.model.Template): its neutral and ARKit shapes."""
     eye = np.eye(N_SHAPES)
     deltas = np.stack([template.blend(eye[i]) - template.neutral for i in range(N_SHAPES)])
-    from softdeca_train.template.components import N_SKIN
-
     return template_head_of(template.neutral, deltas, N_SKIN)
