@@ -1,5 +1,5 @@
-"""The runtime stage's commands: the untrained bundle, avatars, replay previews, the native
-tests' inputs and the runtime benchmark."""
+"""The runtime stage's commands: the untrained bundle and its additions, replay previews, the
+native tests' inputs and the runtime benchmark."""
 
 from __future__ import annotations
 
