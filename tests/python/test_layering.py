@@ -76,6 +76,8 @@ PYTHON_LAYERS: tuple[tuple[str, ...], ...] = (
     # the head template and its regions; the landmarks on it; the layered head model
     ("template",),
     ("landmarks",),
+    # test avatars: the template and ARKit's face in the conventions users' avatars come in
+    ("avatars",),
     ("lhm",),
     # face streams (live formats, recordings) in the template's terms
     ("streaming",),

@@ -21,6 +21,7 @@ STAGES = (
     "softdeca_train.train.cli",
     "softdeca_train.controls.cli",
     "softdeca_train.runtime.cli",
+    "softdeca_train.avatars.cli",
     "softdeca_train.streaming.cli",
 )
 

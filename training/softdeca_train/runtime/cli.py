@@ -1,5 +1,5 @@
-"""The runtime stage's commands: the untrained bundle, avatars, replay previews, the native
-tests' inputs and the runtime benchmark."""
+"""The runtime stage's commands: the untrained bundle and its additions, replay previews, the
+native tests' inputs and the runtime benchmark."""
 
 from __future__ import annotations
 
@@ -110,20 +110,6 @@ def _template_head_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _avatar_args(p: argparse.ArgumentParser) -> None:
-    add_ict_argument(p)
-    p.add_argument("--seed", type=int, required=True, help="identity seed")
-    p.add_argument("--out", required=True, help="avatar folder for `softdeca replay`")
-
-
-def _avatar_run(args: argparse.Namespace) -> int:
-    from softdeca_train.runtime.files import write_identity_avatar
-
-    out = write_identity_avatar(args.seed, Path(args.out), args.ict)
-    print(f"wrote avatar of identity seed {args.seed} to {out}")
-    return 0
-
-
 def _replay_preview_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--replay", required=True, help="output folder of `softdeca replay`")
     p.add_argument("--frames", type=int, default=4, help="rows of the contact sheet (4)")
@@ -194,13 +180,6 @@ COMMANDS = [
         "(template_head.bin, format version 5).",
         _template_head_args,
         _template_head_run,
-    ),
-    Command(
-        "avatar",
-        "Write an ICT identity's avatar folder (neutral, 52 shapes, ARKit user face) "
-        "for `softdeca replay`.",
-        _avatar_args,
-        _avatar_run,
     ),
     Command(
         "replay-preview",

@@ -1,0 +1,84 @@
+"""What a test avatar is: one field per choice of `python -m softdeca_train avatar`.
+
+Identities: the template, or ICT identities no dataset holds. Datasets derive their identity
+seeds from a SeedSequence of (dataset seed, 1, identity id), 32-bit hashes (data/plan.py,
+`derived_seed`), so a small seed names a head training never saw; the controls gallery takes
+101, 202 and 303, the test avatars take 404, 505 and 606 (HELD_OUT_IDENTITIES)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+from softdeca_train.face_names import ARKIT_BLENDSHAPES
+
+# Metres per unit of each unit an avatar comes in.
+UNITS: dict[str, float] = {"mm": 0.001, "cm": 0.01, "inch": 0.0254, "dm": 0.1, "m": 1.0}
+UP_AXES = ("y", "z")
+# The naming habits of rigs (names.py): eyeBlinkLeft, blendShape1.eyeBlinkLeft,
+# AK_09_EyeBlinkLeft, eyeBlink_L, eye_blink_l, EyeBlinkLeft.
+REMESH_STYLES = ("isotropic", "adaptive")  # remesh.py
+NAME_STYLES = ("arkit", "namespace", "prefix", "suffix_LR", "snake", "pascal")
+HELD_OUT_IDENTITIES = ("seed 404", "seed 505", "seed 606")
+DEFAULT_IDENTITY = HELD_OUT_IDENTITIES[0]
+DEFAULT_BODY_VERTICES = 20_000
+
+
+@dataclass(frozen=True)
+class AvatarConfig:
+    """A test avatar. The defaults give the ICT head of a held-out identity in the template's
+    own topology and conventions (metres, +Y up, right-handed, ARKit's names): the avatar
+    `softdeca replay` takes. Every other field moves it into a convention users' avatars come
+    in; the fields combine."""
+
+    # "template", "seed N" or "h+2.5σ"/"h-2.5σ" (template/identities.py); ignored by arkit_face
+    identity: str = DEFAULT_IDENTITY
+    # the skin remeshed to about this many vertices (another topology); None keeps ICT's
+    remesh: int | None = None
+    remesh_style: str = "isotropic"  # or "adaptive" (remesh.py)
+    shuffle: bool = False  # the vertices in a random order
+    unit: str = "m"  # a key of UNITS
+    up: str = "y"  # "z": the template's +Y becomes +Z (and its +Z, out of the face, -Y)
+    mirror: bool = False  # a left-handed export: x negated, the triangles' indices kept
+    body: bool = False  # a synthetic whole body joined under the neck, moved by no shape
+    body_vertices: int = DEFAULT_BODY_VERTICES  # the body's own vertices, about
+    # the skin, the eyeballs and the teeth as separate objects (ICT's other inner parts left out)
+    separate_eyes_teeth: bool = False
+    keep_shapes: int | None = None  # only this many of the shapes, chosen at random
+    drop: tuple[str, ...] = ()  # canonical ARKit names of shapes left out
+    names: str = "arkit"  # a NAME_STYLES entry
+    arkit_face: bool = False  # ARKit's reference face (1,220 vertices) instead of an ICT head
+    variant_seed: int = 0  # the random choices: vertex order, the kept shapes
+
+    def __post_init__(self) -> None:
+        problems = []
+        if self.unit not in UNITS:
+            problems.append(f"unit must be one of {', '.join(UNITS)}")
+        if self.up not in UP_AXES:
+            problems.append(f"up must be one of {', '.join(UP_AXES)}")
+        if self.names not in NAME_STYLES:
+            problems.append(f"names must be one of {', '.join(NAME_STYLES)}")
+        if self.remesh is not None and not 500 <= self.remesh <= 200_000:
+            problems.append("remesh must be between 500 and 200,000 vertices")
+        if self.remesh_style not in REMESH_STYLES:
+            problems.append(f"remesh_style must be one of {', '.join(REMESH_STYLES)}")
+        if self.keep_shapes is not None and not 1 <= self.keep_shapes <= 52:
+            problems.append("keep_shapes must be between 1 and 52")
+        if self.body and self.body_vertices < 2_000:
+            problems.append("body_vertices must be at least 2,000")
+        unknown = [n for n in self.drop if n not in ARKIT_BLENDSHAPES]
+        if unknown:
+            problems.append(f"drop: not ARKit blendshape names: {', '.join(unknown)}")
+        if self.arkit_face and (self.body or self.separate_eyes_teeth):
+            problems.append(
+                "arkit_face takes neither body nor separate_eyes_teeth (ARKit's reference face "
+                "has no neck, eyes or teeth)"
+            )
+        if problems:
+            raise ValueError("avatar: " + "; ".join(problems))
+
+    @property
+    def metres_per_unit(self) -> float:
+        return UNITS[self.unit]
+
+    def to_dict(self) -> dict:
+        return {**asdict(self), "drop": list(self.drop)}
