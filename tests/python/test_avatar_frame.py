@@ -14,13 +14,16 @@ from softdeca_train.template import Template
 
 @pytest.fixture(scope="module")
 def head(template: Template) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The template's neutral head, its 52 ARKit shapes as deltas, and its triangles."""
+    """The template's skin S (what a bundle's template head holds), its 52 ARKit shapes as
+    deltas, and its triangles."""
     eye = np.eye(52)
     deltas = np.stack([template.blend(eye[i]) - template.neutral for i in range(52)])
+    skin = template.skin_triangles
+    n = int(skin.max()) + 1
     return (
-        template.neutral.astype(np.float32),
-        deltas.astype(np.float32),
-        template.triangles.astype(np.int32),
+        template.neutral[:n].astype(np.float32),
+        deltas[:, :n].astype(np.float32),
+        skin.astype(np.int32),
     )
 
 
@@ -76,11 +79,11 @@ SIDE_PAIRS = [
 def test_each_side_pair_alone_gives_the_unit(head, stem: str) -> None:
     """One Left/Right pair, one eye and one mouth shape: the table's distance for that pair is
     the template's (so any subset of shapes measures the unit)."""
-    neutral, deltas, _ = head
+    neutral, deltas, triangles = head
     present = np.zeros(52, bool)
     for name in (stem + "Left", stem + "Right", "eyeBlinkLeft", "jawOpen"):
         present[ARKIT_BLENDSHAPES.index(name)] = True
-    f = frame(neutral, deltas, present)
+    f = frame(neutral, deltas, present, triangles)
     assert abs(f["metres_per_unit_measured"] - 1.0) < 0.01, f
     assert angle_deg(f["left"], (1, 0, 0)) < 2.0
 
@@ -125,19 +128,19 @@ def test_a_whole_body_and_shuffled_vertices(head) -> None:
 
 
 def test_a_mirrored_export_is_recognised(head) -> None:
-    neutral, deltas, _ = head
+    neutral, deltas, triangles = head
     m = np.array([-1.0, 1.0, 1.0], np.float32)  # x negated: a left-handed export
-    f = frame(neutral * m, deltas * m)
+    f = frame(neutral * m, deltas * m, triangles=triangles)
     assert f["mirrored"]
     assert angle_deg(f["left"], (-1, 0, 0)) < 1.0
     assert angle_deg(f["forward"], (0, 0, 1)) < 5.0  # still out of the face
 
 
 def test_forty_of_fifty_two_shapes(head) -> None:
-    neutral, deltas, _ = head
+    neutral, deltas, triangles = head
     present = np.ones(52, bool)
     present[np.random.default_rng(3).choice(52, 12, replace=False)] = False
-    f = frame(neutral, deltas, present)
+    f = frame(neutral, deltas, present, triangles)
     moving = (np.abs(deltas).reshape(52, -1).max(axis=1) > 0) & present
     assert f["shapes_used"] == moving.sum() and f["metres_per_unit"] == 1.0
     assert angle_deg(f["up"], (0, 1, 0)) < 5.0

@@ -137,6 +137,8 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   AvatarShapes ts;
   ts.neutral = t.head_neutral;
   ts.vertex_count = vs;
+  ts.triangles = t.skin_triangles;
+  ts.triangle_count = t.skin_triangle_count;
   for (std::size_t k = 0; k < kShapes; ++k) ts.deltas[k] = t.moves[k] ? t.shapes + k * vs * 3 : nullptr;
   const AvatarFrame tframe = avatar_frame(ts);
 

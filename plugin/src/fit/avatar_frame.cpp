@@ -24,11 +24,11 @@ struct SidePair {
   double template_distance;
 };
 constexpr SidePair kSidePairs[] = {
-    {"browDown", 0.0836},    {"browOuterUp", 0.0939},  {"cheekSquint", 0.0775},   {"eyeBlink", 0.0657},
-    {"eyeLookDown", 0.0679}, {"eyeLookIn", 0.0672},    {"eyeLookOut", 0.0685},    {"eyeLookUp", 0.0663},
-    {"eyeSquint", 0.0709},   {"eyeWide", 0.0676},      {"mouthDimple", 0.0400},   {"mouthFrown", 0.0408},
-    {"mouthLowerDown", 0.0250}, {"mouthPress", 0.0318}, {"mouthSmile", 0.0512},  {"mouthStretch", 0.0426},
-    {"mouthUpperUp", 0.0326}, {"noseSneer", 0.0391},
+    {"browDown", 0.0852},    {"browOuterUp", 0.0989},  {"cheekSquint", 0.0967},   {"eyeBlink", 0.0600},
+    {"eyeLookDown", 0.0699}, {"eyeLookIn", 0.0671},    {"eyeLookOut", 0.0671},    {"eyeLookUp", 0.0685},
+    {"eyeSquint", 0.0918},   {"eyeWide", 0.0683},      {"mouthDimple", 0.0530},   {"mouthFrown", 0.0561},
+    {"mouthLowerDown", 0.0323}, {"mouthPress", 0.0427}, {"mouthSmile", 0.0701},  {"mouthStretch", 0.0649},
+    {"mouthUpperUp", 0.0523}, {"noseSneer", 0.0596},
 };
 
 // Units a measured scale snaps to when within 25 %: mm, cm, inch, dm, m.
@@ -54,8 +54,10 @@ void check_finite(const float* p, std::size_t n, const std::string& what) {
     require(std::isfinite(p[i]), what + " has a non-finite value at vertex " + std::to_string(i / 3));
 }
 
-// The motion-weighted centre of one shape's moving vertices; marks them in `face`.
-Motion shape_motion(const AvatarShapes& s, const float* d, std::vector<uint8_t>& face) {
+// The motion-weighted centre of one shape's moving vertices, each vertex weighted by its share
+// of the surface (so a mesh dense at the eyes and lips and one evenly meshed agree); marks them
+// in `face`.
+Motion shape_motion(const AvatarShapes& s, const float* d, const std::vector<double>& area, std::vector<uint8_t>& face) {
   const std::size_t n = s.vertex_count;
   double peak = 0;
   for (std::size_t v = 0; v < n; ++v)
@@ -64,13 +66,15 @@ Motion shape_motion(const AvatarShapes& s, const float* d, std::vector<uint8_t>&
   if (!(peak > 0)) return m;
   double total = 0;
   for (std::size_t v = 0; v < n; ++v) {
-    const double w = Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm();
-    if (w <= kMotionShare * peak) continue;
+    const double motion = Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm();
+    if (motion <= kMotionShare * peak) continue;
     face[v] = 1;
+    const double w = motion * area[v];
     total += w;
     m.centre += w * Eigen::Vector3d(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
     m.direction += Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]);
   }
+  if (!(total > 0)) return m;  // only vertices on no triangle with area move
   m.centre /= total;
   m.direction /= total;
   m.moves = true;
@@ -101,6 +105,19 @@ Eigen::Vector3d face_normal_sum(const AvatarShapes& s, const std::vector<uint8_t
   return sum;
 }
 
+// Each vertex's share of the surface: a third of its triangles' areas (1 each without triangles).
+std::vector<double> vertex_areas(const AvatarShapes& s) {
+  if (s.triangles == nullptr || s.triangle_count == 0) return std::vector<double>(s.vertex_count, 1.0);
+  std::vector<double> area(s.vertex_count, 0.0);
+  const auto at = [&](int32_t i) { return Eigen::Vector3d(s.neutral[3 * i], s.neutral[3 * i + 1], s.neutral[3 * i + 2]); };
+  for (std::size_t t = 0; t < s.triangle_count; ++t) {
+    const int32_t* c = s.triangles + 3 * t;
+    const double a = (at(c[1]) - at(c[0])).cross(at(c[2]) - at(c[0])).norm() / 6.0;
+    for (int k = 0; k < 3; ++k) area[static_cast<std::size_t>(c[k])] += a;
+  }
+  return area;
+}
+
 }  // namespace
 
 AvatarFrame avatar_frame(const AvatarShapes& s) {
@@ -113,10 +130,11 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   AvatarFrame f;
   f.face.assign(s.vertex_count, 0);
   std::array<Motion, kShapes> motion{};
+  const std::vector<double> area = vertex_areas(s);
   for (std::size_t i = 0; i < kShapes; ++i) {
     if (s.deltas[i] == nullptr) continue;
     check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
-    motion[i] = shape_motion(s, s.deltas[i], f.face);
+    motion[i] = shape_motion(s, s.deltas[i], area, f.face);
     f.shapes_used += motion[i].moves;
     f.moves[i] = motion[i].moves;
     f.centres[i] = motion[i].centre;

@@ -23,7 +23,9 @@ struct AvatarShapes {
   const float* neutral = nullptr;
   std::size_t vertex_count = 0;
   std::array<const float*, kShapes> deltas{};
-  const int32_t* triangles = nullptr;  // optional: the face's normals, where no forward shape is
+  // Optional, but what the unit's table assumes: each vertex weighs by its share of the
+  // surface (without triangles, 1 each); and the face's normals, where no forward shape is.
+  const int32_t* triangles = nullptr;
   std::size_t triangle_count = 0;
 };
 
