@@ -25,6 +25,8 @@ struct TemplateData {
   std::size_t head_vertices = 0, skin_vertices = 0;
   const float* shapes = nullptr;  // 52 x skin_vertices x 3 deltas
   std::array<bool, kShapes> moves{};
+  const float* identity_modes = nullptr;  // K x skin_vertices x 3 (h about N(0, 1)); may be none
+  std::size_t identity_count = 0;         // K
   const std::int32_t* skin_triangles = nullptr;
   std::size_t skin_triangle_count = 0;
   // The bundle's landmarks on the skin: a triangle row and barycentric weights each (optional).
@@ -82,6 +84,9 @@ struct AvatarFit {
   std::size_t vertex_count = 0, triangle_count = 0;
   Placement placement;
   std::vector<float> registered;  // head_vertices x 3: the registered template head (metres)
+  // The template identity closest to the avatar (K coefficients over the identity modes): its
+  // head is where the registration started and what the identity code is read off.
+  std::vector<float> identity;
   ShapeSource source;
   std::array<ShapeOrigin, kShapes> origin{};
   Embedding embedding;
@@ -90,6 +95,9 @@ struct AvatarFit {
 
 // Throws softdeca::Error (invalid argument) with a message a user can act on.
 AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& avatar, const FitOptions& options);
+
+// The skin of the template identity `fit.identity` (skin_vertices x 3, metres).
+std::vector<float> identity_skin(const TemplateData& t, const AvatarFit& fit);
 
 // The 52 shapes of the registered template head (52 x head_vertices x 3, non-skin rows zero):
 // the avatar's own carried through the fit where it has them, else the template's.

@@ -12,6 +12,7 @@ namespace softdeca::fit {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'D', 'E', 'C', 'A', 'F', 'I', 'T'};
+constexpr std::uint32_t kMaxIdentity = 1000;  // identity modes a bundle may hold (runtime/manifest.cpp)
 
 class Writer {
  public:
@@ -65,6 +66,8 @@ std::vector<std::uint8_t> encode_fit(const AvatarFit& f, const std::string& bund
   w.put(f.source.bary.data(), vs * 3);
   w.put(f.source.weight.data(), vs);
   for (const ShapeOrigin o : f.origin) w.value(static_cast<std::uint8_t>(o));
+  w.value(static_cast<std::uint32_t>(f.identity.size()));
+  w.put(f.identity.data(), f.identity.size());
   w.value(static_cast<std::uint32_t>(f.embedding.size()));
   w.put(f.embedding.vertex.data(), f.embedding.size());
   w.put(f.embedding.triangle.data(), f.embedding.size());
@@ -114,6 +117,10 @@ AvatarFit decode_fit(const std::uint8_t* data, std::size_t size, const std::stri
     if (b > 2) fail(name + ": a shape's origin is unknown");
     o = static_cast<ShapeOrigin>(b);
   }
+  const auto nh = in.value<std::uint32_t>("the identity's size");
+  if (nh > kMaxIdentity) fail(name + ": the identity has more coefficients than any bundle");
+  f.identity = in.vector<float>(nh, "the identity");
+  finite(f.identity, name, "the identity's coefficients");
   const auto ne = in.value<std::uint32_t>("the embedding's size");
   if (ne > f.vertex_count) fail(name + ": the embedding has more entries than the avatar has vertices");
   f.embedding.vertex = in.vector<std::int32_t>(ne, "the embedding");

@@ -78,6 +78,12 @@ std::size_t ShapeMatcher::described() const {
   return static_cast<std::size_t>(std::count_if(described_.begin(), described_.end(), [](const Match& m) { return m.weight > 0; }));
 }
 
+std::vector<Match> ShapeMatcher::shape_matches(const Points& skin, double radius) const {
+  search(skin, radius);
+  searched_reach_ = 0;  // the registration searches again from its own start
+  return described_;
+}
+
 bool ShapeMatcher::on_boundary(const geometry::SurfacePoint& p) const {
   if (p.triangle < 0) return true;
   constexpr double kEdge = 1e-9;

@@ -39,6 +39,8 @@ class ShapeMatcher {
   std::size_t shapes() const { return dims_ / 3; }
   // Template vertices matched by their response at the last search.
   std::size_t described() const;
+  // The matches by response alone within `radius` of `skin` (weight 0: none), searched now.
+  std::vector<Match> shape_matches(const Points& skin, double radius) const;
 
  private:
   void search(const Points& skin, double radius) const;  // descriptor matches near the current skin

@@ -19,15 +19,6 @@ double ms(Clock::time_point a, Clock::time_point b) { return std::chrono::durati
 constexpr int kSoftDeca = 0, kSparse = 1;
 constexpr float kWeightSlack = 0.01f;  // weights may overshoot [0, 1] by this much (clamped)
 
-// h from the neutral skin (the first skin_vertices of the head).
-std::vector<float> run_identity_encoder(const Model& model, const float* skin) {
-  std::vector<float> h(static_cast<std::size_t>(model.manifest().identity));
-  model.identity_encoder().run({skin}, {h.data()}, 1);
-  for (std::size_t i = 0; i < h.size(); ++i)
-    if (!std::isfinite(h[i])) throw Error(SOFTDECA_ERROR_NON_FINITE, "the identity encoder produced a non-finite code");
-  return h;
-}
-
 bool all_finite(const float* v, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i)
     if (!std::isfinite(v[i])) return false;
@@ -93,7 +84,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
   const auto& bones = model_->non_skin_bones();
   for (std::size_t i = 0; i < bones.size(); ++i)
     (bones[i] ? jaw_vertices_ : cranium_vertices_).push_back(static_cast<int>(vs_ + i));
-  identity_ = run_identity_encoder(*model_, neutral_.data());
+  identity_ = model_->encode_identity(neutral_.data());
   if (model_->has(false)) f_w_ = model_->encoder(false)->bind({weights_.data()}, {z_.data()}, 1);
   if (model_->has(true)) f_l_ = model_->encoder(true)->bind({offsets_.data()}, {z_.data()}, 1);
   if (const OnnxNetwork* r = model_->residual_coefficients())

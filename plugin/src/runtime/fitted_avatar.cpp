@@ -23,6 +23,8 @@ fit::TemplateData fit_template(const Model& m) {
   t.skin_vertices = static_cast<std::size_t>(mf.skin_vertices);
   t.shapes = th->shapes.data();
   t.moves = th->moves;
+  t.identity_modes = th->identity_modes.data();
+  t.identity_count = th->identity_count;
   t.skin_triangles = m.skin_triangles().data();
   t.skin_triangle_count = m.skin_triangles().size() / 3;
   for (const LandmarkSpec& l : mf.landmarks) {
@@ -59,7 +61,13 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   core.blendshape_count = kBlendshapeCount;
   core.threads = d.threads;
   core.precision = d.precision;
+  // The identity code of the template identity closest to the avatar: the encoder reads a head
+  // of the template's own making, not the registration's (a few millimetres of sliding along
+  // the skin changes its code far more than the head's shape does).
+  const std::vector<float> identity =
+      f.identity.empty() ? std::vector<float>{} : model->encode_identity(fit::identity_skin(t, f).data());
   core_ = std::make_unique<Avatar>(std::move(model), core);
+  if (!identity.empty()) core_->set_identity(identity.data(), identity.size());
 
   neutral_.assign(a.neutral, a.neutral + n_ * 3);
   triangles_.assign(a.triangles, a.triangles + a.triangle_count * 3);

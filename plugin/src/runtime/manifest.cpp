@@ -377,6 +377,10 @@ void parse_template_head(const Json& doc, Manifest& m) {
   const Json& t = doc.at(what.c_str(), "manifest");
   m.template_head_file = t.at("file", what).string(what + ".file");
   m.template_head_sha256 = sha256_of(t, what);
+  const Json& modes = t.at("identity_modes", what).at("shape", what);
+  const auto& mdims = modes.array(what + ".identity_modes.shape");
+  check(!mdims.empty(), what + ".identity_modes.shape has the wrong rank");
+  m.template_identity_modes = bounded_int(mdims[0], what + ".identity_modes.shape[0]", 0, 1000);
   const auto shape = [&](const char* key, const char* dtype, std::vector<long long> expected) {
     const Json& e = t.at(key, what);
     check(e.at("dtype", what).string(what + "." + key + ".dtype") == dtype, what + "." + key + ".dtype must be " + dtype);
@@ -388,6 +392,7 @@ void parse_template_head(const Json& doc, Manifest& m) {
   };
   shape("neutral", "float32", {m.head_vertices, 3});
   shape("shapes", "float16", {kBlendshapeCount, m.skin_vertices, 3});
+  shape("identity_modes", "float16", {m.template_identity_modes, m.skin_vertices, 3});
   m.has_template_head = true;
 }
 }  // namespace

@@ -85,10 +85,11 @@ struct Manifest {
   int residual_modes = 0, residual_condition = 0;
   bool has_rest_physics = false;  // format version 4
   RestPhysicsSpec rest_physics;
-  // The template head (format version 5): the neutral head (float32) and the 52 ARKit shapes
-  // over the skin (float16) in one file; sizes are the template's.
+  // The template head (format version 5): the neutral head (float32), the 52 ARKit shapes
+  // and template_identity_modes identity modes over the skin (float16) in one file.
   bool has_template_head = false;
   std::string template_head_file, template_head_sha256;
+  int template_identity_modes = 0;
 
   const NetworkSpec& network(const std::string& key) const;
   int find_parameter(const std::string& name) const;  // -1 when absent

@@ -1,6 +1,7 @@
 #include "runtime/model.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <iterator>
@@ -157,6 +158,18 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
                                                          per_frame ? 1 : options.prepare_threads));
   }
   return m;
+}
+
+}  // namespace softdeca::runtime
+
+namespace softdeca::runtime {
+
+std::vector<float> Model::encode_identity(const float* skin) const {
+  std::vector<float> h(static_cast<std::size_t>(manifest_.identity));
+  identity_encoder().run({skin}, {h.data()}, 1);
+  for (const float x : h)
+    if (!std::isfinite(x)) throw Error(SOFTDECA_ERROR_NON_FINITE, "the identity encoder produced a non-finite code");
+  return h;
 }
 
 }  // namespace softdeca::runtime

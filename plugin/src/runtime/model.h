@@ -46,6 +46,9 @@ class Model {
   const std::vector<std::uint8_t>& non_skin_bones() const { return non_skin_bones_; }  // Vh-Vs, 0 cranium 1 jaw
 
   const OnnxNetwork& identity_encoder() const { return *networks_.at(0); }
+  // The identity code h of a neutral skin (skin_vertices x 3): the identity encoder's output,
+  // checked finite (Error(NON_FINITE) otherwise).
+  std::vector<float> encode_identity(const float* skin) const;
   // Per model ("softdeca" or "sparse"): the per-frame encoder, the hypernetwork and dynamics.
   const OnnxNetwork* encoder(bool sparse) const { return networks_.at(sparse ? 4 : 1).get(); }
   const OnnxNetwork* hyper(bool sparse) const { return networks_.at(sparse ? 5 : 2).get(); }
