@@ -33,6 +33,8 @@ namespace SoftDeca.Tests
                 { "softdeca_avatar_desc", typeof(AvatarDesc) },
                 { "softdeca_output", typeof(Output) },
                 { "softdeca_stats", typeof(AvatarStats) },
+                { "softdeca_avatar_mesh", typeof(NativeAvatarMesh) },
+                { "softdeca_fit_options", typeof(FitOptions) },
                 { "softdeca_parameter_info", typeof(NativeParameterInfo) },
                 { "softdeca_pose", typeof(Pose) },
                 { "softdeca_frame", typeof(Frame) },
