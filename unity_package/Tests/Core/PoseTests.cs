@@ -244,6 +244,51 @@ namespace SoftDeca.Tests
         }
 
         [Test]
+        public void LiveLinkFacesAnglesAndARecordingsPosesArriveAsOnePose()
+        {
+            // Live Link Face over loopback: 52 weights, then yaw, pitch and roll of the head, the
+            // left eye and the right eye (radians, R = Ry(yaw) Rx(pitch) Rz(roll) in ARKit's frame).
+            var values = new float[61];
+            values[52] = 0.3f;   // the head turns to the subject's left
+            values[55] = 0.2f;   // the left eye looks to the subject's left
+            values[59] = -0.1f;  // the right eye looks up
+            var frame = Frame.Create();
+            using (var receiver = new Receiver(StreamFormat.LiveLinkFace, "127.0.0.1", 0))
+            using (var udp = new System.Net.Sockets.UdpClient())
+            {
+                udp.Connect("127.0.0.1", receiver.Port);
+                byte[] packet = StreamingTests.LiveLinkFacePacket(5000, values);
+                udp.Send(packet, packet.Length);
+                Assert.IsTrue(receiver.TryNext(ref frame, 5.0), "the datagram arrives");
+            }
+            FacePose live = FacePose.FromFrame(ref frame);
+            Assert.IsTrue(live.HasHead && live.HasEyes);
+            AssertRotation(Quat.AxisAngle(0, 1, 0, 0.3f), live.Head, "head");
+            AssertRotation(Quat.AxisAngle(0, 1, 0, 0.2f), live.LeftEye, "left eye");
+            AssertRotation(Quat.AxisAngle(1, 0, 0, -0.1f), live.RightEye, "right eye");
+
+            // The same frame recorded and played back.
+            string path = System.IO.Path.Combine(TestData.TempDir, "poses.sdrec");
+            using (var recorder = new Recorder(path)) recorder.Write(ref frame);
+            var played = Frame.Create();
+            using (var player = new Player(path)) player.GetFrame(0, ref played);
+            FacePose recorded = FacePose.FromFrame(ref played);
+            AssertRotation(live.Head, recorded.Head, "recorded head");
+            AssertRotation(live.LeftEye, recorded.LeftEye, "recorded left eye");
+
+            // On the avatar: the head turns to its own left, and so does its left eye.
+            var driver = new HeadEyeDriver();
+            driver.Update(ref recorded, 0.02f);
+            float[] r;
+            Rotated(driver.Head, 0, 0, 1, out r);
+            Assert.AreEqual(-Math.Sin(0.3), r[0], 1e-5);
+            Rotated(driver.LeftEye, 0, 0, 1, out r);
+            Assert.AreEqual(-Math.Sin(0.2), r[0], 1e-5);
+            Rotated(driver.RightEye, 0, 0, 1, out r);
+            Assert.AreEqual(Math.Sin(0.1), r[1], 1e-5, "the right eye looks up");
+        }
+
+        [Test]
         public unsafe void FramesAllocateNothing()
         {
             var driver = new HeadEyeDriver { SmoothingTime = 0.05f, NeckShare = 0.4f };
