@@ -71,7 +71,12 @@ namespace SoftDeca.Editor
             EditorGUILayout.Space();
             EditorGUILayout.LabelField("Your avatar", EditorStyles.boldLabel);
             EditorGUI.BeginDisabledGroup(EditorApplication.isPlaying || avatar.SourceMesh == null);
-            if (GUILayout.Button(avatar.fit == null ? "Fit" : "Fit again")) Fit(avatar);
+            if (GUILayout.Button(avatar.fit == null ? "Fit" : "Fit again"))
+                EditorApplication.delayCall += () =>  // outside the inspector's layout pass
+                {
+                    Fit(avatar);
+                    Repaint();
+                };
             EditorGUI.EndDisabledGroup();
             if (fitMessage != null) EditorGUILayout.HelpBox(fitMessage, MessageType.Error);
             ShowReport(avatar);
@@ -82,6 +87,7 @@ namespace SoftDeca.Editor
         private void Fit(SoftDecaAvatar avatar)
         {
             const string title = "SoftDECA: fitting the avatar";
+            if (avatar == null || avatar.SourceMesh == null) return;  // gone since the click
             Mesh source = avatar.SourceMesh;
             string asset = FitAssetPath(source);
             fitMessage = null;

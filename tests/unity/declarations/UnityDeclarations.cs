@@ -229,6 +229,7 @@ namespace UnityEditor
         public Object target { get { throw new NotImplementedException(); } }
         public SerializedObject serializedObject { get { throw new NotImplementedException(); } }
         public virtual void OnInspectorGUI() { }
+        public void Repaint() { throw new NotImplementedException(); }
         protected static void DrawPropertiesExcluding(SerializedObject obj, params string[] propertyToExclude) { throw new NotImplementedException(); }
     }
     public class ScriptableObjectStandIn : Object { }
@@ -252,7 +253,12 @@ namespace UnityEditor
         public static void BeginDisabledGroup(bool disabled) { throw new NotImplementedException(); }
         public static void EndDisabledGroup() { throw new NotImplementedException(); }
     }
-    public static class EditorApplication { public static bool isPlaying { get { throw new NotImplementedException(); } } }
+    public sealed class EditorApplication
+    {
+        public delegate void CallbackFunction();
+        public static CallbackFunction delayCall;
+        public static bool isPlaying { get { throw new NotImplementedException(); } }
+    }
     public static class EditorUtility
     {
         public static void DisplayProgressBar(string title, string info, float progress) { throw new NotImplementedException(); }
