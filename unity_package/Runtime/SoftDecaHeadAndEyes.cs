@@ -16,8 +16,8 @@ namespace SoftDeca.Unity
     /// and the left and right eye bones, assigned here or found on a Humanoid Animator. Every
     /// input's poses arrive in ARKit's face-anchor frame and reach the bones through
     /// HeadEyeDriver: turned into Unity's space, smoothed (frame-rate independent) and applied
-    /// relative to each bone's rest rotation, after the Animator (LateUpdate). Frames allocate
-    /// nothing.
+    /// relative to each bone's rest rotation, after the Animator (LateUpdate). The bones are left
+    /// alone until the first pose arrives. Frames allocate nothing.
     /// </summary>
     [AddComponentMenu("SoftDECA/Head and Eyes")]
     [DisallowMultipleComponent]
@@ -47,6 +47,7 @@ namespace SoftDeca.Unity
         private readonly HeadEyeDriver driver = new HeadEyeDriver();
         private readonly Transform[] bones = new Transform[HeadEyeDriver.BoneCount];
         private FacePose pose;
+        private bool tracking;  // a pose has arrived since enabled: until then the bones are left alone
 
         /// <summary>The core driver (its smoothed rotations, Recenter).</summary>
         public HeadEyeDriver Driver { get { return driver; } }
@@ -76,12 +77,13 @@ namespace SoftDeca.Unity
                 driver.SetBone((PoseBone)b, bones[b].localRotation.ToQuat(), toCharacter * bones[b].rotation.ToQuat());
             }
             driver.Reset();
+            tracking = false;
         }
 
         private void OnDisable()
         {
             driver.Reset();
-            if (!overAnimation) ApplyToBones();  // back to rest
+            if (tracking && !overAnimation) ApplyToBones();  // back to rest
         }
 
         /// <summary>The current head pose becomes "looking straight ahead".</summary>
@@ -94,6 +96,8 @@ namespace SoftDeca.Unity
             if (input == null || !input.TryGetPose(ref pose)) pose.HasHead = pose.HasEyes = false;
             pose.HasHead &= driveHead;
             pose.HasEyes &= driveEyes;
+            tracking |= pose.HasHead || pose.HasEyes;
+            if (!tracking) return;
             driver.Update(ref pose, Time.deltaTime);
             ApplyToBones();
         }
