@@ -162,11 +162,14 @@ namespace SoftDeca.Editor
             if (report == null) return;
             EditorGUILayout.LabelField("Metres per unit", Format(report.MetresPerUnit, "G4"));
             EditorGUILayout.LabelField("Up axis", report.UpAxis ?? "?");
-            EditorGUILayout.LabelField("ARKit shapes", Format(report.ShapesMatched, "F0") + " matched, " +
-                                                       Format(report.ShapesCarried, "F0") + " carried from the template");
+            EditorGUILayout.LabelField("ARKit shapes", Count(report.ShapesMatched) + " matched, " + Count(report.ShapesCarried) +
+                                                       " carried from the template, " + Count(report.ShapesMissing) + " missing");
+            if (report.Mirrored) EditorGUILayout.HelpBox("The mesh was exported mirrored (left-handed).", MessageType.Warning);
             EditorGUILayout.LabelField("Face residual", Format(report.FaceResidualMmMean, "F2") + " mm mean, " +
                                                         Format(report.FaceResidualMmMax, "F2") + " mm largest");
         }
+
+        private static string Count(string[] names) { return names == null ? "?" : names.Length.ToString(); }
 
         private static string Format(double value, string format)
         {

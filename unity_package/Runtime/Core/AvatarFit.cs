@@ -175,10 +175,14 @@ namespace SoftDeca
         public double MetresPerUnit { get { return Number("metres_per_unit"); } }
         /// <summary>The avatar's axis closest to up ("+Y", "+Z", ...).</summary>
         public string UpAxis { get { return Text("up_axis"); } }
-        /// <summary>ARKit shapes the rig has.</summary>
-        public double ShapesMatched { get { return Number("shapes_matched"); } }
-        /// <summary>ARKit shapes the rig lacks that the fit carries over from the template.</summary>
-        public double ShapesCarried { get { return Number("shapes_carried"); } }
+        /// <summary>Whether the mesh was exported mirrored (left-handed after the conversion).</summary>
+        public bool Mirrored { get { return Text("mirrored") == "true"; } }
+        /// <summary>The ARKit shapes the rig has (names), or null.</summary>
+        public string[] ShapesMatched { get { return Strings("shapes_matched"); } }
+        /// <summary>The ARKit shapes the rig lacks that the fit carries over from the template.</summary>
+        public string[] ShapesCarried { get { return Strings("shapes_carried"); } }
+        /// <summary>The ARKit shapes neither has.</summary>
+        public string[] ShapesMissing { get { return Strings("shapes_missing"); } }
         public double FaceVertices { get { return Number("face_vertices"); } }
         /// <summary>The registered template's distance to the avatar's face, mean and largest, millimetres.</summary>
         public double FaceResidualMmMean { get { return Number("face_residual_mm_mean"); } }
@@ -201,6 +205,37 @@ namespace SoftDeca
             string v = Text(name);
             double d;
             return v != null && double.TryParse(v, NumberStyles.Float, CultureInfo.InvariantCulture, out d) ? d : double.NaN;
+        }
+
+        /// <summary>A field that is an array of strings, or null when it is missing or something else.</summary>
+        public string[] Strings(string name)
+        {
+            string v = Text(name);
+            if (v == null || !v.StartsWith("[", StringComparison.Ordinal)) return null;
+            var items = new List<string>();
+            int i = Skip(v, 1);
+            if (i < v.Length && v[i] == ']') return items.ToArray();
+            try
+            {
+                while (true)
+                {
+                    i = Skip(v, i);
+                    if (i >= v.Length || v[i] != '"') return null;
+                    items.Add(ReadString(v, ref i));
+                    i = Skip(v, i);
+                    if (i < v.Length && v[i] == ',')
+                    {
+                        ++i;
+                        continue;
+                    }
+                    Expect(v, i, ']');
+                    return items.ToArray();
+                }
+            }
+            catch (FormatException)
+            {
+                return null;
+            }
         }
 
         /// <summary>Reads a JSON object's top-level fields; throws FormatException on malformed JSON.</summary>

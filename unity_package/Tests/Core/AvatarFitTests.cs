@@ -2,10 +2,7 @@
 // softdeca_avatar_create_fitted): the fixture's head as a user's avatar would come (its vertices
 // shuffled, in centimetres, above a body no shape moves) is fitted, saved, loaded and animated,
 // and the library's errors arrive with its messages.
-//
-// Category "AvatarFit": tests/unity/run leaves it out while its SOFTDECA_UNITY_EXCLUDE names it
-// (until the library exports the fit). Run against a library without the fit, every test fails
-// (EntryPointNotFoundException), none passes.
+// Category "AvatarFit" (tests/unity/run leaves it out when SOFTDECA_UNITY_EXCLUDE names it).
 using System;
 using System.IO;
 using NUnit.Framework;
@@ -105,8 +102,9 @@ namespace SoftDeca.Tests
             Assert.AreEqual(0.01, report.MetresPerUnit, 1e-12, "centimetres");
             Assert.AreEqual("+Y", report.UpAxis);
             int present = ShapesPresent(rig);
-            Assert.AreEqual(present, report.ShapesMatched, "the rig's ARKit shapes");
-            Assert.AreEqual(52 - present, report.ShapesCarried, "the others carried from the template");
+            Assert.AreEqual(present, report.ShapesMatched.Length, "the rig's ARKit shapes");
+            Assert.AreEqual(52 - present, report.ShapesCarried.Length + report.ShapesMissing.Length, "the others");
+            Assert.IsFalse(report.Mirrored);
             Assert.IsTrue(report.FaceResidualMmMean >= 0 && report.FaceResidualMmMean <= report.FaceResidualMmMax,
                           report.FaceResidualMmMean + " / " + report.FaceResidualMmMax);
             Assert.Less(report.FaceResidualMmMean, 2.0, "mm between the registered template and the face");
@@ -128,6 +126,9 @@ namespace SoftDeca.Tests
                 Assert.IsFalse(double.IsNaN(d2), "registered point " + t);
                 sum += Math.Sqrt(d2);
             }
+            Console.WriteLine("avatar fit: {0} vertices in {1:F1} s, {2} shapes matched, residual {3:F2} mm mean, {4:F2} mm largest; " +
+                              "registered skin {5:F3} cm from its vertices, mean", mesh.VertexCount, report.Seconds,
+                              report.ShapesMatched.Length, report.FaceResidualMmMean, report.FaceResidualMmMax, sum / skin);
             Assert.Less(sum / skin, 1.0, "cm from each registered skin vertex to its vertex of the avatar, mean");
         }
 
@@ -213,6 +214,8 @@ namespace SoftDeca.Tests
                         reference += c * c;
                         difference += (f - c) * (f - c);
                     }
+                Console.WriteLine("avatar fit: the fitted correction's RMS difference from the template head's {0:F3} of its RMS",
+                                  Math.Sqrt(difference / reference));
                 Assert.Greater(reference, 0, "the template head has a correction to compare with");
                 Assert.Less(Math.Sqrt(difference / reference), 0.5, "the fitted correction's RMS difference from the template's, relative");
 

@@ -110,15 +110,20 @@ namespace SoftDeca.Tests
         [Test]
         public void TheFitsReportReadsAsItsFields()
         {
-            const string json = "{\n  \"metres_per_unit\": 0.01,\n  \"up_axis\": \"+Y\",\n  \"shapes_matched\": 51,\n" +
-                                "  \"shapes_carried\": 1,\n  \"missing\": [\"tongueOut\", \"a \\\"quoted\\\" \\u00e9\"],\n" +
+            const string json = "{\n  \"metres_per_unit\": 0.01,\n  \"up_axis\": \"+Y\",\n" +
+                                "  \"shapes_matched\": [\"jawOpen\", \"eyeBlinkLeft\"],\n  \"shapes_carried\": [],\n" +
+                                "  \"missing\": [\"tongueOut\", \"a \\\"quoted\\\" \\u00e9\"],\n" +
                                 "  \"nested\": {\"a\": [1, 2, {\"b\": \"}\"}]},\n  \"face_residual_mm_mean\": 0.25,\n" +
                                 "  \"face_residual_mm_max\": 1.5e0,\n  \"mirrored\": false\n}";
             FitReport r = FitReport.Parse(json);
             Assert.AreEqual(0.01, r.MetresPerUnit);
             Assert.AreEqual("+Y", r.UpAxis);
-            Assert.AreEqual(51, r.ShapesMatched);
-            Assert.AreEqual(1, r.ShapesCarried);
+            CollectionAssert.AreEqual(new[] { "jawOpen", "eyeBlinkLeft" }, r.ShapesMatched);
+            CollectionAssert.IsEmpty(r.ShapesCarried);
+            CollectionAssert.AreEqual(new[] { "tongueOut", "a \"quoted\" \u00e9" }, r.Strings("missing"));
+            Assert.IsNull(r.ShapesMissing, "a missing field");
+            Assert.IsNull(r.Strings("nested"), "not an array of strings");
+            Assert.IsFalse(r.Mirrored);
             Assert.AreEqual(0.25, r.FaceResidualMmMean);
             Assert.AreEqual(1.5, r.FaceResidualMmMax);
             Assert.AreEqual("[\"tongueOut\", \"a \\\"quoted\\\" \\u00e9\"]", r.Text("missing"));
