@@ -22,6 +22,8 @@ SIZE_FIRST(softdeca_model_info);
 SIZE_FIRST(softdeca_avatar_desc);
 SIZE_FIRST(softdeca_output);
 SIZE_FIRST(softdeca_stats);
+SIZE_FIRST(softdeca_avatar_mesh);
+SIZE_FIRST(softdeca_fit_options);
 SIZE_FIRST(softdeca_parameter_info);
 SIZE_FIRST(softdeca_sim_collision_set);
 SIZE_FIRST(softdeca_sim_mesh);
@@ -53,6 +55,8 @@ static int print_sizes(void) {
   PRINT_SIZE(softdeca_avatar_desc);
   PRINT_SIZE(softdeca_output);
   PRINT_SIZE(softdeca_stats);
+  PRINT_SIZE(softdeca_avatar_mesh);
+  PRINT_SIZE(softdeca_fit_options);
   PRINT_SIZE(softdeca_parameter_info);
   PRINT_SIZE(softdeca_pose);
   PRINT_SIZE(softdeca_frame);

@@ -2,7 +2,8 @@
 (unity_package/Runtime/Core/NativeTypes.cs) and the Python binding (softdeca_train/runtime/
 native.py) mirror them by hand. These tests parse the header and hold every mirror to it: the
 same fields in the same order with the same types (and names, up to the languages' spelling),
-and the same ABI version."""
+the same ABI version, and C#'s P/Invoke declarations (NativeMethods.cs) the header's
+signatures."""
 
 from __future__ import annotations
 
@@ -27,6 +28,8 @@ MIRRORS: dict[str, tuple[str, str | None]] = {
     "softdeca_avatar_desc": ("AvatarDesc", "AvatarDesc"),
     "softdeca_output": ("Output", "Output"),
     "softdeca_stats": ("AvatarStats", "Stats"),
+    "softdeca_avatar_mesh": ("NativeAvatarMesh", "AvatarMesh"),
+    "softdeca_fit_options": ("FitOptions", "FitOptions"),
     "softdeca_pose": ("Pose", None),
     "softdeca_frame": ("Frame", None),
     "softdeca_receiver_config": ("ReceiverConfig", None),
@@ -70,14 +73,14 @@ def _evaluate(expr: str, constants: dict[str, int]) -> int:
     return int(eval(text))  # digits and operators only (checked above)
 
 
-def header_structs() -> tuple[dict[str, list[Field]], int]:
+def _header_text() -> str:
     text = HEADER.read_text(encoding="utf-8")
     text = re.sub(r"/\*.*?\*/", " ", text, flags=re.DOTALL)
-    text = re.sub(r"//[^\n]*", " ", text)
-    constants = {
-        m[1]: int(m[2])
-        for m in re.finditer(r"#define\s+(\w+)\s+(\d+)u?\b", text, re.MULTILINE)
-    }
+    return re.sub(r"//[^\n]*", " ", text)
+
+
+def _type_kinds(text: str) -> dict[str, str]:
+    """C_KINDS with the header's typedefs of them and its enums."""
     kinds = dict(C_KINDS)
     for m in re.finditer(r"typedef\s+(\w+)\s+(\w+)\s*;", text):
         if m[1] in kinds:
@@ -86,6 +89,16 @@ def header_structs() -> tuple[dict[str, list[Field]], int]:
         kinds[m[1]] = (
             "i32"  # the C ABI's enums have int's size on every platform it targets
         )
+    return kinds
+
+
+def header_structs() -> tuple[dict[str, list[Field]], int]:
+    text = _header_text()
+    constants = {
+        m[1]: int(m[2])
+        for m in re.finditer(r"#define\s+(\w+)\s+(\d+)u?\b", text, re.MULTILINE)
+    }
+    kinds = _type_kinds(text)
     structs: dict[str, list[Field]] = {}
     for m in re.finditer(r"typedef\s+struct\s+(\w+)\s*\{([^}]*)\}\s*(\w+)\s*;", text):
         fields = []
@@ -291,6 +304,145 @@ def test_mirrors_name_the_headers_abi_version() -> None:
     _, version = header_structs()
     assert csharp_abi_version() == version, "NativeMethods.AbiVersion"
     assert native.ABI_VERSION == version, "softdeca_train.runtime.native.ABI_VERSION"
+
+
+# ---- functions: C#'s P/Invoke declarations against the header's prototypes -------------------
+# A parameter's kind: a scalar kind, "struct:<header name>", "opaque" (a handle's struct, which
+# the header never defines), "void", "any" (IntPtr: any pointer), or "ptr:" + the pointee's kind.
+C_SCALARS = {**C_KINDS, "void": "void"}
+
+
+def _c_kind(text: str, structs: dict[str, list[Field]], kinds: dict[str, str]) -> str:
+    text = re.sub(r"\b(const|struct)\b", " ", text).strip()
+    if text.endswith("*"):
+        return "ptr:" + _c_kind(text[:-1], structs, kinds)
+    base = text.strip()
+    if base in C_SCALARS:
+        return C_SCALARS[base]
+    if base in kinds:
+        return kinds[base]
+    if base in structs:
+        return f"struct:{base}"
+    assert base.startswith("softdeca_"), f"unknown C type {base!r}"
+    return "opaque"
+
+
+def header_functions() -> dict[str, tuple[str, list[str]]]:
+    """name -> (return kind, parameter kinds) of every SOFTDECA_API function."""
+    structs, _ = header_structs()
+    text = _header_text()
+    kinds = _type_kinds(text)
+    out = {}
+    for m in re.finditer(
+        r"SOFTDECA_API\s+([^;(]*?)\b(softdeca_\w+)\s*\(([^)]*)\)\s*;", text
+    ):
+        params = [p.strip() for p in m[3].split(",")]
+        if params == ["void"]:
+            params = []
+        # each parameter without its name: the last identifier
+        types = [re.sub(r"\w+\s*$", "", p) for p in params]
+        out[m[2]] = (
+            _c_kind(m[1], structs, kinds),
+            [_c_kind(t, structs, kinds) for t in types],
+        )
+    return out
+
+
+CS_SCALARS = {**CS_KINDS, "void": "void", "Status": "i32", "IntPtr": "any"}
+
+
+def _cs_kind(text: str) -> str:
+    text = text.strip()
+    m = re.fullmatch(r"(ref|out)\s+(.+)", text)
+    if m:
+        return "ptr:" + _cs_kind(m[2])
+    if text.endswith("*"):
+        return "ptr:" + _cs_kind(text[:-1])
+    if text.endswith("Handle"):
+        return "ptr:opaque"  # a SafeHandle (Handles.cs) passes the handle's pointer
+    by_mirror = {cs: c for c, (cs, _) in MIRRORS.items()}
+    if text in by_mirror:
+        return f"struct:{by_mirror[text]}"
+    assert text in CS_SCALARS, f"unknown C# type {text!r}"
+    return CS_SCALARS[text]
+
+
+def csharp_functions() -> dict[str, tuple[str, list[str]]]:
+    text = re.sub(r"//[^\n]*", " ", CSHARP_METHODS.read_text(encoding="utf-8"))
+    out = {}
+    for m in re.finditer(
+        r"\bstatic\s+extern\s+([\w*]+)\s+(softdeca_\w+)\s*\(([^)]*)\)\s*;", text
+    ):
+        params = [p.strip() for p in m[3].split(",") if p.strip()]
+        types = [re.sub(r"\w+$", "", p) for p in params]
+        out[m[2]] = (_cs_kind(m[1]), [_cs_kind(t) for t in types])
+    return out
+
+
+def kinds_match(c: str, cs: str) -> bool:
+    """IntPtr stands for any pointer, and void* takes any pointer."""
+    if c == cs or (cs == "any" and c.startswith("ptr:")):
+        return True
+    if c.startswith("ptr:") and cs.startswith("ptr:"):
+        return c == "ptr:void" or kinds_match(c[4:], cs[4:])
+    return False
+
+
+def signature_problems(header: dict, declared: dict) -> dict[str, str]:
+    problems = {}
+    for name, (ret, params) in declared.items():
+        if name not in header:
+            problems[name] = "not in the header"
+            continue
+        c_ret, c_params = header[name]
+        if not kinds_match(c_ret, ret):
+            problems[name] = f"returns {ret}, the header {c_ret}"
+        elif len(params) != len(c_params):
+            problems[name] = f"{len(params)} parameters, the header {len(c_params)}"
+        else:
+            bad = [
+                i
+                for i, (c, cs) in enumerate(zip(c_params, params))
+                if not kinds_match(c, cs)
+            ]
+            if bad:
+                problems[name] = (
+                    f"parameter {bad[0]}: {params[bad[0]]}, the header {c_params[bad[0]]}"
+                )
+    return problems
+
+
+def test_csharp_declarations_match_the_headers_prototypes() -> None:
+    header, declared = header_functions(), csharp_functions()
+    assert len(declared) > 60 and "softdeca_avatar_fit_create" in declared
+    assert header["softdeca_avatar_fit_create"] == (
+        "i32",
+        [
+            "ptr:opaque",
+            "ptr:struct:softdeca_avatar_mesh",
+            "ptr:struct:softdeca_fit_options",
+            "ptr:ptr:opaque",
+        ],
+    )
+    assert signature_problems(header, declared) == {}
+
+
+def test_a_signature_mismatch_is_found() -> None:
+    header = {"f": ("i32", ["ptr:opaque", "u32", "ptr:f32"])}
+    assert (
+        signature_problems(header, {"f": ("i32", ["ptr:opaque", "u32", "ptr:f32"])})
+        == {}
+    )
+    assert (
+        signature_problems(header, {"f": ("i32", ["ptr:opaque", "u32", "any"])}) == {}
+    )
+    for wrong in (
+        ["ptr:opaque", "i32", "ptr:f32"],
+        ["ptr:opaque", "u32"],
+        ["ptr:opaque", "u32", "ptr:f64"],
+    ):
+        assert "f" in signature_problems(header, {"f": ("i32", wrong)}), wrong
+    assert signature_problems(header, {"g": ("void", [])}) == {"g": "not in the header"}
 
 
 @pytest.mark.parametrize(

@@ -1,4 +1,7 @@
-using System.Collections.Generic;
+using System;
+using System.Diagnostics;
+using System.IO;
+using System.Threading.Tasks;
 using SoftDeca;
 using SoftDeca.Unity;
 using UnityEditor;
@@ -7,9 +10,10 @@ using UnityEngine;
 namespace SoftDeca.Editor
 {
     /// <summary>
-    /// Material controls for SoftDecaAvatar: a slider per bundle parameter (its range and unit
-    /// from the bundle), region controls (spheres on the face, moved in the Scene view), and the
-    /// component's own fields.
+    /// The inspector of SoftDecaAvatar: the Fit button (fits the user's own mesh to the bundle's
+    /// template in the editor and stores the fit as an asset) with the fit's report, a slider per
+    /// bundle parameter (its range and unit from the bundle), region controls (spheres on the
+    /// face, moved in the Scene view), and the component's own fields.
     /// </summary>
     [CustomEditor(typeof(SoftDecaAvatar))]
     public sealed class SoftDecaAvatarEditor : UnityEditor.Editor
@@ -17,12 +21,16 @@ namespace SoftDeca.Editor
         private ParameterInfo[] parameters;
         private string loadedFrom;
         private string loadError;
+        private TextAsset reportOf;  // the fit asset whose report is shown
+        private FitReport report;
+        private string fitMessage;
 
         public override void OnInspectorGUI()
         {
             var avatar = (SoftDecaAvatar)target;
             serializedObject.Update();
             DrawPropertiesExcluding(serializedObject, "parameters", "regions");
+            FitSection(avatar);
             LoadParameters(avatar);
             EditorGUILayout.Space();
             EditorGUILayout.LabelField("Material", EditorStyles.boldLabel);
@@ -46,18 +54,129 @@ namespace SoftDeca.Editor
             loadedFrom = avatar.bundlePath;
             try
             {
-                string path = System.IO.Path.IsPathRooted(avatar.bundlePath)
-                                  ? avatar.bundlePath
-                                  : System.IO.Path.Combine(Application.streamingAssetsPath, avatar.bundlePath);
-                using (var model = Model.Load(path)) parameters = model.Parameters;
+                using (var model = Model.Load(avatar.BundleFullPath)) parameters = model.Parameters;
                 loadError = null;
             }
-            catch (System.Exception e)
+            catch (Exception e)
             {
                 parameters = null;
                 loadError = "The bundle's parameters are not available: " + e.Message;
             }
         }
+
+        // ---- the fit -------------------------------------------------------------------------
+
+        private void FitSection(SoftDecaAvatar avatar)
+        {
+            EditorGUILayout.Space();
+            EditorGUILayout.LabelField("Your avatar", EditorStyles.boldLabel);
+            EditorGUI.BeginDisabledGroup(EditorApplication.isPlaying || avatar.SourceMesh == null);
+            if (GUILayout.Button(avatar.fit == null ? "Fit" : "Fit again"))
+                EditorApplication.delayCall += () =>  // outside the inspector's layout pass
+                {
+                    Fit(avatar);
+                    Repaint();
+                };
+            EditorGUI.EndDisabledGroup();
+            if (fitMessage != null) EditorGUILayout.HelpBox(fitMessage, MessageType.Error);
+            ShowReport(avatar);
+        }
+
+        // Fits the renderer's mesh on a worker thread under a progress bar, saves the fit next to
+        // the mesh asset and assigns it.
+        private void Fit(SoftDecaAvatar avatar)
+        {
+            const string title = "SoftDECA: fitting the avatar";
+            if (avatar == null || avatar.SourceMesh == null) return;  // gone since the click
+            Mesh source = avatar.SourceMesh;
+            string asset = FitAssetPath(source);
+            fitMessage = null;
+            try
+            {
+                EditorUtility.DisplayProgressBar(title, "Reading " + source.name + " and its ARKit shapes", 0.05f);
+                AvatarMesh mesh = SoftDecaAvatar.ReadAvatarMesh(source);
+                using (var model = Model.Load(avatar.BundleFullPath))
+                {
+                    Task<AvatarFit> fitting = Task.Run(() => AvatarFit.Create(model, mesh));
+                    var clock = Stopwatch.StartNew();
+                    while (!fitting.Wait(100))
+                    {
+                        double t = clock.Elapsed.TotalSeconds;
+                        EditorUtility.DisplayProgressBar(title, "Fitting the template to the face of " + mesh.VertexCount + " vertices (" +
+                                                                t.ToString("F0") + " s)", 0.1f + 0.8f * (float)(1 - Math.Exp(-t / 10)));
+                    }
+                    EditorUtility.DisplayProgressBar(title, "Saving " + asset, 0.95f);
+                    using (AvatarFit done = fitting.Result)
+                    {
+                        done.Save(Path.GetFullPath(asset));
+                        report = done.Report();
+                    }
+                }
+                AssetDatabase.ImportAsset(asset);
+                Undo.RecordObject(avatar, "Fit avatar");
+                avatar.fit = AssetDatabase.LoadAssetAtPath<TextAsset>(asset);
+                reportOf = avatar.fit;
+                EditorUtility.SetDirty(avatar);
+            }
+            catch (Exception e)
+            {
+                var inner = e is AggregateException && e.InnerException != null ? e.InnerException : e;
+                fitMessage = "The fit failed: " + inner.Message;
+            }
+            finally
+            {
+                EditorUtility.ClearProgressBar();
+            }
+        }
+
+        // Next to the mesh's asset (an FBX's folder), else under Assets.
+        private static string FitAssetPath(Mesh mesh)
+        {
+            string meshPath = AssetDatabase.GetAssetPath(mesh);
+            string folder = string.IsNullOrEmpty(meshPath) ? "Assets" : Path.GetDirectoryName(meshPath).Replace('\\', '/');
+            if (!folder.StartsWith("Assets", StringComparison.Ordinal)) folder = "Assets";  // e.g. a package's read-only mesh
+            string name = mesh.name;
+            foreach (char c in Path.GetInvalidFileNameChars()) name = name.Replace(c, '_');
+            return folder + "/" + name + ".softdeca-fit.bytes";
+        }
+
+        // The assigned fit's report: kept from the fit just made, else read from the asset.
+        private void ShowReport(SoftDecaAvatar avatar)
+        {
+            if (avatar.fit == null) return;
+            if (reportOf != avatar.fit)
+            {
+                reportOf = avatar.fit;
+                report = null;
+                try
+                {
+                    using (var model = Model.Load(avatar.BundleFullPath))
+                    using (AvatarFit saved = AvatarFit.LoadBytes(model, avatar.fit.bytes, Application.temporaryCachePath))
+                        report = saved.Report();
+                }
+                catch (Exception e)
+                {
+                    fitMessage = "The fit " + avatar.fit.name + " cannot be read: " + e.Message;
+                }
+            }
+            if (report == null) return;
+            EditorGUILayout.LabelField("Metres per unit", Format(report.MetresPerUnit, "G4"));
+            EditorGUILayout.LabelField("Up axis", report.UpAxis ?? "?");
+            EditorGUILayout.LabelField("ARKit shapes", Count(report.ShapesMatched) + " matched, " + Count(report.ShapesCarried) +
+                                                       " carried from the template, " + Count(report.ShapesMissing) + " missing");
+            if (report.Mirrored) EditorGUILayout.HelpBox("The mesh was exported mirrored (left-handed).", MessageType.Warning);
+            EditorGUILayout.LabelField("Face residual", Format(report.FaceResidualMmMean, "F2") + " mm mean, " +
+                                                        Format(report.FaceResidualMmMax, "F2") + " mm largest");
+        }
+
+        private static string Count(string[] names) { return names == null ? "?" : names.Length.ToString(); }
+
+        private static string Format(double value, string format)
+        {
+            return double.IsNaN(value) ? "?" : value.ToString(format, System.Globalization.CultureInfo.InvariantCulture);
+        }
+
+        // ---- material ------------------------------------------------------------------------
 
         private void ParameterSlider(SoftDecaAvatar avatar, ParameterInfo p)
         {

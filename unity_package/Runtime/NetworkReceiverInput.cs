@@ -22,6 +22,8 @@ namespace SoftDeca.Unity
 
         private Receiver receiver;
         private Frame frame;
+        private int fetchedFrame = -1;
+        private bool haveFrame;
 
         public Receiver Receiver { get { return receiver; } }
 
@@ -39,13 +41,28 @@ namespace SoftDeca.Unity
             if (!string.IsNullOrEmpty(recordTo)) receiver.StopRecording();
             receiver.Dispose();
             receiver = null;
+            fetchedFrame = -1;
+        }
+
+        // The newest delivered frame, fetched once per Unity frame for weights and poses alike.
+        private bool Latest()
+        {
+            if (receiver == null) return false;
+            if (fetchedFrame != Time.frameCount)
+            {
+                fetchedFrame = Time.frameCount;
+                haveFrame = receiver.TryLatest(ref frame);
+            }
+            return haveFrame;
         }
 
         public override bool TryGetWeights(float[] weights)
         {
-            if (receiver == null || !receiver.TryLatest(ref frame) || frame.Tracking == (int)Tracking.Lost) return false;
+            if (!Latest() || frame.Tracking == (int)Tracking.Lost) return false;
             frame.CopyWeights(weights);
             return true;
         }
+
+        public override bool TryGetPose(ref FacePose pose) { return Latest() && PoseOf(ref frame, ref pose); }
     }
 }

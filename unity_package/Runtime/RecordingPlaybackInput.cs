@@ -63,5 +63,7 @@ namespace SoftDeca.Unity
             frame.CopyWeights(weights);
             return true;
         }
+
+        public override bool TryGetPose(ref FacePose pose) { return haveFrame && PoseOf(ref frame, ref pose); }
     }
 }

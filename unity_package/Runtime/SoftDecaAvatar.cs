@@ -4,6 +4,7 @@ using System.IO;
 using System.Threading.Tasks;
 using SoftDeca;
 using Unity.Collections;
+using Unity.Collections.LowLevel.Unsafe;
 using UnityEngine;
 
 namespace SoftDeca.Unity
@@ -21,17 +22,20 @@ namespace SoftDeca.Unity
     public struct MaterialRegion
     {
         public string parameter;
-        [Tooltip("Centre in the mesh's local space (metres)")] public Vector3 centre;
+        [Tooltip("Centre in the mesh's local space (its unit: metres for the template)")] public Vector3 centre;
         [Min(0)] public float radius;
         public float value;
     }
 
     /// <summary>
-    /// Drives a mesh in the template topology with SoftDECA (from blendshape weights), SparseSoftDECA
-    /// (from a tracked face mesh) or linear blendshapes. The mesh comes from a MeshFilter or a
-    /// SkinnedMeshRenderer on this object; its blendshapes named after ARKit's 52 give the
-    /// avatar's expressions. Each frame writes positions and normals through NativeArrays:
-    /// nothing is allocated on the managed heap per frame.
+    /// Drives the mesh of a MeshFilter or SkinnedMeshRenderer on this object with SoftDECA (from
+    /// blendshape weights), SparseSoftDECA (from a tracked face mesh) or linear blendshapes. With
+    /// a fit (the inspector's Fit button writes one) the mesh is the user's own avatar, of any
+    /// topology, a head or a whole body; without, it is a head in the bundle's template topology.
+    /// Its blendshapes named after ARKit's 52 give the avatar's expressions. The corrected
+    /// vertices are written into the mesh the renderer draws, so a SkinnedMeshRenderer's bones
+    /// still skin them. Each frame writes positions and normals through NativeArrays: nothing is
+    /// allocated on the managed heap per frame.
     /// </summary>
     [AddComponentMenu("SoftDECA/SoftDECA Avatar")]
     [DisallowMultipleComponent]
@@ -41,7 +45,9 @@ namespace SoftDeca.Unity
 
         [Tooltip("Model bundle folder or .tar, relative to StreamingAssets (or absolute)")]
         public string bundlePath = "softdeca-default";
-        [Tooltip("Optional: the template-topology neutral OBJ (saved as .bytes) when Unity's import split or reordered vertices")]
+        [Tooltip("The fit of this mesh to the bundle's template (the Fit button below writes it): animates your own avatar. Empty: the mesh is in the template topology")]
+        public TextAsset fit;
+        [Tooltip("Optional, template topology only: the template-topology neutral OBJ (saved as .bytes) when Unity's import split or reordered vertices")]
         public TextAsset templateObj;
         public SoftDecaFaceInput input;
         public Method method = Method.SoftDeca;
@@ -53,12 +59,14 @@ namespace SoftDeca.Unity
 
         private Model model;
         private Avatar avatar;
+        private AvatarFit avatarFit;
         private LandmarkInput landmarks;
-        private Mesh mesh;
-        private int[] toTemplate;           // Unity vertex -> template vertex
+        private Mesh sourceMesh;            // the renderer's own mesh, given back on disable
+        private Mesh mesh;                  // the copy the avatar writes
+        private int[] toAvatar;             // Unity vertex -> avatar vertex (template or fitted)
         private float[] weights = new float[BlendshapeMap.Count];
-        private float[] libraryNeutral;     // template order, library frame
-        private int[] skinTriangles;
+        private float[] libraryNeutral;     // the avatar's neutral (avatar order, library frame)
+        private int[] mapTriangles;         // the triangles material maps are given over
         private NativeArray<Vector3> positions, normals;
         private bool dirty;
         // The running prepare: material changes are prepared off the main thread (the physics
@@ -71,16 +79,37 @@ namespace SoftDeca.Unity
         public bool Preparing { get { return preparing != null && !preparing.IsCompleted; } }
         public Model Model { get { return model; } }
 
+        /// <summary>The bundle's path: bundlePath under StreamingAssets, or as it is when absolute.</summary>
+        public string BundleFullPath
+        {
+            get { return Path.IsPathRooted(bundlePath) ? bundlePath : Path.Combine(Application.streamingAssetsPath, bundlePath); }
+        }
+
+        /// <summary>The renderer's own mesh (what a fit is made for), also while the avatar draws its copy.</summary>
+        public Mesh SourceMesh
+        {
+            get
+            {
+                if (sourceMesh != null) return sourceMesh;
+                var skinned = GetComponent<SkinnedMeshRenderer>();
+                if (skinned != null) return skinned.sharedMesh;
+                var filter = GetComponent<MeshFilter>();
+                return filter != null ? filter.sharedMesh : null;
+            }
+        }
+
         private void OnEnable()
         {
-            Mesh source = SourceMesh();
+            Mesh source = SourceMesh;
             if (source == null) throw new InvalidOperationException("SoftDecaAvatar needs a MeshFilter or SkinnedMeshRenderer with a mesh");
-            string path = Path.IsPathRooted(bundlePath) ? bundlePath : Path.Combine(Application.streamingAssetsPath, bundlePath);
-            model = Model.Load(path);
+            model = Model.Load(BundleFullPath);
+            if (fit != null) BuildFitted(source);
+            else BuildTemplate(source);
+            avatar.SetDynamics(dynamics);
+            sourceMesh = source;
             mesh = Instantiate(source);
             mesh.MarkDynamic();
-            AssignMesh(mesh);
-            BuildAvatar(source);
+            AssignMesh(mesh, true);
             positions = new NativeArray<Vector3>(mesh.vertexCount, Allocator.Persistent);
             normals = new NativeArray<Vector3>(mesh.vertexCount, Allocator.Persistent);
             if (model.Info.HasSparse != 0) landmarks = new LandmarkInput(model);
@@ -92,9 +121,15 @@ namespace SoftDeca.Unity
         {
             FinishPrepare(true);
             if (avatar != null) avatar.Dispose();
+            if (avatarFit != null) avatarFit.Dispose();
             if (model != null) model.Dispose();
             avatar = null;
+            avatarFit = null;
             model = null;
+            if (sourceMesh != null) AssignMesh(sourceMesh, false);
+            if (mesh != null) Destroy(mesh);
+            sourceMesh = null;
+            mesh = null;
             if (positions.IsCreated) positions.Dispose();
             if (normals.IsCreated) normals.Dispose();
         }
@@ -102,82 +137,97 @@ namespace SoftDeca.Unity
         /// <summary>Re-applies parameters and regions at the next frame (the inspector calls this).</summary>
         public void MarkMaterialDirty() { dirty = true; }
 
-        private Mesh SourceMesh()
-        {
-            var skinned = GetComponent<SkinnedMeshRenderer>();
-            if (skinned != null) return skinned.sharedMesh;
-            var filter = GetComponent<MeshFilter>();
-            return filter != null ? filter.sharedMesh : null;
-        }
-
-        private void AssignMesh(Mesh m)
+        private void AssignMesh(Mesh m, bool avatarApplies)
         {
             var skinned = GetComponent<SkinnedMeshRenderer>();
             if (skinned != null)
             {
                 skinned.sharedMesh = m;
-                for (int i = 0; i < m.blendShapeCount; ++i) skinned.SetBlendShapeWeight(i, 0);  // the avatar applies them
+                if (avatarApplies)
+                    for (int i = 0; i < m.blendShapeCount; ++i) skinned.SetBlendShapeWeight(i, 0);  // the avatar applies them
             }
             else GetComponent<MeshFilter>().sharedMesh = m;
         }
 
-        private void BuildAvatar(Mesh source)
+        /// <summary>
+        /// A Unity mesh as the fit and the fitted avatar take it: positions and shapes in the
+        /// library's frame, its ARKit shapes by name, split vertices welded (AvatarMesh.FromUnity).
+        /// The Fit button and the avatar at run time read the mesh through this one function.
+        /// </summary>
+        public static AvatarMesh ReadAvatarMesh(Mesh source) { return ReadMesh(source, null, 0); }
+
+        // The mesh's positions, triangles and ARKit shapes: onto target vertices by toTarget, or welded.
+        private static unsafe AvatarMesh ReadMesh(Mesh source, int[] toTarget, int targetVertexCount)
+        {
+            var names = new string[source.blendShapeCount];
+            for (int i = 0; i < names.Length; ++i) names[i] = source.GetBlendShapeName(i);
+            var frame = new Vector3[source.vertexCount];
+            ShapeReader read = (shape, deltas) =>
+            {
+                source.GetBlendShapeFrameVertices(shape, source.GetBlendShapeFrameCount(shape) - 1, frame, null, null);
+                Flatten(frame, deltas);
+            };
+            Vector3[] vertices = source.vertices;
+            var unity = new float[3 * vertices.Length];
+            Flatten(vertices, unity);
+            return toTarget == null ? AvatarMesh.FromUnity(unity, source.triangles, names, read)
+                                    : AvatarMesh.FromUnity(unity, source.triangles, names, read, toTarget, targetVertexCount);
+        }
+
+        private static unsafe void Flatten(Vector3[] v, float[] xyz)
+        {
+            fixed (Vector3* p = v)
+            {
+                float* f = (float*)p;
+                for (int i = 0; i < xyz.Length; ++i) xyz[i] = f[i];
+            }
+        }
+
+        // The user's own avatar: the saved fit and the mesh it was made for.
+        private void BuildFitted(Mesh source)
+        {
+            AvatarMesh own = ReadAvatarMesh(source);
+            avatarFit = AvatarFit.LoadBytes(model, fit.bytes, Application.temporaryCachePath);
+            avatar = new Avatar(model, avatarFit, own, (uint)threads, precision);
+            toAvatar = own.UnityToAvatar;
+            libraryNeutral = own.Neutral;
+            mapTriangles = own.Triangles;
+        }
+
+        // A head in the template topology, its Unity vertices matched to the template's.
+        private void BuildTemplate(Mesh source)
         {
             int headCount = (int)model.Info.HeadVertexCount;
-            Vector3[] unity = source.vertices;
-            float[] unityLibrary = new float[unity.Length * 3];
-            for (int i = 0; i < unity.Length; ++i)
-            {
-                unityLibrary[3 * i] = -unity[i].x;  // Unity's importer negated x
-                unityLibrary[3 * i + 1] = unity[i].y;
-                unityLibrary[3 * i + 2] = unity[i].z;
-            }
-            int[] templateTriangles;
+            int[] templateTriangles = null;
             if (templateObj != null)
             {
                 ObjText obj = ObjText.Parse(templateObj.text);
                 libraryNeutral = obj.Positions;
                 templateTriangles = obj.Triangles;
-                toTemplate = TemplateMapping.Build(unityLibrary, libraryNeutral);
+                Vector3[] unity = source.vertices;
+                var unityLibrary = new float[unity.Length * 3];
+                Flatten(unity, unityLibrary);
+                MeshConversion.PositionsToLibrary(unityLibrary, unityLibrary);
+                toAvatar = TemplateMapping.Build(unityLibrary, libraryNeutral);
             }
             else
             {
-                if (unity.Length != headCount)
-                    throw new InvalidOperationException("the mesh has " + unity.Length + " vertices, the bundle's template " + headCount +
-                                                        ": assign templateObj (the neutral OBJ) so vertices can be matched");
-                libraryNeutral = unityLibrary;
-                templateTriangles = MeshConversion.TrianglesToLibrary(source.triangles);
-                toTemplate = new int[headCount];
-                for (int i = 0; i < headCount; ++i) toTemplate[i] = i;
+                if (source.vertexCount != headCount)
+                    throw new InvalidOperationException("the mesh has " + source.vertexCount + " vertices, the bundle's template " +
+                                                        headCount + ": assign a fit (the Fit button) for a mesh of its own " +
+                                                        "topology, or templateObj (the neutral OBJ) so vertices can be matched");
+                toAvatar = new int[headCount];
+                for (int i = 0; i < headCount; ++i) toAvatar[i] = i;
             }
-            avatar = new Avatar(model, libraryNeutral, templateTriangles, Blendshapes(source, headCount), (uint)threads, precision);
-            skinTriangles = model.SkinTriangles();
-            avatar.SetDynamics(dynamics);
-        }
-
-        // The mesh's blendshapes named after ARKit's shapes, as template-order deltas; null without any.
-        private float[] Blendshapes(Mesh source, int headCount)
-        {
-            var names = new string[source.blendShapeCount];
-            for (int i = 0; i < names.Length; ++i) names[i] = source.GetBlendShapeName(i);
-            var map = new BlendshapeMap(names);
-            if (map.Unmatched.Length == names.Length) return null;
-            var deltas = new float[BlendshapeMap.Count * headCount * 3];
-            var frame = new Vector3[source.vertexCount];
-            for (int i = 0; i < names.Length; ++i)
+            AvatarMesh rig = ReadMesh(source, toAvatar, headCount);
+            if (templateObj == null)
             {
-                int c = map.ToCanonical(i);
-                if (c < 0) continue;
-                source.GetBlendShapeFrameVertices(i, source.GetBlendShapeFrameCount(i) - 1, frame, null, null);
-                for (int v = 0; v < frame.Length; ++v)
-                {
-                    int t = 3 * (c * headCount + toTemplate[v]);
-                    deltas[t] = -frame[v].x;
-                    deltas[t + 1] = frame[v].y;
-                    deltas[t + 2] = frame[v].z;
-                }
+                libraryNeutral = rig.Neutral;
+                templateTriangles = rig.Triangles;
             }
-            return deltas;
+            avatar = new Avatar(model, libraryNeutral, templateTriangles, rig.ShapesFound == 0 ? null : rig.Blendshapes, (uint)threads,
+                                precision);
+            mapTriangles = model.SkinTriangles();
         }
 
         private void ApplyMaterial()
@@ -190,12 +240,14 @@ namespace SoftDeca.Unity
                 float[] faces;
                 if (!byParameter.TryGetValue(r.parameter, out faces))
                 {
-                    faces = new float[skinTriangles.Length / 3];
+                    faces = new float[mapTriangles.Length / 3];
                     float baseline = (float)avatar.GetParameter(r.parameter);
                     for (int f = 0; f < faces.Length; ++f) faces[f] = baseline;
                     byParameter[r.parameter] = faces;
                 }
-                RegionMap.Paint(libraryNeutral, skinTriangles, faces, -r.centre.x, r.centre.y, r.centre.z, r.radius, r.value);
+                var centre = new[] { r.centre.x, r.centre.y, r.centre.z };
+                MeshConversion.PositionsToLibrary(centre, centre);
+                RegionMap.Paint(libraryNeutral, mapTriangles, faces, centre[0], centre[1], centre[2], r.radius, r.value);
             }
             foreach (var kv in byParameter) avatar.SetParameterFaces(kv.Key, kv.Value);
             dirty = false;
@@ -242,15 +294,12 @@ namespace SoftDeca.Unity
             WriteMesh();
         }
 
-        private void WriteMesh()
+        private unsafe void WriteMesh()
         {
-            float[] v = avatar.Vertices, n = avatar.Normals;
-            for (int i = 0; i < toTemplate.Length; ++i)
-            {
-                int t = 3 * toTemplate[i];
-                positions[i] = new Vector3(-v[t], v[t + 1], v[t + 2]);
-                normals[i] = new Vector3(-n[t], n[t + 1], n[t + 2]);
-            }
+            MeshConversion.PositionsToUnity(avatar.Vertices, toAvatar, (float*)NativeArrayUnsafeUtility.GetUnsafePtr(positions),
+                                            positions.Length);
+            MeshConversion.PositionsToUnity(avatar.Normals, toAvatar, (float*)NativeArrayUnsafeUtility.GetUnsafePtr(normals),
+                                            normals.Length);
             mesh.SetVertices(positions);
             mesh.SetNormals(normals);
             mesh.RecalculateBounds();

@@ -4,9 +4,9 @@ using UnityEngine;
 namespace SoftDeca.Unity
 {
     /// <summary>
-    /// A source of face frames for SoftDecaAvatar: AR Foundation face tracking, the network
-    /// receiver or a recording. Inputs are interchangeable: the avatar asks the one it is given
-    /// for the current frame each Update.
+    /// A source of face frames for SoftDecaAvatar and SoftDecaHeadAndEyes: AR Foundation face
+    /// tracking, the network receiver or a recording. Inputs are interchangeable: the components
+    /// ask the one they are given for the current frame each Update.
     /// </summary>
     public abstract class SoftDecaFaceInput : MonoBehaviour
     {
@@ -18,5 +18,18 @@ namespace SoftDeca.Unity
         /// profile; false when the input has no face mesh (then the avatar uses the weights).
         /// </summary>
         public virtual bool TryGetLandmarks(LandmarkInput landmarks) { return false; }
+
+        /// <summary>
+        /// Writes the current head pose and eye gaze in ARKit's face-anchor frame (the canonical
+        /// frame's); false when the input has neither (SoftDecaHeadAndEyes then holds the last).
+        /// </summary>
+        public virtual bool TryGetPose(ref FacePose pose) { return false; }
+
+        /// <summary>The poses a canonical frame carries (receiver, recordings); false when it has none.</summary>
+        protected static bool PoseOf(ref Frame frame, ref FacePose pose)
+        {
+            pose = FacePose.FromFrame(ref frame);
+            return pose.HasHead || pose.HasEyes;
+        }
     }
 }

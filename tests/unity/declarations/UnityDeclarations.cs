@@ -11,7 +11,9 @@ namespace UnityEngine
 {
     public class Object
     {
+        public string name { get { throw new NotImplementedException(); } set { throw new NotImplementedException(); } }
         public static T Instantiate<T>(T original) where T : Object { throw new NotImplementedException(); }
+        public static void Destroy(Object obj) { throw new NotImplementedException(); }
         public static T FindAnyObjectByType<T>() where T : Object { throw new NotImplementedException(); }
     }
     public class Component : Object
@@ -19,6 +21,7 @@ namespace UnityEngine
         public Transform transform { get { throw new NotImplementedException(); } }
         public GameObject gameObject { get { throw new NotImplementedException(); } }
         public T GetComponent<T>() { throw new NotImplementedException(); }
+        public T GetComponentInParent<T>() { throw new NotImplementedException(); }
     }
     public class Behaviour : Component { public bool enabled; }
     public class GameObject : Object { public T AddComponent<T>() where T : Component { throw new NotImplementedException(); } }
@@ -33,6 +36,7 @@ namespace UnityEngine
     public class Transform : Component
     {
         public Quaternion rotation;
+        public Quaternion localRotation;
         public Vector3 lossyScale;
         public Vector3 TransformPoint(Vector3 p) { throw new NotImplementedException(); }
         public Vector3 InverseTransformPoint(Vector3 p) { throw new NotImplementedException(); }
@@ -42,7 +46,18 @@ namespace UnityEngine
         public float x, y, z;
         public Vector3(float x, float y, float z) { this.x = x; this.y = y; this.z = z; }
     }
-    public struct Quaternion { public float x, y, z, w; }
+    public struct Quaternion
+    {
+        public float x, y, z, w;
+        public Quaternion(float x, float y, float z, float w) { this.x = x; this.y = y; this.z = z; this.w = w; }
+    }
+    // The members' values are Unity's (HumanBodyBones.Neck = 9, ...); the others are left out.
+    public enum HumanBodyBones { Neck = 9, Head = 10, LeftEye = 21, RightEye = 22 }
+    public class Animator : Behaviour
+    {
+        public bool isHuman { get { throw new NotImplementedException(); } }
+        public Transform GetBoneTransform(HumanBodyBones humanBoneId) { throw new NotImplementedException(); }
+    }
     public struct Color { public Color(float r, float g, float b, float a) { } }
     public class Mesh : Object
     {
@@ -66,12 +81,21 @@ namespace UnityEngine
         public Mesh sharedMesh;
         public void SetBlendShapeWeight(int index, float value) { throw new NotImplementedException(); }
     }
-    public class TextAsset : Object { public string text { get { throw new NotImplementedException(); } } }
-    public static class Application { public static string streamingAssetsPath { get { throw new NotImplementedException(); } } }
+    public class TextAsset : Object
+    {
+        public string text { get { throw new NotImplementedException(); } }
+        public byte[] bytes { get { throw new NotImplementedException(); } }
+    }
+    public static class Application
+    {
+        public static string streamingAssetsPath { get { throw new NotImplementedException(); } }
+        public static string temporaryCachePath { get { throw new NotImplementedException(); } }
+    }
     public static class Time
     {
         public static float deltaTime { get { throw new NotImplementedException(); } }
         public static float time { get { throw new NotImplementedException(); } }
+        public static int frameCount { get { throw new NotImplementedException(); } }
     }
     public static class SystemInfo { public static string deviceName { get { throw new NotImplementedException(); } } }
     public static class Mathf { public static float Max(float a, float b) { throw new NotImplementedException(); } }
@@ -119,6 +143,7 @@ namespace Unity.Collections.LowLevel.Unsafe
     public static class NativeArrayUnsafeUtility
     {
         public static unsafe void* GetUnsafeReadOnlyPtr<T>(NativeArray<T> array) where T : struct { throw new NotImplementedException(); }
+        public static unsafe void* GetUnsafePtr<T>(NativeArray<T> array) where T : struct { throw new NotImplementedException(); }
     }
 }
 
@@ -156,6 +181,8 @@ namespace UnityEngine.XR.ARFoundation
     public class ARFace : ARTrackable
     {
         public Unity.Collections.NativeArray<Vector3> vertices { get { throw new NotImplementedException(); } }
+        public Transform leftEye { get { throw new NotImplementedException(); } }
+        public Transform rightEye { get { throw new NotImplementedException(); } }
     }
     public struct ARTrackablesChangedEventArgs<T>
     {
@@ -202,6 +229,7 @@ namespace UnityEditor
         public Object target { get { throw new NotImplementedException(); } }
         public SerializedObject serializedObject { get { throw new NotImplementedException(); } }
         public virtual void OnInspectorGUI() { }
+        public void Repaint() { throw new NotImplementedException(); }
         protected static void DrawPropertiesExcluding(SerializedObject obj, params string[] propertyToExclude) { throw new NotImplementedException(); }
     }
     public class ScriptableObjectStandIn : Object { }
@@ -210,6 +238,7 @@ namespace UnityEditor
     public static class EditorGUILayout
     {
         public static void LabelField(string label, GUIStyle style) { throw new NotImplementedException(); }
+        public static void LabelField(string label, string label2, params GUILayoutOption[] options) { throw new NotImplementedException(); }
         public static void Space() { throw new NotImplementedException(); }
         public static void HelpBox(string message, MessageType type) { throw new NotImplementedException(); }
         public static bool PropertyField(SerializedProperty property, bool includeChildren) { throw new NotImplementedException(); }
@@ -221,6 +250,26 @@ namespace UnityEditor
     {
         public static void BeginChangeCheck() { throw new NotImplementedException(); }
         public static bool EndChangeCheck() { throw new NotImplementedException(); }
+        public static void BeginDisabledGroup(bool disabled) { throw new NotImplementedException(); }
+        public static void EndDisabledGroup() { throw new NotImplementedException(); }
+    }
+    public sealed class EditorApplication
+    {
+        public delegate void CallbackFunction();
+        public static CallbackFunction delayCall;
+        public static bool isPlaying { get { throw new NotImplementedException(); } }
+    }
+    public static class EditorUtility
+    {
+        public static void DisplayProgressBar(string title, string info, float progress) { throw new NotImplementedException(); }
+        public static void ClearProgressBar() { throw new NotImplementedException(); }
+        public static void SetDirty(Object target) { throw new NotImplementedException(); }
+    }
+    public static class AssetDatabase
+    {
+        public static string GetAssetPath(Object assetObject) { throw new NotImplementedException(); }
+        public static void ImportAsset(string path) { throw new NotImplementedException(); }
+        public static T LoadAssetAtPath<T>(string assetPath) where T : Object { throw new NotImplementedException(); }
     }
     public static class Undo { public static void RecordObject(Object o, string name) { throw new NotImplementedException(); } }
     public static class Handles

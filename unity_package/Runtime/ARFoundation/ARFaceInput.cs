@@ -12,7 +12,8 @@ namespace SoftDeca.Unity
     /// <summary>
     /// Live face tracking through AR Foundation (ARKit on iOS): blendshape coefficients mapped by
     /// name into the canonical order, and the face mesh (ARFace.vertices, 1,220 vertices) for
-    /// SparseSoftDECA through the bundle's landmark profile (z negated back to ARKit's frame).
+    /// SparseSoftDECA through the bundle's landmark profile (z negated back to ARKit's frame), and
+    /// the head's and eyes' rotations for SoftDecaHeadAndEyes (mirrored back likewise).
     /// </summary>
     [AddComponentMenu("SoftDECA/AR Face Input")]
     public sealed class ARFaceInput : SoftDecaFaceInput
@@ -64,6 +65,25 @@ namespace SoftDeca.Unity
             using (NativeArray<XRFaceBlendShape> shapes = result.value)
             {
                 for (int i = 0; i < shapes.Length; ++i) map.Set(weights, shapes[i].blendShapeId, shapes[i].coefficient);
+            }
+            return true;
+        }
+
+        /// <summary>
+        /// The face anchor's rotation in session space and the eyes' relative to it (ARFace.leftEye,
+        /// rightEye), turned back into ARKit's frame: AR Foundation's provider mirrored z.
+        /// </summary>
+        public override bool TryGetPose(ref FacePose pose)
+        {
+            if (face == null || face.trackingState != TrackingState.Tracking) return false;
+            pose.HasHead = true;
+            pose.Head = PoseMath.ArFoundationToArkit(face.transform.localRotation.ToQuat());
+            Transform left = face.leftEye, right = face.rightEye;
+            pose.HasEyes = left != null && right != null;
+            if (pose.HasEyes)
+            {
+                pose.LeftEye = PoseMath.ArFoundationToArkit(left.localRotation.ToQuat());
+                pose.RightEye = PoseMath.ArFoundationToArkit(right.localRotation.ToQuat());
             }
             return true;
         }

@@ -4,7 +4,8 @@ using System.Collections.Generic;
 namespace SoftDeca
 {
     /// <summary>
-    /// One head driven by a model (softdeca_avatar). Frames write into Vertices and Normals
+    /// One head driven by a model (softdeca_avatar): a head in the bundle's template topology, or
+    /// a user's own avatar made from an AvatarFit. Frames write into Vertices and Normals
     /// (allocated once), or into caller memory through the pointer overloads; a frame allocates
     /// nothing on the managed heap. Evaluate calls come from one thread at a time.
     /// </summary>
@@ -15,14 +16,19 @@ namespace SoftDeca
         private readonly ParameterInfo[] parameters;
         private readonly Dictionary<string, int> parameterIndex = new Dictionary<string, int>(StringComparer.Ordinal);
         private readonly Model model;
+        private readonly int vertexCount;
+        private readonly AvatarFit fit;
 
-        /// <summary>The last frame's vertices, xyz per head vertex (template order).</summary>
+        /// <summary>The last frame's vertices, xyz per vertex: the template's head, or the fitted avatar's own vertices.</summary>
         public readonly float[] Vertices;
-        /// <summary>The last frame's unit normals, xyz per head vertex.</summary>
+        /// <summary>The last frame's unit normals, xyz per vertex.</summary>
         public readonly float[] Normals;
 
         public ModelInfo ModelInfo { get { return info; } }
-        public int VertexCount { get { return (int)info.HeadVertexCount; } }
+        /// <summary>Vertices per frame: the template's HeadVertexCount, or the fitted avatar's own count.</summary>
+        public int VertexCount { get { return vertexCount; } }
+        /// <summary>Whether this avatar is a user's own mesh made from an AvatarFit.</summary>
+        public bool Fitted { get { return fit != null; } }
         private AvatarHandle Handle { get { handle.ThrowIfClosed("Avatar"); return handle; } }
 
         /// <param name="neutral">the avatar's neutral head, xyz per vertex (HeadVertexCount vertices)</param>
@@ -30,16 +36,42 @@ namespace SoftDeca
         /// <param name="blendshapes">null, or 52 * HeadVertexCount * 3 deltas from the neutral, canonical ARKit order</param>
         public Avatar(Model model, float[] neutral, int[] triangles, float[] blendshapes = null, uint threads = 1,
                       Precision precision = Precision.Half)
+            : this(model, CreateTemplate(model, neutral, triangles, blendshapes, threads, precision), null, -1)
+        {
+        }
+
+        /// <summary>
+        /// A user's own avatar: mesh is the mesh the fit was made for (the library checks it by a
+        /// hash of its neutral and triangles: a changed mesh is refused); Vertices then hold the
+        /// avatar's own vertices, and parameter maps are given per avatar triangle or vertex.
+        /// Keep the fit until this avatar is disposed.
+        /// </summary>
+        public Avatar(Model model, AvatarFit fit, AvatarMesh mesh, uint threads = 1, Precision precision = Precision.Half)
+            : this(model, CreateFitted(model, fit, mesh, threads, precision), fit, mesh.VertexCount)
+        {
+        }
+
+        private Avatar(Model model, AvatarHandle handle, AvatarFit fit, int vertexCount)
+        {
+            this.model = model;
+            this.handle = handle;
+            this.fit = fit;
+            info = model.Info;
+            parameters = model.Parameters;
+            foreach (var p in parameters) parameterIndex[p.Name] = p.Index;
+            this.vertexCount = vertexCount < 0 ? (int)info.HeadVertexCount : vertexCount;
+            Vertices = new float[this.vertexCount * 3];
+            Normals = new float[this.vertexCount * 3];
+        }
+
+        private static AvatarHandle CreateTemplate(Model model, float[] neutral, int[] triangles, float[] blendshapes, uint threads,
+                                                   Precision precision)
         {
             if (model == null) throw new ArgumentNullException("model");
             if (neutral == null) throw new ArgumentNullException("neutral");
             if (triangles == null) throw new ArgumentNullException("triangles");
             if (neutral.Length % 3 != 0) throw new ArgumentException("neutral holds xyz triples", "neutral");
             if (triangles.Length % 3 != 0) throw new ArgumentException("triangles holds 3 indices each", "triangles");
-            this.model = model;
-            info = model.Info;
-            parameters = model.Parameters;
-            foreach (var p in parameters) parameterIndex[p.Name] = p.Index;
             int vertexCount = neutral.Length / 3;
             if (blendshapes != null && blendshapes.Length != 52 * neutral.Length)
                 throw new ArgumentException("blendshapes must hold 52 * " + vertexCount + " * 3 floats, not " + blendshapes.Length,
@@ -61,11 +93,28 @@ namespace SoftDeca
                 desc.Blendshapes = (IntPtr)b;
                 s = NativeMethods.softdeca_avatar_create(model.Handle, ref desc, out native);
             }
+            return Adopt(s, native);
+        }
+
+        private static AvatarHandle CreateFitted(Model model, AvatarFit fit, AvatarMesh mesh, uint threads, Precision precision)
+        {
+            if (model == null) throw new ArgumentNullException("model");
+            if (fit == null) throw new ArgumentNullException("fit");
+            if (mesh == null) throw new ArgumentNullException("mesh");
+            IntPtr native;
+            Status s;
+            using (var pinned = new PinnedAvatarMesh(mesh))
+                s = NativeMethods.softdeca_avatar_create_fitted(model.Handle, fit.Handle, ref pinned.Native, threads, (int)precision,
+                                                                out native);
+            return Adopt(s, native);
+        }
+
+        private static AvatarHandle Adopt(Status s, IntPtr native)
+        {
             Library.Check(s);
-            handle = new AvatarHandle();
-            handle.Adopt(native);
-            Vertices = new float[info.HeadVertexCount * 3];
-            Normals = new float[info.HeadVertexCount * 3];
+            var h = new AvatarHandle();
+            h.Adopt(native);
+            return h;
         }
 
         // ---- parameters ------------------------------------------------------------------------

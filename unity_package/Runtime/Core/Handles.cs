@@ -31,6 +31,11 @@ namespace SoftDeca
         protected override bool ReleaseHandle() { NativeMethods.softdeca_avatar_destroy(handle); return true; }
     }
 
+    public sealed class AvatarFitHandle : SoftDecaHandle
+    {
+        protected override bool ReleaseHandle() { NativeMethods.softdeca_avatar_fit_destroy(handle); return true; }
+    }
+
     public sealed class ReceiverHandle : SoftDecaHandle
     {
         protected override bool ReleaseHandle() { NativeMethods.softdeca_receiver_destroy(handle); return true; }

@@ -5,24 +5,68 @@ using System.Globalization;
 namespace SoftDeca
 {
     /// <summary>
-    /// Between a Unity mesh and the library's template. Unity's model importer turns the
-    /// right-handed files the repository's tools write (OBJ, FBX) left-handed by negating x and
-    /// reversing each triangle's winding; ToLibrary and FromLibrary undo and redo that. Unity may
-    /// also split or reorder vertices: TemplateMapping finds each Unity vertex's template vertex
-    /// by position.
+    /// Between a Unity mesh and the library. Unity's model importer turns the right-handed files
+    /// DCC tools write (OBJ, FBX) left-handed by negating x and reversing each triangle's
+    /// winding; the library takes right-handed coordinates. This is the package's one rule for
+    /// mesh data (positions, blendshape deltas, normals) in both directions: x negated, the
+    /// second and third corner of a triangle swapped. Unity may also split or reorder vertices:
+    /// TemplateMapping finds each Unity vertex's template vertex by position, AvatarMesh welds a
+    /// user's avatar's split vertices.
     /// </summary>
-    public static class MeshConversion
+    public static unsafe class MeshConversion
     {
+        /// <summary>The axis whose sign differs between Unity's mesh space and the library's (x).</summary>
+        public const int MirroredAxis = 0;
+
         /// <summary>Unity mesh positions (xyz) into the library's frame: x negated.</summary>
         public static void PositionsToLibrary(float[] unity, float[] library)
         {
             if (unity == null || library == null || library.Length < unity.Length)
                 throw new ArgumentException("library needs as many floats as unity");
-            for (int i = 0; i < unity.Length; i += 3)
+            fixed (float* u = unity)
+            fixed (float* l = library)
+                PositionsToLibrary(u, l, unity.Length / 3);
+        }
+
+        /// <summary>
+        /// vertexCount xyz triples from Unity's frame into the library's, or back (the mirror is
+        /// its own inverse); unity and library may be the same memory.
+        /// </summary>
+        public static void PositionsToLibrary(float* unity, float* library, int vertexCount)
+        {
+            for (int i = 0; i < 3 * vertexCount; i += 3)
             {
                 library[i] = -unity[i];
                 library[i + 1] = unity[i + 1];
                 library[i + 2] = unity[i + 2];
+            }
+        }
+
+        /// <summary>
+        /// Library xyz triples into a Unity buffer of vertexCount vertices (e.g. a NativeArray of
+        /// Vector3): Unity vertex i takes library vertex map[i] (map null: vertex i), x negated.
+        /// Per frame: allocates nothing.
+        /// </summary>
+        public static void PositionsToUnity(float[] library, int[] map, float* unity, int vertexCount)
+        {
+            if (library == null) throw new ArgumentNullException("library");
+            if (map != null && map.Length < vertexCount) throw new ArgumentException("map has fewer entries than vertices", "map");
+            if (map == null && library.Length < 3 * vertexCount)
+                throw new ArgumentException("library has fewer vertices than the Unity buffer", "library");
+            int libraryCount = library.Length / 3;
+            fixed (float* l = library)
+            {
+                for (int i = 0; i < vertexCount; ++i)
+                {
+                    int source = map == null ? i : map[i];
+                    if ((uint)source >= (uint)libraryCount)
+                        throw new ArgumentException("map[" + i + "] = " + source + " is not a library vertex", "map");
+                    float* s = l + 3 * source;
+                    float* d = unity + 3 * i;
+                    d[0] = -s[0];
+                    d[1] = s[1];
+                    d[2] = s[2];
+                }
             }
         }
 

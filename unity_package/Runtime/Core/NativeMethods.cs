@@ -82,6 +82,24 @@ namespace SoftDeca
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_avatar_get_stats(AvatarHandle avatar, ref AvatarStats stats);
 
+        // ---- a user's own avatar: the fit and the fitted avatar ----
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_fit_options_init(ref FitOptions options);
+        [DllImport(Library, CallingConvention = Cdecl)]
+        public static extern Status softdeca_avatar_fit_create(ModelHandle model, ref NativeAvatarMesh mesh, ref FitOptions options,
+                                                               out IntPtr fit);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern void softdeca_avatar_fit_destroy(IntPtr fit);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_avatar_fit_save(AvatarFitHandle fit, byte* path);
+        [DllImport(Library, CallingConvention = Cdecl)]
+        public static extern Status softdeca_avatar_fit_load(ModelHandle model, byte* path, out IntPtr fit);
+        [DllImport(Library, CallingConvention = Cdecl)]
+        public static extern Status softdeca_avatar_fit_report(AvatarFitHandle fit, byte* buffer, uint capacity, out uint length);
+        [DllImport(Library, CallingConvention = Cdecl)]
+        public static extern Status softdeca_avatar_fit_get_registered(AvatarFitHandle fit, float* points, uint pointCapacity,
+                                                                       out uint vertexCount);
+        [DllImport(Library, CallingConvention = Cdecl)]
+        public static extern Status softdeca_avatar_create_fitted(ModelHandle model, AvatarFitHandle fit, ref NativeAvatarMesh mesh,
+                                                                  uint threads, int precision, out IntPtr avatar);
+
         // ---- receiver ----
         [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_receiver_config_init(ref ReceiverConfig config);
         [DllImport(Library, CallingConvention = Cdecl)]

@@ -172,6 +172,44 @@ namespace SoftDeca
         }
     }
 
+    /// <summary>
+    /// softdeca_avatar_mesh: a user's avatar in its own units and right-handed coordinates (the
+    /// managed side is AvatarMesh).
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct NativeAvatarMesh
+    {
+        /// <summary>SOFTDECA_MAX_AVATAR_VERTICES.</summary>
+        public const uint MaxVertices = 4000000u;
+
+        public uint StructSize;
+        public IntPtr Neutral;
+        public uint VertexCount;
+        public IntPtr Triangles;
+        public uint TriangleCount;
+        public IntPtr Blendshapes;
+        public uint BlendshapeCount;
+        public IntPtr Landmarks;
+        public uint LandmarkCount;
+
+        public static NativeAvatarMesh Create()
+        {
+            return new NativeAvatarMesh { StructSize = (uint)sizeof(NativeAvatarMesh) };
+        }
+    }
+
+    /// <summary>softdeca_fit_options: how an avatar is fitted to the bundle's template.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public unsafe struct FitOptions
+    {
+        public uint StructSize;
+        /// <summary>0: read off the avatar's shapes (snapped to mm, cm, inch, dm or m).</summary>
+        public double MetresPerUnit;
+        /// <summary>Registration iterations; 0: the library's default.</summary>
+        public uint Iterations;
+        public uint Reserved;
+    }
+
     /// <summary>softdeca_pose: position in metres, rotation as a unit quaternion (x, y, z, w).</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct Pose

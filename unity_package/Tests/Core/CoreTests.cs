@@ -33,6 +33,8 @@ namespace SoftDeca.Tests
                 { "softdeca_avatar_desc", typeof(AvatarDesc) },
                 { "softdeca_output", typeof(Output) },
                 { "softdeca_stats", typeof(AvatarStats) },
+                { "softdeca_avatar_mesh", typeof(NativeAvatarMesh) },
+                { "softdeca_fit_options", typeof(FitOptions) },
                 { "softdeca_parameter_info", typeof(NativeParameterInfo) },
                 { "softdeca_pose", typeof(Pose) },
                 { "softdeca_frame", typeof(Frame) },
@@ -402,22 +404,31 @@ namespace SoftDeca.Tests
 
         private static float i2f(int i, int shape) { return ((shape + i) % 10) / 10.0f; }
 
-        // Live Link Face UDP, version 6: version byte, device id and subject name (int32 length +
-        // UTF-8), frame number, sub-frame (float), frame rate, the value count and 61 big-endian floats (52 ARKit shapes in Live Link Face's order,
-        // then head and eye angles). The jaw-open slot carries i2f(i, 24).
+        // The jaw-open slot carries i2f(i, 24).
         private static byte[] LiveLinkFacePacket(int i)
+        {
+            var values = new float[61];
+            values[LiveLinkFaceJawOpen] = i2f(i, 24);
+            return LiveLinkFacePacket(1000 + i, values);
+        }
+
+        // Live Link Face UDP, version 6: version byte, device id and subject name (int32 length +
+        // UTF-8), frame number, sub-frame (float), frame rate, the value count and 61 big-endian
+        // floats (52 ARKit shapes in Live Link Face's order, then head and eye angles: yaw, pitch
+        // and roll of the head, the left eye and the right eye).
+        internal static byte[] LiveLinkFacePacket(int frameNumber, float[] values)
         {
             var ms = new MemoryStream();
             var w = new BinaryWriter(ms);
             w.Write((byte)6);
             WriteString(w, "nunit-device");
             WriteString(w, "nunit");
-            WriteBE(w, 1000 + i);          // frame number
+            WriteBE(w, frameNumber);
             WriteBE(w, 0.0f);              // sub-frame
             WriteBE(w, 60);                // fps numerator
             WriteBE(w, 1);                 // fps denominator
-            w.Write((byte)61);
-            for (int k = 0; k < 61; ++k) WriteBE(w, k == LiveLinkFaceJawOpen ? i2f(i, 24) : 0.0f);
+            w.Write((byte)values.Length);
+            foreach (float v in values) WriteBE(w, v);
             return ms.ToArray();
         }
 

@@ -26,6 +26,8 @@ namespace SoftDeca.Tests
         public static string SmallData { get { return Require("SOFTDECA_SMALL_DATA"); } }
         public static string TempDir { get { return Require("SOFTDECA_TEST_TMP"); } }
         public static string SmallBundle { get { return Path.Combine(SmallData, "bundle"); } }
+        /// <summary>The bundle the avatar fit tests fit to (one with the template head).</summary>
+        public static string FitBundle { get { return Require("SOFTDECA_FIT_BUNDLE"); } }
 
         private static Rig smallRig;
 
