@@ -174,8 +174,9 @@ def _fit_check_run(args: argparse.Namespace) -> int:
     worst = max(t["softdeca_ratio"] for i in report["identities"] for t in i["takes"])
     residual = max(i["fit"]["face_residual_mm_mean"] for i in report["identities"])
     print(
-        f"wrote {out}: face residual at most {residual:.3f} mm; SoftDECA's correction off by at "
-        f"most {100 * worst:.1f} % of its mean over the face (per take) in {report['seconds']:.0f} s"
+        f"wrote {out}: face residual at most {residual:.3f} mm; SoftDECA's correction off by "
+        f"at most {100 * worst:.1f} % of its mean over the face (per take); "
+        f"{report['seconds']:.0f} s"
     )
     return 0
 

@@ -166,8 +166,9 @@ def check_identity(
         result.takes.append(r)
         if progress:
             print(
-                f"  {identity:>9} {r.take:<11} {r.frames:4d} frames  SoftDECA {r.softdeca_ratio:.3f} "
-                f"(max {r.softdeca_ratio_max:.3f})  sparse {r.sparse_ratio:.3f}  "
+                f"  {identity:>9} {r.take:<11} {r.frames:4d} frames  "
+                f"SoftDECA {r.softdeca_ratio:.3f} (max {r.softdeca_ratio_max:.3f})  "
+                f"sparse {r.sparse_ratio:.3f}  "
                 f"max from linear {r.max_from_linear_mm:.1f} mm",
                 file=sys.stderr,
                 flush=True,
