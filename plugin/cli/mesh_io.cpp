@@ -39,7 +39,7 @@ ObjMesh read_obj(const std::string& path) {
         if (end == p) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad face");
         const long n = static_cast<long>(m.vertex_count());
         idx = idx < 0 ? n + idx : idx - 1;
-        if (idx < 0) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": face index out of range");
+        if (idx < 0 || idx > 0x7fffffffL) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": face index out of range");
         poly.push_back(static_cast<std::int32_t>(idx));
         p = end;
         while (*p && *p != ' ' && *p != '\t') ++p;  // skip /vt/vn

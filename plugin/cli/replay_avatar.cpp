@@ -62,6 +62,7 @@ ReplayAvatar open_replay_avatar(const Model& model, const std::string& path, con
   if (template_topology(model, path)) open_template(model, path, threads, precision, a);
   else open_fitted(model, path, names, options, threads, precision, a);
   a.user = read_rig(path + "/user_face", true);
+  if (a.user.empty() && a.kind == "fit folder") a.user = read_rig(a.mesh->path + "/user_face", true);  // beside the fitted mesh
   if (!a.user.empty()) {
     a.calibration = a.user.neutral.vertices;
   } else if (a.landmarks) {

@@ -5,7 +5,8 @@
 //     vertex count, e.g. python -m softdeca_train avatar): the template's own heads;
 //   - any other avatar (glTF, FBX, an avatar folder of another topology): fitted now.
 // A fitted avatar's frames are the user's own vertices; they are written in its parts' own
-// coordinates (part_space.h). A folder's optional user_face/ rig stands in for a phone's face.
+// coordinates (part_space.h). A folder's optional user_face/ rig (a fit folder's, else its
+// avatar folder's) stands in for a phone's face.
 #pragma once
 
 #include <memory>
