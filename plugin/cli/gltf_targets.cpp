@@ -13,18 +13,19 @@ using runtime::Json;
 
 // The JSON of a .gltf, or the first chunk of a binary glTF (.glb, .vrm); "" when there is none.
 std::string gltf_json(const std::string& path, const AvatarLimits& limits) {
+  const std::uint64_t size = require_file_within(path, limits);
   std::ifstream in(path, std::ios::binary);
   char header[20];
   if (!in.read(header, sizeof header)) return "";
   if (std::string(header, 4) != "glTF") {
     in.seekg(0);
-    std::string text(static_cast<std::size_t>(require_file_within(path, limits)), '\0');
+    std::string text(static_cast<std::size_t>(size), '\0');
     in.read(&text[0], static_cast<std::streamsize>(text.size()));
     return text;
   }
   std::uint32_t length = 0;
   for (int k = 3; k >= 0; --k) length = (length << 8) | static_cast<unsigned char>(header[12 + k]);
-  if (std::string(header + 16, 4) != "JSON" || length > limits.max_file_bytes) return "";
+  if (std::string(header + 16, 4) != "JSON" || length > size - sizeof header) return "";  // a length the file cannot hold
   std::string text(length, '\0');
   return in.read(&text[0], static_cast<std::streamsize>(length)) ? text : "";
 }
