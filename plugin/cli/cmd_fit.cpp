@@ -64,11 +64,11 @@ int run_fit(const Args& args) {
                    "bundle's template once. MESH: a glTF 2.0 file (.gltf, .glb, .vrm), an FBX file, or an avatar folder\n"
                    "(neutral.obj and blendshapes/<name>.obj, one OBJ per shape in the neutral's vertex order). The meshes\n"
                    "with at least one ARKit shape are fitted, each placed by its node's transform; meshes without one (hair,\n"
-                   "clothes) are listed and left out. Shape names follow the product's rule (eyeBlinkLeft, blendShape1.\n"
-                   "eyeBlinkLeft, AK_07_EyeBlinkLeft, eyeBlink_L, mouth_smile_l, ...; docs/avatars.md) unless --names maps\n"
-                   "them. Writes DIR/avatar.fit, DIR/fit.json (the fit's report, the parts, each ARKit shape's rig names,\n"
-                   "the names not used) and DIR/fit.png (front and side views: the template in colour on the avatar).\n"
-                   "Then: softdeca replay TAKE --bundle B --avatar DIR.");
+                   "clothes) are listed and left out. Shape names follow the product's rule (eyeBlinkLeft,\n"
+                   "blendShape1.eyeBlinkLeft, AK_07_EyeBlinkLeft, eyeBlink_L, mouth_smile_l, ...; docs/avatars.md) unless\n"
+                   "--names maps them. Writes DIR/avatar.fit, DIR/fit.json (the fit's report, the parts, each ARKit shape's\n"
+                   "rig names, the names not used) and DIR/fit.png (front and side views: the template in colour on the\n"
+                   "avatar). Then: softdeca replay TAKE --bundle B --avatar DIR.");
   o.positional("MESH", "the avatar: .gltf, .glb, .vrm, .fbx, or an avatar folder");
   o.option("--bundle", "DIR", "model bundle folder or .tar (with the template head)").option("--out", "DIR", "the fit folder to write");
   declare_fit_options(o);
