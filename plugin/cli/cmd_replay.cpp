@@ -1,9 +1,11 @@
 // softdeca replay: a take (Live Link Face CSV or recording) through plain linear blendshapes, SoftDECA (from the weights) and
-// SparseSoftDECA (from landmarks) onto one avatar. Writes per model a PC2 point cache over the
-// avatar's neutral OBJ (Blender: import neutral.obj, add a Mesh Cache modifier; Unity: the OBJ
-// sequence of --obj-every) and replay.json with the timing summary. Native end to end: the avatar
-// (e.g. an ICT identity: python -m softdeca_train avatar) and the contact sheet of the output
-// (python -m softdeca_train replay-preview) come from the training package, before and after.
+// SparseSoftDECA (from landmarks) onto one avatar: a head in the template's topology, or a user's
+// own mesh through its fit (replay_avatar.h). Writes per model a PC2 point cache over the
+// avatar's neutral OBJ, both in the avatar's own meshes' coordinates (Blender: import
+// neutral.obj, add a Mesh Cache modifier; Unity: the OBJ sequence of --obj-every) and replay.json
+// with the timing summary. Native end to end: a template avatar (e.g. an ICT identity: python -m
+// softdeca_train avatar) and the contact sheet of the output (python -m softdeca_train
+// replay-preview) come from the training package, before and after.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,9 +15,11 @@
 #include <stdexcept>
 
 #include "command.h"
+#include "fit_options_arg.h"
 #include "json.h"
 #include "mesh_io.h"
 #include "options.h"
+#include "replay_avatar.h"
 #include "runtime_session.h"
 #include "take.h"
 
@@ -73,11 +77,13 @@ std::vector<Change> parse_changes(const std::string& list) {
   return out;
 }
 
-// Applies changes; returns the number of skin faces a regional change covered.
-std::size_t apply(const Model& model, Avatar& avatar, const ObjMesh& neutral, const std::vector<Change>& changes) {
+// Applies changes; returns the number of faces a regional change covered (the skin's faces of a
+// template avatar, the user's own faces of a fitted one).
+std::size_t apply(const Model& model, ReplayAvatar& target, const std::vector<Change>& changes) {
   std::size_t covered = 0;
-  std::vector<std::int32_t> tri(3 * model.info.skin_triangle_count);
-  check(softdeca_model_get_skin_triangles(model.handle, tri.data(), model.info.skin_triangle_count), "skin triangles");
+  const std::vector<std::int32_t>& tri = target.map_triangles;
+  const std::vector<float>& neutral = target.map_vertices;
+  softdeca_avatar* avatar = target.avatar->handle;
   for (Change c : changes) {
     const int index = model.parameter(c.name);
     if (!c.bound.empty()) {
@@ -88,17 +94,17 @@ std::size_t apply(const Model& model, Avatar& avatar, const ObjMesh& neutral, co
       std::fprintf(stderr, "%s=%s: %g\n", c.name.c_str(), c.bound.c_str(), static_cast<double>(c.value));
     }
     if (!c.region) {
-      check(softdeca_avatar_set_parameter(avatar.handle, static_cast<uint32_t>(index), c.value), "setting " + c.name);
+      check(softdeca_avatar_set_parameter(avatar, static_cast<uint32_t>(index), c.value), "setting " + c.name);
       continue;
     }
     double current = 0;
-    check(softdeca_avatar_get_parameter(avatar.handle, static_cast<uint32_t>(index), &current, nullptr), "parameter");
-    std::vector<float> map(model.info.skin_triangle_count, static_cast<float>(current));
+    check(softdeca_avatar_get_parameter(avatar, static_cast<uint32_t>(index), &current, nullptr), "parameter");
+    std::vector<float> map(tri.size() / 3, static_cast<float>(current));
     for (std::size_t f = 0; f < map.size(); ++f) {
       double d2 = 0;
       for (int k = 0; k < 3; ++k) {
         double centroid = 0;
-        for (int j = 0; j < 3; ++j) centroid += neutral.vertices[3 * static_cast<std::size_t>(tri[3 * f + static_cast<std::size_t>(j)]) + static_cast<std::size_t>(k)] / 3.0;
+        for (int j = 0; j < 3; ++j) centroid += neutral[3 * static_cast<std::size_t>(tri[3 * f + static_cast<std::size_t>(j)]) + static_cast<std::size_t>(k)] / 3.0;
         d2 += (centroid - c.centre[k]) * (centroid - c.centre[k]);
       }
       if (d2 <= c.radius * c.radius) {
@@ -106,7 +112,7 @@ std::size_t apply(const Model& model, Avatar& avatar, const ObjMesh& neutral, co
         ++covered;
       }
     }
-    check(softdeca_avatar_set_parameter_faces(avatar.handle, static_cast<uint32_t>(index), map.data(), static_cast<uint32_t>(map.size())),
+    check(softdeca_avatar_set_parameter_faces(avatar, static_cast<uint32_t>(index), map.data(), static_cast<uint32_t>(map.size())),
           "setting " + c.name + " over a region");
   }
   return covered;
@@ -175,39 +181,38 @@ std::vector<std::string> models_to_run(const std::string& list, bool localised) 
 // One avatar replaying the take, and the buffers its frames are written through.
 struct Replay {
   Model& model;
-  Avatar& avatar;
-  const FaceRig& rig;
-  const FaceRig& user;
+  ReplayAvatar& target;
   const Take& take;
   std::string out;
   long obj_every = 0;
   std::vector<float> vertices, normals, user_face, linear, landmarks;
   softdeca_output output{}, linear_out{};
 
-  Replay(Model& m, Avatar& a, const FaceRig& r, const FaceRig& u, const Take& t, std::string dir, long every)
-      : model(m), avatar(a), rig(r), user(u), take(t), out(std::move(dir)), obj_every(every) {
-    const uint32_t vh = model.info.head_vertex_count;
-    vertices.resize(vh * 3);
-    normals.resize(vh * 3);
-    user_face.resize(user.neutral.vertices.size());
-    linear.resize(vh * 3);
+  Replay(Model& m, ReplayAvatar& a, const Take& t, std::string dir, long every)
+      : model(m), target(a), take(t), out(std::move(dir)), obj_every(every) {
+    const auto n = static_cast<uint32_t>(target.vertex_count);
+    vertices.resize(3 * std::size_t{n});
+    normals.resize(3 * std::size_t{n});
+    user_face.resize(target.user.neutral.vertices.size());
+    linear.resize(3 * std::size_t{n});
     landmarks.resize(3 * model.info.landmark_count);
-    output = {sizeof(softdeca_output), vertices.data(), vh, normals.data(), vh};
-    linear_out = {sizeof(softdeca_output), linear.data(), vh, nullptr, 0};
+    output = {sizeof(softdeca_output), vertices.data(), n, normals.data(), n};
+    linear_out = {sizeof(softdeca_output), linear.data(), n, nullptr, 0};
   }
 
   // The tracked face SparseSoftDECA reads for weights w: a user rig blended with the take, or
-  // the avatar's own landmarks; returns the point count.
+  // the landmarks of the avatar's own linear blend; returns the point count.
   std::size_t tracked_points(const float* w, const float** points) {
-    if (!user.empty()) {
-      user.blend(w, user_face.data());
+    if (!target.user.empty()) {
+      target.user.blend(w, user_face.data());
       *points = user_face.data();
-      return user.neutral.vertex_count();
+      return target.user.neutral.vertex_count();
     }
-    const uint32_t vh = model.info.head_vertex_count;
-    check(softdeca_avatar_evaluate_linear(avatar.handle, w, 52, &linear_out), "linear blend");
-    check(softdeca_model_evaluate_landmarks(model.handle, linear.data(), vh, landmarks.data(), model.info.landmark_count),
-          "landmarks");
+    check(softdeca_avatar_evaluate_linear(target.avatar->handle, w, 52, &linear_out), "linear blend");
+    if (target.landmarks) target.landmarks->evaluate(linear.data(), landmarks.data());
+    else check(softdeca_model_evaluate_landmarks(model.handle, linear.data(), static_cast<uint32_t>(target.vertex_count),
+                                                 landmarks.data(), model.info.landmark_count),
+               "landmarks");
     *points = landmarks.data();
     return model.info.landmark_count;
   }
@@ -216,20 +221,20 @@ struct Replay {
     make_directories(out + "/obj");
     char file[64];
     std::snprintf(file, sizeof file, "/obj/%s_%05zu.obj", name.c_str(), f);
-    write_obj(out + file, vertices.data(), model.info.head_vertex_count, normals.data(), rig.neutral.triangles.data(),
-              rig.neutral.triangles.size() / 3, name + " frame " + std::to_string(f));
+    target.space->write_obj(out + file, vertices.data(), normals.data(), name + " frame " + std::to_string(f));
   }
 
   // Every frame of the take through model `name` into <out>/<name>.pc2; returns the timings.
   Timing run(const std::string& name) {
     const bool sparse = name == "sparse";
+    softdeca_avatar* avatar = target.avatar->handle;
     if (sparse && !model.info.has_sparse) throw std::runtime_error("the bundle has no SparseSoftDECA model");
     if (!sparse && name != "linear" && !model.info.has_softdeca) throw std::runtime_error("the bundle has no SoftDECA model");
-    if (sparse && !user.empty())
-      check(softdeca_avatar_calibrate_landmarks(avatar.handle, user.neutral.vertices.data(), user.neutral.vertex_count()),
+    if (sparse && !target.calibration.empty())
+      check(softdeca_avatar_calibrate_landmarks(avatar, target.calibration.data(), static_cast<uint32_t>(target.calibration.size() / 3)),
             "calibration");
-    check(softdeca_avatar_reset_dynamics(avatar.handle), "reset dynamics");
-    Pc2Writer cache(out + "/" + name + ".pc2", model.info.head_vertex_count);
+    check(softdeca_avatar_reset_dynamics(avatar), "reset dynamics");
+    Pc2Writer cache(out + "/" + name + ".pc2", target.vertex_count);
     Timing timing;
     std::fprintf(stderr, "%-18s", name.c_str());
     for (std::size_t f = 0; f < take.weights.size(); ++f) {
@@ -237,11 +242,11 @@ struct Replay {
       const float* points = nullptr;
       const std::size_t point_count = sparse ? tracked_points(w, &points) : 0;
       const auto t0 = Clock::now();
-      if (name == "linear") check(softdeca_avatar_evaluate_linear(avatar.handle, w, 52, &output), "frame " + std::to_string(f));
-      else if (sparse) check(softdeca_avatar_evaluate_landmarks(avatar.handle, points, point_count, &output), "frame " + std::to_string(f));
-      else check(softdeca_avatar_evaluate_weights(avatar.handle, w, 52, &output), "frame " + std::to_string(f));
-      timing.add(std::chrono::duration<double, std::milli>(Clock::now() - t0).count(), avatar.stats());
-      cache.add(vertices.data());
+      if (name == "linear") check(softdeca_avatar_evaluate_linear(avatar, w, 52, &output), "frame " + std::to_string(f));
+      else if (sparse) check(softdeca_avatar_evaluate_landmarks(avatar, points, point_count, &output), "frame " + std::to_string(f));
+      else check(softdeca_avatar_evaluate_weights(avatar, w, 52, &output), "frame " + std::to_string(f));
+      timing.add(std::chrono::duration<double, std::milli>(Clock::now() - t0).count(), target.avatar->stats());
+      cache.add(target.space->to_local(vertices.data()));
       if (obj_every > 0 && f % static_cast<std::size_t>(obj_every) == 0) write_frame_obj(name, f);
       if (f % 200 == 0) std::fprintf(stderr, ".");
     }
@@ -250,20 +255,38 @@ struct Replay {
     return timing;
   }
 };
+
+// What replay.json says about the avatar: its kind, and for a user's mesh its parts.
+std::string avatar_json(const ReplayAvatar& a) {
+  JsonObject o;
+  o.text("kind", a.kind).number("vertices", static_cast<double>(a.vertex_count));
+  if (a.mesh) {
+    std::string parts = "[";
+    for (const AvatarPart& p : a.mesh->parts) parts += (parts.size() > 1 ? "," : "") + json_string(p.name);
+    o.text("mesh", a.mesh->path).raw("parts", parts + "]");
+  }
+  if (a.landmarks) o.number("landmarks_max_distance_from_surface", a.landmarks->max_distance());
+  return o.str();
+}
 }  // namespace
 
 int run_replay(const Args& args) {
   Options o("replay", "Replay a take (Live Link Face CSV or a recording) through linear blendshapes, SoftDECA and\n"
                       "SparseSoftDECA onto one avatar; writes <out>/neutral.obj, <model>.pc2 point caches and replay.json (timings).\n"
-                      "SparseSoftDECA reads landmarks of a tracked face: the avatar's user_face rig blended with the\n"
-                      "take (as a phone would track it), else the avatar's own. An ICT identity as avatar:\n"
-                      "python -m softdeca_train avatar --seed N --out DIR; a contact sheet of the result:\n"
-                      "python -m softdeca_train replay-preview --replay OUT.");
+                      "The avatar: a fit folder (softdeca fit), an avatar folder in the template's topology, or any user's\n"
+                      "avatar (glTF, FBX, avatar folder), fitted first (--names, --metres-per-unit, --iterations: as for\n"
+                      "softdeca fit). A user's avatar is written as its meshes with ARKit\n"
+                      "shapes, each in its own coordinates, in file order. SparseSoftDECA reads landmarks of a tracked face:\n"
+                      "the avatar folder's user_face rig blended with the take (as a phone would track it), else the avatar's\n"
+                      "own. An ICT identity as avatar: python -m softdeca_train avatar --seed N --out DIR; a contact sheet of\n"
+                      "the result: python -m softdeca_train replay-preview --replay OUT.");
   o.positional("TAKE", "Live Link Face CSV (.csv) or a recording of the streaming format");
-  declare_model_inputs(o);
-  o.option("--out", "DIR", "output folder", "out/replay")
+  o.option("--bundle", "DIR", "model bundle folder or .tar")
+      .option("--avatar", "X", "fit folder, avatar folder (neutral.obj, blendshapes/, optional user_face/), or .gltf/.glb/.vrm/.fbx")
+      .option("--out", "DIR", "output folder", "out/replay")
       .option("--models", "LIST", "comma-separated: linear, softdeca, sparse", "linear,softdeca,sparse")
-      .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region), ';'-separated (value: a number, min, max or default)")
+      .option("--set", "SPECS", "parameter changes 'name=value' or 'name=value@x,y,z,r' (a region, in the avatar's coordinates), "
+                                "';'-separated (value: a number, min, max or default)")
       .option("--localised", "SPEC", "an extra SoftDECA pass with this change 'name=value@x,y,z,r' on top of --set")
       .option("--start", "N", "skip the take's first N frames", "0")
       .option("--frames", "N", "at most N frames of the take after --start (0: all)", "0")
@@ -271,6 +294,7 @@ int run_replay(const Args& args) {
       .option("--precision", "P", "hyper-tensor storage: half, float or int8", "half")
       .option("--obj-every", "N", "also write every Nth frame as OBJ (0: none)", "0")
       .flag("--dynamics", "enable the second-order dynamics");
+  declare_fit_options(o);  // for an avatar fitted now
   if (!o.parse(args)) return 0;
   require_model_inputs(o);
   const std::string out = o.text("--out");
@@ -280,30 +304,25 @@ int run_replay(const Args& args) {
   const long start = o.integer("--start");
   const Take take = read_replay_take(o.arg(0), start, o.integer("--frames"));
   const std::vector<std::string> models = models_to_run(o.text("--models"), o.given("--localised"));
-  const std::string avatar_dir = o.text("--avatar");
-  const FaceRig rig = read_rig(avatar_dir);
-  const FaceRig user = read_rig(avatar_dir + "/user_face", true);
+  const std::string avatar_path = o.text("--avatar");
 
   Model model(o.text("--bundle"));
-  const uint32_t vh = model.info.head_vertex_count;
-  if (rig.neutral.vertex_count() != vh)
-    throw std::runtime_error(avatar_dir + "/neutral.obj has " + std::to_string(rig.neutral.vertex_count()) +
-                             " vertices; the bundle's template has " + std::to_string(vh));
-  Avatar avatar(model, rig.neutral, rig.deltas, threads, precision);
-  apply(model, avatar, rig.neutral, parse_changes(o.text("--set")));
-  check(softdeca_avatar_set_dynamics(avatar.handle, o.on("--dynamics") ? SOFTDECA_TRUE : SOFTDECA_FALSE), "dynamics");
-  check(softdeca_avatar_prepare(avatar.handle), "prepare");
-  const double prepare_ms = avatar.stats().prepare_ms;
+  ReplayAvatar target = open_replay_avatar(model, avatar_path, shape_names(o), fit_options(o), threads, precision);
+  softdeca_avatar* avatar = target.avatar->handle;
+  apply(model, target, parse_changes(o.text("--set")));
+  check(softdeca_avatar_set_dynamics(avatar, o.on("--dynamics") ? SOFTDECA_TRUE : SOFTDECA_FALSE), "dynamics");
+  check(softdeca_avatar_prepare(avatar), "prepare");
+  const double prepare_ms = target.avatar->stats().prepare_ms;
 
-  write_obj(out + "/neutral.obj", rig.neutral.vertices.data(), vh, nullptr, rig.neutral.triangles.data(),
-            rig.neutral.triangles.size() / 3, "SoftDECA replay: the avatar's neutral (PC2 caches animate it)");
-  Replay replay(model, avatar, rig, user, take, out, o.integer("--obj-every"));
+  const float* neutral = target.fitted() ? target.mesh->neutral.data() : target.rig.neutral.vertices.data();
+  target.space->write_obj(out + "/neutral.obj", neutral, nullptr, "SoftDECA replay: the avatar's neutral (PC2 caches animate it)");
+  Replay replay(model, target, take, out, o.integer("--obj-every"));
   JsonObject timings, files;
   std::size_t localised_faces = 0;
   for (const std::string& name : models) {
     if (name == "softdeca_localised") {
-      localised_faces = apply(model, avatar, rig.neutral, parse_changes(o.text("--localised")));
-      check(softdeca_avatar_prepare(avatar.handle), "prepare (localised)");
+      localised_faces = apply(model, target, parse_changes(o.text("--localised")));
+      check(softdeca_avatar_prepare(avatar), "prepare (localised)");
     }
     timings.raw(name, replay.run(name).json());
     files.text(name, out + "/" + name + ".pc2");
@@ -319,8 +338,11 @@ int run_replay(const Args& args) {
       .number("take_median_frame_s", take.median_frame_s)
       .text("bundle", o.text("--bundle"))
       .raw("untrained", model.info.untrained ? "true" : "false")
-      .text("avatar", avatar_dir)
-      .raw("landmarks_from", json_string(user.empty() ? "the avatar's linear blend" : "the user_face rig blended with the take"))
+      .text("avatar", avatar_path)
+      .raw("avatar_mesh", avatar_json(target))
+      .raw("landmarks_from", json_string(!target.user.empty() ? "the user_face rig blended with the take"
+                                         : target.fitted()    ? "the bundle's landmarks carried onto the avatar's linear blend (calibrated at rest)"
+                                                              : "the avatar's linear blend"))
       .raw("dynamics", o.on("--dynamics") ? "true" : "false")
       .number("threads", threads)
       .text("precision", o.text("--precision"))

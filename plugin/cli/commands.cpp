@@ -9,6 +9,7 @@ int run_convert(const Args&);
 int run_info(const Args&);
 int run_bench_streaming(const Args&);
 int run_bench_reliability(const Args&);
+int run_fit(const Args&);
 int run_replay(const Args&);
 int run_bench_runtime(const Args&);
 
@@ -23,6 +24,7 @@ const std::vector<Command>& commands() {
        run_bench_streaming},
       {"bench-reliability", "measure the receiver and recording reader under hostile input -> JSON",
        run_bench_reliability},
+      {"fit", "fit a user's own ARKit-rigged avatar (glTF, FBX, avatar folder) to a bundle's template once", run_fit},
       {"replay", "replay a take through linear blendshapes, SoftDECA and SparseSoftDECA onto an avatar", run_replay},
       {"bench-runtime", "measure the runtime per frame (both models, 1 and 2 threads) -> JSON", run_bench_runtime},
   };

@@ -39,7 +39,7 @@ ObjMesh read_obj(const std::string& path) {
         if (end == p) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad face");
         const long n = static_cast<long>(m.vertex_count());
         idx = idx < 0 ? n + idx : idx - 1;
-        if (idx < 0) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": face index out of range");
+        if (idx < 0 || idx > 0x7fffffffL) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": face index out of range");
         poly.push_back(static_cast<std::int32_t>(idx));
         p = end;
         while (*p && *p != ' ' && *p != '\t') ++p;  // skip /vt/vn
@@ -53,14 +53,21 @@ ObjMesh read_obj(const std::string& path) {
 }
 
 void write_obj(const std::string& path, const float* v, std::size_t nv, const float* n, const std::int32_t* t, std::size_t nt,
-               const std::string& comment) {
+               const std::string& comment, const std::vector<ObjGroup>& groups) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) throw std::runtime_error("cannot write " + path);
   std::fprintf(f, "# %s\n", comment.c_str());
   for (std::size_t i = 0; i < nv; ++i) std::fprintf(f, "v %.6f %.6f %.6f\n", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
   if (n)
     for (std::size_t i = 0; i < nv; ++i) std::fprintf(f, "vn %.5f %.5f %.5f\n", n[3 * i], n[3 * i + 1], n[3 * i + 2]);
+  std::size_t group = 0;
   for (std::size_t i = 0; i < nt; ++i) {
+    for (; group < groups.size() && groups[group].first_triangle <= i; ++group) {
+      std::string name = groups[group].name;  // a file's own names: no line breaks into the OBJ
+      for (char& ch : name)
+        if (static_cast<unsigned char>(ch) < 0x20) ch = '_';
+      std::fprintf(f, "o %s\n", name.c_str());
+    }
     const long a = t[3 * i] + 1, b = t[3 * i + 1] + 1, c = t[3 * i + 2] + 1;
     if (n) std::fprintf(f, "f %ld//%ld %ld//%ld %ld//%ld\n", a, a, b, b, c, c);
     else std::fprintf(f, "f %ld %ld %ld\n", a, b, c);
@@ -70,6 +77,7 @@ void write_obj(const std::string& path, const float* v, std::size_t nv, const fl
 
 Pc2Writer::Pc2Writer(const std::string& path, std::size_t points, float start_frame, float sample_rate)
     : path_(path), points_(points) {
+  if (points > 0x7fffffffu) throw std::runtime_error(path + ": a PC2 file holds at most 2^31 - 1 points");
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) throw std::runtime_error("cannot write " + path);
   char signature[12] = "POINTCACHE2";

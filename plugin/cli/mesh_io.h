@@ -15,10 +15,17 @@ struct ObjMesh {
   std::size_t vertex_count() const { return vertices.size() / 3; }
 };
 
+// A named part of an OBJ: an `o <name>` line before its first triangle.
+struct ObjGroup {
+  std::string name;
+  std::size_t first_triangle = 0;
+};
+
 // Reads `v` and `f` records (f may use v/vt/vn and negative indices). Throws std::runtime_error.
 ObjMesh read_obj(const std::string& path);
 void write_obj(const std::string& path, const float* vertices, std::size_t vertex_count, const float* normals,
-               const std::int32_t* triangles, std::size_t triangle_count, const std::string& comment);
+               const std::int32_t* triangles, std::size_t triangle_count, const std::string& comment,
+               const std::vector<ObjGroup>& groups = {});
 
 // PC2: "POINTCACHE2\0", version 1, point count, start frame, sample rate, frame count, then
 // float xyz per point per frame. The frame count is written when the file is closed.

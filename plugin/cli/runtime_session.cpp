@@ -43,6 +43,40 @@ Avatar::Avatar(const Model& model, const ObjMesh& neutral, const std::vector<flo
   check(softdeca_avatar_create(model.handle, &d, &handle), "creating the avatar");
 }
 
+Avatar::Avatar(const Model& model, const Fit& fit, const softdeca_avatar_mesh& mesh, unsigned threads, unsigned precision) {
+  check(softdeca_avatar_create_fitted(model.handle, fit.handle, &mesh, threads, static_cast<int32_t>(precision), &handle),
+        "creating the fitted avatar");
+}
+
+Fit::Fit(const Model& model, const softdeca_avatar_mesh& mesh, const softdeca_fit_options& options) {
+  check(softdeca_avatar_fit_create(model.handle, &mesh, &options, &handle), "fitting the avatar");
+}
+
+Fit::Fit(const Model& model, const std::string& path) {
+  check(softdeca_avatar_fit_load(model.handle, path.c_str(), &handle), "loading the fit " + path);
+}
+
+void Fit::save(const std::string& path) const { check(softdeca_avatar_fit_save(handle, path.c_str()), "saving the fit " + path); }
+
+std::string Fit::report() const {
+  std::string text(1 << 16, '\0');
+  uint32_t length = 0;
+  softdeca_status status = softdeca_avatar_fit_report(handle, &text[0], static_cast<uint32_t>(text.size()), &length);
+  if (status == SOFTDECA_ERROR_BUFFER_TOO_SMALL) {
+    text.assign(std::size_t{length} + 1, '\0');
+    status = softdeca_avatar_fit_report(handle, &text[0], static_cast<uint32_t>(text.size()), &length);
+  }
+  check(status, "the fit's report");
+  text.resize(length);
+  return text;
+}
+
+std::vector<float> Fit::registered(const Model& model) const {
+  std::vector<float> points(3 * std::size_t{model.info.skin_vertex_count});
+  check(softdeca_avatar_fit_get_registered(handle, points.data(), model.info.skin_vertex_count, nullptr), "the registered template");
+  return points;
+}
+
 softdeca_stats Avatar::stats() const {
   softdeca_stats s{};
   s.struct_size = sizeof s;

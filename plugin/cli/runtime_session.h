@@ -28,9 +28,24 @@ struct Model {
   int parameter(const std::string& name) const;
 };
 
+// A user's own mesh fitted to the bundle's template: made from the mesh, or loaded from a file.
+struct Fit {
+  softdeca_avatar_fit* handle = nullptr;
+  Fit(const Model& model, const softdeca_avatar_mesh& mesh, const softdeca_fit_options& options);
+  Fit(const Model& model, const std::string& path);
+  ~Fit() { softdeca_avatar_fit_destroy(handle); }
+  Fit(const Fit&) = delete;
+  Fit& operator=(const Fit&) = delete;
+  void save(const std::string& path) const;
+  std::string report() const;  // the library's JSON
+  std::vector<float> registered(const Model& model) const;  // the template's skin on the avatar
+};
+
 struct Avatar {
   softdeca_avatar* handle = nullptr;
   Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads, unsigned precision);
+  // On the user's own mesh, through its fit (outputs hold the mesh's vertices).
+  Avatar(const Model& model, const Fit& fit, const softdeca_avatar_mesh& mesh, unsigned threads, unsigned precision);
   ~Avatar() { softdeca_avatar_destroy(handle); }
   Avatar(const Avatar&) = delete;
   Avatar& operator=(const Avatar&) = delete;

@@ -1,0 +1,141 @@
+// glTF 2.0 and FBX avatars through assimp. Only triangulation runs (no joining of identical
+// vertices, which would reorder them): each mesh keeps the vertex order its file gives, so a
+// point cache written in that order loads onto the mesh. assimp reads FBX one vertex per polygon
+// corner; those corners are welded back into the file's vertices (avatar_weld.h).
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cctype>
+#include <fstream>
+#include <stdexcept>
+
+#include "avatar_source.h"
+#include "avatar_weld.h"
+#include "gltf_targets.h"
+
+namespace softdeca::cli {
+
+namespace {
+struct Reader {
+  const std::string& path;
+  const AvatarLimits& limits;
+  const aiScene& scene;
+  SourceScene out;
+
+  std::string mesh_name(const aiNode& node, unsigned k) const {
+    const aiMesh& mesh = *scene.mMeshes[node.mMeshes[k]];
+    const std::string node_name = node.mName.C_Str(), own = mesh.mName.C_Str();
+    if (node_name.empty()) return own;
+    if (node.mNumMeshes == 1) return node_name;
+    return node_name + "/" + (own.empty() ? std::to_string(k) : own);
+  }
+
+  SourceMesh read_mesh(const aiMesh& mesh, std::string name, const aiMatrix4x4& global) const {
+    if (mesh.mNumVertices > limits.max_vertices)
+      throw std::runtime_error(path + ": mesh '" + name + "': " + std::to_string(mesh.mNumVertices) + " vertices, more than the " +
+                               std::to_string(limits.max_vertices) + " an avatar may have");
+    SourceMesh out;
+    out.name = std::move(name);
+    out.vertices.resize(3 * std::size_t{mesh.mNumVertices});
+    for (unsigned i = 0; i < mesh.mNumVertices; ++i)
+      for (unsigned c = 0; c < 3; ++c) out.vertices[3 * i + c] = mesh.mVertices[i][c];
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines
+      for (unsigned c = 0; c < 3; ++c) out.triangles.push_back(static_cast<std::int32_t>(face.mIndices[c]));
+    }
+    // assimp stores morph targets as whole positions; the fit takes deltas.
+    for (unsigned a = 0; a < mesh.mNumAnimMeshes; ++a) {
+      const aiAnimMesh& target = *mesh.mAnimMeshes[a];
+      SourceShape shape{target.mName.C_Str(), {}};
+      if (!target.HasPositions()) {
+        shape.deltas.assign(out.vertices.size(), 0.0f);  // a target of normals alone moves nothing
+      } else if (target.mNumVertices <= limits.max_vertices) {
+        shape.deltas.resize(3 * std::size_t{target.mNumVertices});
+        for (unsigned i = 0; i < target.mNumVertices; ++i)
+          for (unsigned c = 0; c < 3; ++c)
+            shape.deltas[3 * i + c] = target.mVertices[i][c] - (i < mesh.mNumVertices ? mesh.mVertices[i][c] : 0.0f);
+      }
+      out.shapes.push_back(std::move(shape));
+    }
+    const ai_real* m = &global.a1;
+    std::copy(m, m + 16, out.transform);
+    return out;
+  }
+
+  void walk(const aiNode& node, const aiMatrix4x4& parent, unsigned depth) {
+    if (depth > 1000) throw std::runtime_error(path + ": nodes nested more than 1000 deep");
+    const aiMatrix4x4 global = parent * node.mTransformation;
+    for (unsigned k = 0; k < node.mNumMeshes; ++k) {
+      if (node.mMeshes[k] >= scene.mNumMeshes) throw std::runtime_error(path + ": a node refers to a mesh that does not exist");
+      out.meshes.push_back(read_mesh(*scene.mMeshes[node.mMeshes[k]], mesh_name(node, k), global));
+    }
+    for (unsigned c = 0; c < node.mNumChildren; ++c) walk(*node.mChildren[c], global, depth + 1);
+  }
+};
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+// FBX says how many centimetres a unit is (UnitScaleFactor); assimp keeps the raw units and
+// passes the factor on as metadata.
+void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
+  if (!fbx) {
+    out.declared_unit = "metre (glTF 2.0)";
+    out.declared_metres_per_unit = 1;
+    return;
+  }
+  double centimetres = 0;
+  float as_float = 0;
+  if (!scene.mMetaData) return;
+  if (scene.mMetaData->Get("UnitScaleFactor", as_float)) centimetres = as_float;
+  else if (!scene.mMetaData->Get("UnitScaleFactor", centimetres)) return;
+  if (!(centimetres > 0)) return;
+  char text[96];
+  std::snprintf(text, sizeof text, "%g cm (FBX UnitScaleFactor %g)", centimetres, centimetres);
+  out.declared_unit = text;
+  out.declared_metres_per_unit = centimetres / 100.0;
+}
+}  // namespace
+
+bool scene_files_supported() { return true; }
+
+SourceScene read_scene_file(const std::string& path, const AvatarLimits& limits) {
+  const std::uint64_t size = require_file_within(path, limits);
+  const std::string ext = lower(path.substr(path.find_last_of('.') + 1));
+  const bool fbx = ext == "fbx";
+  if (!fbx) check_gltf_targets(path, limits);
+  Assimp::Importer importer;
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);  // one node per FBX model
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
+  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate;
+  const aiScene* scene = nullptr;
+  if (ext == "vrm") {
+    // VRM is a binary glTF under its own extension, which assimp does not know.
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes(static_cast<std::size_t>(size), '\0');
+    if (!in.read(&bytes[0], static_cast<std::streamsize>(size))) throw std::runtime_error("cannot read " + path);
+    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, "glb");
+  } else {
+    scene = importer.ReadFile(path, flags);
+  }
+  if (!scene || !scene->mRootNode)
+    throw std::runtime_error(path + ": not a readable " + (fbx ? "FBX" : "glTF 2.0") + " file (" + importer.GetErrorString() + ")");
+  Reader reader{path, limits, *scene, {}};
+  reader.out.format = fbx ? "FBX" : "glTF 2.0";
+  reader.out.vertex_order = fbx ? "the FBX file's vertices in the order its polygons first use them"
+                                : "as in the file's vertex buffers";
+  declared_unit(*scene, fbx, reader.out);
+  reader.walk(*scene->mRootNode, aiMatrix4x4(), 0);
+  if (fbx)
+    for (SourceMesh& mesh : reader.out.meshes) weld_corners(mesh);
+  return std::move(reader.out);
+}
+
+}  // namespace softdeca::cli

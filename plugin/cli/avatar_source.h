@@ -1,0 +1,61 @@
+// A user's avatar file as its readers hand it over, before any mesh is chosen: every mesh of the
+// file in its own local coordinates with its own shapes under the rig's own names, and the
+// transform that places it in the file's common space. avatar_file.h chooses and joins them.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "shape_names.h"
+#include "softdeca/softdeca.h"
+
+namespace softdeca::cli {
+
+// Bounds on what a reader accepts (hostile files): the file's size before parsing, vertices
+// per mesh and in all included meshes after.
+struct AvatarLimits {
+  std::uint64_t max_file_bytes = std::uint64_t{2} << 30;
+  std::size_t max_vertices = SOFTDECA_MAX_AVATAR_VERTICES;
+};
+
+struct SourceShape {
+  std::string name;           // the rig's own name, as the file spells it
+  std::vector<float> deltas;  // vertex_count x 3, local coordinates; empty: left unread
+};
+
+struct SourceMesh {
+  std::string name;  // the node's name, else the mesh's
+  std::vector<float> vertices;          // local coordinates, the file's vertex order
+  std::vector<std::int32_t> triangles;  // points and lines dropped
+  std::vector<SourceShape> shapes;
+  double transform[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // row-major, local -> file space
+  std::size_t vertex_count() const { return vertices.size() / 3; }
+};
+
+struct SourceScene {
+  std::string format;         // "glTF 2.0", "FBX", "avatar folder"
+  std::string declared_unit;  // what the file says about its unit, "" when it says nothing
+  double declared_metres_per_unit = 0;  // 0: not declared
+  std::string vertex_order;   // how the vertex order relates to the file's
+  std::vector<SourceMesh> meshes;
+};
+
+// glTF 2.0 (.gltf, .glb, .vrm) and FBX through assimp, triangulated only (each mesh keeps its
+// vertex order; FBX's per-corner vertices are welded back, avatar_weld.h). Throws
+// std::runtime_error naming the file, and the mesh where one is at fault.
+SourceScene read_scene_file(const std::string& path, const AvatarLimits& limits);
+
+// An avatar folder (avatar_file.h): neutral.obj and the shapes of blendshapes/ that `names`
+// chooses (choose_shapes), one mesh; the other shape files are listed by name, unread.
+SourceScene read_avatar_folder(const std::string& dir, const ShapeNames& names, const AvatarLimits& limits);
+
+// Throws unless `path` is a regular file within limits.max_file_bytes; returns its size.
+std::uint64_t require_file_within(const std::string& path, const AvatarLimits& limits);
+
+// False when this build has no assimp: read_scene_file then throws, saying so.
+bool scene_files_supported();
+
+}  // namespace softdeca::cli

@@ -1,0 +1,28 @@
+// A fit folder, what `softdeca fit MESH --out DIR` writes and `softdeca replay --avatar DIR` reads:
+//   DIR/avatar.fit   the fit (softdeca_avatar_fit_save; tied to its bundle)
+//   DIR/fit.json     the library's report under "fit", with what the file gave: "source" (the
+//                    mesh's path, absolute and from DIR, the names file, the SHA-256 of the mesh
+//                    as read), the parts included and left out, each ARKit shape's rig names and
+//                    the names not used
+//   DIR/fit.png      front and side views of the template on the avatar (fit_picture.h)
+// The fit holds no copy of the mesh: the replay reads the mesh again and checks its SHA-256, so a
+// changed mesh is refused before the library's own check.
+#pragma once
+
+#include <string>
+
+#include "avatar_file.h"
+
+namespace softdeca::cli {
+
+bool is_fit_folder(const std::string& dir);
+std::string fit_file(const std::string& dir);  // DIR/avatar.fit
+
+// fit.json's text for `avatar` fitted into `dir`, around the library's report (JSON).
+std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std::string& library_report);
+
+// The mesh a fit folder was made for, read again as the fit read it (its names file too);
+// throws std::runtime_error when it cannot be found or is not the mesh that was fitted.
+AvatarFile read_fitted_mesh(const std::string& dir, const AvatarLimits& limits = {});
+
+}  // namespace softdeca::cli
