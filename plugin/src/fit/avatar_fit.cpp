@@ -43,6 +43,7 @@ constexpr double kShapeNear = 0.004, kShapeFar = 0.015;
 // The identity fit's priors: a shape match's error (2 mm) and a registered vertex's (10 mm,
 // squared, metres^2): the registration's errors slide along the skin, coherently.
 constexpr double kMatchVariance = 0.002 * 0.002, kRegisteredVariance = 1e-4;
+constexpr int kRegistrationRounds = 2;
 
 double smooth_fall(double d, double near, double far) {
   if (d <= near) return 1;
@@ -133,22 +134,39 @@ Points identity_points(const TemplateData& t, const std::vector<float>& h) {
 
 // Identity coefficients whose skin best meets the matches: min sum w |T0 + M h - target|^2 +
 // prior |h|^2, the modes scaled so that h is about N(0, 1); `prior`: a match's error, squared
-// (metres^2).
+// (metres^2). Reweighted kRobustRounds times (Cauchy, scale kRobustScale): a part the identity
+// modes cannot explain (a remesh's cut ears, a stylised nose) does not pull the whole head.
 std::vector<float> fit_identity(const TemplateData& t, const std::vector<Match>& matches, const Points& tskin,
                                 double prior) {
-  const double kPriorVariance = prior;
+  constexpr int kRobustRounds = 4;
+  constexpr double kRobustScale = 0.001;
   const std::size_t k = t.identity_count, vs = t.skin_vertices;
-  Eigen::MatrixXd a = Eigen::MatrixXd::Identity(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) * kPriorVariance;
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k));
-  Eigen::MatrixXd rows(3, static_cast<Eigen::Index>(k));
-  for (std::size_t v = 0; v < vs; ++v) {
-    const Match& m = matches[v];
-    if (!(m.weight > 0)) continue;
+  const auto kk = static_cast<Eigen::Index>(k);
+  std::vector<double> robust(vs, 1.0);
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(kk);
+  Eigen::MatrixXd rows(3, kk);
+  const auto modes_at = [&](std::size_t v) {
     for (std::size_t j = 0; j < k; ++j) rows.col(static_cast<Eigen::Index>(j)) = row3(t.identity_modes + j * vs * 3, v);
-    a.noalias() += m.weight * rows.transpose() * rows;
-    b.noalias() += m.weight * rows.transpose() * (m.target - tskin.row(static_cast<Eigen::Index>(v)).transpose());
+  };
+  for (int round = 0; round < kRobustRounds; ++round) {
+    Eigen::MatrixXd a = Eigen::MatrixXd::Identity(kk, kk) * prior;
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(kk);
+    for (std::size_t v = 0; v < vs; ++v) {
+      const Match& m = matches[v];
+      if (!(m.weight > 0)) continue;
+      modes_at(v);
+      const double w = m.weight * robust[v];
+      a.noalias() += w * rows.transpose() * rows;
+      b.noalias() += w * rows.transpose() * (m.target - tskin.row(static_cast<Eigen::Index>(v)).transpose());
+    }
+    h = a.ldlt().solve(b);
+    for (std::size_t v = 0; v < vs; ++v) {
+      if (!(matches[v].weight > 0)) continue;
+      modes_at(v);
+      const double r = (rows * h + tskin.row(static_cast<Eigen::Index>(v)).transpose() - matches[v].target).norm();
+      robust[v] = 1.0 / (1.0 + (r / kRobustScale) * (r / kRobustScale));
+    }
   }
-  const Eigen::VectorXd h = a.ldlt().solve(b);
   std::vector<float> out(k);
   for (std::size_t j = 0; j < k; ++j) out[j] = static_cast<float>(h[static_cast<Eigen::Index>(j)]);
   return out;
@@ -319,19 +337,24 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   step("registering the template", 0.1);
   RegistrationSettings settings;
   if (options.iterations > 0) settings.iterations = options.iterations;
-  const Registration reg = register_skin(start, ttri, std::cref(*matcher), guides, settings, [&](int i, int of) {
-    step("registering the template", 0.1 + 0.65 * i / of);
-  });
-  const geometry::SurfaceQuery& avatar_surface = matcher->neutral();
-
-  // The identity again, now from the registered face: every face vertex placed (measured on
-  // held-out ICT identities: a prior this wide reads their codes best).
-  if (t.identity_count) {
+  // Twice when the bundle has identity modes: the identity read off the first registration is
+  // a closer start for the second.
+  const int rounds = t.identity_count ? kRegistrationRounds : 1;
+  Registration reg;
+  for (int round = 0; round < rounds; ++round) {
+    reg = register_skin(start, ttri, std::cref(*matcher), guides, settings, [&](int i, int of) {
+      step("registering the template", 0.1 + 0.65 * (round + static_cast<double>(i) / of) / rounds);
+    });
+    // The identity again, from the registered face: every face vertex placed (measured on
+    // held-out ICT identities: a prior this wide reads their codes best).
+    if (!t.identity_count) continue;
     std::vector<Match> registered(vs);
     for (std::size_t v = 0; v < vs; ++v)
       if (tframe.face[v]) registered[v] = {reg.skin.row(static_cast<Eigen::Index>(v)).transpose(), 1.0};
     identity = fit_identity(t, registered, tskin, kRegisteredVariance);
+    start = identity_points(t, identity);
   }
+  const geometry::SurfaceQuery& avatar_surface = matcher->neutral();
 
   AvatarFit fit;
   fit.mesh_sha256 = mesh_sha256(a.neutral, n, a.triangles, a.triangle_count);
