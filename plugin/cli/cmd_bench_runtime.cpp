@@ -8,10 +8,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
 
+#include "avatar_file.h"
 #include "bench_figures.h"
 #include "command.h"
 #include "json.h"
@@ -89,6 +91,7 @@ struct Bench {
   std::vector<float> vertices, normals;
   softdeca_output output{};
   JsonObject figures;
+  std::string out_dir;  // where the benchmark JSON goes (scratch files beside it)
 };
 
 // What SparseSoftDECA reads each frame: the user rig's face mesh, or the avatar's own landmarks.
@@ -343,6 +346,60 @@ void measure_storage_error(Bench& bench) {
                  worst_sp[p]);
   }
 }
+// A user's own avatar (a whole body, another topology): the fit, loading it, and its frames
+// against the template path's on the same take, alternating frame by frame (1 thread).
+void measure_own_avatar(Bench& bench, const std::string& path) {
+  const AvatarFile file = read_avatar_file(path);
+  const softdeca_avatar_mesh mesh = file.abi_mesh();
+  softdeca_fit_options options{};
+  options.struct_size = sizeof options;
+  check(softdeca_fit_options_init(&options), "fit options");
+  std::vector<double> fit_s;
+  std::unique_ptr<Fit> fit;
+  for (int i = 0; i < 3; ++i) {
+    const auto t0 = Clock::now();
+    fit = std::make_unique<Fit>(bench.model, mesh, options);
+    fit_s.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+  }
+  const std::string saved = bench.out_dir + "/byo.fit";
+  check(softdeca_avatar_fit_save(fit->handle, saved.c_str()), "save the fit");
+  std::vector<double> load_ms;
+  for (int i = 0; i < 5; ++i) {
+    const auto t0 = Clock::now();
+    const Fit loaded(bench.model, saved);
+    load_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+  }
+  std::remove(saved.c_str());
+  Avatar own(bench.model, *fit, mesh, 1, SOFTDECA_PRECISION_HALF);
+  Avatar plain(bench.model, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  check(softdeca_avatar_prepare(own.handle), "prepare");
+  check(softdeca_avatar_prepare(plain.handle), "prepare");
+  const auto n = static_cast<uint32_t>(file.vertex_count());
+  std::vector<float> vertices(3 * n), normals(3 * n);
+  softdeca_output out{sizeof(softdeca_output), vertices.data(), n, normals.data(), n};
+  std::vector<double> own_ms, plain_ms;
+  for (std::size_t i = 0; i < bench.warmup + bench.frames; ++i) {
+    const float* w = bench.take.weights[i % bench.frames].data();
+    const Times a = median_ms(1, 0, [&](std::size_t) { check(softdeca_avatar_evaluate_weights(own.handle, w, 52, &out), "own"); });
+    const Times b = median_ms(1, 0, [&](std::size_t) {
+      check(softdeca_avatar_evaluate_weights(plain.handle, w, 52, &bench.output), "template");
+    });
+    if (i >= bench.warmup) own_ms.push_back(a.wall), plain_ms.push_back(b.wall);
+  }
+  const std::string how = std::string("; ") + path + " (" + std::to_string(n) + " vertices, " + std::to_string(file.parts.size()) +
+                          " parts); 1 thread; " + bench.how;
+  bench.figures.raw("runtime.fit_s", figure(median(fit_s), "s", "softdeca_avatar_fit_create, median of 3" + how, 10.0));
+  bench.figures.raw("runtime.fit_load_ms", figure(median(load_ms), "ms", "softdeca_avatar_fit_load of the saved fit, median of 5" + how));
+  bench.figures.raw("runtime.byo_frame_ms",
+                    figure(median(own_ms), "ms", "evaluate_weights on the fitted avatar, with normals, wall-clock" + how));
+  bench.figures.raw("runtime.byo_over_template",
+                    figure(median(own_ms) / median(plain_ms), "x",
+                           "byo_frame_ms over the template path's frame on the same take, frames alternating" + how, 1.15));
+  bench.figures.raw("runtime.byo_memory_mb",
+                    figure(static_cast<double>(own.stats().memory_bytes) / (1 << 20), "MiB", "the fitted avatar's memory_bytes" + how));
+  std::fprintf(stderr, "own avatar: fit %.2f s, load %.1f ms, frame %.3f ms (template %.3f ms)\n", median(fit_s), median(load_ms),
+               median(own_ms), median(plain_ms));
+}
 }  // namespace
 
 int run_bench_runtime(const Args& args) {
@@ -354,6 +411,7 @@ int run_bench_runtime(const Args& args) {
       .option("--warmup", "N", "frames run before measuring", "30")
       .option("--prepares", "N", "prepares measured", "5")
       .option("--out", "FILE", "benchmark JSON", "build/bench/runtime.json")
+      .option("--own-avatar", "MESH", "a user's avatar (glTF, FBX or avatar folder) to fit and run against the template path")
       .option("--how", "TEXT", "the command line to record in the figures", "softdeca bench-runtime");
   if (!o.parse(args)) return 0;
   require_model_inputs(o);
@@ -369,13 +427,20 @@ int run_bench_runtime(const Args& args) {
                   std::to_string(frames) + " frames of " + take.path + ", median; " +
                   std::to_string(model.info.skin_triangle_count) + " skin triangles, " + std::to_string(vh) + " head vertices" +
                   (model.info.untrained ? ", untrained (random) networks of full size" : ""),
-              sparse_inputs(take, frames, rig, user, model), std::vector<float>(vh * 3), std::vector<float>(vh * 3), {}, {}};
+              sparse_inputs(take, frames, rig, user, model), std::vector<float>(vh * 3), std::vector<float>(vh * 3), {}, {}, {}};
   bench.output = {sizeof(softdeca_output), bench.vertices.data(), vh, bench.normals.data(), vh};
+  {
+    const std::string out = o.text("--out");
+    const std::size_t slash = out.rfind('/');
+    bench.out_dir = slash == std::string::npos ? "." : out.substr(0, slash);
+    make_directories(bench.out_dir);
+  }
 
   for (const unsigned threads : {1u, 2u}) measure_with_threads(bench, threads);
   for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) measure_storage(bench, precision);
   measure_storage_error(bench);
   measure_rest_physics(bench);
+  if (o.given("--own-avatar")) measure_own_avatar(bench, o.text("--own-avatar"));
 
   const std::string path = o.text("--out");
   const std::size_t slash = path.rfind('/');

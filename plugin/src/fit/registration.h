@@ -32,7 +32,7 @@ struct Guide {
 };
 
 struct RegistrationSettings {
-  int iterations = 20;
+  int iterations = 12;
   double stiffness_start = 30, stiffness_end = 0.5;  // smoothness weight, geometric schedule
   double reach_start = 0.02, reach_end = 0.004;        // metres a match may lie away
   double guide_weight = 0.5;                           // the guides' weight at the start, fading to a tenth

@@ -54,6 +54,11 @@ def bench_runtime(
     if not (avatar / "neutral.obj").is_file():
         face = make_avatar(AvatarConfig(arkit_face=True))  # the tracked face's stand-in
         write_avatar(make_avatar(AvatarConfig(identity="seed 1"), template), avatar, face)
+    # a user's avatar: a held-out identity remeshed, inside a whole body (about 20,000 vertices)
+    own = work / "avatar-body"
+    if not (own / "neutral.obj").is_file():
+        body = AvatarConfig(identity="seed 404", remesh=6000, body=True, body_vertices=14_000)
+        write_avatar(make_avatar(body, template), own, None)
     path = out / "runtime.json"
     how = (
         f"make bench (softdeca bench-runtime, {len(specs)} parameters, "
@@ -63,6 +68,7 @@ def bench_runtime(
     cmd = [
         str(CLI), "bench-runtime", "--bundle", str(bundle), "--avatar", str(avatar),
         "--take", str(take), "--frames", str(frames), "--out", str(path), "--how", how,
+        "--own-avatar", str(own),
     ]  # fmt: skip
     print("running", " ".join(cmd), file=sys.stderr)
     subprocess.run(cmd, check=True, env=os.environ.copy())
