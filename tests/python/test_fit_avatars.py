@@ -13,16 +13,16 @@ from bounds import below
 from scipy.spatial import cKDTree
 from softdeca_train.avatars.build import make_avatar
 from softdeca_train.avatars.config import AvatarConfig
-from softdeca_train.avatars.fit_check import (
+from softdeca_train.face_names import ARKIT_BLENDSHAPES
+from softdeca_train.landmarks.arkit_reference import ArkitFace
+from softdeca_train.paths import default_takes_path
+from softdeca_train.runtime.fit_check import (
     DEFAULT_BUNDLE,
     FitCheckConfig,
     avatar_arrays,
     check_identity,
     template_head,
 )
-from softdeca_train.face_names import ARKIT_BLENDSHAPES
-from softdeca_train.landmarks.arkit_reference import ArkitFace
-from softdeca_train.paths import default_takes_path
 from softdeca_train.runtime.native import NativeAvatar, NativeFit, NativeModel
 from softdeca_train.sim.take import read_take
 

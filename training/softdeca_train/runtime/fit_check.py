@@ -30,6 +30,7 @@ from softdeca_train.paths import REPO_ROOT, default_takes_path
 from softdeca_train.runtime.native import AvatarArrays, NativeAvatar, NativeFit, NativeModel
 from softdeca_train.sim.take import read_take
 from softdeca_train.template import Template
+from softdeca_train.template.identities import identity_coefficients
 
 DEFAULT_BUNDLE = REPO_ROOT / "models" / "softdeca-default"
 
@@ -71,8 +72,6 @@ def avatar_arrays(avatar: AvatarMesh) -> AvatarArrays:
 
 def template_head(template: Template, identity: str) -> tuple[np.ndarray, np.ndarray]:
     """The identity's head in the template's topology (metres) and its 52 shapes as deltas."""
-    from softdeca_train.template.identities import identity_coefficients
-
     h = identity_coefficients(template, identity)
     eye = np.eye(52)
     neutral = template.blend(np.zeros(52), h)
