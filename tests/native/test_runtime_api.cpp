@@ -39,7 +39,7 @@ class Runtime : public ::testing::Test {
 };
 
 TEST_F(Runtime, ModelInfoDescribesTheBundle) {
-  EXPECT_EQ(info.format_version, 4u);  // with the physics at prepare: written as version 4
+  EXPECT_EQ(info.format_version, 5u);  // with the template head: written as version 5
   EXPECT_LE(info.format_version, static_cast<uint32_t>(SOFTDECA_BUNDLE_FORMAT_VERSION));
   EXPECT_EQ(info.head_vertex_count, head.vertices());
   EXPECT_EQ(info.blendshape_count, 52u);
@@ -134,11 +134,11 @@ TEST_F(Runtime, LoadsFromMemoryAndFromATarFile) {
 
 TEST_F(Runtime, RefusesAnotherFormatVersion) {
   BundleCopy copy(data_dir() + "/bundle", "version");
-  copy.replace_in("manifest.json", "\"format_version\": 4", "\"format_version\": 5");
+  copy.replace_in("manifest.json", "\"format_version\": 5", "\"format_version\": 6");
   softdeca_model* m = nullptr;
   EXPECT_EQ(softdeca_model_load(copy.path().c_str(), nullptr, &m), SOFTDECA_ERROR_FORMAT);
-  EXPECT_NE(error().find("version 5"), std::string::npos) << error();
-  EXPECT_NE(error().find("versions 1 to 4"), std::string::npos) << error();
+  EXPECT_NE(error().find("version 6"), std::string::npos) << error();
+  EXPECT_NE(error().find("versions 1 to 5"), std::string::npos) << error();
   EXPECT_EQ(m, nullptr);
 }
 
@@ -146,7 +146,7 @@ TEST_F(Runtime, TheVertexStageNeedsVersionTwoAndTheSoftDecaModel) {
   // softdeca.f_ph_v under a version-1 manifest: refused (a version-1 reader would ignore it)
   BundleCopy copy(data_dir() + "/bundle", "stage");
   copy.replace_in("manifest.json", "\"sparse.f_ph_v\"", "\"softdeca.f_ph_v\"");
-  copy.replace_in("manifest.json", "\"format_version\": 4", "\"format_version\": 1");
+  copy.replace_in("manifest.json", "\"format_version\": 5", "\"format_version\": 1");
   softdeca_model* m = nullptr;
   EXPECT_EQ(softdeca_model_load(copy.path().c_str(), nullptr, &m), SOFTDECA_ERROR_FORMAT);
   EXPECT_NE(error().find("format version 2"), std::string::npos) << error();

@@ -303,16 +303,16 @@ std::shared_ptr<const Preparation> Avatar::current() const {
 
 // ---- frames ----------------------------------------------------------------------------------
 
-void Avatar::check_output(const Output& out) const {
+void check_output_capacity(const Output& out, std::size_t vertices) {
   require_not_null(out.vertices, "output.vertices");
-  expect(out.vertex_capacity >= vh_, [&] {
-    return "output.vertex_capacity " + std::to_string(out.vertex_capacity) + " is below the head's " + std::to_string(vh_) +
-           " vertices";
+  expect(out.vertex_capacity >= vertices, [&] {
+    return "output.vertex_capacity " + std::to_string(out.vertex_capacity) + " is below the avatar's " +
+           std::to_string(vertices) + " vertices";
   }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
   if (out.normals)
-    expect(out.normal_capacity >= vh_, [&] {
-      return "output.normal_capacity " + std::to_string(out.normal_capacity) + " is below the head's " + std::to_string(vh_) +
-             " vertices";
+    expect(out.normal_capacity >= vertices, [&] {
+      return "output.normal_capacity " + std::to_string(out.normal_capacity) + " is below the avatar's " +
+             std::to_string(vertices) + " vertices";
     }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
 }
 
@@ -456,7 +456,7 @@ void Avatar::evaluate_weights(const float* weights, std::size_t count, const Out
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
   require_model(*model_, false);
-  check_output(out);
+  check_output_capacity(out, vh_);
   expect(!blendshapes_.empty(),
          [] { return std::string("the avatar was created without blendshapes: use softdeca_avatar_evaluate_surface"); });
   read_weights(weights, count);
@@ -476,7 +476,7 @@ void Avatar::evaluate_surface(const float* weights, std::size_t count, const flo
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
   require_model(*model_, false);
-  check_output(out);
+  check_output_capacity(out, vh_);
   read_weights(weights, count);
   require_not_null(surface, "surface");
   expect(vertices == vs_ || vertices == vh_, [&] {
@@ -536,7 +536,7 @@ void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Ou
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
   require_model(*model_, true);
-  check_output(out);
+  check_output_capacity(out, vh_);
   select_landmarks(points, count, "points");
   const auto prep = require_prepared(current());
   AvatarStats st;
@@ -577,7 +577,7 @@ void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Ou
 void Avatar::evaluate_linear(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
-  check_output(out);
+  check_output_capacity(out, vh_);
   expect(!blendshapes_.empty(), [] { return std::string("the avatar was created without blendshapes"); });
   read_weights(weights, count);
   AvatarStats st;

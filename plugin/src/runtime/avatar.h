@@ -49,6 +49,10 @@ struct Output {
   std::size_t normal_capacity = 0;
 };
 
+// Error(BUFFER_TOO_SMALL) when `out` holds fewer than `vertices` vertices (or normals, when
+// it has normals); Error(INVALID_ARGUMENT) without vertices.
+void check_output_capacity(const Output& out, std::size_t vertices);
+
 struct AvatarStats {
   std::size_t threads = 1;
   std::uint64_t frames = 0, preparations = 0, generation = 0;
@@ -118,7 +122,6 @@ class Avatar {
   std::shared_ptr<const Preparation> current() const;
   HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                            const std::vector<float>& identity, std::size_t n, std::size_t width) const;
-  void check_output(const Output& out) const;
   void read_weights(const float* weights, std::size_t count);
   const float* select_landmarks(const float* points, std::size_t count, const char* what) const;
   // The shared tail of a frame: dynamics, checks, output of the head and normals.

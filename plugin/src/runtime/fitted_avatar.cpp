@@ -92,17 +92,16 @@ std::size_t FittedAvatar::bytes() const {
          source_.bary.size() * 4 + source_.weight.size() * 4 + skin_triangles_.size() * 4;
 }
 
-void FittedAvatar::check_output(const Output& out) const {
-  require_not_null(out.vertices, "output.vertices");
-  expect(out.vertex_capacity >= n_, [&] {
-    return "output.vertex_capacity " + std::to_string(out.vertex_capacity) + " is below the avatar's " + std::to_string(n_) +
-           " vertices";
-  }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
-  if (out.normals)
-    expect(out.normal_capacity >= n_, [&] {
-      return "output.normal_capacity " + std::to_string(out.normal_capacity) + " is below the avatar's " + std::to_string(n_) +
-             " vertices";
-    }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+Output FittedAvatar::core_output() {
+  Output inner;
+  inner.vertices = head_out_.data();
+  inner.vertex_capacity = vh_;
+  return inner;
+}
+
+void FittedAvatar::own_blend(const float* weights, float* out) {
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kBlendshapeCount); ++i) weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
+  blendshapes_.blend(weights_.data(), neutral_.data(), out, 0);
 }
 
 void FittedAvatar::add_carried(const float* field, float* out) const {
@@ -124,26 +123,19 @@ void FittedAvatar::finish(const Output& out) {
 
 void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
-  check_output(out);
-  Output inner;
-  inner.vertices = head_out_.data();
-  inner.vertex_capacity = vh_;
-  core_->evaluate_weights(weights, count, inner);  // checks the weights
+  check_output_capacity(out, n_);
+  core_->evaluate_weights(weights, count, core_output());  // checks the weights
   const float* lin = core_->linear_skin();
   for (std::size_t i = 0; i < vs_ * 3; ++i) field_[i] = head_out_[i] - lin[i];
-  for (std::size_t i = 0; i < static_cast<std::size_t>(kBlendshapeCount); ++i) weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
-  blendshapes_.blend(weights_.data(), neutral_.data(), out.vertices, 0);
+  own_blend(weights, out.vertices);
   add_carried(field_.data(), out.vertices);
   finish(out);
 }
 
 void FittedAvatar::evaluate_landmarks(const float* points, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
-  check_output(out);
-  Output inner;
-  inner.vertices = head_out_.data();
-  inner.vertex_capacity = vh_;
-  core_->evaluate_landmarks(points, count, inner);
+  check_output_capacity(out, n_);
+  core_->evaluate_landmarks(points, count, core_output());
   for (std::size_t i = 0; i < vs_ * 3; ++i) field_[i] = head_out_[i] - registered_skin_[i];
   std::memcpy(out.vertices, neutral_.data(), n_ * 3 * sizeof(float));
   add_carried(field_.data(), out.vertices);
@@ -152,13 +144,9 @@ void FittedAvatar::evaluate_landmarks(const float* points, std::size_t count, co
 
 void FittedAvatar::evaluate_linear(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
-  check_output(out);
-  Output inner;
-  inner.vertices = head_out_.data();
-  inner.vertex_capacity = vh_;
-  core_->evaluate_linear(weights, count, inner);  // checks the weights, counts the frame
-  for (std::size_t i = 0; i < static_cast<std::size_t>(kBlendshapeCount); ++i) weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
-  blendshapes_.blend(weights_.data(), neutral_.data(), out.vertices, 0);
+  check_output_capacity(out, n_);
+  core_->evaluate_linear(weights, count, core_output());  // checks the weights, counts the frame
+  own_blend(weights, out.vertices);
   finish(out);
 }
 

@@ -46,7 +46,8 @@ class FittedAvatar {
   std::size_t bytes() const;
 
  private:
-  void check_output(const Output& out) const;
+  Output core_output();                             // the registered template's frame buffer
+  void own_blend(const float* weights, float* out);  // the avatar's own linear blend
   // out[v] += weight * A^-1 (sum of bary * field[corner]) over the embedding; field: skin x 3.
   void add_carried(const float* field, float* out) const;
   void finish(const Output& out);
