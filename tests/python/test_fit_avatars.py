@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from bounds import below
+from bounds import above, below
 from scipy.spatial import cKDTree
 from softdeca_train.avatars.build import make_avatar
 from softdeca_train.avatars.config import AvatarConfig
@@ -23,7 +23,13 @@ from softdeca_train.runtime.fit_check import (
     check_identity,
     template_head,
 )
-from softdeca_train.runtime.native import NativeAvatar, NativeFit, NativeModel
+from softdeca_train.runtime.native import (
+    AvatarArrays,
+    NativeAvatar,
+    NativeError,
+    NativeFit,
+    NativeModel,
+)
 from softdeca_train.sim.take import read_take
 
 LIMIT_RATIO = (
@@ -184,3 +190,30 @@ def test_the_fitted_head_is_the_template_paths_on_its_own_topology(
     magnitude = np.linalg.norm(truth[skin], axis=1).mean()
     ratio = np.linalg.norm((out - lin)[skin] - truth[skin], axis=1).mean() / magnitude
     below(ratio, LIMIT_RATIO, "acceptance: within 20 %")
+
+
+def test_an_avatar_without_shapes_fits_on_landmarks_and_animates(model, arkit) -> None:
+    """ARKit's face with no shapes at all, in centimetres and Z-up, and the bundle's landmarks on
+    it: it fits, and the template's shapes carried back through the fit move it."""
+    a = make_avatar(AvatarConfig(arkit_face=True, unit="cm", up="z"), face=arkit)
+    landmarks = a.neutral[np.argsort(a.truth.order)][model.landmark_vertices()]
+    mesh = AvatarArrays(a.neutral, a.triangles, np.zeros_like(a.deltas), landmarks)
+    fit = NativeFit.create(model, mesh)
+    report = fit.report()
+    assert report["metres_per_unit"] == 0.01 and report["up_axis"] == "+Z"
+    assert report["landmarks"] == len(landmarks) and report["shapes_matched"] == []
+    below(report["face_residual_mm_mean"], 1.0, "acceptance: a face mask within 1 mm")
+    avatar = NativeAvatar.fitted(model, fit, mesh)
+    avatar.prepare()
+    w = np.zeros(52, np.float32)
+    w[ARKIT_BLENDSHAPES.index("jawOpen")] = 0.8
+    lin, _ = avatar.evaluate_linear(w)
+    above(
+        float(np.abs(lin - a.neutral).max()) * 10,
+        10.0,
+        "jawOpen opens it by centimetres",
+    )
+    with pytest.raises(NativeError, match="landmarks"):
+        NativeFit.create(
+            model, AvatarArrays(a.neutral, a.triangles, np.zeros_like(a.deltas))
+        )

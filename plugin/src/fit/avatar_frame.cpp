@@ -87,11 +87,6 @@ double median(std::vector<double> x) {
   return x.size() % 2 ? x[h] : 0.5 * (x[h - 1] + x[h]);
 }
 
-std::string axis_name(const Eigen::Vector3d& up) {
-  Eigen::Index k = 0;
-  up.cwiseAbs().maxCoeff(&k);
-  return std::string(up[k] < 0 ? "-" : "+") + "XYZ"[k];
-}
 
 // Area-weighted normals of the triangles whose corners all move: a face's sum points out of it.
 Eigen::Vector3d face_normal_sum(const AvatarShapes& s, const std::vector<uint8_t>& face) {
@@ -119,6 +114,19 @@ std::vector<double> vertex_areas(const AvatarShapes& s) {
 }
 
 }  // namespace
+
+std::string axis_name(const Eigen::Vector3d& up) {
+  Eigen::Index k = 0;
+  up.cwiseAbs().maxCoeff(&k);
+  return std::string(up[k] < 0 ? "-" : "+") + "XYZ"[k];
+}
+
+double snap_unit(double measured) {
+  double unit = measured;
+  for (const double u : kUnits)
+    if (std::fabs(std::log(measured / u)) < std::log(kSnap)) unit = u;
+  return unit;
+}
 
 AvatarFrame avatar_frame(const AvatarShapes& s) {
   require(s.neutral != nullptr && s.vertex_count > 0, "the avatar has no vertices");
@@ -187,9 +195,7 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   f.up_axis = axis_name(f.up);
 
   f.metres_per_unit_measured = median(scales);
-  f.metres_per_unit = f.metres_per_unit_measured;
-  for (const double unit : kUnits)
-    if (std::fabs(std::log(f.metres_per_unit_measured / unit)) < std::log(kSnap)) f.metres_per_unit = unit;
+  f.metres_per_unit = snap_unit(f.metres_per_unit_measured);
   if (eye_pairs) {
     f.eye_distance = eye_distance / eye_pairs;
     f.eyes = eyes / eye_pairs;

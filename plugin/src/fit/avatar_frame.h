@@ -51,6 +51,12 @@ struct AvatarFrame {
   std::size_t shapes_used = 0;
 };
 
+// A measured metres-per-unit snapped to mm, cm, inch, dm or m when within 25 %.
+double snap_unit(double measured);
+
+// The avatar axis closest to a direction: "+Y", "-Z", ...
+std::string axis_name(const Eigen::Vector3d& direction);
+
 // Throws softdeca::Error (invalid argument) with a message a user can act on: no vertices,
 // non-finite values, no ARKit shape that moves anything, no Left/Right pair or no shapes
 // above and below to tell the orientation from.

@@ -71,14 +71,18 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
 
   neutral_.assign(a.neutral, a.neutral + n_ * 3);
   triangles_.assign(a.triangles, a.triangles + a.triangle_count * 3);
-  std::vector<float> own(kBlendshapeCount * n_ * 3, 0.0f);
-  for (std::size_t k = 0; k < static_cast<std::size_t>(kBlendshapeCount); ++k)
-    if (a.deltas[k]) std::memcpy(own.data() + k * n_ * 3, a.deltas[k], n_ * 3 * sizeof(float));
-  blendshapes_ = Blendshapes(own.data(), kBlendshapeCount, n_, 1);
   registered_skin_.assign(f.registered.begin(), f.registered.begin() + static_cast<std::ptrdiff_t>(vs_ * 3));
   embedding_ = f.embedding;
   skin_triangles_.assign(t.skin_triangles, t.skin_triangles + t.skin_triangle_count * 3);
   to_avatar_ = f.placement.linear.inverse().cast<float>();
+  // The avatar's own shapes; a shape its rig lacks is the template's, carried back onto the
+  // avatar's face through the embedding, so a rig without some (or any) shapes animates fully.
+  std::vector<float> own(kBlendshapeCount * n_ * 3, 0.0f);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(kBlendshapeCount); ++k) {
+    if (a.deltas[k]) std::memcpy(own.data() + k * n_ * 3, a.deltas[k], n_ * 3 * sizeof(float));
+    else if (f.origin[k] == fit::ShapeOrigin::Template) add_carried(shapes.data() + k * vh_ * 3, own.data() + k * n_ * 3);
+  }
+  blendshapes_ = Blendshapes(own.data(), kBlendshapeCount, n_, 1);
   source_ = f.source;
   head_out_.resize(vh_ * 3);
   field_.resize(vs_ * 3);
