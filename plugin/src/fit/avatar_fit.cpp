@@ -303,6 +303,258 @@ std::vector<float> identity_skin(const TemplateData& t, const AvatarFit& fit) {
   return out;
 }
 
+namespace {
+
+// The avatar's skin: the parts the skin-only shapes move (every face part without such a
+// shape), their triangles with area and those triangles' open edges.
+struct SkinSurface {
+  std::vector<uint8_t> part;  // per part of the mesh: skin
+  std::vector<std::int32_t> triangles;
+  std::vector<uint8_t> open_edges;
+  std::size_t parts() const { return static_cast<std::size_t>(std::count(part.begin(), part.end(), 1)); }
+};
+
+SkinSurface skin_surface(const AvatarMesh& a, const AvatarFrame& frame, const MeshTopology& topo) {
+  const std::size_t n = a.vertex_count;
+  SkinSurface s;
+  s.part.assign(topo.components, 0);
+  for (const char* name : kSkinShapes) {
+    const float* d = a.deltas[static_cast<std::size_t>(stream::blendshape_index(name))];
+    if (!d) continue;
+    double peak = 0;
+    for (std::size_t v = 0; v < n; ++v) peak = std::max(peak, row3(d, v).norm());
+    for (std::size_t v = 0; v < n; ++v)
+      if (peak > 0 && row3(d, v).norm() > 0.05 * peak) s.part[static_cast<std::size_t>(topo.component[v])] = 1;
+  }
+  if (s.parts() == 0)
+    for (std::size_t v = 0; v < n; ++v)
+      if (frame.face[v]) s.part[static_cast<std::size_t>(topo.component[v])] = 1;
+  const auto weld = [&](std::int32_t v) { return topo.weld[static_cast<std::size_t>(v)]; };
+  for (std::size_t f = 0; f < a.triangle_count; ++f) {
+    const std::int32_t* c = a.triangles + 3 * f;
+    if (!s.part[static_cast<std::size_t>(topo.component[static_cast<std::size_t>(c[0])])]) continue;
+    if (weld(c[0]) == weld(c[1]) || weld(c[1]) == weld(c[2]) || weld(c[0]) == weld(c[2])) continue;
+    s.triangles.insert(s.triangles.end(), c, c + 3);
+    s.open_edges.push_back(topo.boundary_edges[f]);
+  }
+  require(!s.triangles.empty(), "the avatar's face has no triangle with area: nothing to fit to");
+  return s;
+}
+
+Triangles triangle_rows(const std::int32_t* indices, std::size_t count) {
+  Triangles f(static_cast<Eigen::Index>(count), 3);
+  for (std::size_t i = 0; i < count * 3; ++i) f(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) = indices[i];
+  return f;
+}
+
+// What the steps of one fit share.
+struct Session {
+  const TemplateData& t;
+  const AvatarMesh& a;
+  AvatarFrame tframe;
+  Located at;
+  MeshTopology topo;
+  SkinSurface skin;
+  Points y, tskin, start;  // the avatar placed; the template's skin; where the registration starts
+  Triangles ttri, atri;
+  std::vector<double> data_weight;
+  std::unique_ptr<ShapeMatcher> matcher;
+  std::vector<float> identity;
+
+  // The avatar in the template's frame on the current placement, and the matcher on it.
+  void place() {
+    y.resize(static_cast<Eigen::Index>(a.vertex_count), 3);
+    for (std::size_t v = 0; v < a.vertex_count; ++v)
+      y.row(static_cast<Eigen::Index>(v)) = at.place.to_template(row3(a.neutral, v)).transpose();
+    matcher = std::make_unique<ShapeMatcher>(y, atri, skin.open_edges, topo.boundary_vertex, data_weight,
+                                             shared_shapes(t, a, at.frame, tframe, at.place.linear));
+  }
+};
+
+// The template identity closest to the avatar, and the placement refined: the template vertices
+// the shapes pin down are matched to the avatar, the rigid motion that best takes the avatar
+// onto them refines the placement, and the identity modes fit to them (a ridge regression:
+// coefficients about N(0, 1), matches good to a couple of millimetres).
+void closest_identity(Session& s) {
+  const std::size_t vs = s.t.skin_vertices;
+  for (const double radius : {0.02, 0.01}) {
+    std::vector<Match> m = s.matcher->shape_matches(s.start, radius);
+    std::vector<Eigen::Vector3d> from, to;
+    for (std::size_t i = 0; i < vs; ++i)
+      if (m[i].weight > 0) from.push_back(m[i].target), to.push_back(s.start.row(static_cast<Eigen::Index>(i)).transpose());
+    if (from.size() < 10) break;
+    Eigen::Matrix3d r;
+    Eigen::Vector3d tr;
+    kabsch(from, to, r, tr);
+    s.at.place.linear = r * s.at.place.linear;
+    s.at.place.offset = r * s.at.place.offset + tr;
+    s.place();
+    if (s.t.identity_count == 0) continue;
+    m = s.matcher->shape_matches(s.start, radius);
+    s.identity = fit_identity(s.t, m, s.tskin, kMatchVariance);
+    s.start = identity_points(s.t, s.identity);
+  }
+}
+
+// The bundle's landmarks on the avatar, when the host gives them, as guides.
+std::vector<Guide> landmark_guides(const Session& s) {
+  std::vector<Guide> guides;
+  const TemplateData& t = s.t;
+  if (!s.a.landmarks || s.a.landmark_count != t.landmark_triangle.size()) return guides;
+  for (std::size_t l = 0; l < s.a.landmark_count; ++l) {
+    const auto tri = static_cast<std::size_t>(t.landmark_triangle[l]);
+    std::size_t corner = 0;
+    for (std::size_t k = 1; k < 3; ++k)
+      if (t.landmark_bary[l][k] > t.landmark_bary[l][corner]) corner = k;
+    guides.push_back({t.skin_triangles[3 * tri + corner], s.at.place.to_template(row3(s.a.landmarks, l)), 2.0});
+  }
+  return guides;
+}
+
+// From the closest identity onto the avatar's skin; twice when the bundle has identity modes:
+// the identity read off the first registration (every face vertex placed; measured on held-out
+// ICT identities, a prior this wide reads their codes best) is a closer start for the second.
+Registration register_rounds(Session& s, const std::vector<Guide>& guides, const RegistrationSettings& settings,
+                             const std::function<void(double)>& progress) {
+  const std::size_t vs = s.t.skin_vertices;
+  const int rounds = s.t.identity_count ? kRegistrationRounds : 1;
+  Registration reg;
+  for (int round = 0; round < rounds; ++round) {
+    reg = register_skin(s.start, s.ttri, std::cref(*s.matcher), guides, settings,
+                        [&](int i, int of) { progress((round + static_cast<double>(i) / of) / rounds); });
+    if (!s.t.identity_count) continue;
+    std::vector<Match> registered(vs);
+    for (std::size_t v = 0; v < vs; ++v)
+      if (s.tframe.face[v]) registered[v] = {reg.skin.row(static_cast<Eigen::Index>(v)).transpose(), 1.0};
+    s.identity = fit_identity(s.t, registered, s.tskin, kRegisteredVariance);
+    s.start = identity_points(s.t, s.identity);
+  }
+  return reg;
+}
+
+// The registered head: the skin, and every other vertex moved with its nearest skin vertex.
+std::vector<float> registered_head(const Session& s, const Points& skin) {
+  const TemplateData& t = s.t;
+  const std::size_t vs = t.skin_vertices;
+  std::vector<float> head(t.head_neutral, t.head_neutral + t.head_vertices * 3);
+  for (std::size_t v = 0; v < vs; ++v)
+    for (int c = 0; c < 3; ++c) head[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(skin(static_cast<Eigen::Index>(v), c));
+  if (t.head_vertices == vs) return head;
+  geometry::Sites rest(static_cast<Eigen::Index>(t.head_vertices - vs), 3);
+  for (std::size_t v = vs; v < t.head_vertices; ++v) rest.row(static_cast<Eigen::Index>(v - vs)) = row3(t.head_neutral, v).transpose();
+  const std::vector<std::int32_t> near = geometry::nearest_sites(s.tskin, rest);
+  for (std::size_t v = vs; v < t.head_vertices; ++v) {
+    const auto n = static_cast<Eigen::Index>(near[v - vs]);
+    for (int c = 0; c < 3; ++c) head[3 * v + static_cast<std::size_t>(c)] += static_cast<float>(skin(n, c) - s.tskin(n, c));
+  }
+  return head;
+}
+
+struct Residual {
+  double mean_mm = 0, max_mm = 0;
+  std::size_t points = 0;
+};
+
+// The registered template's distance to the avatar's surface over the template's face, where the
+// avatar has surface (a face mask's rim is not counted).
+Residual face_residual(const Session& s, const Points& skin, double reach) {
+  Residual r;
+  double sum = 0;
+  for (std::size_t v = 0; v < s.t.skin_vertices; ++v) {
+    if (!s.tframe.face[v]) continue;
+    const geometry::SurfacePoint p = s.matcher->neutral().closest(skin.row(static_cast<Eigen::Index>(v)).transpose(), reach);
+    if (p.triangle < 0 || s.matcher->on_boundary(p)) continue;
+    const double d = 1000 * std::sqrt(p.squared_distance);
+    sum += d;
+    r.max_mm = std::max(r.max_mm, d);
+    ++r.points;
+  }
+  require(r.points > 0, "the template's face found no surface of the avatar near it: is this mesh a face?");
+  r.mean_mm = sum / static_cast<double>(r.points);
+  return r;
+}
+
+// Where each template vertex reads the avatar's shapes: its closest point of the avatar's skin.
+ShapeSource shape_source(const Session& s, const Points& skin) {
+  const std::size_t vs = s.t.skin_vertices;
+  ShapeSource src;
+  src.corners.assign(vs * 3, 0);
+  src.bary.assign(vs * 3, 0.0f);
+  src.weight.assign(vs, 0.0f);
+  for (std::size_t v = 0; v < vs; ++v) {
+    const geometry::SurfacePoint p = s.matcher->neutral().closest(skin.row(static_cast<Eigen::Index>(v)).transpose());
+    if (p.triangle < 0) continue;
+    for (std::size_t k = 0; k < 3; ++k) {
+      src.corners[3 * v + k] = s.skin.triangles[3 * static_cast<std::size_t>(p.triangle) + k];
+      src.bary[3 * v + k] = static_cast<float>(p.bary[static_cast<Eigen::Index>(k)]);
+    }
+    src.weight[v] = static_cast<float>(smooth_fall(std::sqrt(p.squared_distance), kShapeNear, kShapeFar));
+  }
+  return src;
+}
+
+// Every skin-part vertex of the avatar near the registered skin, weighted 1 on the template's
+// face and fading over kFaceFade beyond it and from kNear to kFar away from the skin.
+Embedding embed(const Session& s, const Points& skin) {
+  const std::size_t vs = s.t.skin_vertices;
+  std::vector<Eigen::Index> in_face;
+  for (std::size_t v = 0; v < vs; ++v)
+    if (s.tframe.face[v]) in_face.push_back(static_cast<Eigen::Index>(v));
+  geometry::Sites sites(static_cast<Eigen::Index>(in_face.size()), 3);
+  for (std::size_t i = 0; i < in_face.size(); ++i) sites.row(static_cast<Eigen::Index>(i)) = s.tskin.row(in_face[i]);
+  const std::vector<std::int32_t> near = geometry::nearest_sites(sites, s.tskin);
+  std::vector<double> face_weight(vs);
+  for (std::size_t v = 0; v < vs; ++v)
+    face_weight[v] = smooth_fall((s.tskin.row(static_cast<Eigen::Index>(v)) - sites.row(near[v])).norm(), 0.0, kFaceFade);
+  const geometry::SurfaceQuery registered(skin, s.ttri);
+  const Points normals = vertex_normals(skin, s.ttri);
+  Embedding e;
+  for (std::size_t v = 0; v < s.a.vertex_count; ++v) {
+    if (!s.skin.part[static_cast<std::size_t>(s.topo.component[v])]) continue;
+    const Eigen::Vector3d q = s.y.row(static_cast<Eigen::Index>(v)).transpose();
+    const geometry::SurfacePoint p = registered.closest(q, kFar);
+    if (p.triangle < 0) continue;
+    double fw = 0;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const auto c = static_cast<std::size_t>(s.ttri(p.triangle, k));
+      fw += p.bary[k] * face_weight[c];
+      normal += p.bary[k] * normals.row(static_cast<Eigen::Index>(c)).transpose();
+    }
+    const double w = fw * smooth_fall(std::sqrt(p.squared_distance), kNear, kFar);
+    if (!(w > 0)) continue;
+    e.vertex.push_back(static_cast<std::int32_t>(v));
+    e.triangle.push_back(p.triangle);
+    for (int k = 0; k < 3; ++k) e.bary.push_back(static_cast<float>(p.bary[k]));
+    e.offset.push_back(static_cast<float>((q - p.point).dot(normal.normalized())));
+    e.weight.push_back(static_cast<float>(w));
+  }
+  require(!e.vertex.empty(), "no vertex of the avatar lies on the registered face");
+  return e;
+}
+
+std::string report_json(const Session& s, const AvatarFit& fit, const Residual& r, std::size_t landmarks, double seconds) {
+  const AvatarFrame& frame = s.at.frame;
+  std::size_t full = 0;
+  for (const float w : fit.embedding.weight) full += w >= 1.0f;
+  std::ostringstream o;
+  o.precision(6);
+  o << "{\"metres_per_unit\": " << s.at.unit << ", \"metres_per_unit_measured\": " << frame.metres_per_unit_measured
+    << ", \"up_axis\": " << json_string(frame.up_axis) << ", \"mirrored\": " << (s.at.mirrored ? "true" : "false")
+    << ", \"vertices\": " << s.a.vertex_count << ", \"triangles\": " << s.a.triangle_count << ", \"parts\": " << s.topo.components
+    << ", \"skin_parts\": " << s.skin.parts() << ", \"degenerate_triangles\": " << s.topo.degenerate_triangles
+    << ", \"face_vertices\": " << frame.face_vertices << ", \"embedded_vertices\": " << fit.embedding.size()
+    << ", \"embedded_fully\": " << full << ", \"shapes_matched\": " << name_list(fit.origin, ShapeOrigin::Avatar)
+    << ", \"shapes_carried\": " << name_list(fit.origin, ShapeOrigin::Template)
+    << ", \"shapes_missing\": " << name_list(fit.origin, ShapeOrigin::None) << ", \"landmarks\": " << landmarks
+    << ", \"matched_by_shapes\": " << s.matcher->described() << ", \"face_residual_mm_mean\": " << r.mean_mm
+    << ", \"face_residual_mm_max\": " << r.max_mm << ", \"face_residual_points\": " << r.points
+    << ", \"seconds\": " << seconds << "}";
+  return o.str();
+}
+
+}  // namespace
+
 AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOptions& options) {
   const auto t0 = Clock::now();
   const auto step = [&](const char* what, double share) {
@@ -310,250 +562,59 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   };
   check_mesh(a);
   require(t.head_neutral && t.shapes && t.skin_triangles && t.skin_vertices > 0, "the bundle has no template head");
-  const std::size_t n = a.vertex_count, vs = t.skin_vertices;
+  const std::size_t vs = t.skin_vertices;
   step("reading the avatar's face", 0.0);
 
-  // 1. The face, its axes and unit, on the avatar and (the same way) on the template.
+  // The face, its axes and unit, on the avatar and (the same way) on the template, and the
+  // placement: from the shapes, or from the bundle's landmarks on an avatar without shapes.
   AvatarShapes ts;
   ts.neutral = t.head_neutral;
   ts.vertex_count = vs;
   ts.triangles = t.skin_triangles;
   ts.triangle_count = t.skin_triangle_count;
   for (std::size_t k = 0; k < kShapes; ++k) ts.deltas[k] = t.moves[k] ? t.shapes + k * vs * 3 : nullptr;
-  const AvatarFrame tframe = avatar_frame(ts);
+  Session s{t, a, avatar_frame(ts), {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}};
   const bool any_shape = std::any_of(a.deltas.begin(), a.deltas.end(), [](const float* d) { return d != nullptr; });
   const bool by_landmarks = !any_shape && a.landmarks && a.landmark_count == t.landmark_triangle.size();
   require(any_shape || by_landmarks,
           "none of the avatar's ARKit blendshapes moves a vertex: give the rig's ARKit shapes (by name) or the "
           "bundle's landmarks on the avatar");
-  // 2. The placement: the avatar's unit and axes to the template's.
-  const Located at = by_landmarks ? locate_by_landmarks(t, a, tframe, options.metres_per_unit)
-                                   : locate_by_shapes(a, tframe, options.metres_per_unit);
-  const AvatarFrame& frame = at.frame;
-  const double unit = at.unit;
-  const bool mirrored = at.mirrored;
-  Placement place = at.place;
+  s.at = by_landmarks ? locate_by_landmarks(t, a, s.tframe, options.metres_per_unit)
+                      : locate_by_shapes(a, s.tframe, options.metres_per_unit);
+  s.topo = mesh_topology(a.neutral, a.vertex_count, a.triangles, a.triangle_count);
+  s.skin = skin_surface(a, s.at.frame, s.topo);
+  s.tskin.resize(static_cast<Eigen::Index>(vs), 3);
+  for (std::size_t v = 0; v < vs; ++v) s.tskin.row(static_cast<Eigen::Index>(v)) = row3(t.head_neutral, v).transpose();
+  s.start = s.tskin;
+  s.ttri = triangle_rows(t.skin_triangles, t.skin_triangle_count);
+  s.atri = triangle_rows(s.skin.triangles.data(), s.skin.triangles.size() / 3);
+  s.data_weight.resize(vs);
+  for (std::size_t v = 0; v < vs; ++v) s.data_weight[v] = s.tframe.face[v] ? 1.0 : 0.5;
+  s.place();
 
-  // 3. The avatar's parts and its skin: the parts the skin-only shapes move.
-  const MeshTopology topo = mesh_topology(a.neutral, n, a.triangles, a.triangle_count);
-  std::vector<uint8_t> skin_part(topo.components, 0);
-  for (const char* name : kSkinShapes) {
-    const float* d = a.deltas[static_cast<std::size_t>(stream::blendshape_index(name))];
-    if (!d) continue;
-    double peak = 0;
-    for (std::size_t v = 0; v < n; ++v) peak = std::max(peak, row3(d, v).norm());
-    for (std::size_t v = 0; v < n; ++v)
-      if (peak > 0 && row3(d, v).norm() > 0.05 * peak) skin_part[static_cast<std::size_t>(topo.component[v])] = 1;
-  }
-  if (std::find(skin_part.begin(), skin_part.end(), 1) == skin_part.end())  // no skin-only shape: every face part
-    for (std::size_t v = 0; v < n; ++v)
-      if (frame.face[v]) skin_part[static_cast<std::size_t>(topo.component[v])] = 1;
-  std::vector<std::int32_t> skin_tris;
-  std::vector<uint8_t> skin_edges;
-  for (std::size_t f = 0; f < a.triangle_count; ++f) {
-    const std::int32_t* c = a.triangles + 3 * f;
-    if (!skin_part[static_cast<std::size_t>(topo.component[static_cast<std::size_t>(c[0])])]) continue;
-    if (topo.weld[static_cast<std::size_t>(c[0])] == topo.weld[static_cast<std::size_t>(c[1])] ||
-        topo.weld[static_cast<std::size_t>(c[1])] == topo.weld[static_cast<std::size_t>(c[2])] ||
-        topo.weld[static_cast<std::size_t>(c[0])] == topo.weld[static_cast<std::size_t>(c[2])])
-      continue;
-    skin_tris.insert(skin_tris.end(), c, c + 3);
-    skin_edges.push_back(topo.boundary_edges[f]);
-  }
-  require(!skin_tris.empty(), "the avatar's face has no triangle with area: nothing to fit to");
-
-  // The avatar in the template's frame.
-  Points y(static_cast<Eigen::Index>(n), 3);
-  const auto place_all = [&] {
-    for (std::size_t v = 0; v < n; ++v) y.row(static_cast<Eigen::Index>(v)) = place.to_template(row3(a.neutral, v)).transpose();
-  };
-  place_all();
-
-  Points tskin(static_cast<Eigen::Index>(vs), 3);
-  for (std::size_t v = 0; v < vs; ++v) tskin.row(static_cast<Eigen::Index>(v)) = row3(t.head_neutral, v).transpose();
-  Triangles ttri(static_cast<Eigen::Index>(t.skin_triangle_count), 3);
-  for (std::size_t f = 0; f < t.skin_triangle_count * 3; ++f) ttri(static_cast<Eigen::Index>(f / 3), static_cast<Eigen::Index>(f % 3)) = t.skin_triangles[f];
-  Triangles atri(static_cast<Eigen::Index>(skin_tris.size() / 3), 3);
-  for (std::size_t f = 0; f < skin_tris.size(); ++f) atri(static_cast<Eigen::Index>(f / 3), static_cast<Eigen::Index>(f % 3)) = skin_tris[f];
-  std::vector<double> data_weight(vs);
-  for (std::size_t v = 0; v < vs; ++v) data_weight[v] = tframe.face[v] ? 1.0 : 0.5;
-  std::unique_ptr<ShapeMatcher> matcher;
-  const auto match_on_placement = [&] {
-    place_all();
-    matcher = std::make_unique<ShapeMatcher>(y, atri, skin_edges, topo.boundary_vertex, data_weight,
-                                             shared_shapes(t, a, frame, tframe, place.linear));
-  };
-  match_on_placement();
-
-  // 4. The template identity closest to the avatar, and the placement refined: the template
-  // vertices the shapes pin down are matched to the avatar, the rigid motion that best takes the
-  // avatar onto them refines the placement, and the identity modes fit to them (a ridge
-  // regression: coefficients about N(0, 1), matches good to a couple of millimetres).
   step("finding the closest identity", 0.05);
-  Points start = tskin;
-  std::vector<float> identity;
-  for (const double radius : {0.02, 0.01}) {
-    std::vector<Match> m = matcher->shape_matches(start, radius);
-    std::vector<Eigen::Vector3d> from, to;
-    for (std::size_t i = 0; i < vs; ++i)
-      if (m[i].weight > 0) from.push_back(m[i].target), to.push_back(start.row(static_cast<Eigen::Index>(i)).transpose());
-    if (from.size() < 10) break;
-    Eigen::Matrix3d r;
-    Eigen::Vector3d tr;
-    kabsch(from, to, r, tr);
-    place.linear = r * place.linear;
-    place.offset = r * place.offset + tr;
-    match_on_placement();
-    if (t.identity_count == 0) continue;
-    m = matcher->shape_matches(start, radius);
-    identity = fit_identity(t, m, tskin, kMatchVariance);
-    start = identity_points(t, identity);
-  }
-
-  // Guides: the bundle's landmarks on the avatar, when the host gives them.
-  std::vector<Guide> guides;
-  if (a.landmarks && a.landmark_count == t.landmark_triangle.size())
-    for (std::size_t l = 0; l < a.landmark_count; ++l) {
-      const auto tri = static_cast<Eigen::Index>(t.landmark_triangle[l]);
-      int corner = 0;
-      for (int k = 1; k < 3; ++k)
-        if (t.landmark_bary[l][static_cast<std::size_t>(k)] > t.landmark_bary[l][static_cast<std::size_t>(corner)]) corner = k;
-      guides.push_back({t.skin_triangles[3 * tri + corner], place.to_template(row3(a.landmarks, l)), 2.0});
-    }
-
-  // 5. Registration: from the closest identity onto the avatar's skin.
+  closest_identity(s);
+  const std::vector<Guide> guides = landmark_guides(s);
   step("registering the template", 0.1);
   RegistrationSettings settings;
   if (options.iterations > 0) settings.iterations = options.iterations;
-  // Twice when the bundle has identity modes: the identity read off the first registration is
-  // a closer start for the second.
-  const int rounds = t.identity_count ? kRegistrationRounds : 1;
-  Registration reg;
-  for (int round = 0; round < rounds; ++round) {
-    reg = register_skin(start, ttri, std::cref(*matcher), guides, settings, [&](int i, int of) {
-      step("registering the template", 0.1 + 0.65 * (round + static_cast<double>(i) / of) / rounds);
-    });
-    // The identity again, from the registered face: every face vertex placed (measured on
-    // held-out ICT identities: a prior this wide reads their codes best).
-    if (!t.identity_count) continue;
-    std::vector<Match> registered(vs);
-    for (std::size_t v = 0; v < vs; ++v)
-      if (tframe.face[v]) registered[v] = {reg.skin.row(static_cast<Eigen::Index>(v)).transpose(), 1.0};
-    identity = fit_identity(t, registered, tskin, kRegisteredVariance);
-    start = identity_points(t, identity);
-  }
-  const geometry::SurfaceQuery& avatar_surface = matcher->neutral();
+  const Registration reg = register_rounds(s, guides, settings, [&](double share) { step("registering the template", 0.1 + 0.65 * share); });
 
   AvatarFit fit;
-  fit.mesh_sha256 = mesh_sha256(a.neutral, n, a.triangles, a.triangle_count);
-  fit.vertex_count = n;
+  fit.mesh_sha256 = mesh_sha256(a.neutral, a.vertex_count, a.triangles, a.triangle_count);
+  fit.vertex_count = a.vertex_count;
   fit.triangle_count = a.triangle_count;
-  fit.placement = place;
-  fit.identity = identity;
-
-  // The registered head: the skin, and every other vertex moved with its nearest skin vertex.
-  fit.registered.assign(t.head_neutral, t.head_neutral + t.head_vertices * 3);
-  for (std::size_t v = 0; v < vs; ++v)
-    for (int c = 0; c < 3; ++c) fit.registered[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(reg.skin(static_cast<Eigen::Index>(v), c));
-  if (t.head_vertices > vs) {
-    geometry::Sites rest(static_cast<Eigen::Index>(t.head_vertices - vs), 3);
-    for (std::size_t v = vs; v < t.head_vertices; ++v) rest.row(static_cast<Eigen::Index>(v - vs)) = row3(t.head_neutral, v).transpose();
-    const std::vector<std::int32_t> near = geometry::nearest_sites(tskin, rest);
-    for (std::size_t v = vs; v < t.head_vertices; ++v) {
-      const auto s = static_cast<Eigen::Index>(near[v - vs]);
-      for (int c = 0; c < 3; ++c)
-        fit.registered[3 * v + static_cast<std::size_t>(c)] += static_cast<float>(reg.skin(s, c) - tskin(s, c));
-    }
-  }
-
-  // 6. The residual over the template's face, where the avatar has surface.
+  fit.placement = s.at.place;
+  fit.identity = s.identity;
+  fit.registered = registered_head(s, reg.skin);
   step("measuring the fit", 0.8);
-  double sum = 0, worst = 0;
-  std::size_t counted = 0;
-  for (std::size_t v = 0; v < vs; ++v) {
-    if (!tframe.face[v]) continue;
-    const geometry::SurfacePoint p = avatar_surface.closest(reg.skin.row(static_cast<Eigen::Index>(v)).transpose(), settings.reach_end * 2);
-    if (p.triangle < 0 || matcher->on_boundary(p)) continue;
-    const double d = std::sqrt(p.squared_distance);
-    sum += d;
-    worst = std::max(worst, d);
-    ++counted;
-  }
-  require(counted > 0, "the template's face found no surface of the avatar near it: is this mesh a face?");
-
-  // 7. Where each template vertex reads the avatar's shapes.
-  fit.source.corners.assign(vs * 3, 0);
-  fit.source.bary.assign(vs * 3, 0.0f);
-  fit.source.weight.assign(vs, 0.0f);
-  for (std::size_t v = 0; v < vs; ++v) {
-    const geometry::SurfacePoint p = avatar_surface.closest(reg.skin.row(static_cast<Eigen::Index>(v)).transpose());
-    if (p.triangle < 0) continue;
-    for (std::size_t k = 0; k < 3; ++k) {
-      fit.source.corners[3 * v + k] = skin_tris[3 * static_cast<std::size_t>(p.triangle) + k];
-      fit.source.bary[3 * v + k] = static_cast<float>(p.bary[static_cast<Eigen::Index>(k)]);
-    }
-    fit.source.weight[v] = static_cast<float>(smooth_fall(std::sqrt(p.squared_distance), kShapeNear, kShapeFar));
-  }
+  const Residual residual = face_residual(s, reg.skin, settings.reach_end * 2);
+  fit.source = shape_source(s, reg.skin);
   for (std::size_t k = 0; k < kShapes; ++k)
-    fit.origin[k] = frame.moves[k] ? ShapeOrigin::Avatar : t.moves[k] ? ShapeOrigin::Template : ShapeOrigin::None;
-
-  // 8. The embedding: every skin-part vertex of the avatar near the registered skin.
+    fit.origin[k] = s.at.frame.moves[k] ? ShapeOrigin::Avatar : t.moves[k] ? ShapeOrigin::Template : ShapeOrigin::None;
   step("embedding the avatar", 0.85);
-  std::vector<double> face_weight(vs, 1.0);
-  {
-    std::vector<Eigen::Index> in_face;
-    for (std::size_t v = 0; v < vs; ++v)
-      if (tframe.face[v]) in_face.push_back(static_cast<Eigen::Index>(v));
-    geometry::Sites sites(static_cast<Eigen::Index>(in_face.size()), 3), queries(static_cast<Eigen::Index>(vs), 3);
-    for (std::size_t i = 0; i < in_face.size(); ++i) sites.row(static_cast<Eigen::Index>(i)) = tskin.row(in_face[i]);
-    queries = tskin;
-    const std::vector<std::int32_t> near = geometry::nearest_sites(sites, queries);
-    for (std::size_t v = 0; v < vs; ++v)
-      face_weight[v] = smooth_fall((tskin.row(static_cast<Eigen::Index>(v)) - sites.row(near[v])).norm(), 0.0, kFaceFade);
-  }
-  const geometry::SurfaceQuery registered(reg.skin, ttri);
-  const Points tnormals = vertex_normals(reg.skin, ttri);
-  for (std::size_t v = 0; v < n; ++v) {
-    if (!skin_part[static_cast<std::size_t>(topo.component[v])]) continue;
-    const Eigen::Vector3d q = y.row(static_cast<Eigen::Index>(v)).transpose();
-    const geometry::SurfacePoint p = registered.closest(q, kFar);
-    if (p.triangle < 0) continue;
-    double fw = 0;
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) {
-      const auto c = static_cast<std::size_t>(ttri(p.triangle, k));
-      fw += p.bary[k] * face_weight[c];
-      normal += p.bary[k] * tnormals.row(static_cast<Eigen::Index>(c)).transpose();
-    }
-    const double w = fw * smooth_fall(std::sqrt(p.squared_distance), kNear, kFar);
-    if (!(w > 0)) continue;
-    fit.embedding.vertex.push_back(static_cast<std::int32_t>(v));
-    fit.embedding.triangle.push_back(p.triangle);
-    for (int k = 0; k < 3; ++k) fit.embedding.bary.push_back(static_cast<float>(p.bary[k]));
-    fit.embedding.offset.push_back(static_cast<float>((q - p.point).dot(normal.normalized())));
-    fit.embedding.weight.push_back(static_cast<float>(w));
-  }
-  require(!fit.embedding.vertex.empty(), "no vertex of the avatar lies on the registered face");
-
-  // 9. The report.
-  const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  std::size_t full = 0;
-  for (const float w : fit.embedding.weight) full += w >= 1.0f;
-  std::ostringstream r;
-  r.precision(6);
-  r << "{\"metres_per_unit\": " << unit << ", \"metres_per_unit_measured\": " << frame.metres_per_unit_measured
-    << ", \"up_axis\": " << json_string(frame.up_axis) << ", \"mirrored\": " << (mirrored ? "true" : "false")
-    << ", \"vertices\": " << n << ", \"triangles\": " << a.triangle_count << ", \"parts\": " << topo.components
-    << ", \"skin_parts\": " << std::count(skin_part.begin(), skin_part.end(), 1)
-    << ", \"degenerate_triangles\": " << topo.degenerate_triangles << ", \"face_vertices\": " << frame.face_vertices
-    << ", \"embedded_vertices\": " << fit.embedding.size() << ", \"embedded_fully\": " << full
-    << ", \"shapes_matched\": " << name_list(fit.origin, ShapeOrigin::Avatar)
-    << ", \"shapes_carried\": " << name_list(fit.origin, ShapeOrigin::Template)
-    << ", \"shapes_missing\": " << name_list(fit.origin, ShapeOrigin::None) << ", \"landmarks\": " << guides.size() << ", \"matched_by_shapes\": " << matcher->described()
-    << ", \"face_residual_mm_mean\": " << 1000 * sum / static_cast<double>(counted)
-    << ", \"face_residual_mm_max\": " << 1000 * worst << ", \"face_residual_points\": " << counted
-    << ", \"seconds\": " << seconds << "}";
-  fit.report = r.str();
+  fit.embedding = embed(s, reg.skin);
+  fit.report = report_json(s, fit, residual, guides.size(), std::chrono::duration<double>(Clock::now() - t0).count());
   step("done", 1.0);
   return fit;
 }
