@@ -1,19 +1,18 @@
 #include "fit/avatar_fit.h"
 
 #include <Eigen/Geometry>
-#include <Eigen/Cholesky>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <sstream>
-#include <unordered_map>
 
 #include "core/error.h"
+#include "fit/closest_identity.h"
 #include "fit/mesh_hash.h"
 #include "fit/mesh_topology.h"
+#include "fit/placement.h"
 #include "fit/registration.h"
 #include "fit/shape_matcher.h"
 #include "geometry/nearest_points.h"
@@ -52,30 +51,6 @@ double smooth_fall(double d, double near, double far) {
   return 1 - t * t * (3 - 2 * t);
 }
 
-Eigen::Vector3d row3(const float* p, std::size_t i) { return {p[3 * i], p[3 * i + 1], p[3 * i + 2]}; }
-
-// Kabsch (Umeyama with `scale`): the rotation (no reflection), scale and translation taking src
-// onto dst.
-void kabsch(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst, Eigen::Matrix3d& r,
-            Eigen::Vector3d& t, double* scale = nullptr) {
-  Eigen::Vector3d cs = Eigen::Vector3d::Zero(), cd = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < src.size(); ++i) cs += src[i], cd += dst[i];
-  cs /= static_cast<double>(src.size());
-  cd /= static_cast<double>(src.size());
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < src.size(); ++i) h += (src[i] - cs) * (dst[i] - cd).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-  r = svd.matrixV() * d * svd.matrixU().transpose();
-  if (scale) {
-    double spread = 0;
-    for (const Eigen::Vector3d& p : src) spread += (p - cs).squaredNorm();
-    *scale = spread > 0 ? (svd.singularValues().asDiagonal() * d).trace() / spread : 1.0;
-    r *= *scale;
-  }
-  t = cd - r * cs;
-}
 
 void check_mesh(const AvatarMesh& a) {
   require(a.neutral != nullptr && a.vertex_count >= 3, "the avatar has no vertices");
@@ -110,119 +85,6 @@ std::string name_list(const std::array<ShapeOrigin, kShapes>& origin, ShapeOrigi
   return o + "]";
 }
 
-// Where an avatar is: its frame, its unit and the placement into the template's frame.
-struct Located {
-  AvatarFrame frame;
-  double unit = 1;
-  bool mirrored = false;
-  Placement place;
-};
-
-// From the shapes: the frame read off them, then the rigid motion that best takes each shape's
-// centre of motion onto the template's. Both hands are tried: the one whose Left and Right
-// shapes land on the template's wins (the frame's own guess from the forward shapes or normals
-// can be fooled by an unusual rig).
-Located locate_by_shapes(const AvatarMesh& a, const AvatarFrame& tframe, double unit_option) {
-  AvatarShapes as;
-  as.neutral = a.neutral;
-  as.vertex_count = a.vertex_count;
-  as.deltas = a.deltas;
-  as.triangles = a.triangles;
-  as.triangle_count = a.triangle_count;
-  Located at;
-  at.frame = avatar_frame(as);
-  const AvatarFrame& frame = at.frame;
-  at.unit = unit_option > 0 ? unit_option : frame.metres_per_unit;
-  Eigen::Matrix3d axes;
-  axes.row(0) = frame.left.transpose();
-  axes.row(1) = frame.up.transpose();
-  axes.row(2) = frame.forward.transpose();
-  std::vector<std::size_t> shared;
-  for (std::size_t k = 0; k < kShapes; ++k)
-    if (frame.moves[k] && tframe.moves[k]) shared.push_back(k);
-  require(shared.size() >= 3, "the avatar shares fewer than 3 moving ARKit shapes with the template: too few to place it");
-  double best = std::numeric_limits<double>::infinity();
-  for (const double hand : {1.0, -1.0}) {
-    Eigen::Matrix3d linear = at.unit * axes;
-    linear.row(2) *= hand;
-    std::vector<Eigen::Vector3d> src, dst;
-    for (const std::size_t k : shared) {
-      src.push_back(linear * frame.centres[k]);
-      dst.push_back(tframe.centres[k]);
-    }
-    Eigen::Matrix3d r;
-    Eigen::Vector3d tr;
-    kabsch(src, dst, r, tr);
-    double rms = 0;
-    for (std::size_t i = 0; i < src.size(); ++i) rms += (r * src[i] + tr - dst[i]).squaredNorm();
-    if (rms < best) {
-      best = rms;
-      at.place.linear = r * linear;
-      at.place.offset = tr;
-      at.mirrored = hand < 0 ? !frame.mirrored : frame.mirrored;
-    }
-  }
-  return at;
-}
-
-// From the bundle's landmarks on an avatar without ARKit shapes: the similarity (either hand)
-// that best takes them onto the template's; the face is what lies near the template's face.
-Located locate_by_landmarks(const TemplateData& t, const AvatarMesh& a, const AvatarFrame& tframe, double unit_option) {
-  constexpr double kFaceReach = 0.015;  // metres from the template's face that count as the avatar's face
-  std::vector<Eigen::Vector3d> src, dst;
-  for (std::size_t l = 0; l < a.landmark_count; ++l) {
-    src.push_back(row3(a.landmarks, l));
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < 3; ++k)
-      p += t.landmark_bary[l][k] *
-           row3(t.head_neutral, static_cast<std::size_t>(t.skin_triangles[3 * static_cast<std::size_t>(t.landmark_triangle[l]) + k]));
-    dst.push_back(p);
-  }
-  Located at;
-  double best = std::numeric_limits<double>::infinity();
-  for (const double hand : {1.0, -1.0}) {
-    const Eigen::Matrix3d flip = Eigen::Vector3d(1, 1, hand).asDiagonal();
-    std::vector<Eigen::Vector3d> flipped;
-    for (const Eigen::Vector3d& p : src) flipped.push_back(flip * p);
-    Eigen::Matrix3d r;
-    Eigen::Vector3d tr;
-    double scale = 1;
-    kabsch(flipped, dst, r, tr, &scale);
-    double rms = 0;
-    for (std::size_t i = 0; i < src.size(); ++i) rms += (r * flipped[i] + tr - dst[i]).squaredNorm();
-    if (!(rms < best) || !(scale > 0)) continue;
-    best = rms;
-    at.frame.metres_per_unit_measured = scale;
-    at.unit = unit_option > 0 ? unit_option : snap_unit(scale);
-    at.mirrored = hand < 0;
-    const Eigen::Matrix3d axes = r / scale * flip;  // avatar directions to the template's
-    at.place.linear = at.unit * axes;
-    Eigen::Vector3d cs = Eigen::Vector3d::Zero(), cd = Eigen::Vector3d::Zero();
-    for (std::size_t i = 0; i < src.size(); ++i) cs += src[i], cd += dst[i];
-    at.place.offset = (cd - at.place.linear * cs) / static_cast<double>(src.size());
-    at.frame.left = axes.row(0).transpose();
-    at.frame.up = axes.row(1).transpose();
-    at.frame.forward = axes.row(2).transpose();
-  }
-  require(std::isfinite(best), "the landmarks give no placement: are they the bundle's, in its order?");
-  at.frame.metres_per_unit = at.unit;
-  at.frame.up_axis = axis_name(at.frame.up);
-  at.frame.mirrored = at.mirrored;
-  // The face: the avatar's vertices near the template's face once placed.
-  std::vector<Eigen::Index> face;
-  for (std::size_t v = 0; v < t.skin_vertices; ++v)
-    if (tframe.face[v]) face.push_back(static_cast<Eigen::Index>(v));
-  geometry::Sites sites(static_cast<Eigen::Index>(face.size()), 3), placed(static_cast<Eigen::Index>(a.vertex_count), 3);
-  for (std::size_t i = 0; i < face.size(); ++i) sites.row(static_cast<Eigen::Index>(i)) = row3(t.head_neutral, static_cast<std::size_t>(face[i])).transpose();
-  for (std::size_t v = 0; v < a.vertex_count; ++v) placed.row(static_cast<Eigen::Index>(v)) = at.place.to_template(row3(a.neutral, v)).transpose();
-  const std::vector<std::int32_t> near = geometry::nearest_sites(sites, placed);
-  at.frame.face.assign(a.vertex_count, 0);
-  for (std::size_t v = 0; v < a.vertex_count; ++v)
-    if ((placed.row(static_cast<Eigen::Index>(v)) - sites.row(near[v])).norm() < kFaceReach) at.frame.face[v] = 1, ++at.frame.face_vertices;
-  require(at.frame.face_vertices > 0, "no vertex of the avatar lies near the template's face at its landmarks");
-  return at;
-}
-
 // The shapes both meshes move, with their deltas in the template's frame.
 std::vector<SharedShape> shared_shapes(const TemplateData& t, const AvatarMesh& a, const AvatarFrame& frame,
                                        const AvatarFrame& tframe, const Eigen::Matrix3d& lin) {
@@ -238,58 +100,6 @@ std::vector<SharedShape> shared_shapes(const TemplateData& t, const AvatarMesh& 
     shapes.push_back(std::move(s));
   }
   return shapes;
-}
-
-// The skin of identity h: the template plus h . modes.
-Points identity_points(const TemplateData& t, const std::vector<float>& h) {
-  const std::size_t vs = t.skin_vertices;
-  Points p(static_cast<Eigen::Index>(vs), 3);
-  for (std::size_t v = 0; v < vs; ++v) {
-    Eigen::Vector3d x = row3(t.head_neutral, v);
-    for (std::size_t k = 0; k < h.size(); ++k) x += static_cast<double>(h[k]) * row3(t.identity_modes + k * vs * 3, v);
-    p.row(static_cast<Eigen::Index>(v)) = x.transpose();
-  }
-  return p;
-}
-
-// Identity coefficients whose skin best meets the matches: min sum w |T0 + M h - target|^2 +
-// prior |h|^2, the modes scaled so that h is about N(0, 1); `prior`: a match's error, squared
-// (metres^2). Reweighted kRobustRounds times (Cauchy, scale kRobustScale): a part the identity
-// modes cannot explain (a remesh's cut ears, a stylised nose) does not pull the whole head.
-std::vector<float> fit_identity(const TemplateData& t, const std::vector<Match>& matches, const Points& tskin,
-                                double prior) {
-  constexpr int kRobustRounds = 4;
-  constexpr double kRobustScale = 0.001;
-  const std::size_t k = t.identity_count, vs = t.skin_vertices;
-  const auto kk = static_cast<Eigen::Index>(k);
-  std::vector<double> robust(vs, 1.0);
-  Eigen::VectorXd h = Eigen::VectorXd::Zero(kk);
-  Eigen::MatrixXd rows(3, kk);
-  const auto modes_at = [&](std::size_t v) {
-    for (std::size_t j = 0; j < k; ++j) rows.col(static_cast<Eigen::Index>(j)) = row3(t.identity_modes + j * vs * 3, v);
-  };
-  for (int round = 0; round < kRobustRounds; ++round) {
-    Eigen::MatrixXd a = Eigen::MatrixXd::Identity(kk, kk) * prior;
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(kk);
-    for (std::size_t v = 0; v < vs; ++v) {
-      const Match& m = matches[v];
-      if (!(m.weight > 0)) continue;
-      modes_at(v);
-      const double w = m.weight * robust[v];
-      a.noalias() += w * rows.transpose() * rows;
-      b.noalias() += w * rows.transpose() * (m.target - tskin.row(static_cast<Eigen::Index>(v)).transpose());
-    }
-    h = a.ldlt().solve(b);
-    for (std::size_t v = 0; v < vs; ++v) {
-      if (!(matches[v].weight > 0)) continue;
-      modes_at(v);
-      const double r = (rows * h + tskin.row(static_cast<Eigen::Index>(v)).transpose() - matches[v].target).norm();
-      robust[v] = 1.0 / (1.0 + (r / kRobustScale) * (r / kRobustScale));
-    }
-  }
-  std::vector<float> out(k);
-  for (std::size_t j = 0; j < k; ++j) out[j] = static_cast<float>(h[static_cast<Eigen::Index>(j)]);
-  return out;
 }
 
 }  // namespace
