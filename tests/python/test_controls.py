@@ -24,12 +24,23 @@ from softdeca_train.controls.metrics import (
     leakage,
     response_error,
 )
+from softdeca_train.controls.real_takes import (
+    MILD_MM,
+    FrameDistances,
+    RecordedTake,
+    recorded_takes,
+    summarise,
+    trained_on,
+    trained_take_names,
+)
 from softdeca_train.controls.report import (
     kept_real_takes,
     merge_into_report,
     validate_report,
 )
 from softdeca_train.parameters import load_parameters
+from softdeca_train.streaming.frame import Frame
+from softdeca_train.streaming.livelinkface import format_csv
 from softdeca_train.template.regions import REGIONS
 
 REPO = Path(__file__).resolve().parents[2]
@@ -167,13 +178,75 @@ def _report() -> dict:
                 "leakage": 0.3,
             },
         ],
-        "real_takes": {
-            "frames": 10,
-            "identities": 3,
-            "softdeca_mm": 0.4,
-            "linear_mm": 0.6,
-        },
+        "real_takes": _real_takes(),
     }
+
+
+def _real_takes() -> dict:
+    """Two takes, the first seen in training: 3 frames each, one of them mild."""
+    takes = [
+        RecordedTake("source-a/seen", "0" * 64, np.zeros((3, 52), np.float32)),
+        RecordedTake("source-b/unseen", "1" * 64, np.zeros((3, 52), np.float32)),
+    ]
+    d = FrameDistances(
+        take=np.array([0, 0, 0, 1, 1, 1]),
+        softdeca_mm=np.array([0.01, 0.1, 0.2, 0.05, 0.3, 0.5]),
+        linear_mm=np.array([0.05, 0.2, 0.4, 0.08, 0.2, 0.6]),
+    )
+    return summarise(takes, [True, False], d, every=10, identities=1)
+
+
+def test_real_takes_are_reported_per_take_with_unseen_and_mild_frames_apart() -> None:
+    real = _real_takes()
+    unseen, seen = real["takes"][1], real["takes"][0]
+    assert (unseen["take"], unseen["trained_on"], seen["trained_on"]) == (
+        "source-b/unseen",
+        False,
+        True,
+    )
+    assert real["unseen"]["frames"] == 3 and real["seen"]["frames"] == 3
+    # pooled over frames, not the mean of per-frame ratios
+    assert real["unseen"]["ratio"] == pytest.approx(0.85 / 0.88)
+    assert real["unseen"]["mild"]["frames"] == 1  # linear 0.08 mm <= MILD_MM
+    assert real["unseen"]["strong"]["ratio"] == pytest.approx(0.8 / 0.8)
+    assert real["seen"]["mild"]["frames"] == 1 and real["seen"]["strong"]["frames"] == 2
+    assert real["unseen"]["worst_take_ratio"] == pytest.approx(0.85 / 0.88)
+    assert MILD_MM == real["mild_mm"]
+
+
+def test_the_takes_a_bundle_trained_on_come_from_its_training_record() -> None:
+    manifest = {
+        "training": {
+            "dataset": {
+                "splits": {"train": {"takes": ["apfel"]}, "test": {"takes": ["x"]}}
+            },
+            "more_static": [{"splits": {"train": {"takes": ["S07-001"]}}}],
+            "contrasts": None,
+        }
+    }
+    trained = trained_take_names(manifest)
+    assert trained == {"apfel", "S07-001"}
+    assert trained_take_names({"untrained": True}) == set()
+    take = RecordedTake("another-source/apfel", "", np.zeros((1, 52)))
+    assert trained_on(
+        take, trained
+    )  # a stem collision never flatters: it counts as seen
+    assert not trained_on(RecordedTake("a/x", "", np.zeros((1, 52))), trained)
+
+
+def test_recorded_takes_are_named_by_source_and_take(tmp_path) -> None:
+    frames = [Frame(capture_time=i / 60.0) for i in range(5)]
+    for f in frames:
+        f.weights[:] = 0.1 * f.capture_time
+    for source in ("one", "two"):
+        (tmp_path / source).mkdir()
+        (tmp_path / source / "a.csv").write_text(format_csv(frames))
+    takes = recorded_takes(tmp_path, every=2)
+    assert [t.name for t in takes] == ["one/a", "two/a"]
+    assert takes[0].weights.shape == (3, 52)  # frames 0, 2, 4
+    assert takes[0].sha256 == takes[1].sha256
+    with pytest.raises(FileNotFoundError):
+        recorded_takes(tmp_path / "one" / "none", every=1)
 
 
 def test_the_report_schema() -> None:
@@ -188,8 +261,10 @@ def test_the_report_schema() -> None:
         ),  # a global control has no leakage
         lambda d: d["controls"][1].update(physics_max_mm=-1.0),
         lambda d: d["controls"][1].update(response_error=float("nan")),
-        lambda d: d["real_takes"].pop("linear_mm"),
-        lambda d: d["real_takes"].update(frames=0),
+        lambda d: d["real_takes"].pop("unseen"),
+        lambda d: d["real_takes"]["takes"][0].update(frames=0),
+        lambda d: d["real_takes"]["takes"][1].update(linear_mm=float("nan")),
+        lambda d: d["real_takes"].update(unseen=None, seen=None),
     ):
         d = copy.deepcopy(_report())
         change(d)
@@ -212,7 +287,7 @@ def test_the_committed_report_follows_the_schema() -> None:
 def test_a_rerun_without_real_takes_keeps_the_reports(tmp_path) -> None:
     report = tmp_path / "evaluation.json"
     assert kept_real_takes(report) is None
-    real = {"frames": 4, "identities": 1, "softdeca_mm": 0.2, "linear_mm": 0.3}
+    real = _real_takes()
     report.write_text(json.dumps({"errors": {}, "real_takes": real}))
     kept = kept_real_takes(report)
     report.write_text(json.dumps({"errors": {}}))  # the rerun writes its report afresh
@@ -224,14 +299,14 @@ def test_the_plan_samples_p_per_instance_with_regional_patterns() -> None:
     from softdeca_train.data.expressions import expression_sources, load_takes
     from softdeca_train.data.plan import FIXED, make_plan
     from softdeca_train.data.ranges import sampling_parameters
-    from softdeca_train.paths import default_takes_path
+    from softdeca_train.paths import default_recordings_path
     from softdeca_train.template.regions import REGIONAL_DOMAINS
 
     cfg = GenerateConfig(static=24, dynamic=0, sparse=8, region_share=0.5, seed=3)
     assert cfg.frames_per_params == 1 and cfg.ranges == "controls"
     params = sampling_parameters(load_parameters(), cfg.ranges)
     sources, _ = expression_sources(
-        load_takes(default_takes_path()), cfg.test_take, cfg.seed, cfg.test_share
+        load_takes(default_recordings_path()), cfg.test_takes, cfg.seed, cfg.test_share
     )
     plan = make_plan(cfg, params, sources)
     groups = [(s.kind, g) for s in plan for g in s.groups]
@@ -263,7 +338,7 @@ def test_contrasts_share_frames_and_change_one_factor() -> None:
     from softdeca_train.data.expressions import expression_sources, load_takes
     from softdeca_train.data.plan import FIXED, make_plan
     from softdeca_train.data.ranges import sampling_parameters
-    from softdeca_train.paths import default_takes_path
+    from softdeca_train.paths import default_recordings_path
 
     cfg = GenerateConfig(
         static=30, dynamic=0, sparse=0, seed=4, frames_per_params=2, params_per_identity=4,
@@ -271,7 +346,7 @@ def test_contrasts_share_frames_and_change_one_factor() -> None:
     )  # fmt: skip
     params = sampling_parameters(load_parameters(), cfg.ranges)
     sources, _ = expression_sources(
-        load_takes(default_takes_path()), cfg.test_take, cfg.seed, cfg.test_share
+        load_takes(default_recordings_path()), cfg.test_takes, cfg.seed, cfg.test_share
     )
     plan = make_plan(cfg, params, sources)
     regional = changed = 0
@@ -310,7 +385,12 @@ def test_the_report_readme_section_is_replaced_not_repeated(tmp_path) -> None:
     text = readme.read_text()
     assert text.startswith("# Evaluation\n\ntext\n") and text.count(SECTION) == 1
     assert "median response error 0.800" in text and "target_volume@lips" in text
-    assert "SoftDECA 0.400 mm, linear blendshapes 0.600 mm" in text
+    # unseen takes first, each pooled figure labelled
+    assert text.index("| source-b/unseen | no |") < text.index(
+        "| source-a/seen | yes |"
+    )
+    assert "| **unseen takes, pooled** |  | 3 | 0.283 | 0.293 | 0.97 |" in text
+    assert "in-distribution takes, pooled" in text
 
 
 def test_the_gallery_page_names_the_tolerance_and_the_identity_spread() -> None:

@@ -3,10 +3,19 @@
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 
 import numpy as np
 import pytest
-from softdeca_train.data.coverage import JAW_OPEN, MOUTH_CLOSE, CoverageSampler
+from softdeca_train.data.coverage import (
+    BLINKS,
+    JAW_OPEN,
+    KINDS,
+    MOUTH_CLOSE,
+    SIDES,
+    CoverageSampler,
+    DrawShares,
+)
 from softdeca_train.data.shards import (
     Manifest,
     iter_shards,
@@ -84,3 +93,27 @@ def test_coverage_sampler_keeps_co_activation_and_covers_the_range() -> None:
         == w[:, JAW_OPEN][w[:, MOUTH_CLOSE] > 0]
     ).any()
     assert not np.array_equal(w, sampler.sample(np.random.default_rng(2), 4000))
+
+
+def test_coverage_draws_real_faces_kinds_in_their_shares() -> None:
+    rng = np.random.default_rng(0)
+    frames = np.clip(rng.random((2000, 52)) * 0.1, 0, 1)  # a calm "person"
+    sampler = CoverageSampler.fit(frames)
+    n = 6000
+    kinds = sampler.kinds(np.random.default_rng(3), n)
+    shares = np.bincount(kinds, minlength=len(KINDS)) / n
+    assert np.allclose(shares, list(asdict(DrawShares()).values()), atol=0.02)
+    w = sampler.sample(np.random.default_rng(4), n)
+    blink = w[:, BLINKS]
+    # blinks: both lids closing together, far more often than the calm person does
+    together = (blink > 0.6).all(axis=1) & (np.abs(blink[:, 0] - blink[:, 1]) < 0.1)
+    assert 0.08 < together.mean() < 0.2
+    # asymmetric draws: one side's shapes clearly weaker than the other's
+    left, right = w[:, SIDES["Left"]].sum(1), w[:, SIDES["Right"]].sum(1)
+    assert (np.minimum(left, right) < 0.5 * np.maximum(left, right)).mean() > 0.1
+    # calm frames: a face near rest
+    assert (w.max(axis=1) < 0.4).mean() > 0.1
+    # strong frames: a stress combination's largest weights at 60 % or more
+    assert (w.max(axis=1) >= 0.6).mean() > 0.15 + 0.1
+    with pytest.raises(ValueError, match="sum to 1"):
+        DrawShares(mild=0.9).cumulative()

@@ -116,10 +116,12 @@ def test_train_and_test_share_no_identity_parameters_or_expressions(small) -> No
     m = json.loads((out / "manifest.json").read_text())
     sp = m["dataset"]["splits"]
     assert not set(sp["train"]["identities"]) & set(sp["test"]["identities"])
-    assert set(sp["test"]["takes"]) == {SMALL.test_take}
-    assert SMALL.test_take not in sp["train"]["takes"]
+    assert set(sp["test"]["takes"]) == set(SMALL.test_takes)
+    assert not set(SMALL.test_takes) & set(sp["train"]["takes"])
+    # every source's takes are used: more than one person trains
+    assert len(sp["train"]["takes"]) >= 6
     names = [t["name"] for t in m["header"]["takes"]]
-    test_take = names.index(SMALL.test_take)
+    test_take = [names.index(t) for t in SMALL.test_takes]
     rows = {TRAIN: [], TEST: []}
     for kind in KINDS:
         rows_kind = {}
@@ -155,8 +157,8 @@ def test_train_and_test_share_no_identity_parameters_or_expressions(small) -> No
     assert not p_rows[TRAIN] & p_rows[TEST]
     # Real frames: the test split uses the held-out take only, train never does.
     real_test = cat[TEST]["source_take"][cat[TEST]["source_take"] != COVERAGE]
-    assert np.all(real_test == test_take)
-    assert not np.any(cat[TRAIN]["source_take"] == test_take)
+    assert np.all(np.isin(real_test, test_take))
+    assert not np.any(np.isin(cat[TRAIN]["source_take"], test_take))
     # No weight vector (real or coverage) appears in both splits.
     w = {
         s: {r.tobytes() for part in rows[s] for r in part["weights"].reshape(-1, 52)}
@@ -171,7 +173,7 @@ def test_plan_is_deterministic_and_ids_unique(template) -> None:
     plans = []
     for _ in range(2):
         sources, _ = expression_sources(
-            takes, SMALL.test_take, SMALL.seed, SMALL.test_share
+            takes, SMALL.test_takes, SMALL.seed, SMALL.test_share
         )
         plans.append(make_plan(SMALL, params, sources))
     a, b = plans
@@ -184,7 +186,7 @@ def test_plan_is_deterministic_and_ids_unique(template) -> None:
     assert np.array_equal(ids, np.arange(len(ids)))
     other = GenerateConfig(**{**SMALL.as_dict(), "seed": SMALL.seed + 1})
     sources, _ = expression_sources(
-        takes, other.test_take, other.seed, other.test_share
+        takes, other.test_takes, other.seed, other.test_share
     )
     c = make_plan(other, params, sources)
     assert not np.array_equal(a[0].groups[0].p, c[0].groups[0].p)
@@ -306,8 +308,8 @@ def test_bad_configurations_and_folders_are_refused(tmp_path) -> None:
     tiny = GenerateConfig(static=1, dynamic=0, sparse=0, level=1)
     with pytest.raises(ValueError, match="no dataset manifest"):
         generate(tiny, RunSettings(out=tmp_path / "junk", workers=0, progress=False))
-    bad_take = GenerateConfig(static=1, dynamic=0, sparse=0, test_take="nope")
-    with pytest.raises(ValueError, match="test take 'nope'"):
+    bad_take = GenerateConfig(static=1, dynamic=0, sparse=0, test_takes=("nope",))
+    with pytest.raises(ValueError, match=r"test takes \['nope'\]"):
         generate(bad_take, RunSettings(out=tmp_path / "a", workers=0, progress=False))
 
 

@@ -286,8 +286,11 @@ def test_the_committed_list_covers_what_the_project_reads() -> None:
         "arkit-reference/ARKit_landmarks68.txt",
         "recordings/livelinkface-alexdjulin/S07-001.csv",
         "recordings/livelinkface-alexdjulin/alex_rom_3.csv",
+        "recordings/livelinkface-sentien/recording.csv",
+        "recordings/livelinkface-llv/dao.gesichter",
     ):
         assert needed in paths
-    for top in ("ict-facekit", "arkit-reference", "recordings/livelinkface-alexdjulin"):
+    recordings = {p.rsplit("/", 1)[0] for p in paths if p.startswith("recordings/")}
+    for top in ("ict-facekit", "arkit-reference", *recordings):
         assert f"{top}/LICENSE" in paths  # each source's license travels with its data
     assert all(len(f.commit) == 40 for f in files)

@@ -33,6 +33,12 @@ def default_takes_path() -> Path:
     return Path(env) if env else data_dir() / "recordings" / "livelinkface-alexdjulin"
 
 
+def default_recordings_path() -> Path:
+    """$SOFTDECA_RECORDINGS, else the data folder's recordings: every source's takes."""
+    env = os.environ.get("SOFTDECA_RECORDINGS")
+    return Path(env) if env else data_dir() / "recordings"
+
+
 def cache_dir() -> Path:
     """$SOFTDECA_CACHE, else .cache in the repository (ignored by git)."""
     env = os.environ.get("SOFTDECA_CACHE")

@@ -181,6 +181,7 @@ def report_parts(args: argparse.Namespace, bundle: Path) -> tuple[list[dict], di
 
 
 def _run_report(args: argparse.Namespace) -> int:
+    from softdeca_train.controls.real_takes import one_line
     from softdeca_train.controls.report import merge_into_report, update_readme, validate_report
 
     controls, real = report_parts(args, args.bundle)
@@ -188,11 +189,7 @@ def _run_report(args: argparse.Namespace) -> int:
     update_readme(Path(args.report).parent / "README.md", doc)
     if "real_takes" in doc:
         validate_report(doc)
-        r = doc["real_takes"]
-        print(
-            f"real takes: {r['frames']} frames, SoftDECA {r['softdeca_mm']:.3f} mm, "
-            f"linear {r['linear_mm']:.3f} mm"
-        )
+        print(one_line(doc["real_takes"]))
     print(f"wrote {args.report}")
     return 0
 

@@ -16,13 +16,20 @@ from tqdm import tqdm
 from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase
 from softdeca_train.controls.definitions import Setting
 from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
+from softdeca_train.controls.real_takes import (
+    FrameDistances,
+    readme_lines,
+    recorded_takes,
+    summarise,
+    trained_on,
+    trained_take_names,
+    validate_real_takes,
+)
 from softdeca_train.models.bundle import OnnxNetworks
 from softdeca_train.parameters import load_parameters
-from softdeca_train.streaming.livelinkface import read_csv
 from softdeca_train.template import Template
 
 CONTROL_KEYS = ("name", "region", "physics_max_mm", "response_error", "leakage")
-REAL_TAKE_KEYS = ("frames", "identities", "softdeca_mm", "linear_mm")
 
 
 def _number_or_none(x: object) -> bool:
@@ -32,7 +39,7 @@ def _number_or_none(x: object) -> bool:
 def validate_report(doc: dict) -> None:
     """ValueError naming the first problem, unless `doc` has `errors` (a table keyed by model),
     `controls` (a list of {name, region, physics_max_mm, response_error, leakage}) and
-    `real_takes` ({frames, identities, softdeca_mm, linear_mm})."""
+    `real_takes` (controls/real_takes.py)."""
     if not isinstance(doc.get("errors"), dict) or not doc["errors"]:
         raise ValueError("report: `errors` must be a non-empty table")
     controls = doc.get("controls")
@@ -51,16 +58,7 @@ def validate_report(doc: dict) -> None:
             raise ValueError(f"report: response_error and leakage are numbers or null: {c}")
         if c["region"] is None and c["leakage"] is not None:
             raise ValueError(f"report: a global control has no leakage: {c}")
-    real = doc.get("real_takes")
-    if not isinstance(real, dict) or set(real) != set(REAL_TAKE_KEYS):
-        raise ValueError(f"report: `real_takes` needs exactly {REAL_TAKE_KEYS}")
-    if not (isinstance(real["frames"], int) and real["frames"] > 0):
-        raise ValueError("report: real_takes.frames must be a positive count")
-    if not (isinstance(real["identities"], int) and real["identities"] > 0):
-        raise ValueError("report: real_takes.identities must be a positive count")
-    for k in ("softdeca_mm", "linear_mm"):
-        if not (isinstance(real[k], (int, float)) and math.isfinite(real[k]) and real[k] >= 0):
-            raise ValueError(f"report: real_takes.{k} must be a distance in mm")
+    validate_real_takes(doc.get("real_takes"))
 
 
 @dataclass(frozen=True)
@@ -74,24 +72,14 @@ class RealTakes:
     physics_cache: Path | None = field(default_factory=default_folder)
 
 
-def take_frames(recordings: Path, every: int) -> np.ndarray:
-    """(n, 52) every `every`-th tracked frame of every Live Link Face take below `recordings`."""
-    paths = sorted(Path(recordings).rglob("*.csv"))
-    if not paths:
-        raise FileNotFoundError(f"no Live Link Face takes (*.csv) below {recordings}")
-    frames = []
-    for p in paths:
-        w = np.stack([f.weights for f in read_csv(p).frames]).astype(np.float32)
-        frames.append(w[::every])
-    return np.concatenate(frames)
-
-
 def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
-    """Mean distance (mm) of SoftDECA (the bundle, default parameters) and of the linear
-    blendshapes to the physics (default parameters), over every vertex of S and every frame."""
+    """SoftDECA (the bundle, default parameters) and the linear blendshapes against the physics
+    (default parameters) on every n-th frame of every take, per take (controls/real_takes.py);
+    the takes the bundle trained on apart from those it never saw."""
     if not 1 <= cfg.identities <= len(IDENTITY_SEEDS) or cfg.every < 1:
         raise ValueError(f"identities must be in 1..{len(IDENTITY_SEEDS)}, every >= 1")
-    weights = take_frames(cfg.recordings, cfg.every)
+    takes = recorded_takes(cfg.recordings, cfg.every)
+    trained = trained_take_names(json.loads((Path(bundle) / "manifest.json").read_text()))
     template = Template.load()
     nets = OnnxNetworks(bundle)
     physics = load_parameters()
@@ -99,30 +87,30 @@ def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
     defaults.update({s.name: s.default for s in physics.controls().specs})
     domains = {s.name: s.domain for s in physics.specs}
     cache = open_cache(cfg.physics_cache)
-    sums = {"softdeca": 0.0, "linear": 0.0}
-    count = 0
-    total = cfg.identities * len(weights)
+    rows: dict[str, list] = {"take": [], "softdeca": [], "linear": []}
+    total = cfg.identities * sum(len(t.weights) for t in takes)
     with tqdm(total=total, desc="real takes", unit="frame", disable=not progress) as bar:
         for seed in IDENTITY_SEEDS[: cfg.identities]:
-            first = PhysicsCase(template, template.sample_identity(seed), weights[:1], cfg.level)
+            head = template.sample_identity(seed)
+            first = PhysicsCase(template, head, takes[0].weights[:1], cfg.level)
             model = ModelCase(nets, first)
-            for start in range(0, len(weights), cfg.chunk):
-                case = first.with_weights(weights[start : start + cfg.chunk])
-                model.use(case)
-                t = solve_cached(cache, case, Setting(), defaults, domains)
-                x = model.solve(Setting())
-                sums["softdeca"] += float(np.linalg.norm(x - t, axis=-1).mean(axis=1).sum())
-                sums["linear"] += float(
-                    np.linalg.norm(case.targets - t, axis=-1).mean(axis=1).sum()
-                )
-                count += len(t)
-                bar.update(len(t))
-    return {
-        "frames": count,
-        "identities": cfg.identities,
-        "softdeca_mm": 1e3 * sums["softdeca"] / count,
-        "linear_mm": 1e3 * sums["linear"] / count,
-    }
+            for index, take in enumerate(takes):
+                for start in range(0, len(take.weights), cfg.chunk):
+                    case = first.with_weights(take.weights[start : start + cfg.chunk])
+                    model.use(case)
+                    t = solve_cached(cache, case, Setting(), defaults, domains)
+                    x = model.solve(Setting())
+                    rows["take"] += [index] * len(t)
+                    rows["softdeca"] += list(1e3 * np.linalg.norm(x - t, axis=-1).mean(axis=1))
+                    rows["linear"] += list(
+                        1e3 * np.linalg.norm(case.targets - t, axis=-1).mean(axis=1)
+                    )
+                    bar.update(len(t))
+    distances = FrameDistances(
+        np.array(rows["take"]), np.array(rows["softdeca"]), np.array(rows["linear"])
+    )
+    seen = [trained_on(t, trained) for t in takes]
+    return summarise(takes, seen, distances, cfg.every, cfg.identities)
 
 
 def kept_real_takes(path: Path) -> dict | None:
@@ -175,11 +163,7 @@ def readme_section(doc: dict) -> str:
         lines.append("")
     real = doc.get("real_takes")
     if real:
-        lines.append(
-            f"Real takes ({real['frames']} frames over {real['identities']} unseen identities, "
-            "default parameters): mean distance to the physics, SoftDECA "
-            f"{real['softdeca_mm']:.3f} mm, linear blendshapes {real['linear_mm']:.3f} mm."
-        )
+        lines += readme_lines(real)
     return "\n".join(lines) + "\n"
 
 

@@ -45,7 +45,6 @@ _SAMPLING = (
         "region_share",
         "share of static/sparse groups with per-region parameter values ({})",
     ),
-    ("--test-take", "test_take", "take held out for testing ({})"),
     ("--noise-mm", "landmark_noise_mm", "landmark noise sigma, mm ({})"),
 )
 _SOLVER = (
@@ -76,8 +75,8 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--takes",
         default=None,
-        help="folder of Live Link Face CSV takes "
-        f"(default: $SOFTDECA_TAKES or {default_takes_path()})",
+        help="folder of takes, searched recursively (Live Link Face CSV, LLV recordings) "
+        f"(default: $SOFTDECA_RECORDINGS or {default_takes_path()})",
     )
     g = p.add_argument_group("what to generate (fixes the dataset; a resume must match)")
     _add_config_options(g, _COUNTS)
@@ -89,6 +88,14 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         "dynamic sequences (the paper's mix)",
     )
     _add_config_options(g, _SAMPLING)
+    g.add_argument(
+        "--test-take",
+        dest="test_takes",
+        action="append",
+        default=None,
+        help="a take held out entirely for testing, by file stem; repeat for more "
+        f"(default: {' '.join(D.test_takes)})",
+    )
     g.add_argument(
         "--contrasts",
         action="store_true",
@@ -129,6 +136,7 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
 def config_from_args(args: argparse.Namespace) -> GenerateConfig:
     kw = {field: getattr(args, _dest(option)) for option, field, _ in (*_SAMPLING, *_SOLVER)}
     kw |= {"collisions": args.collisions, "ranges": args.ranges, "contrasts": args.contrasts}
+    kw["test_takes"] = tuple(args.test_takes) if args.test_takes else D.test_takes
     if args.instances is not None:
         return GenerateConfig.from_total(args.instances, args.sparse, **kw)
     return GenerateConfig(static=args.static, dynamic=args.dynamic, sparse=args.sparse, **kw)

@@ -17,8 +17,8 @@ PAPER_STATIC_SHARE = 0.75  # paper 4.2.1: 75 % static instances, 25 % dynamic (b
 
 
 def default_takes_path() -> Path:
-    """$SOFTDECA_TAKES, else the Live Link Face takes in the data folder."""
-    return paths.default_takes_path()
+    """$SOFTDECA_RECORDINGS, else every source's takes in the data folder."""
+    return paths.default_recordings_path()
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,9 @@ class GenerateConfig:
     lead_in_gamma: float = 0.5
     lead_in_beta: float = 0.5
     real_share: float = 0.5  # static/sparse frames from real takes; the rest from coverage
-    test_take: str = "facial"  # Live Link Face take held out entirely for the test split
+    # Takes held out entirely for the test split, by name (file stem): one take of the
+    # person most takes come from, and every take of a person no other take shows.
+    test_takes: tuple[str, ...] = ("facial", "dao")
     landmark_noise_mm: float = 1.0  # sigma of the coordinate-wise Gaussian noise (eq. 24)
     identity_scale: float = 1.0  # identity coefficients h ~ N(0, scale^2) (plausible only)
     # Lip/teeth collision sets (paper 3.3.2) and the lips placed on S (docs/physics.md).
@@ -104,6 +106,8 @@ class GenerateConfig:
             problems.append("lead-in dynamics need gamma in (0, 1], beta in [0, 1)")
         if self.dynamic and self.lead_in < 2:
             problems.append("dynamic sequences need lead_in >= 2 (the two previous frames)")
+        if not self.test_takes:
+            problems.append("at least one test take")
         if not is_profile(self.ranges):
             problems.append(f"unknown range profile {self.ranges!r}")
         if problems:
@@ -128,13 +132,17 @@ class GenerateConfig:
         return self.sequences_per_identity if kind == "dynamic" else self.params_per_identity
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        return {**asdict(self), "test_takes": list(self.test_takes)}  # as JSON holds it
 
     @classmethod
     def from_dict(cls, d: dict) -> GenerateConfig:
         names = {f.name for f in fields(cls)}
         # written before range profiles and regional patterns existed
         d = {"ranges": LEGACY_PROFILE, "region_share": 0.0, "contrasts": False, **d}
+        if "test_take" in d:  # written when one take was held out
+            d["test_takes"] = [d.pop("test_take")]
+        if "test_takes" in d:
+            d["test_takes"] = tuple(d["test_takes"])
         return cls(**{k: v for k, v in d.items() if k in names})
 
 

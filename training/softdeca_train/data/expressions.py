@@ -1,4 +1,4 @@
-"""Expression frames: the real Live Link Face takes (one held out for the test split) and the
+"""Expression frames: the real takes (whole takes held out for the test split) and the
 coverage sampler fitted to the training takes only. Every frame drawn carries its source:
 (take index, frame index) for a real frame, (-1, draw index) for a coverage draw."""
 
@@ -12,7 +12,7 @@ import numpy as np
 
 from softdeca_train.data.config import TEST, TRAIN
 from softdeca_train.data.coverage import CoverageSampler
-from softdeca_train.streaming.livelinkface import read_csv
+from softdeca_train.streaming.takes import TAKE_SUFFIXES, read_take, take_paths
 
 COVERAGE = -1  # source_take of a coverage draw
 MAX_GAP_S = 0.1  # a dynamic window may not span a face-lost gap longer than this
@@ -28,14 +28,19 @@ class Take:
 
 
 def load_takes(folder: Path) -> list[Take]:
-    """All `*.csv` takes of a folder, sorted by name (the take index is the position)."""
+    """Every take below a folder (Live Link Face CSV or LLV recording, streaming/takes.py),
+    sorted by path (the take index is the position), named by file stem: stems must differ."""
     folder = Path(folder)
-    paths = sorted(folder.glob("*.csv"))
+    paths = take_paths(folder)
     if not paths:
-        raise FileNotFoundError(f"no Live Link Face takes (*.csv) in {folder}")
+        raise FileNotFoundError(f"no takes ({', '.join(TAKE_SUFFIXES)}) below {folder}")
+    stems = [p.stem for p in paths]
+    if len(set(stems)) != len(stems):
+        twice = sorted({s for s in stems if stems.count(s) > 1})
+        raise ValueError(f"takes below {folder} share a name: {', '.join(twice)}")
     takes = []
     for p in paths:
-        csv = read_csv(p)
+        csv = read_take(p)
         if not csv.frames:
             raise ValueError(f"{p}: no tracked frames")
         takes.append(
@@ -131,17 +136,18 @@ class ExpressionSource:
 
 
 def expression_sources(
-    takes: list[Take], test_take: str, seed: int, test_share: float
+    takes: list[Take], test_takes: tuple[str, ...], seed: int, test_share: float
 ) -> tuple[dict[int, ExpressionSource], CoverageSampler]:
-    """Train and test sources: the test split owns `test_take` alone; the coverage sampler is
-    fitted to the other takes only."""
+    """Train and test sources: the test split owns the `test_takes` alone; the coverage
+    sampler is fitted to the other takes only."""
     names = [t.name for t in takes]
-    if test_take not in names:
-        raise ValueError(f"test take '{test_take}' is not among the takes {names}")
-    held = names.index(test_take)
-    train_ids = [i for i in range(len(takes)) if i != held]
+    missing = [t for t in test_takes if t not in names]
+    if missing:
+        raise ValueError(f"test takes {missing} are not among the takes {names}")
+    held = [names.index(t) for t in test_takes]
+    train_ids = [i for i in range(len(takes)) if i not in held]
     if not train_ids:
-        raise ValueError("need at least one take besides the held-out test take")
+        raise ValueError("need at least one take besides the held-out test takes")
     train_frames = np.concatenate([takes[i].weights for i in train_ids])
     sampler = CoverageSampler.fit(train_frames)
     sources = {
@@ -149,6 +155,6 @@ def expression_sources(
     }
     if test_share > 0:
         sources[TEST] = ExpressionSource(
-            takes, [held], sampler, (seed, 10, TEST), exclude=train_frames
+            takes, held, sampler, (seed, 10, TEST), exclude=train_frames
         )
     return sources, sampler

@@ -64,7 +64,6 @@ def describe_plan(cfg: GenerateConfig, plan: list[ShardSpec], takes: list[Take])
     """The dataset as planned: counts, splits (identities, parameter sets, expression
     sources) and the parameter definition, written before anything is simulated."""
     params = sampling_parameters(load_parameters(), cfg.ranges)
-    test_take = [t.name for t in takes].index(cfg.test_take)
     per_kind: dict[str, dict] = {}
     splits: dict[str, dict] = {
         s: {"identities": [], "parameter_sets": 0, "takes": [], "coverage_draws": 0}
@@ -90,8 +89,8 @@ def describe_plan(cfg: GenerateConfig, plan: list[ShardSpec], takes: list[Take])
         if kind != "dynamic":
             k["regional_patterns"] = sum(g.p_regions is not None for s in shards for g in s.groups)
         per_kind[kind] = k
-    splits["train"]["takes"] = [t.name for i, t in enumerate(takes) if i != test_take]
-    splits["test"]["takes"] = [cfg.test_take]
+    splits["train"]["takes"] = [t.name for t in takes if t.name not in cfg.test_takes]
+    splits["test"]["takes"] = list(cfg.test_takes)
     return {
         "kinds": per_kind,
         "splits": splits,
@@ -123,7 +122,7 @@ def _prepare(cfg: GenerateConfig, run: RunSettings) -> tuple[Manifest, list[Shar
     if out.is_dir() and any(out.iterdir()) and not (out / "manifest.json").is_file():
         raise ValueError(f"{out} is not empty and holds no dataset manifest: use a new folder")
     takes = load_takes(run.takes)
-    sources, _ = expression_sources(takes, cfg.test_take, cfg.seed, cfg.test_share)
+    sources, _ = expression_sources(takes, cfg.test_takes, cfg.seed, cfg.test_share)
     plan = make_plan(cfg, sampling_parameters(load_parameters(), cfg.ranges), sources)
     out.mkdir(parents=True, exist_ok=True)
     header = make_header(cfg, takes)

@@ -90,7 +90,7 @@ def _target_weights(manifest: dict, takes_dir: Path | None, n: int = 20000) -> n
         takes = None
     if takes is None:
         return None
-    sources, sampler = expression_sources(takes, cfg.test_take, cfg.seed + 1, 0.0)
+    sources, sampler = expression_sources(takes, cfg.test_takes, cfg.seed + 1, 0.0)
     src = sources[0]
     real = src.pool[np.random.default_rng(0).integers(len(src.pool), size=n)]
     w_real = np.stack([takes[t].weights[i] for t, i in real])

@@ -14,6 +14,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from softdeca_train.data.config import GenerateConfig
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.train.batches import EVERY_FRAME, Batch
 from softdeca_train.train.models import (
@@ -45,7 +46,7 @@ class ErrorSum:
     frames: int = 0
     by_source: dict[str, list[float]] = field(default_factory=dict)
 
-    def add(self, err: torch.Tensor, sources: np.ndarray, test_take: int) -> None:
+    def add(self, err: torch.Tensor, sources: np.ndarray, test_takes: list[int]) -> None:
         e = err.detach().double().numpy().reshape(-1, err.shape[-1])  # (frames, V) metres
         self.total += float(e.sum())
         self.count += e.size
@@ -54,7 +55,7 @@ class ErrorSum:
         self.per_vertex = pv if self.per_vertex is None else self.per_vertex + pv
         src = np.asarray(sources).reshape(-1)
         for f in range(len(e)):
-            key = "real_take" if src[f] == test_take else "coverage"
+            key = "real_take" if src[f] in test_takes else "coverage"
             self.by_source.setdefault(key, []).append(float(e[f].mean()))
 
     def summary(self) -> dict:
@@ -79,10 +80,11 @@ def _with_landmarks(batch: Batch, which: str, model: SparseSoftDeca) -> Batch:
     return batch
 
 
-def _test_take(run: Run) -> int:
+def _test_takes(run: Run) -> list[int]:
+    """The indices (header.takes) of the takes held out for the test split."""
     header = run.data.manifest["header"]
     names = [t["name"] if isinstance(t, dict) else t for t in header["takes"]]
-    return names.index(header["config"]["test_take"])
+    return [names.index(t) for t in GenerateConfig.from_dict(header["config"]).test_takes]
 
 
 class GroupOffsetOracle(NoCorrection):
@@ -101,7 +103,7 @@ def measure(
     run: Run, name: str, model: Trainable, which: str | None = None, split: str = "test"
 ) -> ErrorSum:
     acc = ErrorSum()
-    take = _test_take(run)
+    take = _test_takes(run)
     # batches of up to 8 frames of one (identity, p) group (GroupOffsetOracle needs whole
     # groups: the datasets have 2 or 8 frames per group). A test split is judged on every
     # frame; a train split on the frames training saw.

@@ -17,6 +17,7 @@ import torch
 from tqdm import tqdm
 
 from softdeca_train.bench import write_area
+from softdeca_train.data.config import GenerateConfig
 from softdeca_train.models.bundle import OnnxNetworks
 from softdeca_train.models.reference import ReferenceAvatar
 from softdeca_train.render import MeshLayer, RenderSettings, render, tile
@@ -27,7 +28,7 @@ from softdeca_train.train.evaluate import (
     ErrorSum,
     GroupOffsetOracle,
     _AsDynamic,
-    _test_take,
+    _test_takes,
     measure,
     no_correction,
     time_per_frame,
@@ -76,7 +77,7 @@ def _bundle_errors(run: Run, bundle: Path, progress: bool) -> dict[str, dict]:
     t = run.template
     tris = t.triangles
     acc = {"softdeca": ErrorSum(), "sparse": ErrorSum()}
-    take = _test_take(run)
+    take = _test_takes(run)
     avatars: dict[tuple[int, int], ReferenceAvatar] = {}
     for kind, model in (("static", "softdeca"), ("sparse", "sparse")):
         batches = list(run.data.batches(kind, "test", None, 8, EVERY_FRAME))
@@ -269,6 +270,11 @@ def _left_out_line(left: dict[str, dict[str, int]]) -> str:
     )
 
 
+def _held_out_takes(cfg: dict) -> str:
+    names = GenerateConfig.from_dict(cfg).test_takes
+    return ", ".join(f"`{n}`" for n in names)
+
+
 def _more_static_clause(run: Run) -> str:
     """Where SoftDECA's start also read static frames of other datasets (--more-static)."""
     names = [f"`{Path(d).name}`" for d in run.config.more_static]
@@ -290,7 +296,8 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         f"{_more_static_clause(run)}; "
         f"bundle `{bundle}`. Errors: mean per-vertex Euclidean distance to the simulated skin "
         "T over all skin vertices of S, in mm, on the test split (identities, parameter sets "
-        f"and expression frames unseen in training: the held-out take `{cfg['test_take']}` and "
+        "and expression frames unseen in training: the held-out takes "
+        f"{_held_out_takes(cfg)} and "
         "test coverage draws). Times: median per-frame work, torch, 1 thread, batch 1, "
         "per-avatar parts prepared; the native runtime's figures are in docs/benchmarks.md.",
         "",

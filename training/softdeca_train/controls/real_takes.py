@@ -1,0 +1,212 @@
+"""The report's `real_takes`: SoftDECA and the linear blendshapes against the physics on every
+n-th frame of every recorded take, for identities no model trained on, reported per take.
+
+A figure on frames the model trained on says little about a user's own takes, so the takes
+any training frame of the bundle came from (its manifest's training record) are summarised
+apart from those it never saw, and the report leads with the unseen ones. Mild frames (the
+linear blend within MILD_MM of the physics: speech, small co-activations) are summarised apart
+from strong ones, since a pooled mean is mostly the many mild frames."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from softdeca_train.streaming.takes import TAKE_SUFFIXES, read_take, take_paths
+
+MILD_MM = 0.1  # a frame is mild when the linear blend is this close to the physics (mean, mm)
+GROUP_KEYS = ("frames", "softdeca_mm", "linear_mm", "ratio")
+TAKE_KEYS = ("take", "trained_on", *GROUP_KEYS, "mild", "strong")
+KEYS = ("every", "identities", "mild_mm", "takes", "unseen", "seen")
+
+
+@dataclass(frozen=True)
+class RecordedTake:
+    name: str  # "<source folder>/<take>" relative to the recordings folder
+    sha256: str
+    weights: np.ndarray  # (n, 52) every n-th tracked frame, canonical ARKit order
+
+
+def recorded_takes(recordings: Path, every: int) -> list[RecordedTake]:
+    """Every `every`-th tracked frame of every take below `recordings` (Live Link Face CSV or
+    LLV recording: streaming/takes.py), sorted by name."""
+    root = Path(recordings)
+    paths = take_paths(root)
+    if not paths:
+        raise FileNotFoundError(f"no takes ({', '.join(TAKE_SUFFIXES)}) below {recordings}")
+    takes = []
+    for p in paths:
+        frames = read_take(p).frames
+        if not frames:
+            raise ValueError(f"{p}: no tracked frames")
+        w = np.stack([f.weights for f in frames]).astype(np.float32)[::every]
+        name = p.relative_to(root).with_suffix("").as_posix()
+        takes.append(RecordedTake(name, hashlib.sha256(p.read_bytes()).hexdigest(), w))
+    return takes
+
+
+def _split_takes(dataset: dict) -> list[str]:
+    return list(((dataset.get("splits") or {}).get("train") or {}).get("takes") or [])
+
+
+def trained_take_names(manifest: dict) -> set[str]:
+    """The names of the takes any training frame of a bundle came from: the train split of
+    its dataset and of every dataset added to it (an untrained bundle: none)."""
+    training = manifest.get("training") or {}
+    datasets = [training.get("dataset") or {}]
+    datasets += list(training.get("more_static") or [])
+    datasets += [training["contrasts"]] if training.get("contrasts") else []
+    return {name for d in datasets for name in _split_takes(d)}
+
+
+def trained_on(take: RecordedTake, trained: set[str]) -> bool:
+    """Whether a training frame may have come from `take`. The training record names takes
+    by file stem only, so any take of that stem counts as seen: a collision can only make
+    the unseen figure leave a take out, never flatter it."""
+    return take.name.rsplit("/", 1)[-1] in trained
+
+
+@dataclass(frozen=True)
+class FrameDistances:
+    """Per evaluated frame (one identity, one take frame): the take's index and the mean
+    distance over the skin (mm) of SoftDECA and of the linear blend to the physics."""
+
+    take: np.ndarray  # (n,) int
+    softdeca_mm: np.ndarray  # (n,)
+    linear_mm: np.ndarray  # (n,)
+
+
+def _group(softdeca: np.ndarray, linear: np.ndarray) -> dict | None:
+    if len(softdeca) == 0:
+        return None
+    s, lin = float(softdeca.mean()), float(linear.mean())
+    return {
+        "frames": len(softdeca),
+        "softdeca_mm": s,
+        "linear_mm": lin,
+        "ratio": s / lin if lin > 0 else None,
+    }
+
+
+def _with_mild_and_strong(softdeca: np.ndarray, linear: np.ndarray) -> dict | None:
+    whole = _group(softdeca, linear)
+    if whole is None:
+        return None
+    mild = linear <= MILD_MM
+    return {
+        **whole,
+        "mild": _group(softdeca[mild], linear[mild]),
+        "strong": _group(softdeca[~mild], linear[~mild]),
+    }
+
+
+def _pooled(d: FrameDistances, takes: list[int], per_take: list[dict]) -> dict | None:
+    rows = np.isin(d.take, takes)
+    pooled = _with_mild_and_strong(d.softdeca_mm[rows], d.linear_mm[rows])
+    if pooled is None:
+        return None
+    ratios = [per_take[t]["ratio"] for t in takes if per_take[t]["ratio"] is not None]
+    pooled["mean_take_ratio"] = float(np.mean(ratios)) if ratios else None
+    pooled["worst_take_ratio"] = max(ratios) if ratios else None
+    return pooled
+
+
+def summarise(
+    takes: list[RecordedTake], seen: list[bool], d: FrameDistances, every: int, identities: int
+) -> dict:
+    """The `real_takes` section: per take, pooled over the unseen takes and over the seen ones
+    (those a training frame came from); ratio: SoftDECA's distance to the physics over the
+    linear blend's, pooled over frames."""
+    per_take = []
+    for i, take in enumerate(takes):
+        rows = d.take == i
+        group = _with_mild_and_strong(d.softdeca_mm[rows], d.linear_mm[rows])
+        if group is None:
+            raise ValueError(f"take {take.name}: no frame evaluated")
+        per_take.append({"take": take.name, "trained_on": seen[i], **group})
+    return {
+        "every": every,
+        "identities": identities,
+        "mild_mm": MILD_MM,
+        "takes": per_take,
+        "unseen": _pooled(d, [i for i in range(len(takes)) if not seen[i]], per_take),
+        "seen": _pooled(d, [i for i in range(len(takes)) if seen[i]], per_take),
+    }
+
+
+def _check_group(where: str, g: object, optional: bool = False) -> None:
+    if g is None and optional:
+        return
+    if not isinstance(g, dict) or not set(GROUP_KEYS) <= set(g):
+        raise ValueError(f"report: real_takes {where} needs {GROUP_KEYS}")
+    if not (isinstance(g["frames"], int) and g["frames"] > 0):
+        raise ValueError(f"report: real_takes {where}.frames must be a positive count")
+    for k in ("softdeca_mm", "linear_mm"):
+        if not (isinstance(g[k], (int, float)) and math.isfinite(g[k]) and g[k] >= 0):
+            raise ValueError(f"report: real_takes {where}.{k} must be a distance in mm")
+
+
+def validate_real_takes(real: object) -> None:
+    """ValueError naming the first problem of a `real_takes` section."""
+    if not isinstance(real, dict) or set(real) != set(KEYS):
+        raise ValueError(f"report: `real_takes` needs exactly {KEYS}")
+    if not (isinstance(real["identities"], int) and real["identities"] > 0):
+        raise ValueError("report: real_takes.identities must be a positive count")
+    if not isinstance(real["takes"], list) or not real["takes"]:
+        raise ValueError("report: real_takes.takes must be a non-empty list")
+    for t in real["takes"]:
+        if not isinstance(t, dict) or set(t) != set(TAKE_KEYS):
+            raise ValueError(f"report: a real take needs exactly {TAKE_KEYS}")
+        _check_group(t["take"], t)
+        for part in ("mild", "strong"):
+            _check_group(f"{t['take']}.{part}", t[part], optional=True)
+    if real["unseen"] is None and real["seen"] is None:
+        raise ValueError("report: real_takes has neither unseen nor seen takes")
+    for part in ("unseen", "seen"):
+        _check_group(part, real[part], optional=True)
+
+
+def _cell(g: dict | None, key: str) -> str:
+    if g is None or g.get(key) is None:
+        return "–"
+    return f"{g[key]:.2f}" if key == "ratio" else f"{g[key]:.3f}"
+
+
+def readme_lines(real: dict) -> list[str]:
+    """The report README's real-takes table: unseen takes first, each pooled figure labelled."""
+    lines = [
+        f"Real takes (every {real['every']}th frame, {real['identities']} identities no model "
+        "trained on, default parameters): mean distance to the physics over the skin (mm) and "
+        "SoftDECA's share of the linear blend's (ratio; below 1 is closer to the physics). "
+        f"Mild frames: the linear blend within {real['mild_mm']} mm of the physics.",
+        "",
+        "| take | trained on | frames | SoftDECA | linear | ratio | mild ratio | strong ratio |",
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    rows = sorted(real["takes"], key=lambda t: (t["trained_on"], t["take"]))
+    for label, g in [(t["take"], t) for t in rows] + [
+        ("**unseen takes, pooled**", real["unseen"]),
+        ("in-distribution takes, pooled", real["seen"]),
+    ]:
+        if g is None:
+            continue
+        seen = {True: "yes", False: "no"}.get(g.get("trained_on"), "")
+        lines.append(
+            f"| {label} | {seen} | {g['frames']} | {_cell(g, 'softdeca_mm')} "
+            f"| {_cell(g, 'linear_mm')} | {_cell(g, 'ratio')} | {_cell(g['mild'], 'ratio')} "
+            f"| {_cell(g['strong'], 'ratio')} |"
+        )
+    return lines
+
+
+def one_line(real: dict) -> str:
+    """The figure a command prints: the unseen takes' pooled distances, else the seen ones'."""
+    part, label = (real["unseen"], "unseen") if real["unseen"] else (real["seen"], "seen")
+    return (
+        f"real takes ({label}, {part['frames']} frames): SoftDECA {part['softdeca_mm']:.3f} mm, "
+        f"linear {part['linear_mm']:.3f} mm, ratio {_cell(part, 'ratio')}"
+    )
