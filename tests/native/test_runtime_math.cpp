@@ -13,21 +13,22 @@
 #include <string>
 #include <vector>
 
+#include "bundle/bundle_files.h"
+#include "bundle/json.h"
 #include "core/error.h"
+#include "geometry/normals.h"
+#include "geometry/rigid.h"
+#include "geometry/sparse_ldlt.h"
+#include "kernels/half.h"
+#include "kernels/hypertensor.h"
+#include "kernels/worker.h"
 #include "runtime/blendshapes.h"
-#include "runtime/bundle_files.h"
 #include "runtime/deformation_transfer.h"
 #include "runtime/dynamics.h"
-#include "runtime/half.h"
-#include "runtime/hypertensor.h"
-#include "runtime/json.h"
-#include "runtime/normals.h"
-#include "runtime/rigid.h"
-#include "runtime/sparse_ldlt.h"
-#include "runtime/worker.h"
 
 namespace {
 using namespace softdeca::runtime;
+using namespace softdeca::geometry;
 
 TEST(Half, RoundTripsAndRoundsToNearestEven) {
   EXPECT_EQ(float_to_half(1.0f), 0x3C00);

@@ -31,6 +31,15 @@ bool ParameterState::at_defaults() const {
   return true;
 }
 
+bool ParameterState::operator==(const ParameterState& other) const {
+  if (values_.size() != other.values_.size()) return false;
+  for (std::size_t i = 0; i < values_.size(); ++i) {
+    const Value &a = values_[i], &b = other.values_[i];
+    if (a.kind != b.kind || a.global != b.global || a.map != b.map) return false;
+  }
+  return true;
+}
+
 ParameterState ParameterState::only(const std::vector<int>& indices) const {
   ParameterState out(*this);
   out.reset();

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "runtime/manifest.h"
+#include "bundle/manifest.h"
 
 namespace softdeca::runtime {
 
@@ -27,6 +27,8 @@ class ParameterState {
   Kind kind(int index) const { return values_.at(static_cast<std::size_t>(index)).kind; }
   // Every parameter a global value at its default.
   bool at_defaults() const;
+  // The same values (kind, global value and map) for every parameter.
+  bool operator==(const ParameterState& other) const;
   // A copy holding only the listed parameters' values, the others at their defaults.
   ParameterState only(const std::vector<int>& indices) const;
   double global(int index) const { return values_.at(static_cast<std::size_t>(index)).global; }
