@@ -47,12 +47,12 @@ struct LandmarkSpec {
 };
 
 // The physics at prepare (docs/bundle.md, "Rest physics"): the sizes of rest_head.bin's arrays
-// and the solver's settings; the arrays themselves are read by rest/rest_head.h.
+// and the solver's settings; the arrays themselves are read by prepare/rest_head.h.
 struct RestPhysicsSpec {
   std::string file, sha256;
   int fill_vertices = 0, soft_tets = 0, muscle_tets = 0, teeth_upper = 0, teeth_lower = 0, cranium = 0, jaw = 0;
   int upper_teeth_triangles = 0, lower_teeth_triangles = 0;
-  // The lip and lid sets' rules (rest/contact_sets.h); absent: no collision sets.
+  // The lip and lid sets' rules (prepare/contact_sets.h); absent: no collision sets.
   bool has_contacts = false;
   int lid_candidates = 0;
   double lip_radius = 0, lip_corner_radius = 0, lid_reach = 0, lid_corner_radius = 0, eye_zone_share = 0;

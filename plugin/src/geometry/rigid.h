@@ -1,6 +1,6 @@
 // Best-fit rigid and similarity transforms between corresponding point sets (3x3 SVD):
-// Kabsch for the jaw's motion, Umeyama for the landmark retargeting. Same conventions as
-// training/softdeca_train/models/reference.py (kabsch, similarity).
+// Kabsch for the jaw's motion and the fit's placement, Umeyama for the landmark retargeting.
+// Same conventions as training/softdeca_train/models/reference.py (kabsch, similarity).
 #pragma once
 
 #include <cstddef>

@@ -21,13 +21,13 @@
 #include "kernels/aligned.h"
 #include "kernels/hypertensor.h"
 #include "kernels/worker.h"
-#include "rest/rest_physics.h"
+#include "prepare/parameters.h"
+#include "prepare/rest_physics.h"
 #include "runtime/blendshapes.h"
 #include "runtime/deformation_transfer.h"
 #include "runtime/dynamics.h"
 #include "runtime/model.h"
 #include "runtime/onnx_network.h"
-#include "runtime/parameters.h"
 
 namespace softdeca::runtime {
 
@@ -77,7 +77,7 @@ struct Preparation {
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
   // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)], p_inert being
-  // p's rest-inert parameters alone, the others at their defaults (rest/rest_physics.h).
+  // p's rest-inert parameters alone, the others at their defaults (prepare/rest_physics.h).
   std::vector<float> rest_offset;
   std::size_t bytes() const;
 };

@@ -13,7 +13,7 @@
 #include "bundle/bundle_files.h"
 #include "bundle/manifest.h"
 #include "bundle/template_head.h"
-#include "rest/rest_head.h"
+#include "prepare/rest_head.h"
 #include "runtime/onnx_network.h"
 
 namespace softdeca::runtime {

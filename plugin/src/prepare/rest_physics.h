@@ -1,11 +1,11 @@
 // Physics at prepare (docs/runtime.md): one avatar's head simulated at rest. The bundle's rest
-// head (rest/rest_head.h) is carried to the avatar's neutral skin,
+// head (prepare/rest_head.h) is carried to the avatar's neutral skin,
 //     V = V0 + K^-1 B^T W (S - B V0),   K = B^T W B + lambda * stiffness(V0),
 // the fill's displacement that follows S where S is and spreads smoothly inward (B: S's
 // embedding, W: the skin points the fill holds); the teeth are the avatar's own. solve() runs
 // the physics' static solve with the skin's targets at the neutral under the avatar's
 // parameters, which the frames' rest correction compares across parameter values. The lip and
-// lid sets are found on the avatar's neutral (rest/contact_sets.h), and a parameter map
+// lid sets are found on the avatar's neutral (prepare/contact_sets.h), and a parameter map
 // reaches a tet through the skin vertex nearest its centroid, as in the training data.
 // Mirrors training/softdeca_train/models/rest_physics.py.
 #pragma once
@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "bundle/manifest.h"
-#include "rest/rest_head.h"
-#include "runtime/parameters.h"
+#include "prepare/parameters.h"
+#include "prepare/rest_head.h"
 #include "sim/simulator.h"
 
 namespace softdeca::runtime {

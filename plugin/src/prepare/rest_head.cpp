@@ -1,4 +1,4 @@
-#include "rest/rest_head.h"
+#include "prepare/rest_head.h"
 
 #include <cmath>
 #include <cstring>

@@ -1,4 +1,4 @@
-#include "rest/rest_physics.h"
+#include "prepare/rest_physics.h"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/LU>
@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "geometry/nearest_points.h"
-#include "rest/contact_sets.h"
+#include "prepare/contact_sets.h"
 #include "sim/parameters.h"
 
 namespace softdeca::runtime {

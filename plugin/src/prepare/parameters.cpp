@@ -1,4 +1,4 @@
-#include "runtime/parameters.h"
+#include "prepare/parameters.h"
 
 #include <cmath>
 #include <string>

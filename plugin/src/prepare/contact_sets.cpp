@@ -1,4 +1,4 @@
-#include "rest/contact_sets.h"
+#include "prepare/contact_sets.h"
 
 #include <algorithm>
 #include <array>

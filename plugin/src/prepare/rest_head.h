@@ -1,7 +1,7 @@
 // The template's simulation mesh a bundle carries for the physics at prepare (docs/bundle.md,
 // "Rest physics"): the tissue fill's vertices and tets, S's embedding in it, the bones, the
 // teeth's surfaces and the rules that find the lip and lid sets on a head. Read and checked
-// once at load; rest/rest_physics.h carries it to each avatar.
+// once at load; prepare/rest_physics.h carries it to each avatar.
 #pragma once
 
 #include <cstddef>
@@ -10,7 +10,7 @@
 
 #include "bundle/bundle_files.h"
 #include "bundle/manifest.h"
-#include "rest/contact_sets.h"
+#include "prepare/contact_sets.h"
 #include "sim/mesh.h"
 #include "sim/parameters.h"
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "rest/contact_rules_table.h"  // generated from plugin/data/contact_rules.json
+#include "prepare/contact_rules_table.h"  // generated from plugin/data/contact_rules.json
 #include "sim/mesh.h"
 
 namespace softdeca::runtime {
