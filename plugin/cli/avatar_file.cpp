@@ -9,7 +9,7 @@
 #include <map>
 #include <stdexcept>
 
-#include "runtime/sha256.h"
+#include "bundle/sha256.h"
 
 namespace softdeca::cli {
 

@@ -12,10 +12,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include "bundle/bundle_files.h"
+#include "bundle/sha256.h"
 #include "core/error.h"
-#include "runtime/bundle_files.h"
 #include "runtime/model.h"
-#include "runtime/sha256.h"
 
 namespace softdeca::cli {
 namespace {

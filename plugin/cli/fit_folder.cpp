@@ -5,8 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "bundle/json.h"
 #include "json.h"
-#include "runtime/json.h"
 
 namespace softdeca::cli {
 

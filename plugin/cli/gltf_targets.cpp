@@ -4,7 +4,7 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "runtime/json.h"
+#include "bundle/json.h"
 
 namespace softdeca::cli {
 

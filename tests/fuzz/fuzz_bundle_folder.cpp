@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
+#include "bundle/bundle_files.h"
 #include "fuzz_check.h"
-#include "runtime/bundle_files.h"
 
 namespace fs = std::filesystem;
 using namespace softdeca::runtime;

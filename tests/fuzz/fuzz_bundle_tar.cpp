@@ -4,11 +4,11 @@
 #include <cstdint>
 #include <string>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
+#include "bundle/bundle_files.h"
+#include "bundle/manifest.h"
+#include "bundle/onnx_model_scan.h"
 #include "fuzz_check.h"
-#include "runtime/bundle_files.h"
-#include "runtime/manifest.h"
-#include "runtime/onnx_model_scan.h"
 
 using namespace softdeca::runtime;
 

@@ -4,10 +4,10 @@
 #include <cstdint>
 #include <string>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
+#include "bundle/json.h"
+#include "bundle/manifest.h"
 #include "fuzz_check.h"
-#include "runtime/json.h"
-#include "runtime/manifest.h"
 
 using namespace softdeca::runtime;
 

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
+#include "bundle/onnx_model_scan.h"
 #include "fuzz_check.h"
 #include "onnx_test_support.h"
-#include "runtime/onnx_model_scan.h"
 
 using namespace softdeca::runtime;
 using softdeca::test::field;

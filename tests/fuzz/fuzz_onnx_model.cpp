@@ -3,9 +3,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
+#include "bundle/onnx_model_scan.h"
 #include "fuzz_check.h"
-#include "runtime/onnx_model_scan.h"
 
 using namespace softdeca::runtime;
 

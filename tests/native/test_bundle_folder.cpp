@@ -10,8 +10,8 @@
 #include <string>
 #include <system_error>
 
+#include "bundle/bundle_files.h"
 #include "core/error.h"
-#include "runtime/bundle_files.h"
 
 namespace fs = std::filesystem;
 using softdeca::Error;

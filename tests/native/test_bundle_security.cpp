@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
-#include "runtime/bundle_files.h"
-#include "runtime/model.h"
+#include "api/error_boundary.h"
+#include "bundle/bundle_files.h"
+#include "bundle/onnx_model_scan.h"
+#include "bundle/sha256.h"
 #include "onnx_test_support.h"
-#include "runtime/onnx_model_scan.h"
-#include "runtime/sha256.h"
+#include "runtime/model.h"
 #include "runtime_fixture.h"
 #include "softdeca/softdeca.h"
 

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "avatar_test_files.h"
+#include "bundle/json.h"
 #include "fit_folder.h"
 #include "mesh_io.h"
-#include "runtime/json.h"
 #include "runtime_fixture.h"
 
 using softdeca::test::TempDir;

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "bundle/onnx_model_scan.h"
 #include "onnx_test_support.h"
-#include "runtime/onnx_model_scan.h"
 
 using namespace softdeca::runtime;
 using softdeca::test::field;

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "avatar_test_files.h"
+#include "bundle/sha256.h"
 #include "png_writer.h"
-#include "runtime/sha256.h"
 #include "stream/crc32.h"
 
 using namespace softdeca::cli;

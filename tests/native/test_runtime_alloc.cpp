@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <new>
 
-#include "runtime/bundle_files.h"
+#include "bundle/bundle_files.h"
 #include "runtime/model.h"
 #include "runtime_fixture.h"
 

@@ -1,6 +1,6 @@
 // The runtime's building blocks against direct computations: half conversion, the compact
 // hyper-tensor kernels, the prefactored solve, blendshape runs, normals, rigid fits, dynamics,
-// the worker, and the manifest's JSON and tar readers.
+// the worker, parameter states, and the manifest's JSON and tar readers.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -13,21 +13,23 @@
 #include <string>
 #include <vector>
 
+#include "bundle/bundle_files.h"
+#include "bundle/json.h"
 #include "core/error.h"
+#include "geometry/normals.h"
+#include "geometry/rigid.h"
+#include "geometry/sparse_ldlt.h"
+#include "kernels/half.h"
+#include "kernels/hypertensor.h"
+#include "kernels/worker.h"
+#include "prepare/parameters.h"
 #include "runtime/blendshapes.h"
-#include "runtime/bundle_files.h"
 #include "runtime/deformation_transfer.h"
 #include "runtime/dynamics.h"
-#include "runtime/half.h"
-#include "runtime/hypertensor.h"
-#include "runtime/json.h"
-#include "runtime/normals.h"
-#include "runtime/rigid.h"
-#include "runtime/sparse_ldlt.h"
-#include "runtime/worker.h"
 
 namespace {
 using namespace softdeca::runtime;
+using namespace softdeca::geometry;
 
 TEST(Half, RoundTripsAndRoundsToNearestEven) {
   EXPECT_EQ(float_to_half(1.0f), 0x3C00);
@@ -416,6 +418,39 @@ TEST(BundleFiles, ReadsTarArchivesAndRejectsDamage) {
   EXPECT_THROW(BundleFiles::from_tar(tar.data(), 700), softdeca::Error);
   std::vector<uint8_t> zeros(1024, 0);
   EXPECT_THROW(BundleFiles::from_tar(zeros.data(), zeros.size()), softdeca::Error);
+}
+
+// Prepare runs the networks once per distinct parameter set, so equal states must compare equal
+// however they were reached, and differ in a kind, a global value or a map's entry.
+TEST(ParameterState, ComparesKindsValuesAndMaps) {
+  Manifest m;
+  m.skin_vertices = 3;
+  for (const char* name : {"a", "b"}) {
+    ParameterSpec p;
+    p.name = name;
+    p.default_value = 0.5;
+    p.max = 1;
+    p.localisable = true;
+    m.parameters.push_back(p);
+  }
+  const std::vector<std::int32_t> triangles = {0, 1, 2};
+  const std::vector<double> area = {1.0};
+  ParameterState x(m, triangles, area), y(m, triangles, area);
+  EXPECT_TRUE(x == y);
+  x.set_global(1, 0.25);
+  EXPECT_FALSE(x == y);
+  EXPECT_TRUE(x.only({1}) == x);  // every change is in the listed parameters
+  EXPECT_TRUE(x.only({0}).at_defaults());
+  y.set_global(1, 0.25);
+  EXPECT_TRUE(x == y);
+  const float map[] = {0.25f, 0.25f, 0.25f};
+  y.set_vertices(1, map, 3);  // the same values as a map: another input kind, another state
+  EXPECT_FALSE(x == y);
+  x.set_vertices(1, map, 3);
+  EXPECT_TRUE(x == y);
+  const float other[] = {0.25f, 0.5f, 0.25f};
+  x.set_vertices(1, other, 3);
+  EXPECT_FALSE(x == y);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
-"""The native library's layers: core/ below everything, the C ABI (api/) on top, nothing below
-api/ including it, and the streaming areas (stream/, recording/, live/) in one order. The
-training package's layers (PYTHON_LAYERS): no import cycle, areas importing only downwards,
-and imports at module top but for a few explained ones."""
+"""The native library's layers (NATIVE_LAYERS): core/ below everything, the C ABI (api/) on
+top, nothing below api/ including it, and every area including only areas of lower layers.
+The training package's layers (PYTHON_LAYERS): no import cycle, areas importing only
+downwards, and imports at module top but for a few explained ones."""
 
 from __future__ import annotations
 
@@ -45,23 +45,43 @@ def test_core_depends_on_nothing_but_the_public_header() -> None:
             )
 
 
-# The streaming areas in their order, bottom up: frames and wire formats, the recording files
-# built on them, the live receiver that records what it delivers. None includes one above it.
-STREAMING_ORDER = ("stream", "recording", "live")
+# The native areas (folders of plugin/src), bottom up. An area includes only areas of lower
+# layers; areas of one layer are independent of each other.
+NATIVE_LAYERS: tuple[tuple[str, ...], ...] = (
+    # the error type, files, CPU features
+    ("core",),
+    # the per-frame CPU kernels and their buffers; frames and wire formats of face streams
+    ("kernels", "stream"),
+    # mesh maths: normals, similarity fits, the sparse LDL^T, nearest points, surface queries
+    ("geometry",),
+    # the physics simulator; reading and checking bundles; recording files of face streams
+    ("sim", "bundle", "recording"),
+    # what prepare reads: an avatar's parameter values and the physics at rest; the live
+    # receiver that records what it delivers
+    ("prepare", "live"),
+    # fitting a user's head to the template
+    ("fit",),
+    # evaluating an avatar's frames
+    ("runtime",),
+    # the C ABI
+    ("api",),
+)
 
 
-def test_streaming_areas_include_only_downwards() -> None:
-    for below, area in enumerate(STREAMING_ORDER):
-        files = sources(area)
-        assert files, area
-        above = STREAMING_ORDER[below + 1 :]
-        offenders = [
-            f"{p.relative_to(SRC)} includes {inc}"
-            for p in files
-            for inc in local_includes(p)
-            if inc.split("/")[0] in above
-        ]
-        assert offenders == [], f"{area}/ includes an area above it"
+def test_native_areas_include_only_downwards() -> None:
+    layer = {a: k for k, areas in enumerate(NATIVE_LAYERS) for a in areas}
+    areas = sorted({p.relative_to(SRC).parts[0] for p in sources()})
+    unplaced = sorted(set(areas) - set(layer))
+    assert unplaced == [], f"areas without a layer in NATIVE_LAYERS: {unplaced}"
+    offenders = [
+        f"{p.relative_to(SRC)} includes {inc}"
+        for p in sources()
+        for inc in local_includes(p)
+        if (target := inc.split("/")[0]) in layer
+        and target != (area := p.relative_to(SRC).parts[0])
+        and layer[target] >= layer[area]
+    ]
+    assert offenders == [], "includes of an area of the same or a higher layer"
 
 
 # The Python package's layers, bottom up. An area (a sub-package, or a module at the package's

@@ -21,8 +21,8 @@ SOURCE_SUFFIXES = (".py", ".h", ".cpp", ".cs", ".swift", ".cmake", ".txt", ".m",
 SOURCE_TREES = ("plugin", "training", "unity_package", "ios_capture", "cmake")
 # The implementations of the contact rules: every number in them counts as a rule's.
 CONTACT_FILES = (
-    "plugin/src/runtime/contact_sets.h",
-    "plugin/src/runtime/contact_sets.cpp",
+    "plugin/src/prepare/contact_sets.h",
+    "plugin/src/prepare/contact_sets.cpp",
     "training/softdeca_train/contact_rules.py",
     "training/softdeca_train/sim/lips.py",
     "training/softdeca_train/sim/lids.py",

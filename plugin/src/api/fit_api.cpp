@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 #include "api/handles.h"
 #include "api/runtime_handles.h"
 #include "core/regular_file.h"

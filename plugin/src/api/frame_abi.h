@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 #include "recording/recording_format.h"
 #include "softdeca/softdeca.h"
 #include "stream/frame.h"

@@ -1,7 +1,7 @@
 // Geometry part of the C ABI: thin, checked wrappers over geometry/.
 #include <string>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 #include "geometry/tet_mesh.h"
 
 namespace {

@@ -5,7 +5,7 @@
 
 #include <memory>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 
 namespace softdeca {
 

@@ -1,5 +1,5 @@
 // Library-level C ABI: version, errors, status names.
-#include "api/error.h"
+#include "api/error_boundary.h"
 
 extern "C" {
 

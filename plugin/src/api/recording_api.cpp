@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 #include "api/frame_abi.h"
 #include "api/handles.h"
 #include "recording/conversions.h"

@@ -4,10 +4,10 @@
 #include <memory>
 #include <string>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 #include "api/handles.h"
 #include "api/runtime_handles.h"
-#include "runtime/bundle_files.h"
+#include "bundle/bundle_files.h"
 
 namespace {
 using namespace softdeca;

@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 
 #include "fit/avatar_fit.h"
 #include "runtime/avatar.h"

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 #include "api/handles.h"
 #include "sim/simulator.h"
 

@@ -2,7 +2,7 @@
 #include <memory>
 #include <string>
 
-#include "api/error.h"
+#include "api/error_boundary.h"
 #include "api/frame_abi.h"
 #include "api/handles.h"
 #include "live/receiver.h"

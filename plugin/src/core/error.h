@@ -1,5 +1,5 @@
 // The library's error type and the checks that raise it, used by every area. An Error carries
-// the status the C ABI returns for it; api/error.h turns it into that status at the boundary.
+// the status the C ABI returns for it; api/error_boundary.h turns it into that status at the boundary.
 // The library has no logging of its own: failures travel as Errors to the caller.
 #pragma once
 

@@ -12,7 +12,7 @@ namespace softdeca::fit {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'D', 'E', 'C', 'A', 'F', 'I', 'T'};
-constexpr std::uint32_t kMaxIdentity = 1000;  // identity modes a bundle may hold (runtime/manifest.cpp)
+constexpr std::uint32_t kMaxIdentity = 1000;  // identity modes a bundle may hold (bundle/manifest.cpp)
 
 class Writer {
  public:

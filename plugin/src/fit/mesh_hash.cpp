@@ -3,7 +3,7 @@
 #include <cstring>
 #include <vector>
 
-#include "runtime/sha256.h"
+#include "bundle/sha256.h"
 
 namespace softdeca::fit {
 

@@ -1,34 +1,22 @@
 #include "fit/placement.h"
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 #include <cmath>
 #include <limits>
 
 #include "core/error.h"
 #include "geometry/nearest_points.h"
+#include "geometry/rigid.h"
 
 namespace softdeca::fit {
 
 void kabsch(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst, Eigen::Matrix3d& r,
             Eigen::Vector3d& t, double* scale) {
-  Eigen::Vector3d cs = Eigen::Vector3d::Zero(), cd = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < src.size(); ++i) cs += src[i], cd += dst[i];
-  cs /= static_cast<double>(src.size());
-  cd /= static_cast<double>(src.size());
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < src.size(); ++i) h += (src[i] - cs) * (dst[i] - cd).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-  r = svd.matrixV() * d * svd.matrixU().transpose();
-  if (scale) {
-    double spread = 0;
-    for (const Eigen::Vector3d& p : src) spread += (p - cs).squaredNorm();
-    *scale = spread > 0 ? (svd.singularValues().asDiagonal() * d).trace() / spread : 1.0;
-    r *= *scale;
-  }
-  t = cd - r * cs;
+  static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "the vectors are read as xyz-interleaved arrays");
+  const geometry::Similarity s = geometry::fit_similarity(src.front().data(), dst.front().data(), src.size(), scale != nullptr);
+  r = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(s.rotation) * s.scale;
+  t = Eigen::Map<const Eigen::Vector3d>(s.translation);
+  if (scale) *scale = s.scale;
 }
 
 Located locate_by_shapes(const AvatarMesh& a, const AvatarFrame& tframe, double unit_option) {

@@ -16,18 +16,18 @@
 #include <mutex>
 #include <vector>
 
-#include "runtime/aligned.h"
+#include "geometry/normals.h"
+#include "geometry/rigid.h"
+#include "kernels/aligned.h"
+#include "kernels/hypertensor.h"
+#include "kernels/worker.h"
+#include "prepare/parameters.h"
+#include "prepare/rest_physics.h"
 #include "runtime/blendshapes.h"
 #include "runtime/deformation_transfer.h"
 #include "runtime/dynamics.h"
-#include "runtime/hypertensor.h"
 #include "runtime/model.h"
-#include "runtime/normals.h"
 #include "runtime/onnx_network.h"
-#include "runtime/parameters.h"
-#include "runtime/rest_physics.h"
-#include "runtime/rigid.h"
-#include "runtime/worker.h"
 
 namespace softdeca::runtime {
 
@@ -77,7 +77,7 @@ struct Preparation {
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
   // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)], p_inert being
-  // p's rest-inert parameters alone, the others at their defaults (runtime/rest_physics.h).
+  // p's rest-inert parameters alone, the others at their defaults (prepare/rest_physics.h).
   std::vector<float> rest_offset;
   std::size_t bytes() const;
 };
@@ -132,11 +132,14 @@ class Avatar {
   // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.
   void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since);
   void prepare_residual(const ParameterState& params, Preparation& prep) const;
+  // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep`.
+  void prepare_softdeca_stages(const ParameterState& params, const std::vector<float>& identity, Preparation& prep) const;
   // The networks' part of a preparation for these parameters and identity.
   std::shared_ptr<Preparation> prepare_networks(const ParameterState& params, const std::vector<float>& identity) const;
   // SoftDECA's static frame at rest (zero weights on the neutral) for a preparation, without
   // touching the frame thread's buffers (prepare runs beside frames).
   std::vector<float> softdeca_rest(const Preparation& prep) const;
+  std::vector<float> softdeca_rest(const ParameterState& params, const std::vector<float>& identity) const;
   // c(p) of Preparation::rest_offset (prepare_mutex_ held); iterations: of the physics' solve.
   std::vector<float> rest_offset(const ParameterState& params, const Preparation& prep, const std::vector<float>& identity,
                                  int& iterations);
@@ -184,9 +187,9 @@ class Avatar {
   AlignedArray<double> solve_work_;
   OnnxNetwork::Binding f_w_, f_l_, f_r_w_;
   DynamicsState dynamics_;
-  Normals normals_;
+  geometry::Normals normals_;
   bool calibrated_ = false;
-  Similarity calibration_;
+  geometry::Similarity calibration_;
   std::vector<double> user_neutral_;  // K x 3
 
   mutable std::mutex stats_mutex_;

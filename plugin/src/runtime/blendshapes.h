@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "runtime/aligned.h"
+#include "kernels/aligned.h"
 
 namespace softdeca::runtime {
 

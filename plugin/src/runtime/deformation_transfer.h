@@ -10,8 +10,8 @@
 #include <memory>
 #include <vector>
 
-#include "runtime/hypertensor.h"
-#include "runtime/sparse_ldlt.h"
+#include "geometry/sparse_ldlt.h"
+#include "kernels/hypertensor.h"
 
 namespace softdeca::runtime {
 
@@ -40,7 +40,7 @@ class DeformationTransfer {
   std::size_t work_size() const { return ldlt_.work_size(); }
   void solve(const float* const* r, std::size_t count, const float* skin, double* work, float* out) const;
   // The same in SparseLdlt's phases (every part of phase p before phase p + 1).
-  static constexpr int kPhases = SparseLdlt::kPhases;
+  static constexpr int kPhases = geometry::SparseLdlt::kPhases;
   void solve_phase(int phase, std::size_t part, const float* const* r, std::size_t count, const float* skin, double* work,
                    float* out) const {
     ldlt_.solve_phase(phase, part, r, count, work, skin, out);
@@ -49,7 +49,7 @@ class DeformationTransfer {
 
  private:
   FaceBlocks faces_;
-  SparseLdlt ldlt_;
+  geometry::SparseLdlt ldlt_;
 };
 
 }  // namespace softdeca::runtime

@@ -6,8 +6,8 @@
 
 #include <cstddef>
 
-#include "runtime/aligned.h"
-#include "runtime/manifest.h"
+#include "bundle/manifest.h"
+#include "kernels/aligned.h"
 
 namespace softdeca::runtime {
 

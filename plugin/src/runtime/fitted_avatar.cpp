@@ -87,7 +87,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   head_out_.resize(vh_ * 3);
   field_.resize(vs_ * 3);
   weights_.resize(kBlendshapeCount);
-  normals_ = Normals(triangles_, n_);
+  normals_ = geometry::Normals(triangles_, n_);
 }
 
 std::size_t FittedAvatar::bytes() const {

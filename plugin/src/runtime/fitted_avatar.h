@@ -66,7 +66,7 @@ class FittedAvatar {
 
   std::atomic<bool> busy_{false};
   std::vector<float> head_out_, field_, weights_;
-  Normals normals_;
+  geometry::Normals normals_;
 };
 
 }  // namespace softdeca::runtime

@@ -6,9 +6,9 @@
 #include <cstring>
 #include <iterator>
 
+#include "bundle/onnx_model_scan.h"
+#include "bundle/sha256.h"
 #include "core/error.h"
-#include "runtime/onnx_model_scan.h"
-#include "runtime/sha256.h"
 #include "sim/parameters.h"
 
 namespace softdeca::runtime {
@@ -106,15 +106,19 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
 
   if (mf.has_rest_physics) {
     // Every parameter must be one the physics knows, over a range it accepts.
+    std::vector<sim::Param> ids;
     for (const ParameterSpec& p : mf.parameters) {
       const auto& table = sim::parameter_table();
       const auto it = std::find_if(table.begin(), table.end(), [&](const sim::ParameterInfo& i) { return p.name == i.name; });
       if (it == table.end()) fail("rest_physics: parameter " + p.name + " is not one of the physics' parameters");
       if (p.min < it->lo || p.max > it->hi)
         fail("rest_physics: parameter " + p.name + "'s range is wider than the physics accepts");
+      ids.push_back(static_cast<sim::Param>(it - table.begin()));  // the table is in Param's order
     }
     const Bytes& data = verified(files, mf.rest_physics.file, mf.rest_physics.sha256);
-    m->rest_head_ = std::make_unique<const RestHead>(parse_rest_head(mf, data));
+    RestHead head = parse_rest_head(mf, data);
+    head.parameter_ids = std::move(ids);
+    m->rest_head_ = std::make_unique<const RestHead>(std::move(head));
   }
 
   if (mf.has_template_head)

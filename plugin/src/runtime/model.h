@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "runtime/bundle_files.h"
-#include "runtime/manifest.h"
+#include "bundle/bundle_files.h"
+#include "bundle/manifest.h"
+#include "bundle/template_head.h"
+#include "prepare/rest_head.h"
 #include "runtime/onnx_network.h"
-#include "runtime/rest_head.h"
-#include "runtime/template_head.h"
 
 namespace softdeca::runtime {
 

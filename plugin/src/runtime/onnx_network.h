@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/bundle_files.h"
-#include "runtime/manifest.h"
+#include "bundle/bundle_files.h"
+#include "bundle/manifest.h"
 
 namespace softdeca::runtime {
 

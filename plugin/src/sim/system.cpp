@@ -1,30 +1,16 @@
 #include "sim/system.h"
 
-#include <Eigen/SparseCholesky>
 #include <chrono>
 #include <string>
-#ifdef SOFTDECA_HAVE_METIS
-#include <iostream>  // Eigen's MetisSupport uses std::cerr without including it
-#include <Eigen/MetisSupport>
-#endif
 
 #include "core/error.h"
+#include "geometry/ldlt_factor.h"
 
 namespace softdeca::sim {
 
-#ifdef SOFTDECA_HAVE_METIS
-using FillReducingOrdering = Eigen::MetisOrdering<int>;
-#else
-using FillReducingOrdering = Eigen::AMDOrdering<int>;
-#endif
-
-struct System::Factor {
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, FillReducingOrdering> ldlt;
-};
-
 System::~System() = default;
 
-System::System(const Model& model, const ConstraintGroup* extra) : factor_(std::make_unique<Factor>()) {
+System::System(const Model& model, const ConstraintGroup* extra) {
   const auto t0 = std::chrono::steady_clock::now();
   const Eigen::Index n = static_cast<Eigen::Index>(model.pinned.size());
   free_index_.assign(static_cast<std::size_t>(n), -1);
@@ -79,9 +65,8 @@ System::System(const Model& model, const ConstraintGroup* extra) : factor_(std::
   require(mean_diag > 0, "the system matrix has no stiffness on the free vertices");
   mu_ = 1e-10 * mean_diag;
   for (Eigen::Index i = 0; i < nf; ++i) A.coeffRef(i, i) += mu_;
-  auto& ldlt = factor_->ldlt;
-  ldlt.compute(A);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0).all())
+  factor_ = std::make_unique<geometry::LdltFactor>(A);
+  if (!factor_->ok() || !(factor_->diagonal().array() > 0).all())
     throw Error(SOFTDECA_ERROR_INTERNAL, "the projective dynamics matrix could not be factorised (not positive definite)");
   factor_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -116,9 +101,9 @@ void System::iteration_rhs(const Positions& P, const Positions& frame, const Pos
 void System::solve(const Positions& B, Positions& X) const {
   // LDL^T with fill-reducing permutation P: A = P^-1 L D L^T P (Eigen's SimplicialLDLT layout:
   // L strictly lower, column-major, unit diagonal implied).
-  const auto& ldlt = factor_->ldlt;
-  Positions y = ldlt.permutationP() * B;
-  const auto& L = ldlt.matrixL().nestedExpression();
+  const geometry::LdltFactor& ldlt = *factor_;
+  Positions y = ldlt.permutation() * B;
+  const auto& L = ldlt.lower();
   const int* outer = L.outerIndexPtr();
   const int* inner = L.innerIndexPtr();
   const double* val = L.valuePtr();
@@ -127,14 +112,14 @@ void System::solve(const Positions& B, Positions& X) const {
     const Eigen::RowVector3d yj = y.row(j);
     for (int k = outer[j]; k < outer[j + 1]; ++k) y.row(inner[k]) -= val[k] * yj;
   }
-  const Eigen::VectorXd& D = ldlt.vectorD();
+  const Eigen::VectorXd& D = ldlt.diagonal();
   for (Eigen::Index j = 0; j < n; ++j) y.row(j) /= D[j];
   for (Eigen::Index j = n - 1; j >= 0; --j) {
     Eigen::RowVector3d yj = y.row(j);
     for (int k = outer[j]; k < outer[j + 1]; ++k) yj -= val[k] * y.row(inner[k]);
     y.row(j) = yj;
   }
-  X = ldlt.permutationPinv() * y;
+  X = ldlt.inverse_permutation() * y;
 }
 
 }  // namespace softdeca::sim

@@ -1,15 +1,15 @@
 // The global step of projective dynamics: the stacked constraints G (rows x vertices) with
 // weights W give the normal equations (G^T W G) x = G^T W P + f. Pinned bone vertices are
 // moved to the right-hand side, and the matrix over the free vertices is factorised once
-// (sparse Cholesky, LDL^T with a METIS nested-dissection ordering where the library was built
-// with METIS: about 30% less fill than AMD on layered heads) and reused for every iteration and every frame until weights or
-// topology change. The x, y and z columns share the matrix: one factorisation, three solves.
+// (the sparse LDL^T of geometry/ldlt_factor.h) and reused for every iteration and every frame
+// until weights or topology change. The x, y and z columns share the matrix: one factorisation, three solves.
 #pragma once
 
 #include <Eigen/SparseCore>
 #include <memory>
 #include <vector>
 
+#include "geometry/ldlt_factor.h"
 #include "sim/constraints.h"
 #include "sim/model.h"
 #include "sim/thread_pool.h"
@@ -54,8 +54,7 @@ class System {
   RowMajorSparse J_;      // G_free^T W over all rows (free x rows)
   RowMajorSparse J_var_;  // its first variable_rows_ columns
   RowMajorSparse G_pin_;  // G over the pinned columns (rows x pinned)
-  struct Factor;  // the sparse LDL^T (fill-reducing ordering: METIS when built with it, else AMD)
-  std::unique_ptr<Factor> factor_;
+  std::unique_ptr<geometry::LdltFactor> factor_;
   double mu_ = 0;
   double factor_seconds_ = 0;
 };

@@ -1,6 +1,6 @@
 """Material parameter specs as the model bundle carries them, and the localisation rules that
 turn a global value, a per-face map or a per-vertex map into the per-element inputs of the
-hypernetworks. The native runtime implements the same rules (plugin/src/runtime/parameters.*);
+hypernetworks. The native runtime implements the same rules (plugin/src/prepare/parameters.*);
 docs/bundle.md states them."""
 
 from __future__ import annotations

@@ -1,0 +1,208 @@
+#include "runtime/avatar.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "core/error.h"
+#include "runtime/avatar_detail.h"
+
+namespace softdeca::runtime {
+
+using namespace avatar_detail;
+
+// A hypernetwork's L(p, h) for n elements of the given width, checked and stored.
+HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
+                                 const std::vector<float>& identity, std::size_t n, std::size_t width) const {
+  std::vector<float> l(n * static_cast<std::size_t>(m_.latent) * width);
+  net.run({parameters.data(), identity.data()}, {l.data()}, 1);
+  if (!all_finite(l.data(), l.size()))
+    throw Error(SOFTDECA_ERROR_FORMAT, net.spec().key + " produced non-finite values for these parameters");
+  return HyperTensor(l.data(), n, m_.latent, static_cast<int>(width), precision_);
+}
+
+std::size_t Preparation::bytes() const {
+  return face_l.bytes() + vertex_l.bytes() + softdeca_vertex_l.bytes() + residual_modes.bytes() +
+         residual_condition.size() * 4 + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4 +
+         rest_offset.size() * 4;
+}
+
+void Avatar::prepare() {
+  std::lock_guard<std::mutex> prepare_lock(prepare_mutex_);
+  const auto t0 = Clock::now();
+  std::vector<float> identity;
+  std::unique_ptr<ParameterState> params;
+  {
+    std::lock_guard<std::mutex> lock(params_mutex_);
+    params = std::make_unique<ParameterState>(params_);
+    identity = identity_;
+  }
+  double factorisation_ms = 0;
+  if (!dt_ && model_->has(false)) {
+    const auto f0 = Clock::now();
+    dt_ = std::make_shared<const DeformationTransfer>(geometry_, vs_, model_->skin_triangles(), m_.dt_regularisation,
+                                                      worker_.parts());
+    factorisation_ms = ms(f0, Clock::now());
+  }
+  const auto n0 = Clock::now();
+  std::shared_ptr<Preparation> prep = prepare_networks(*params, identity);
+  const double networks_ms = ms(n0, Clock::now());
+  // The physics at prepare: nothing to correct at the defaults (c(p0) = 0).
+  double physics_ms = 0;
+  int physics_iterations = 0;
+  if (model_->rest_head() && model_->has(false) && !params->at_defaults()) {
+    const auto r0 = Clock::now();
+    prep->rest_offset = rest_offset(*params, *prep, identity, physics_iterations);
+    physics_ms = ms(r0, Clock::now());
+  }
+  {
+    std::lock_guard<std::mutex> lock(current_mutex_);
+    prep->generation = ++generation_;
+    current_ = std::move(prep);
+  }
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  stats_.preparations += 1;
+  stats_.prepare_ms = ms(t0, Clock::now());
+  stats_.prepare_networks_ms = networks_ms;
+  stats_.prepare_physics_ms = physics_ms;
+  stats_.physics_iterations = physics_iterations;
+  if (factorisation_ms > 0) stats_.factorisation_ms = factorisation_ms;
+}
+
+// SoftDECA's stages for these parameters: its per-face hyper-tensor, its vertex stage and the
+// residual stage's prepare half (what softdeca_rest reads).
+void Avatar::prepare_softdeca_stages(const ParameterState& params, const std::vector<float>& identity,
+                                     Preparation& prep) const {
+  const OnnxNetwork& hyper = *model_->hyper(false);
+  const auto& cols = hyper.spec().parameter_columns;
+  std::vector<float> p(nf_ * cols.size());
+  params.face_matrix(cols, p.data());
+  prep.face_l = hyper_tensor(hyper, p, identity, nf_, 9);
+  if (const OnnxNetwork* stage = model_->softdeca_vertex_stage()) {
+    std::vector<float> pv(vs_ * stage->spec().parameter_columns.size());
+    params.vertex_matrix(stage->spec().parameter_columns, pv.data());
+    prep.softdeca_vertex_l = hyper_tensor(*stage, pv, identity, vs_, 3);
+  }
+  prepare_residual(params, prep);
+}
+
+// The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
+std::shared_ptr<Preparation> Avatar::prepare_networks(const ParameterState& params,
+                                                      const std::vector<float>& identity) const {
+  auto prep = std::make_shared<Preparation>();
+  prep->dt = dt_;
+  prep->identity = identity;
+  for (const int model : {kSoftDeca, kSparse}) {
+    const bool sparse = model == kSparse;
+    if (!model_->has(sparse)) continue;
+    if (sparse) {  // the sparse model's hyper-tensor: per vertex
+      const OnnxNetwork& hyper = *model_->hyper(true);
+      std::vector<float> p(vs_ * hyper.spec().parameter_columns.size());
+      params.vertex_matrix(hyper.spec().parameter_columns, p.data());
+      prep->vertex_l = hyper_tensor(hyper, p, identity, vs_, 3);
+    } else {
+      prepare_softdeca_stages(params, identity, *prep);
+    }
+    // Dynamics coefficients per skin vertex.
+    const OnnxNetwork& dyn = *model_->dynamics(sparse);
+    const auto& dcols = dyn.spec().parameter_columns;
+    std::vector<float> pv(vs_ * dcols.size());
+    params.vertex_matrix(dcols, pv.data());
+    DynamicsCoefficients& c = prep->dynamics[model];
+    c.alpha.resize(vs_);
+    c.beta.resize(vs_);
+    c.gamma.resize(vs_);
+    dyn.run({pv.data(), identity.data()}, {c.alpha.data(), c.beta.data(), c.gamma.data()}, 1);
+    c.check(m_, dyn.spec().key.c_str());
+  }
+  return prep;
+}
+
+// SoftDECA's static frame at rest for other parameters than the preparation's: its stages
+// alone (no dynamics, no sparse model).
+std::vector<float> Avatar::softdeca_rest(const ParameterState& params, const std::vector<float>& identity) const {
+  Preparation stages;
+  stages.dt = dt_;
+  prepare_softdeca_stages(params, identity, stages);
+  return softdeca_rest(stages);
+}
+
+std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
+  const std::vector<float> weights(kBlendshapeCount, 0.0f);
+  std::vector<float> z(static_cast<std::size_t>(m_.latent)), out(vs_ * 3);
+  model_->encoder(false)->run({weights.data()}, {z.data()}, 1);
+  if (prep.face_l.zero()) {
+    std::copy(neutral_.begin(), neutral_.begin() + static_cast<std::ptrdiff_t>(vs_ * 3), out.begin());
+  } else {
+    std::vector<float> rhs(vs_ * 3, 0.0f);
+    dg_rhs(prep.face_l, prep.dt->faces(), z.data(), neutral_.data(), 0, prep.face_l.blocks(), rhs.data());
+    std::vector<double> work(prep.dt->work_size());
+    const float* parts[] = {rhs.data()};
+    prep.dt->solve(parts, 1, neutral_.data(), work.data(), out.data());
+  }
+  if (!prep.softdeca_vertex_l.empty())
+    vertex_offsets(prep.softdeca_vertex_l, z.data(), out.data(), 0, prep.softdeca_vertex_l.blocks(), out.data());
+  if (!prep.residual_modes.empty()) {
+    std::vector<float> c(static_cast<std::size_t>(m_.residual_modes));
+    model_->residual_coefficients()->run({weights.data(), prep.residual_condition.data()}, {c.data()}, 1);
+    vertex_offsets(prep.residual_modes, c.data(), out.data(), 0, prep.residual_modes.blocks(), out.data());
+  }
+  return out;
+}
+
+std::vector<float> Avatar::rest_offset(const ParameterState& params, const Preparation& prep,
+                                       const std::vector<float>& identity, int& iterations) {
+  if (!rest_physics_) {  // kept only once its defaults' solve succeeded
+    auto physics = std::make_unique<RestPhysics>(*model_->rest_head(), m_, neutral_.data(), model_->skin_triangles(),
+                                                 static_cast<int>(worker_.parts()));
+    rest_physics0_ = physics->solve(ParameterState(m_, model_->skin_triangles(), geometry_.face_area));
+    rest_physics_ = std::move(physics);
+  }
+  // Each distinct parameter set runs the networks once: p's own stages are the preparation's,
+  // the defaults' are kept per identity, and p's rest-inert part is p itself when every
+  // parameter p moves is rest-inert.
+  if (rest_model0_.empty() || rest_model0_identity_ != identity) {
+    rest_model0_ = softdeca_rest(ParameterState(m_, model_->skin_triangles(), geometry_.face_area), identity);
+    rest_model0_identity_ = identity;
+  }
+  const sim::Positions physics = rest_physics_->solve(params);
+  iterations = rest_physics_->iterations();
+  // The networks' own rest response to p, less their response to p's rest-inert parameters
+  // alone: the physics says nothing about those at rest, so that part stays the networks'.
+  const ParameterState inert_only = params.only(m_.rest_physics.inert_parameters);
+  const std::vector<float> model = softdeca_rest(prep);
+  std::optional<std::vector<float>> inert_rest;
+  const std::vector<float>& model_inert = inert_only.at_defaults() ? rest_model0_
+                                          : inert_only == params    ? model
+                                                                    : inert_rest.emplace(softdeca_rest(inert_only, identity));
+  std::vector<float> offset(vs_ * 3);
+  for (std::size_t v = 0; v < vs_; ++v)
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::size_t i = 3 * v + c;
+      const auto row = static_cast<Eigen::Index>(v), col = static_cast<Eigen::Index>(c);
+      offset[i] = static_cast<float>((physics(row, col) - rest_physics0_(row, col)) - (double(model[i]) - double(model_inert[i])));
+    }
+  if (!all_finite(offset.data(), offset.size()))
+    throw Error(SOFTDECA_ERROR_NON_FINITE, "the physics at prepare produced a non-finite skin for these parameters");
+  return offset;
+}
+
+// The residual stage's prepare half: its condition and modes for these parameters.
+void Avatar::prepare_residual(const ParameterState& params, Preparation& prep) const {
+  const OnnxNetwork* net = model_->residual_condition();
+  if (!net) return;
+  const auto& cols = net->spec().parameter_columns;
+  std::vector<float> pv(vs_ * cols.size());
+  params.vertex_matrix(cols, pv.data());
+  const std::size_t k = static_cast<std::size_t>(m_.residual_modes);
+  std::vector<float> condition(static_cast<std::size_t>(m_.residual_condition)), modes(vs_ * k * 3);
+  net->run({pv.data()}, {condition.data(), modes.data()}, 1);
+  if (!all_finite(condition.data(), condition.size()) || !all_finite(modes.data(), modes.size()))
+    throw Error(SOFTDECA_ERROR_FORMAT, net->spec().key + " produced non-finite values for these parameters");
+  prep.residual_condition = std::move(condition);
+  prep.residual_modes = HyperTensor(modes.data(), vs_, m_.residual_modes, 3, precision_);
+}
+
+}  // namespace softdeca::runtime
