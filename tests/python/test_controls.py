@@ -193,7 +193,9 @@ def _real_takes() -> dict:
         softdeca_mm=np.array([0.01, 0.1, 0.2, 0.05, 0.3, 0.5]),
         linear_mm=np.array([0.05, 0.2, 0.4, 0.08, 0.2, 0.6]),
     )
-    return summarise(takes, [True, False], d, every=10, identities=1)
+    return summarise(
+        takes, [True, False], d, every=10, identities=1, rest=(0.04, 0.0005)
+    )
 
 
 def test_real_takes_are_reported_per_take_with_unseen_and_mild_frames_apart() -> None:
@@ -265,6 +267,7 @@ def test_the_report_schema() -> None:
         lambda d: d["real_takes"]["takes"][0].update(frames=0),
         lambda d: d["real_takes"]["takes"][1].update(linear_mm=float("nan")),
         lambda d: d["real_takes"].update(unseen=None, seen=None),
+        lambda d: d["real_takes"]["rest"].update(softdeca_mm=-1.0),
     ):
         d = copy.deepcopy(_report())
         change(d)
@@ -391,6 +394,7 @@ def test_the_report_readme_section_is_replaced_not_repeated(tmp_path) -> None:
     )
     assert "| **unseen takes, pooled** |  | 3 | 0.283 | 0.293 | 0.97 |" in text
     assert "in-distribution takes, pooled" in text
+    assert "At rest (every weight 0) SoftDECA is 0.040 mm from the physics" in text
 
 
 def test_the_gallery_page_names_the_tolerance_and_the_identity_spread() -> None:

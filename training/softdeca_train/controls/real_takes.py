@@ -21,7 +21,8 @@ from softdeca_train.streaming.takes import TAKE_SUFFIXES, read_take, take_paths
 MILD_MM = 0.1  # a frame is mild when the linear blend is this close to the physics (mean, mm)
 GROUP_KEYS = ("frames", "softdeca_mm", "linear_mm", "ratio")
 TAKE_KEYS = ("take", "trained_on", *GROUP_KEYS, "mild", "strong")
-KEYS = ("every", "identities", "mild_mm", "takes", "unseen", "seen")
+KEYS = ("every", "identities", "mild_mm", "takes", "unseen", "seen", "rest")
+REST_KEYS = ("softdeca_mm", "linear_mm")
 
 
 @dataclass(frozen=True)
@@ -116,11 +117,17 @@ def _pooled(d: FrameDistances, takes: list[int], per_take: list[dict]) -> dict |
 
 
 def summarise(
-    takes: list[RecordedTake], seen: list[bool], d: FrameDistances, every: int, identities: int
+    takes: list[RecordedTake],
+    seen: list[bool],
+    d: FrameDistances,
+    every: int,
+    identities: int,
+    rest: tuple[float, float] | None = None,
 ) -> dict:
     """The `real_takes` section: per take, pooled over the unseen takes and over the seen ones
     (those a training frame came from); ratio: SoftDECA's distance to the physics over the
-    linear blend's, pooled over frames."""
+    linear blend's, pooled over frames. `rest`: the mean distances (SoftDECA, linear) of the
+    neutral face (every weight 0), where a calm take's frames lie."""
     per_take = []
     for i, take in enumerate(takes):
         rows = d.take == i
@@ -135,6 +142,7 @@ def summarise(
         "takes": per_take,
         "unseen": _pooled(d, [i for i in range(len(takes)) if not seen[i]], per_take),
         "seen": _pooled(d, [i for i in range(len(takes)) if seen[i]], per_take),
+        "rest": None if rest is None else dict(zip(REST_KEYS, rest, strict=True)),
     }
 
 
@@ -168,6 +176,13 @@ def validate_real_takes(real: object) -> None:
         raise ValueError("report: real_takes has neither unseen nor seen takes")
     for part in ("unseen", "seen"):
         _check_group(part, real[part], optional=True)
+    rest = real["rest"]
+    if rest is not None and not (
+        isinstance(rest, dict)
+        and set(rest) == set(REST_KEYS)
+        and all(isinstance(v, (int, float)) and math.isfinite(v) and v >= 0 for v in rest.values())
+    ):
+        raise ValueError(f"report: real_takes.rest needs the distances {REST_KEYS} in mm")
 
 
 def _cell(g: dict | None, key: str) -> str:
@@ -184,6 +199,15 @@ def readme_lines(real: dict) -> list[str]:
         "SoftDECA's share of the linear blend's (ratio; below 1 is closer to the physics). "
         f"Mild frames: the linear blend within {real['mild_mm']} mm of the physics.",
         "",
+        *(
+            [
+                f"At rest (every weight 0) SoftDECA is {real['rest']['softdeca_mm']:.3f} mm from "
+                f"the physics and the linear blend {real['rest']['linear_mm']:.3f} mm.",
+                "",
+            ]
+            if real["rest"]
+            else []
+        ),
         "| take | trained on | frames | SoftDECA | linear | ratio | mild ratio | strong ratio |",
         "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]

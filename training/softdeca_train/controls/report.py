@@ -15,7 +15,12 @@ from tqdm import tqdm
 
 from softdeca_train.controls.cases import IDENTITY_SEEDS, ModelCase, PhysicsCase
 from softdeca_train.controls.definitions import Setting
-from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
+from softdeca_train.controls.physics_cache import (
+    PhysicsCache,
+    default_folder,
+    open_cache,
+    solve_cached,
+)
 from softdeca_train.controls.real_takes import (
     FrameDistances,
     readme_lines,
@@ -72,45 +77,61 @@ class RealTakes:
     physics_cache: Path | None = field(default_factory=default_folder)
 
 
+class _Judge:
+    """The physics and a bundle on one identity's frames: their mean distances (mm) over S."""
+
+    def __init__(self, nets: OnnxNetworks, first: PhysicsCase, cache: PhysicsCache) -> None:
+        physics = load_parameters()
+        self.defaults = {s.name: s.default for s in physics.specs}
+        self.defaults.update({s.name: s.default for s in physics.controls().specs})
+        self.domains = {s.name: s.domain for s in physics.specs}
+        self.first, self.model, self.cache = first, ModelCase(nets, first), cache
+
+    def distances(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(SoftDECA, linear blend) per frame of `weights`."""
+        case = self.first.with_weights(weights)
+        self.model.use(case)
+        t = solve_cached(self.cache, case, Setting(), self.defaults, self.domains)
+        x = self.model.solve(Setting())
+        return (
+            1e3 * np.linalg.norm(x - t, axis=-1).mean(axis=1),
+            1e3 * np.linalg.norm(case.targets - t, axis=-1).mean(axis=1),
+        )
+
+
 def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
     """SoftDECA (the bundle, default parameters) and the linear blendshapes against the physics
     (default parameters) on every n-th frame of every take, per take (controls/real_takes.py);
-    the takes the bundle trained on apart from those it never saw."""
+    the takes the bundle trained on apart from those it never saw, and the neutral face."""
     if not 1 <= cfg.identities <= len(IDENTITY_SEEDS) or cfg.every < 1:
         raise ValueError(f"identities must be in 1..{len(IDENTITY_SEEDS)}, every >= 1")
     takes = recorded_takes(cfg.recordings, cfg.every)
     trained = trained_take_names(json.loads((Path(bundle) / "manifest.json").read_text()))
     template = Template.load()
     nets = OnnxNetworks(bundle)
-    physics = load_parameters()
-    defaults = {s.name: s.default for s in physics.specs}
-    defaults.update({s.name: s.default for s in physics.controls().specs})
-    domains = {s.name: s.domain for s in physics.specs}
     cache = open_cache(cfg.physics_cache)
     rows: dict[str, list] = {"take": [], "softdeca": [], "linear": []}
+    rest = []
     total = cfg.identities * sum(len(t.weights) for t in takes)
     with tqdm(total=total, desc="real takes", unit="frame", disable=not progress) as bar:
         for seed in IDENTITY_SEEDS[: cfg.identities]:
             head = template.sample_identity(seed)
             first = PhysicsCase(template, head, takes[0].weights[:1], cfg.level)
-            model = ModelCase(nets, first)
+            judge = _Judge(nets, first, cache)
+            rest.append(judge.distances(np.zeros((1, 52), np.float32)))
             for index, take in enumerate(takes):
                 for start in range(0, len(take.weights), cfg.chunk):
-                    case = first.with_weights(take.weights[start : start + cfg.chunk])
-                    model.use(case)
-                    t = solve_cached(cache, case, Setting(), defaults, domains)
-                    x = model.solve(Setting())
-                    rows["take"] += [index] * len(t)
-                    rows["softdeca"] += list(1e3 * np.linalg.norm(x - t, axis=-1).mean(axis=1))
-                    rows["linear"] += list(
-                        1e3 * np.linalg.norm(case.targets - t, axis=-1).mean(axis=1)
-                    )
-                    bar.update(len(t))
+                    softdeca, linear = judge.distances(take.weights[start : start + cfg.chunk])
+                    rows["take"] += [index] * len(softdeca)
+                    rows["softdeca"] += list(softdeca)
+                    rows["linear"] += list(linear)
+                    bar.update(len(softdeca))
     distances = FrameDistances(
         np.array(rows["take"]), np.array(rows["softdeca"]), np.array(rows["linear"])
     )
     seen = [trained_on(t, trained) for t in takes]
-    return summarise(takes, seen, distances, cfg.every, cfg.identities)
+    at_rest = (float(np.mean([r[0] for r in rest])), float(np.mean([r[1] for r in rest])))
+    return summarise(takes, seen, distances, cfg.every, cfg.identities, at_rest)
 
 
 def kept_real_takes(path: Path) -> dict | None:
