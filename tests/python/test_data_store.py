@@ -3,18 +3,18 @@
 from __future__ import annotations
 
 import json
-from dataclasses import asdict
 
 import numpy as np
 import pytest
 from softdeca_train.data.coverage import (
     BLINKS,
+    DEFAULT_SHARES,
     JAW_OPEN,
     KINDS,
     MOUTH_CLOSE,
     SIDES,
     CoverageSampler,
-    DrawShares,
+    cumulative_shares,
 )
 from softdeca_train.data.shards import (
     Manifest,
@@ -102,7 +102,7 @@ def test_coverage_draws_real_faces_kinds_in_their_shares() -> None:
     n = 6000
     kinds = sampler.kinds(np.random.default_rng(3), n)
     shares = np.bincount(kinds, minlength=len(KINDS)) / n
-    assert np.allclose(shares, list(asdict(DrawShares()).values()), atol=0.02)
+    assert np.allclose(shares, DEFAULT_SHARES, atol=0.02)
     w = sampler.sample(np.random.default_rng(4), n)
     blink = w[:, BLINKS]
     # blinks: both lids closing together, far more often than the calm person does
@@ -115,5 +115,5 @@ def test_coverage_draws_real_faces_kinds_in_their_shares() -> None:
     assert (w.max(axis=1) < 0.4).mean() > 0.1
     # strong frames: a stress combination's largest weights at 60 % or more
     assert (w.max(axis=1) >= 0.6).mean() > 0.15 + 0.1
-    with pytest.raises(ValueError, match="sum to 1"):
-        DrawShares(mild=0.9).cumulative()
+    with pytest.raises(ValueError, match="summing to 1"):
+        cumulative_shares((0.9, *DEFAULT_SHARES[1:]))

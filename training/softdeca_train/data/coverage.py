@@ -3,8 +3,8 @@
 Real takes are the best source of realistic co-activation but leave parts of the 52-D cube
 empty, and a model trained on one person's takes meets other people's faces. The sampler
 keeps the co-activation (a Gaussian over logit-weights fitted to the real frames, so
-correlated shapes move together) and draws, by kind (DrawShares), what real faces do beyond
-the recorded person:
+correlated shapes move together) and draws, by kind (KINDS, DEFAULT_SHARES), what real faces
+do beyond the recorded person:
 - `calm`: a draw of the fitted Gaussian scaled down to 0-40 %: a face near rest, as in calm
   speech; without it no frame near the neutral is trained on, and a model's response there
   is a guess that a calm take's every frame pays for;
@@ -23,7 +23,7 @@ Real takes keep it: of 15,333 recorded frames 3 exceed it, by at most 0.058."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -47,26 +47,16 @@ BLINKS = np.array([ARKIT_BLENDSHAPES.index(f"eyeBlink{side}") for side in ("Left
 STRONG = np.stack(list(combinations().values()))
 
 
-@dataclass(frozen=True)
-class DrawShares:
-    """Shares of the draw kinds (module docstring); they sum to 1."""
-
-    calm: float = 0.15
-    mild: float = 0.2
-    wide: float = 0.1
-    blink: float = 0.1
-    asymmetric: float = 0.1
-    strong: float = 0.15
-    sweep: float = 0.2
-
-    def cumulative(self) -> np.ndarray:
-        shares = np.array(list(asdict(self).values()))
-        if np.any(shares < 0) or not np.isclose(shares.sum(), 1.0):
-            raise ValueError(f"draw shares must be >= 0 and sum to 1: {asdict(self)}")
-        return np.cumsum(shares)
+KINDS = ("calm", "mild", "wide", "blink", "asymmetric", "strong", "sweep")
+DEFAULT_SHARES = (0.15, 0.2, 0.1, 0.1, 0.1, 0.15, 0.2)  # of the draws, per kind of KINDS
 
 
-KINDS = tuple(asdict(DrawShares()))
+def cumulative_shares(shares: tuple[float, ...]) -> np.ndarray:
+    """The shares of the draw kinds (KINDS order), checked, summed up."""
+    s = np.asarray(shares, dtype=np.float64)
+    if s.shape != (len(KINDS),) or np.any(s < 0) or not np.isclose(s.sum(), 1.0):
+        raise ValueError(f"draw shares: one per kind {KINDS}, each >= 0, summing to 1: {shares}")
+    return np.cumsum(s)
 
 
 @dataclass(frozen=True)
@@ -74,15 +64,15 @@ class CoverageSampler:
     mean: np.ndarray  # (52,) logit space
     chol: np.ndarray  # (52, 52) Cholesky factor of the (regularised) covariance
     spread: float = 1.25  # the `wide` kind: cover beyond the recorded person
-    shares: DrawShares = DrawShares()
+    shares: tuple[float, ...] = DEFAULT_SHARES
 
     @classmethod
     def fit(
-        cls, frames: np.ndarray, spread: float = 1.25, shares: DrawShares | None = None
+        cls, frames: np.ndarray, spread: float = 1.25, shares: tuple[float, ...] = DEFAULT_SHARES
     ) -> CoverageSampler:
         x = _logit(np.asarray(frames, dtype=np.float64))
         cov = np.cov(x, rowvar=False) + 1e-3 * np.eye(x.shape[1])
-        return cls(x.mean(axis=0), np.linalg.cholesky(cov), spread, shares or DrawShares())
+        return cls(x.mean(axis=0), np.linalg.cholesky(cov), spread, shares)
 
     def _gaussian(self, rng: np.random.Generator, n: int, spread: np.ndarray) -> np.ndarray:
         z = rng.standard_normal((n, len(self.mean)))
@@ -90,7 +80,7 @@ class CoverageSampler:
 
     def kinds(self, rng: np.random.Generator, n: int) -> np.ndarray:
         """(n,) indices into KINDS: which kind each of n draws is."""
-        return np.searchsorted(self.shares.cumulative(), rng.random(n), side="right").clip(
+        return np.searchsorted(cumulative_shares(self.shares), rng.random(n), side="right").clip(
             0, len(KINDS) - 1
         )
 

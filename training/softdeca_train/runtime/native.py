@@ -81,15 +81,21 @@ class ParameterInfo(C.Structure):
     ]
 
 
+# softdeca_avatar_desc and softdeca_avatar_mesh begin alike: a mesh and its blendshapes.
+_MESH_FIELDS = [
+    ("struct_size", C.c_uint32),
+    ("neutral", C.POINTER(C.c_float)),
+    ("vertex_count", C.c_uint32),
+    ("triangles", C.POINTER(C.c_int32)),
+    ("triangle_count", C.c_uint32),
+    ("blendshapes", C.POINTER(C.c_float)),
+    ("blendshape_count", C.c_uint32),
+]
+
+
 class AvatarDesc(C.Structure):
     _fields_ = [
-        ("struct_size", C.c_uint32),
-        ("neutral", C.POINTER(C.c_float)),
-        ("vertex_count", C.c_uint32),
-        ("triangles", C.POINTER(C.c_int32)),
-        ("triangle_count", C.c_uint32),
-        ("blendshapes", C.POINTER(C.c_float)),
-        ("blendshape_count", C.c_uint32),
+        *_MESH_FIELDS,
         ("threads", C.c_uint32),
         ("precision", C.c_int32),
     ]
@@ -97,13 +103,7 @@ class AvatarDesc(C.Structure):
 
 class AvatarMesh(C.Structure):
     _fields_ = [
-        ("struct_size", C.c_uint32),
-        ("neutral", C.POINTER(C.c_float)),
-        ("vertex_count", C.c_uint32),
-        ("triangles", C.POINTER(C.c_int32)),
-        ("triangle_count", C.c_uint32),
-        ("blendshapes", C.POINTER(C.c_float)),
-        ("blendshape_count", C.c_uint32),
+        *_MESH_FIELDS,
         ("landmarks", C.POINTER(C.c_float)),
         ("landmark_count", C.c_uint32),
     ]
