@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# What the Linux arm64 (aarch64) cross-build needs on Debian x86-64, installed idempotently
+# (called by `make arm64`; plain `make setup` does not install it):
+#   1. Debian packages: the aarch64 cross compilers, whose own sysroot /usr/aarch64-linux-gnu
+#      holds the target's libc and libstdc++, and qemu-user (qemu-aarch64 runs the tests with
+#      -L /usr/aarch64-linux-gnu, set by cmake/toolchains/aarch64-linux-gnu.cmake).
+#   2. An ONNX Runtime root for arm64 in .deps/onnxruntime-arm64: libonnxruntime.so from the
+#      manylinux aarch64 PyPI wheel of the version the x86-64 build uses
+#      (.deps/onnxruntime/VERSION), and the headers of .deps/onnxruntime/include.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../../.." && pwd)
+cd "$root"
+say() { printf '\033[1m[arm64]\033[0m %s\n' "$*"; }
+
+pkgs=(g++-aarch64-linux-gnu gcc-aarch64-linux-gnu qemu-user)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  say "installing Debian packages: ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+linux_ort=.deps/onnxruntime
+[ -f "$linux_ort/VERSION" ] || { echo "arm64: no $linux_ort/VERSION; run \`make setup\` first" >&2; exit 1; }
+ver=$(cat "$linux_ort/VERSION")
+ort=.deps/onnxruntime-arm64
+if [ ! -f "$ort/.stamp-$ver" ]; then
+  say "assembling the ONNX Runtime $ver root for arm64 in $ort"
+  tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+  # Recent releases are tagged manylinux_2_28 (glibc 2.28; the cross sysroot has 2.36).
+  .venv/bin/python -m pip download -q --no-deps --only-binary=:all: --platform manylinux_2_28_aarch64 \
+    --platform manylinux_2_27_aarch64 --platform manylinux2014_aarch64 --python-version 3.11 "onnxruntime==$ver" -d "$tmp"
+  whl=$(ls "$tmp"/onnxruntime-"$ver"-*aarch64.whl | head -n1)
+  unzip -q -j "$whl" 'onnxruntime/capi/libonnxruntime.so.*' -d "$tmp/lib"
+  lib=$(ls "$tmp"/lib/libonnxruntime.so.* | head -n1)
+  # The headers are the x86-64 root's: the same version's C API serves every architecture.
+  [ "${lib##*.so.}" = "$ver" ] || { echo "arm64: the wheel holds $(basename "$lib"), not ONNX Runtime $ver" >&2; exit 1; }
+  rm -rf "$ort"; mkdir -p "$ort/include" "$ort/lib"
+  cp "$linux_ort"/include/*.h "$ort/include/"
+  cp "$lib" "$ort/lib/"
+  ln -sf "$(basename "$lib")" "$ort/lib/libonnxruntime.so"
+  soname=$(aarch64-linux-gnu-objdump -p "$lib" | awk '/SONAME/{print $2}')
+  [ -z "$soname" ] || [ -e "$ort/lib/$soname" ] || ln -sf "$(basename "$lib")" "$ort/lib/$soname"
+  echo "$ver" > "$ort/VERSION"
+  touch "$ort/.stamp-$ver"
+fi
+say "ready: $(aarch64-linux-gnu-g++ --version | head -n1), $(qemu-aarch64 --version | head -n1), ONNX Runtime $ver ($ort)"
