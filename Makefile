@@ -316,7 +316,7 @@ arm64: setup ## Linux arm64 cross-build (aarch64-linux-gnu) in build/arm64; inst
 	@plugin/platforms/linux-arm64/setup-cross.sh
 	@mkdir -p build; cmake -S . -B $(ARM64) -G Ninja $(LAUNCHER) -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/aarch64-linux-gnu.cmake \
 	  -DCMAKE_BUILD_TYPE=Release -DONNXRUNTIME_ROOT=$(ARM64_ORT) -DSOFTDECA_BUILD_PYTHON=OFF \
-	  -DSOFTDECA_PYTHON=$(CURDIR)/$(PY) > $(ARM64).configure.log 2>&1 || { cat $(ARM64).configure.log; exit 1; }
+	  -DSOFTDECA_PYTHON=$(CURDIR)/$(PY) -DSOFTDECA_QEMU_PREFIX=$(CURDIR)/.deps/arm64-qemu-prefix > $(ARM64).configure.log 2>&1 || { cat $(ARM64).configure.log; exit 1; }
 	@cmake --build $(ARM64) -j $(JOBS) --target softdeca $(ARM64_TESTS)
 
 arm64-check-inputs: build ## the avatar and take of the arm64 replay check -> build/platform-check
@@ -325,7 +325,7 @@ arm64-check-inputs: build ## the avatar and take of the arm64 replay check -> bu
 	@[ -f $(CHECK)/take.sdrec ] || $(BUILD)/plugin/cli/softdeca convert $(CHECK_TAKE) $(CHECK)/take.sdrec > /dev/null
 
 test-arm64: arm64 arm64-check-inputs ## the arm64 build's suites and a replay against x86-64 under qemu (minutes)
-	@echo "== Linux arm64 tests under $$(qemu-aarch64 --version | head -n1)"
+	@echo "== Linux arm64 tests under $$(qemu-aarch64 --version | head -n1), -cpu cortex-a76"
 	@ctest --test-dir $(ARM64) --output-on-failure -j $(JOBS) -R '$(ARM64_CTEST)'
 	@tests/platforms/arm64-check.sh $(BUILD) $(ARM64) $(CHECK)/avatar $(CHECK)/take.sdrec $(CHECK_START) $(ARM64_FRAMES)
 

@@ -1,6 +1,9 @@
 # Cross-compiling Linux arm64 (aarch64) binaries on Debian x86-64 (g++-aarch64-linux-gnu; make
 # arm64 installs it). The compilers' own sysroot /usr/aarch64-linux-gnu holds the target's libc
-# and libstdc++; ctest runs the test executables under qemu-user with it as the library prefix.
+# and libstdc++; ctest runs the test executables under qemu-user, emulating a Cortex-A76 (the core
+# of many arm64 phones), with SOFTDECA_QEMU_PREFIX as its library prefix (make arm64 passes the
+# one plugin/platforms/linux-arm64/setup-cross.sh makes: the sysroot's libraries and a
+# /proc/cpuinfo for ONNX Runtime).
 set(CMAKE_SYSTEM_NAME Linux)
 set(CMAKE_SYSTEM_PROCESSOR aarch64)
 
@@ -17,9 +20,10 @@ set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 
+set(SOFTDECA_QEMU_PREFIX ${SOFTDECA_CROSS_SYSROOT} CACHE PATH "qemu-aarch64's library prefix (-L)")
 find_program(SOFTDECA_QEMU qemu-aarch64)
 if(SOFTDECA_QEMU)
-  set(CMAKE_CROSSCOMPILING_EMULATOR ${SOFTDECA_QEMU} -L ${SOFTDECA_CROSS_SYSROOT})
+  set(CMAKE_CROSSCOMPILING_EMULATOR ${SOFTDECA_QEMU} -cpu cortex-a76 -L ${SOFTDECA_QEMU_PREFIX})
 endif()
 
 # Eigen is header-only: the host's package serves (the sysroot has none).

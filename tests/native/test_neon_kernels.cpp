@@ -127,10 +127,11 @@ TEST(NeonKernels, SubstitutionMatchesThePlainLoops) {
   // scatter: for each column j, y[i] -= L[i, j] y[j] over its rows.
   want = y0;
   std::vector<double> got = y0;
-  for (std::size_t j = 0; j < n; ++j)
+  for (std::size_t j = 0; j < n; ++j) {
+    const double yj[3] = {want[4 * j], want[4 * j + 1], want[4 * j + 2]};  // read once, as the solve does
     for (std::int32_t p = ptr[j]; p < ptr[j + 1]; ++p)
-      for (int c = 0; c < 3; ++c)
-        want[4 * std::size_t(idx32[std::size_t(p)]) + c] -= double(values[std::size_t(p)]) * want[4 * j + c];
+      for (int c = 0; c < 3; ++c) want[4 * std::size_t(idx32[std::size_t(p)]) + c] -= double(values[std::size_t(p)]) * yj[c];
+  }
   neon::scatter(rows.data(), n, ptr.data(), idx32.data(), values.data(), got.data());
   for (std::size_t i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[4 * i + c], want[4 * i + c], 1e-9 * (1 + std::fabs(want[4 * i + c])));

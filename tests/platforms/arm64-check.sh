@@ -9,7 +9,7 @@ set -euo pipefail
 x86=$1 arm=$2 avatar=$3 take=$4 first=$5 frames=$6
 out="$arm/replay-check"
 mkdir -p "$out"
-qemu=(qemu-aarch64 -L /usr/aarch64-linux-gnu)
+qemu=(qemu-aarch64 -cpu cortex-a76 -L .deps/arm64-qemu-prefix)  # plugin/platforms/linux-arm64/setup-cross.sh
 suites='^(HyperTensor|SparseLdlt|DeformationTransfer|CpuFeatures|NeonKernels)\.'
 echo "== kernel family portable on arm64 (SOFTDECA_CPU=portable)"
 SOFTDECA_CPU=portable ctest --test-dir "$arm" --output-on-failure -R "$suites" | tail -n 3

@@ -2,8 +2,8 @@
 # What the Linux arm64 (aarch64) cross-build needs on Debian x86-64, installed idempotently
 # (called by `make arm64`; plain `make setup` does not install it):
 #   1. Debian packages: the aarch64 cross compilers, whose own sysroot /usr/aarch64-linux-gnu
-#      holds the target's libc and libstdc++, and qemu-user (qemu-aarch64 runs the tests with
-#      -L /usr/aarch64-linux-gnu, set by cmake/toolchains/aarch64-linux-gnu.cmake).
+#      holds the target's libc and libstdc++, and qemu-user (qemu-aarch64 runs the tests, as set
+#      by cmake/toolchains/aarch64-linux-gnu.cmake).
 #   2. An ONNX Runtime root for arm64 in .deps/onnxruntime-arm64: libonnxruntime.so from the
 #      manylinux aarch64 PyPI wheel of the version the x86-64 build uses
 #      (.deps/onnxruntime/VERSION), and the headers of .deps/onnxruntime/include.
@@ -48,4 +48,15 @@ if [ ! -f "$ort/.stamp-$ver" ]; then
   echo "$ver" > "$ort/VERSION"
   touch "$ort/.stamp-$ver"
 fi
-say "ready: $(aarch64-linux-gnu-g++ --version | head -n1), $(qemu-aarch64 --version | head -n1), ONNX Runtime $ver ($ort)"
+# 3. qemu's library prefix (-L) in .deps/arm64-qemu-prefix: the sysroot's lib/, and a
+#    /proc/cpuinfo of the CPU qemu emulates (-cpu cortex-a76). Debian 12's qemu-user (7.2) passes the
+#    host's x86 /proc/cpuinfo through, and ONNX Runtime's CPU detection crashes on it (a null
+#    pointer at its first session); qemu serves a guest's absolute paths from the prefix first.
+prefix=.deps/arm64-qemu-prefix
+mkdir -p "$prefix/proc"
+ln -sfn /usr/aarch64-linux-gnu/lib "$prefix/lib"
+for ((cpu = 0; cpu < $(getconf _NPROCESSORS_CONF); cpu++)); do
+  printf 'processor\t: %d\nBogoMIPS\t: 50.00\nFeatures\t: %s\nCPU implementer\t: 0x41\nCPU architecture: 8\nCPU variant\t: 0x4\nCPU part\t: 0xd0b\nCPU revision\t: 1\n\n' \
+    "$cpu" "fp asimd evtstrm aes pmull sha1 sha2 crc32 atomics fphp asimdhp cpuid asimdrdm lrcpc dcpop asimddp"
+done > "$prefix/proc/cpuinfo"
+say "ready: $(aarch64-linux-gnu-g++ --version | head -n1), $(qemu-aarch64 --version | head -n1), ONNX Runtime $ver ($ort), qemu prefix $prefix"
