@@ -122,24 +122,48 @@ bool parse(int argc, char** argv, Options& o) {
   return true;
 }
 
-// The avatar folder as the C ABI's avatar, prepared at the given precision.
-softdeca_avatar* make_avatar(softdeca_model* model, const Obj& neutral, const std::string& avatar_dir, int32_t precision) {
-  const std::size_t n = neutral.vertices.size();
-  std::vector<float> deltas(SOFTDECA_BLENDSHAPE_COUNT * n, 0.0f);
+// A neutral and its 52 ARKit blendshape deltas (as `softdeca replay` reads an avatar or user rig).
+struct Rig {
+  Obj neutral;
+  std::vector<float> deltas;  // [52][3 n]
+  bool empty() const { return neutral.vertices.empty(); }
+  // out = neutral + sum_s w_s delta_s, in the CLI's order (FaceRig::blend).
+  void blend(const float* w, float* out) const {
+    const std::size_t n = neutral.vertices.size();
+    std::copy(neutral.vertices.begin(), neutral.vertices.end(), out);
+    for (std::size_t s = 0; s < SOFTDECA_BLENDSHAPE_COUNT; ++s) {
+      if (w[s] == 0.0f) continue;
+      const float* d = deltas.data() + s * n;
+      for (std::size_t i = 0; i < n; ++i) out[i] += w[s] * d[i];
+    }
+  }
+};
+
+Rig read_rig(const std::string& dir, bool optional) {
+  Rig rig;
+  if (optional && !std::ifstream(dir + "/neutral.obj")) return rig;
+  rig.neutral = read_obj(dir + "/neutral.obj");
+  const std::size_t n = rig.neutral.vertices.size();
+  rig.deltas.assign(SOFTDECA_BLENDSHAPE_COUNT * n, 0.0f);
   for (uint32_t b = 0; b < SOFTDECA_BLENDSHAPE_COUNT; ++b) {
-    const std::string path = avatar_dir + "/blendshapes/" + softdeca_blendshape_name(b) + ".obj";
+    const std::string path = dir + "/blendshapes/" + softdeca_blendshape_name(b) + ".obj";
     if (!std::ifstream(path)) continue;  // a shape the avatar lacks: no motion (as softdeca replay)
     const Obj shape = read_obj(path);
     if (shape.vertices.size() != n) throw std::runtime_error(path + ": vertex count differs from the neutral");
-    for (std::size_t i = 0; i < n; ++i) deltas[b * n + i] = shape.vertices[i] - neutral.vertices[i];
+    for (std::size_t i = 0; i < n; ++i) rig.deltas[b * n + i] = shape.vertices[i] - rig.neutral.vertices[i];
   }
+  return rig;
+}
+
+// The avatar's rig as the C ABI's avatar, prepared at the given precision.
+softdeca_avatar* make_avatar(softdeca_model* model, const Rig& rig, int32_t precision) {
   softdeca_avatar_desc desc{};
   desc.struct_size = sizeof desc;
-  desc.neutral = neutral.vertices.data();
-  desc.vertex_count = static_cast<uint32_t>(n / 3);
-  desc.triangles = neutral.triangles.data();
-  desc.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
-  desc.blendshapes = deltas.data();
+  desc.neutral = rig.neutral.vertices.data();
+  desc.vertex_count = static_cast<uint32_t>(rig.neutral.vertices.size() / 3);
+  desc.triangles = rig.neutral.triangles.data();
+  desc.triangle_count = static_cast<uint32_t>(rig.neutral.triangles.size() / 3);
+  desc.blendshapes = rig.deltas.data();
   desc.blendshape_count = SOFTDECA_BLENDSHAPE_COUNT;
   desc.precision = precision;
   softdeca_avatar* avatar = nullptr;
@@ -148,20 +172,39 @@ softdeca_avatar* make_avatar(softdeca_model* model, const Obj& neutral, const st
   return avatar;
 }
 
-// One frame of weights through SoftDECA, or through SparseSoftDECA from the landmarks of the
-// avatar's linear blend (as `softdeca replay --models sparse` drives a template avatar).
-void evaluate(softdeca_model* model, softdeca_avatar* avatar, const softdeca_model_info& info, bool sparse,
-              const float* weights, softdeca_output& output, std::vector<float>& linear, std::vector<float>& landmarks) {
-  if (!sparse) {
-    check(softdeca_avatar_evaluate_weights(avatar, weights, SOFTDECA_BLENDSHAPE_COUNT, &output), "frame");
-    return;
+// What SparseSoftDECA reads per frame, as `softdeca replay --models sparse` drives a template
+// avatar: the user rig of AVATAR_DIR/user_face blended with the take (calibrated with its
+// neutral), or without one the bundle's landmarks on the avatar's own linear blend.
+struct Tracking {
+  softdeca_model* model;
+  softdeca_avatar* avatar;
+  const softdeca_model_info& info;
+  Rig user;
+  std::vector<float> linear, points;
+
+  Tracking(softdeca_model* m, softdeca_avatar* a, const softdeca_model_info& i, const std::string& avatar_dir)
+      : model(m), avatar(a), info(i), user(read_rig(avatar_dir + "/user_face", true)) {
+    linear.resize(3 * std::size_t{info.head_vertex_count});
+    points.resize(user.empty() ? 3 * std::size_t{info.landmark_count} : user.neutral.vertices.size());
+    if (!user.empty())
+      check(softdeca_avatar_calibrate_landmarks(avatar, user.neutral.vertices.data(),
+                                                static_cast<uint32_t>(user.neutral.vertices.size() / 3)),
+            "calibration");
   }
-  softdeca_output linear_out{sizeof(softdeca_output), linear.data(), info.head_vertex_count, nullptr, 0};
-  check(softdeca_avatar_evaluate_linear(avatar, weights, SOFTDECA_BLENDSHAPE_COUNT, &linear_out), "linear blend");
-  check(softdeca_model_evaluate_landmarks(model, linear.data(), info.head_vertex_count, landmarks.data(), info.landmark_count),
-        "landmarks");
-  check(softdeca_avatar_evaluate_landmarks(avatar, landmarks.data(), info.landmark_count, &output), "frame");
-}
+
+  void evaluate(const float* weights, softdeca_output& output) {
+    if (!user.empty()) {
+      user.blend(weights, points.data());
+    } else {
+      softdeca_output linear_out{sizeof(softdeca_output), linear.data(), info.head_vertex_count, nullptr, 0};
+      check(softdeca_avatar_evaluate_linear(avatar, weights, SOFTDECA_BLENDSHAPE_COUNT, &linear_out), "linear blend");
+      check(softdeca_model_evaluate_landmarks(model, linear.data(), info.head_vertex_count, points.data(), info.landmark_count),
+            "landmarks");
+    }
+    check(softdeca_avatar_evaluate_landmarks(avatar, points.data(), static_cast<uint32_t>(points.size() / 3), &output),
+          "frame");
+  }
+};
 
 int run(int argc, char** argv) {
   Options o;
@@ -175,8 +218,9 @@ int run(int argc, char** argv) {
   check(softdeca_model_get_info(model, &info), "model info");
   if (o.sparse ? !info.has_sparse : !info.has_softdeca) throw std::runtime_error(o.bundle + " has no " + o.model_name + " model");
 
-  const Obj neutral = read_obj(o.avatar_dir + "/neutral.obj");
-  softdeca_avatar* avatar = make_avatar(model, neutral, o.avatar_dir, o.precision);
+  const Rig rig = read_rig(o.avatar_dir, false);
+  const Obj& neutral = rig.neutral;
+  softdeca_avatar* avatar = make_avatar(model, rig, o.precision);
   check(softdeca_avatar_set_dynamics(avatar, o.dynamic ? SOFTDECA_TRUE : SOFTDECA_FALSE), "dynamics");
   softdeca_player* player = nullptr;
   check(softdeca_player_open(o.take.c_str(), &player), "opening " + o.take);
@@ -185,15 +229,16 @@ int run(int argc, char** argv) {
     throw std::runtime_error(o.expected_path + " has " + std::to_string(expected.points) + " points, the bundle's head " +
                              std::to_string(info.head_vertex_count));
 
-  std::vector<float> vertices(std::size_t{info.head_vertex_count} * 3), linear(vertices.size()),
-      landmarks(3 * std::size_t{info.landmark_count});
+  std::vector<float> vertices(std::size_t{info.head_vertex_count} * 3);
+  Tracking tracking(model, avatar, info, o.avatar_dir);
   softdeca_output output{sizeof(softdeca_output), vertices.data(), info.head_vertex_count, nullptr, 0};
   softdeca_frame frame{};
   double worst = 0, motion = 0;
   for (uint32_t f = 0; f < expected.frames; ++f) {
     frame.struct_size = sizeof frame;
     check(softdeca_player_frame(player, o.first + f, &frame), "take frame " + std::to_string(o.first + f));
-    evaluate(model, avatar, info, o.sparse, frame.weights, output, linear, landmarks);
+    if (o.sparse) tracking.evaluate(frame.weights, output);
+    else check(softdeca_avatar_evaluate_weights(avatar, frame.weights, SOFTDECA_BLENDSHAPE_COUNT, &output), "frame");
     const float* want = expected.xyz.data() + std::size_t{f} * expected.points * 3;
     for (std::size_t v = 0; v < expected.points; ++v) {
       double d2 = 0, m2 = 0;
