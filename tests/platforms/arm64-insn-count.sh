@@ -4,7 +4,8 @@
 # docs/platforms.md). qemu-user runs replay_check with a plugin that counts the guest
 # instructions executed (tests/platforms/qemu_insn_count.c); a run of FEW frames is subtracted
 # from one of MANY, which leaves the frames alone (loading, preparing and exiting cancel), divided
-# by the frame difference. One thread, static, half storage unless PRECISION says otherwise.
+# by the frame difference. One thread, static; half storage and both models unless PRECISION or
+# MODELS say otherwise.
 # These are counts of instructions, not times: qemu's speed says nothing of a device's.
 #   usage: tests/platforms/arm64-insn-count.sh X86_BUILD ARM64_BUILD AVATAR_DIR TAKE.sdrec FIRST
 set -euo pipefail
@@ -44,7 +45,7 @@ count() {  # count FAMILY MODEL FRAMES: the instructions of one replay_check run
   awk '/^instructions/ {print $2}' "$out/$1-$2-$3.txt"
 }
 echo "per-frame instructions (arm64, $precision storage, one thread; frames $((first + few))-$((first + many - 1)) of the take)"
-for model in softdeca sparse; do
+for model in ${MODELS:-softdeca sparse}; do
   for family in neon portable; do
     a=$(count "$family" "$model" "$few") b=$(count "$family" "$model" "$many")
     awk -v m="$model" -v f="$family" -v a="$a" -v b="$b" -v n=$((many - few)) 'BEGIN { printf "%-9s %-9s %12.0f\n", m, f, (b - a) / n }'
