@@ -31,7 +31,9 @@ def test_scripts_name_files_that_exist(script: Path) -> None:
     named = set(REPO_PATH.findall(text))
     missing = sorted(p for p in named if not (REPO / p).exists())
     assert not missing, f"{script.relative_to(REPO)} names {missing}"
-    assert 'source "$(dirname "$0")/../common.sh"' in text or "setup-cross" in script.name
+    assert (
+        'source "$(dirname "$0")/../common.sh"' in text or "setup-cross" in script.name
+    )
 
 
 def test_the_scripts_build_targets_of_the_cmake_tree() -> None:
@@ -46,16 +48,23 @@ def test_the_scripts_build_targets_of_the_cmake_tree() -> None:
 
 def test_every_platform_compiles_the_neon_sources() -> None:
     cmake = (REPO / "plugin" / "CMakeLists.txt").read_text()
-    assert 'GLOB_RECURSE SOFTDECA_SOURCES CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp"' in cmake
+    assert (
+        'GLOB_RECURSE SOFTDECA_SOURCES CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp"'
+        in cmake
+    )
     # The only filters are the platform files' suffixes: no NEON source is left out anywhere.
-    filters = re.findall(r"list\(FILTER SOFTDECA_SOURCES EXCLUDE REGEX \"([^\"]+)\"\)", cmake)
+    filters = re.findall(
+        r"list\(FILTER SOFTDECA_SOURCES EXCLUDE REGEX \"([^\"]+)\"\)", cmake
+    )
     assert filters == ["_posix\\\\.cpp$", "_windows\\\\.cpp$"], filters
     sources = sorted((REPO / "plugin" / "src").rglob("*_neon.cpp"))
     assert sources, "no NEON sources"
     for source in sources:
         header = source.with_suffix(".h")
         assert header.exists(), f"{source.name} has no header"
-        assert NEON_GUARD in header.read_text(), f"{header.name}: not enabled by the arm64 macros"
+        assert NEON_GUARD in header.read_text(), (
+            f"{header.name}: not enabled by the arm64 macros"
+        )
         assert "#ifdef SOFTDECA_NEON" in source.read_text()
     ldlt = REPO / "plugin" / "src" / "runtime" / "sparse_ldlt_neon.h"
     assert NEON_GUARD in ldlt.read_text()
@@ -65,6 +74,10 @@ def test_x86_intrinsics_are_included_only_on_x86() -> None:
     for source in (REPO / "plugin" / "src").rglob("*.[ch]*"):
         lines = source.read_text().splitlines()
         for i, line in enumerate(lines):
-            if re.match(r"#include <(immintrin|xmmintrin|emmintrin|x86intrin)\.h>", line):
+            if re.match(
+                r"#include <(immintrin|xmmintrin|emmintrin|x86intrin)\.h>", line
+            ):
                 guard = "\n".join(lines[max(0, i - 3) : i])
-                assert "__x86_64__" in guard, f"{source.relative_to(REPO)}:{i + 1} unguarded"
+                assert "__x86_64__" in guard, (
+                    f"{source.relative_to(REPO)}:{i + 1} unguarded"
+                )
