@@ -298,6 +298,44 @@ test-windows: windows build ## the Windows build's C ABI, streaming and replay t
 	@wine $(WINDOWS)/bin/replay_check.exe models/softdeca-default $(CHECK)/avatar $(CHECK)/take.sdrec \
 	  $(CHECK_START) $(CHECK)/linux/softdeca.pc2 $(CHECK_TOL)
 
+# Linux arm64 (aarch64) is cross-built here with Debian's aarch64 compilers in build/arm64 and
+# tested under qemu-user (plugin/platforms/linux-arm64/setup-cross.sh installs both and ONNX
+# Runtime's aarch64 library on first use). `make test-arm64` runs the C ABI, runtime, bundle,
+# streaming and recording suites and the kernel suites (NEON, then portable) under emulation, and
+# replays real frames through the committed bundle by the arm64 library against the x86-64 CLI
+# (tests/platforms/arm64-check.sh); `.ci/run` runs test-arm64-quick, its reduced form.
+ARM64          := build/arm64
+ARM64_ORT      := $(CURDIR)/.deps/onnxruntime-arm64
+ARM64_TESTS    := test_c_abi test_stream test_bundle_folder test_runtime test_runtime_math test_cpu_features test_neon_kernels \
+                  abi_header_check_c abi_header_check_cpp replay_check
+ARM64_CTEST    := ^(BundleFolder|OnnxConstantSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines|Runtime|Threads|Worker|HyperTensor|SparseLdlt|DeformationTransfer|CpuFeatures|NeonKernels|Half|Blendshapes|BundleFiles|Dynamics|Json|Normals|Rigid)\.|^abi_header_check_|^shared_library_exports
+ARM64_FRAMES   ?= 8
+.PHONY: arm64 test-arm64 test-arm64-quick arm64-check-inputs count-arm64
+
+arm64: setup ## Linux arm64 cross-build (aarch64-linux-gnu) in build/arm64; installs the cross tools and qemu on first use
+	@plugin/platforms/linux-arm64/setup-cross.sh
+	@mkdir -p build; cmake -S . -B $(ARM64) -G Ninja $(LAUNCHER) -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/aarch64-linux-gnu.cmake \
+	  -DCMAKE_BUILD_TYPE=Release -DONNXRUNTIME_ROOT=$(ARM64_ORT) -DSOFTDECA_BUILD_PYTHON=OFF \
+	  -DSOFTDECA_PYTHON=$(CURDIR)/$(PY) -DSOFTDECA_QEMU_PREFIX=$(CURDIR)/.deps/arm64-qemu-prefix > $(ARM64).configure.log 2>&1 || { cat $(ARM64).configure.log; exit 1; }
+	@cmake --build $(ARM64) -j $(JOBS) --target softdeca $(ARM64_TESTS)
+
+arm64-check-inputs: build ## the avatar and take of the arm64 replay check -> build/platform-check
+	@mkdir -p $(CHECK)
+	@[ -f $(CHECK)/avatar/neutral.obj ] || $(PY) -m softdeca_train avatar --seed 1 --out $(CHECK)/avatar > /dev/null
+	@[ -f $(CHECK)/take.sdrec ] || $(BUILD)/plugin/cli/softdeca convert $(CHECK_TAKE) $(CHECK)/take.sdrec > /dev/null
+
+test-arm64: arm64 arm64-check-inputs ## the arm64 build's suites and a replay against x86-64 under qemu (minutes)
+	@echo "== Linux arm64 tests under $$(qemu-aarch64 --version | head -n1), -cpu cortex-a76"
+	@ctest --test-dir $(ARM64) --output-on-failure -j $(JOBS) -R '$(ARM64_CTEST)'
+	@tests/platforms/arm64-check.sh $(BUILD) $(ARM64) $(CHECK)/avatar $(CHECK)/take.sdrec $(CHECK_START) $(ARM64_FRAMES)
+
+test-arm64-quick: arm64 arm64-check-inputs ## test-arm64 reduced: the C ABI and kernel suites, the replay in float storage
+	@ctest --test-dir $(ARM64) --output-on-failure -j $(JOBS) -R '^(CAbi|HyperTensor|SparseLdlt|CpuFeatures|NeonKernels)\.'
+	@PRECISIONS=float tests/platforms/arm64-check.sh $(BUILD) $(ARM64) $(CHECK)/avatar $(CHECK)/take.sdrec $(CHECK_START) 4
+
+count-arm64: arm64 arm64-check-inputs ## per-frame instruction counts of the arm64 build, NEON and portable (qemu plugin)
+	@tests/platforms/arm64-insn-count.sh $(BUILD) $(ARM64) $(CHECK)/avatar $(CHECK)/take.sdrec $(CHECK_START)
+
 unity-package: build windows ## UPM tarball (Add package from tarball) with the Linux and Windows binaries -> build/unity-package/
 	@plugin/platforms/stage-unity-binaries.sh linux $(BUILD) $(ORT_ROOT) $(UNITY_BINARIES)
 	@plugin/platforms/stage-unity-binaries.sh windows $(WINDOWS) $(WINDOWS_ORT) $(UNITY_BINARIES)

@@ -3,11 +3,14 @@
 // bundle, avatar and frames (tests/platforms/windows_replay_check.sh). Uses nothing but
 // softdeca.h, so it builds wherever the library does.
 //
-// usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES [PRECISION]
+// usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES [PRECISION [MODEL [MODE]]]
 //   AVATAR_DIR: neutral.obj and blendshapes/<ARKit name>.obj (as `softdeca replay --avatar` reads)
-//   EXPECTED.pc2: `softdeca replay TAKE.sdrec --models softdeca --start FIRST_FRAME ...`
+//   EXPECTED.pc2: `softdeca replay TAKE.sdrec --models MODEL --start FIRST_FRAME ...`
 //   PRECISION: half (default, as softdeca replay), float or int8: the replay's --precision
-// Also run on one machine under another kernel family (tests/cpu/run-as.sh, make test-kernels).
+//   MODEL: softdeca (default) or sparse (driven by the landmarks of the avatar's linear blend)
+//   MODE: static (default) or dynamic: the replay without or with --dynamics
+// Also run on one machine under another kernel family (tests/cpu/run-as.sh, make test-kernels)
+// and on the arm64 build under qemu against the x86-64 CLI (make test-arm64).
 // Prints the largest vertex difference; exit status 0 when within the tolerance.
 #include <algorithm>
 #include <cmath>
@@ -82,72 +85,160 @@ Pc2 read_pc2(const std::string& path) {
   return pc2;
 }
 
-int run(int argc, char** argv) {
-  if (argc != 7 && argc != 8) {
-    std::fprintf(stderr,
-                 "usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES [half|float|int8]\n");
-    return 2;
-  }
-  const std::string precision_name = argc == 8 ? argv[7] : "half";
-  const int32_t precision = precision_name == "float"  ? SOFTDECA_PRECISION_FLOAT
-                            : precision_name == "int8" ? SOFTDECA_PRECISION_INT8
-                            : precision_name == "half" ? SOFTDECA_PRECISION_HALF
-                                                       : -1;
-  if (precision < 0) {
-    std::fprintf(stderr, "replay_check: precision must be half, float or int8, not '%s'\n", precision_name.c_str());
-    return 2;
-  }
-  const std::string bundle = argv[1], avatar_dir = argv[2], take = argv[3], expected_path = argv[5];
-  const uint32_t first = static_cast<uint32_t>(std::strtoul(argv[4], nullptr, 10));
-  const double tolerance = std::strtod(argv[6], nullptr);
+struct Options {
+  std::string bundle, avatar_dir, take, expected_path, precision_name = "half", model_name = "softdeca";
+  uint32_t first = 0;
+  double tolerance = 0;
+  int32_t precision = SOFTDECA_PRECISION_HALF;
+  bool sparse = false, dynamic = false;
+};
 
-  softdeca_model* model = nullptr;
-  softdeca_model_options options{};
-  options.struct_size = sizeof options;
-  check(softdeca_model_load(bundle.c_str(), &options, &model), "loading " + bundle);
-  softdeca_model_info info{};
-  info.struct_size = sizeof info;
-  check(softdeca_model_get_info(model, &info), "model info");
+// The arguments, or false (with the reason printed) when they are not a valid call.
+bool parse(int argc, char** argv, Options& o) {
+  if (argc < 7 || argc > 10) {
+    std::fprintf(stderr, "usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES "
+                         "[half|float|int8 [softdeca|sparse [static|dynamic]]]\n");
+    return false;
+  }
+  o.bundle = argv[1];
+  o.avatar_dir = argv[2];
+  o.take = argv[3];
+  o.first = static_cast<uint32_t>(std::strtoul(argv[4], nullptr, 10));
+  o.expected_path = argv[5];
+  o.tolerance = std::strtod(argv[6], nullptr);
+  if (argc > 7) o.precision_name = argv[7];
+  if (argc > 8) o.model_name = argv[8];
+  const std::string mode = argc > 9 ? argv[9] : "static";
+  o.precision = o.precision_name == "float" ? SOFTDECA_PRECISION_FLOAT
+                : o.precision_name == "int8" ? SOFTDECA_PRECISION_INT8
+                : o.precision_name == "half" ? SOFTDECA_PRECISION_HALF
+                                             : -1;
+  o.sparse = o.model_name == "sparse";
+  o.dynamic = mode == "dynamic";
+  if (o.precision < 0 || (!o.sparse && o.model_name != "softdeca") || (!o.dynamic && mode != "static")) {
+    std::fprintf(stderr, "replay_check: precision half, float or int8; model softdeca or sparse; static or dynamic\n");
+    return false;
+  }
+  return true;
+}
 
-  const Obj neutral = read_obj(avatar_dir + "/neutral.obj");
-  const std::size_t n = neutral.vertices.size();
-  std::vector<float> deltas(SOFTDECA_BLENDSHAPE_COUNT * n, 0.0f);
+// A neutral and its 52 ARKit blendshape deltas (as `softdeca replay` reads an avatar or user rig).
+struct Rig {
+  Obj neutral;
+  std::vector<float> deltas;  // [52][3 n]
+  bool empty() const { return neutral.vertices.empty(); }
+  // out = neutral + sum_s w_s delta_s, in the CLI's order (FaceRig::blend).
+  void blend(const float* w, float* out) const {
+    const std::size_t n = neutral.vertices.size();
+    std::copy(neutral.vertices.begin(), neutral.vertices.end(), out);
+    for (std::size_t s = 0; s < SOFTDECA_BLENDSHAPE_COUNT; ++s) {
+      if (w[s] == 0.0f) continue;
+      const float* d = deltas.data() + s * n;
+      for (std::size_t i = 0; i < n; ++i) out[i] += w[s] * d[i];
+    }
+  }
+};
+
+Rig read_rig(const std::string& dir, bool optional) {
+  Rig rig;
+  if (optional && !std::ifstream(dir + "/neutral.obj")) return rig;
+  rig.neutral = read_obj(dir + "/neutral.obj");
+  const std::size_t n = rig.neutral.vertices.size();
+  rig.deltas.assign(SOFTDECA_BLENDSHAPE_COUNT * n, 0.0f);
   for (uint32_t b = 0; b < SOFTDECA_BLENDSHAPE_COUNT; ++b) {
-    const std::string path = avatar_dir + "/blendshapes/" + softdeca_blendshape_name(b) + ".obj";
+    const std::string path = dir + "/blendshapes/" + softdeca_blendshape_name(b) + ".obj";
     if (!std::ifstream(path)) continue;  // a shape the avatar lacks: no motion (as softdeca replay)
     const Obj shape = read_obj(path);
     if (shape.vertices.size() != n) throw std::runtime_error(path + ": vertex count differs from the neutral");
-    for (std::size_t i = 0; i < n; ++i) deltas[b * n + i] = shape.vertices[i] - neutral.vertices[i];
+    for (std::size_t i = 0; i < n; ++i) rig.deltas[b * n + i] = shape.vertices[i] - rig.neutral.vertices[i];
   }
+  return rig;
+}
+
+// The avatar's rig as the C ABI's avatar, prepared at the given precision.
+softdeca_avatar* make_avatar(softdeca_model* model, const Rig& rig, int32_t precision) {
   softdeca_avatar_desc desc{};
   desc.struct_size = sizeof desc;
-  desc.neutral = neutral.vertices.data();
-  desc.vertex_count = static_cast<uint32_t>(n / 3);
-  desc.triangles = neutral.triangles.data();
-  desc.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
-  desc.blendshapes = deltas.data();
+  desc.neutral = rig.neutral.vertices.data();
+  desc.vertex_count = static_cast<uint32_t>(rig.neutral.vertices.size() / 3);
+  desc.triangles = rig.neutral.triangles.data();
+  desc.triangle_count = static_cast<uint32_t>(rig.neutral.triangles.size() / 3);
+  desc.blendshapes = rig.deltas.data();
   desc.blendshape_count = SOFTDECA_BLENDSHAPE_COUNT;
   desc.precision = precision;
   softdeca_avatar* avatar = nullptr;
   check(softdeca_avatar_create(model, &desc, &avatar), "creating the avatar");
   check(softdeca_avatar_prepare(avatar), "prepare");
+  return avatar;
+}
 
+// What SparseSoftDECA reads per frame, as `softdeca replay --models sparse` drives a template
+// avatar: the user rig of AVATAR_DIR/user_face blended with the take (calibrated with its
+// neutral), or without one the bundle's landmarks on the avatar's own linear blend.
+struct Tracking {
+  softdeca_model* model;
+  softdeca_avatar* avatar;
+  const softdeca_model_info& info;
+  Rig user;
+  std::vector<float> linear, points;
+
+  Tracking(softdeca_model* m, softdeca_avatar* a, const softdeca_model_info& i, const std::string& avatar_dir)
+      : model(m), avatar(a), info(i), user(read_rig(avatar_dir + "/user_face", true)) {
+    linear.resize(3 * std::size_t{info.head_vertex_count});
+    points.resize(user.empty() ? 3 * std::size_t{info.landmark_count} : user.neutral.vertices.size());
+    if (!user.empty())
+      check(softdeca_avatar_calibrate_landmarks(avatar, user.neutral.vertices.data(),
+                                                static_cast<uint32_t>(user.neutral.vertices.size() / 3)),
+            "calibration");
+  }
+
+  void evaluate(const float* weights, softdeca_output& output) {
+    if (!user.empty()) {
+      user.blend(weights, points.data());
+    } else {
+      softdeca_output linear_out{sizeof(softdeca_output), linear.data(), info.head_vertex_count, nullptr, 0};
+      check(softdeca_avatar_evaluate_linear(avatar, weights, SOFTDECA_BLENDSHAPE_COUNT, &linear_out), "linear blend");
+      check(softdeca_model_evaluate_landmarks(model, linear.data(), info.head_vertex_count, points.data(), info.landmark_count),
+            "landmarks");
+    }
+    check(softdeca_avatar_evaluate_landmarks(avatar, points.data(), static_cast<uint32_t>(points.size() / 3), &output),
+          "frame");
+  }
+};
+
+int run(int argc, char** argv) {
+  Options o;
+  if (!parse(argc, argv, o)) return 2;
+  softdeca_model* model = nullptr;
+  softdeca_model_options options{};
+  options.struct_size = sizeof options;
+  check(softdeca_model_load(o.bundle.c_str(), &options, &model), "loading " + o.bundle);
+  softdeca_model_info info{};
+  info.struct_size = sizeof info;
+  check(softdeca_model_get_info(model, &info), "model info");
+  if (o.sparse ? !info.has_sparse : !info.has_softdeca) throw std::runtime_error(o.bundle + " has no " + o.model_name + " model");
+
+  const Rig rig = read_rig(o.avatar_dir, false);
+  const Obj& neutral = rig.neutral;
+  softdeca_avatar* avatar = make_avatar(model, rig, o.precision);
+  check(softdeca_avatar_set_dynamics(avatar, o.dynamic ? SOFTDECA_TRUE : SOFTDECA_FALSE), "dynamics");
   softdeca_player* player = nullptr;
-  check(softdeca_player_open(take.c_str(), &player), "opening " + take);
-  const Pc2 expected = read_pc2(expected_path);
+  check(softdeca_player_open(o.take.c_str(), &player), "opening " + o.take);
+  const Pc2 expected = read_pc2(o.expected_path);
   if (expected.points != info.head_vertex_count)
-    throw std::runtime_error(expected_path + " has " + std::to_string(expected.points) + " points, the bundle's head " +
+    throw std::runtime_error(o.expected_path + " has " + std::to_string(expected.points) + " points, the bundle's head " +
                              std::to_string(info.head_vertex_count));
 
   std::vector<float> vertices(std::size_t{info.head_vertex_count} * 3);
+  Tracking tracking(model, avatar, info, o.avatar_dir);
   softdeca_output output{sizeof(softdeca_output), vertices.data(), info.head_vertex_count, nullptr, 0};
   softdeca_frame frame{};
   double worst = 0, motion = 0;
   for (uint32_t f = 0; f < expected.frames; ++f) {
     frame.struct_size = sizeof frame;
-    check(softdeca_player_frame(player, first + f, &frame), "take frame " + std::to_string(first + f));
-    check(softdeca_avatar_evaluate_weights(avatar, frame.weights, SOFTDECA_BLENDSHAPE_COUNT, &output),
-          "frame " + std::to_string(f));
+    check(softdeca_player_frame(player, o.first + f, &frame), "take frame " + std::to_string(o.first + f));
+    if (o.sparse) tracking.evaluate(frame.weights, output);
+    else check(softdeca_avatar_evaluate_weights(avatar, frame.weights, SOFTDECA_BLENDSHAPE_COUNT, &output), "frame");
     const float* want = expected.xyz.data() + std::size_t{f} * expected.points * 3;
     for (std::size_t v = 0; v < expected.points; ++v) {
       double d2 = 0, m2 = 0;
@@ -167,11 +258,11 @@ int run(int argc, char** argv) {
 
   // The largest motion off the neutral shows the frames animate (a comparison of two rest poses
   // would pass trivially).
-  const bool ok = worst <= tolerance && motion > 10 * tolerance;
-  std::printf("replay_check (softdeca %s, %s): %u frames x %u vertices, largest difference %.3g m (tolerance %.3g m), "
-              "largest motion %.3g m: %s\n",
-              softdeca_version(), precision_name.c_str(), expected.frames, expected.points, worst, tolerance, motion,
-              ok ? "OK" : "FAILED");
+  const bool ok = worst <= o.tolerance && motion > 10 * o.tolerance;
+  std::printf("replay_check (softdeca %s, %s, %s, %s): %u frames x %u vertices, largest difference %.3g m (tolerance "
+              "%.3g m), largest motion %.3g m: %s\n",
+              softdeca_version(), o.model_name.c_str(), o.precision_name.c_str(), o.dynamic ? "dynamic" : "static",
+              expected.frames, expected.points, worst, o.tolerance, motion, ok ? "OK" : "FAILED");
   return ok ? 0 : 1;
 }
 

@@ -23,16 +23,20 @@ TEST(CpuFeatures, ParsesTheFamilyNamesInAnyCase) {
   ASSERT_TRUE(parse_cpu_cap("", cap));
   EXPECT_EQ(cap, CpuCap::Avx512);
   ASSERT_TRUE(parse_cpu_cap(nullptr, cap));
+  ASSERT_TRUE(parse_cpu_cap("NEON", cap));
+  EXPECT_EQ(cap, CpuCap::Neon);
   EXPECT_FALSE(parse_cpu_cap("sse4", cap));
   EXPECT_FALSE(parse_cpu_cap("avx2 ", cap));
 }
 
 TEST(CpuFeatures, ACapRemovesFamiliesAndNeverAddsOne) {
-  const CpuFeatures all{true, true};
+  const CpuFeatures all{true, true, true};
   EXPECT_TRUE(capped(all, CpuCap::Avx512).avx512_vnni);
   EXPECT_TRUE(capped(all, CpuCap::Avx2).avx2);
   EXPECT_FALSE(capped(all, CpuCap::Avx2).avx512_vnni);
   EXPECT_FALSE(capped(all, CpuCap::Portable).avx2);
+  EXPECT_FALSE(capped(all, CpuCap::Portable).neon);
+  EXPECT_TRUE(capped(all, CpuCap::Neon).neon);
   const CpuFeatures none{};
   EXPECT_FALSE(capped(none, CpuCap::Avx512).avx2);
   EXPECT_FALSE(capped(none, CpuCap::Avx512).avx512_vnni);
@@ -48,5 +52,9 @@ TEST(CpuFeatures, TheProcessFamilyHonoursTheEnvironment) {
   } else if (asked == "avx2") {
     EXPECT_NE(family, "avx512");
   }
+#if defined(__aarch64__)
+  EXPECT_TRUE(family == "portable" || family == "neon") << family;
+#else
   EXPECT_TRUE(family == "portable" || family == "avx2" || family == "avx512") << family;
+#endif
 }

@@ -167,7 +167,7 @@ TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
   for (double w : want) scale = std::max(scale, std::fabs(w));
   for (const Precision p : {Precision::Float, Precision::Half, Precision::Int8}) {
     const HyperTensor tensor(L.data(), nf, K, 9, p);
-    for (const Kernel kernel : {Kernel::Best, Kernel::Portable, Kernel::Avx2, Kernel::Avx512Vnni}) {
+    for (const Kernel kernel : {Kernel::Best, Kernel::Portable, Kernel::Avx2, Kernel::Avx512Vnni, Kernel::Neon}) {
       if (!kernel_available(kernel)) continue;
       std::vector<float> got(3 * g.n, 0.0f);
       const std::size_t half = tensor.blocks() / 2;  // two ranges, as two threads would do
@@ -196,7 +196,8 @@ TEST(HyperTensor, VertexOffsetsMatchTheDirectProduct) {
     for (const auto& [p, kernel] : std::vector<std::pair<Precision, Kernel>>{
              {Precision::Float, Kernel::Avx2}, {Precision::Float, Kernel::Portable}, {Precision::Half, Kernel::Avx2},
              {Precision::Half, Kernel::Portable}, {Precision::Int8, Kernel::Avx2}, {Precision::Int8, Kernel::Avx512Vnni},
-             {Precision::Int8, Kernel::Portable}}) {
+             {Precision::Int8, Kernel::Portable}, {Precision::Float, Kernel::Neon}, {Precision::Half, Kernel::Neon},
+             {Precision::Int8, Kernel::Neon}}) {
       if (!kernel_available(kernel)) continue;
       std::vector<float> out(3 * n + 3, -7.0f);
       const HyperTensor t(L.data(), n, K, 3, p);
@@ -235,7 +236,7 @@ TEST(HyperTensor, Int8KernelsKeepSmallTermsBesideALargeOne) {
     }
   for (int k = 0; k < K; ++k) z[k] = k < 2 ? 1.0f : nd(rng);
   const HyperTensor t(L.data(), n, K, 3, Precision::Int8);
-  for (const Kernel kernel : {Kernel::Portable, Kernel::Avx2, Kernel::Avx512Vnni}) {
+  for (const Kernel kernel : {Kernel::Portable, Kernel::Avx2, Kernel::Avx512Vnni, Kernel::Neon}) {
     if (!kernel_available(kernel)) continue;
     std::vector<float> out(3 * n);
     vertex_offsets(t, z.data(), base.data(), 0, t.blocks(), out.data(), kernel);

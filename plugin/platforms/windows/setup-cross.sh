@@ -13,17 +13,8 @@ root=$(cd "$(dirname "$0")/../../.." && pwd)
 cd "$root"
 say() { printf '\033[1m[windows]\033[0m %s\n' "$*"; }
 
-pkgs=(g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix mingw-w64-tools wine wine64)
-missing=()
-for p in "${pkgs[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  say "installing Debian packages: ${missing[*]}"
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+source "$root/plugin/platforms/apt-install.sh"
+apt_install g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix mingw-w64-tools wine wine64
 
 linux_ort=.deps/onnxruntime
 [ -f "$linux_ort/VERSION" ] || { echo "windows: no $linux_ort/VERSION; run \`make setup\` first" >&2; exit 1; }

@@ -7,6 +7,7 @@
 #include "core/cpu_features.h"
 #include "core/error.h"
 #include "geometry/ldlt_factor.h"
+#include "geometry/sparse_ldlt_neon.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -205,6 +206,12 @@ void substitute(const std::vector<std::int32_t>& rows, const std::vector<std::in
     return;
   }
 #endif
+#ifdef SOFTDECA_LDLT_NEON
+  if (core::cpu_features().neon) {
+    neon::substitute(rows.data(), rows.size(), ptr.data(), idx, values, y);
+    return;
+  }
+#endif
   double a[3];
   for (const std::int32_t r : rows) {
     const std::size_t i = static_cast<std::size_t>(r);
@@ -219,6 +226,12 @@ void scatter(const std::vector<std::int32_t>& cols, const std::vector<std::int32
 #ifdef SOFTDECA_X86
   if (cpu_has_avx2_fma()) {
     scatter_avx2(cols.data(), cols.size(), ptr.data(), idx, values, y);
+    return;
+  }
+#endif
+#ifdef SOFTDECA_LDLT_NEON
+  if (core::cpu_features().neon) {
+    neon::scatter(cols.data(), cols.size(), ptr.data(), idx, values, y);
     return;
   }
 #endif

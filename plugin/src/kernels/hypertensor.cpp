@@ -6,6 +6,7 @@
 
 #include "core/cpu_features.h"
 #include "kernels/half.h"
+#include "kernels/hypertensor_neon.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -70,6 +71,9 @@ namespace {
 // The SIMD int8 kernels sum int16 x int8 products in int32: |sum| <= K * 32767 * 127 < 2^31 up
 // to this many latents (more run the portable kernel).
 constexpr int kMaxInt8Latent = 256;
+#ifdef SOFTDECA_NEON
+static_assert(neon::kMaxInt8Latent >= kMaxInt8Latent, "resolve() sends the NEON kernel up to kMaxInt8Latent latents");
+#endif
 
 // ---- portable kernels -----------------------------------------------------------------------
 
@@ -378,6 +382,7 @@ Kernel resolve(Kernel k, const HyperTensor& L) {
   if (k == Kernel::Best) {
     if (kernel_available(Kernel::Avx512Vnni) && L.precision() == Precision::Int8 && int8_ok) return Kernel::Avx512Vnni;
     if (kernel_available(Kernel::Avx2) && int8_ok) return Kernel::Avx2;
+    if (kernel_available(Kernel::Neon) && int8_ok) return Kernel::Neon;
     return Kernel::Portable;
   }
   if (!kernel_available(k) || !int8_ok || (k == Kernel::Avx512Vnni && L.precision() != Precision::Int8)) return Kernel::Portable;
@@ -397,6 +402,11 @@ bool kernel_available(Kernel k) {
     case Kernel::Avx2:
     case Kernel::Avx512Vnni: return false;
 #endif
+#ifdef SOFTDECA_NEON
+    case Kernel::Neon: return core::cpu_features().neon;
+#else
+    case Kernel::Neon: return false;
+#endif
   }
   return false;
 }
@@ -414,6 +424,9 @@ void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const
       }
       return;
 #endif
+#ifdef SOFTDECA_NEON
+    case Kernel::Neon: neon::dg_rhs(L, faces, z, skin, b0, b1, rhs); return;
+#endif
     default: dg_rhs_portable(L, faces, z, skin, b0, b1, rhs); return;
   }
 }
@@ -430,6 +443,9 @@ void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std
         case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, b0, b1, out); return;
       }
       return;
+#endif
+#ifdef SOFTDECA_NEON
+    case Kernel::Neon: neon::vertex_offsets(L, z, base, b0, b1, out); return;
 #endif
     default: vertex_offsets_portable(L, z, base, b0, b1, out); return;
   }

@@ -71,8 +71,9 @@ struct FaceBlocks {
 
 // Which kernel computes the products: Best (frames) picks the fastest this CPU has for the
 // tensor's storage; the others exist so that tests can compare every kernel the CPU runs.
-// Avx512Vnni serves int8 storage only (vpdpwssd); a kernel the CPU lacks runs as Portable.
-enum class Kernel { Best, Portable, Avx2, Avx512Vnni };
+// Avx512Vnni serves int8 storage only (vpdpwssd); Neon is aarch64's (hypertensor_neon.h); a
+// kernel the CPU lacks runs as Portable.
+enum class Kernel { Best, Portable, Avx2, Avx512Vnni, Neon };
 bool kernel_available(Kernel kernel);
 
 // rhs (V x 3, accumulated) += sum over the faces of blocks [b0, b1) of

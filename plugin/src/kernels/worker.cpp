@@ -3,6 +3,8 @@
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #define SOFTDECA_PAUSE() _mm_pause()
+#elif defined(__aarch64__) && defined(__GNUC__)
+#define SOFTDECA_PAUSE() __asm__ __volatile__("yield")  // the spin-wait hint, not a system call
 #else
 #define SOFTDECA_PAUSE() std::this_thread::yield()
 #endif
