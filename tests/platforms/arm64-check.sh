@@ -4,7 +4,8 @@
 #      SOFTDECA_CPU=portable (the NEON ones ran with the rest);
 #   2. frames of a real take through the committed bundle, replayed by the x86-64 CLI and by the
 #      arm64 library's C ABI (replay_check under qemu), compared vertex by vertex: SoftDECA and
-#      SparseSoftDECA, static and dynamic, per precision (PRECISIONS, default half float int8);
+#      SparseSoftDECA, static and dynamic (MODES, default both), per precision (PRECISIONS,
+#      default half float int8);
 #      then the same through the runtime tests' small bundle, whose DT stage is not zero.
 #   usage: tests/platforms/arm64-check.sh X86_BUILD ARM64_BUILD AVATAR_DIR TAKE.sdrec FIRST FRAMES
 set -euo pipefail
@@ -34,7 +35,7 @@ replay() {
   local bundle=$1 avatar=$2 take=$3 first=$4 frames=$5 tag=$6
   for precision in ${PRECISIONS:-half float int8}; do
     for model in softdeca sparse; do
-      for mode in static dynamic; do
+      for mode in ${MODES:-static dynamic}; do
         local dir="$out/$tag-$precision-$model-$mode" flag=()
         [ "$mode" = dynamic ] && flag=(--dynamics)
         "$x86/plugin/cli/softdeca" replay "$take" --bundle "$bundle" --avatar "$avatar" --models "$model" \

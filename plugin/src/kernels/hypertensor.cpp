@@ -319,13 +319,7 @@ __attribute__((target("avx2"))) inline void write_offsets(const __m256* a, const
                                                         float* out) {
   alignas(32) float acc[3][kLanes];
   for (int c = 0; c < 3; ++c) _mm256_store_ps(acc[c], a[c]);
-  const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
-  for (std::size_t l = 0; l < end; ++l) {
-    const std::size_t v = (b * kLanes + l) * 3;
-    out[v] = base_pos[v] + acc[0][l];
-    out[v + 1] = base_pos[v + 1] + acc[1][l];
-    out[v + 2] = base_pos[v + 2] + acc[2][l];
-  }
+  add_block_offsets(acc, L, b, base_pos, out);
 }
 
 template <Precision P, class Pairs>

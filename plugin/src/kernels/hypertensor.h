@@ -81,6 +81,17 @@ bool kernel_available(Kernel kernel);
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
             std::size_t b1, float* rhs, Kernel kernel = Kernel::Best);
 
+// out[v] = base[v] + lanes[c][l] for the elements of block b that exist (the vector kernels'
+// write-out of one block's 3 components, stored lane by lane).
+inline void add_block_offsets(const float (&lanes)[3][kLanes], const HyperTensor& L, std::size_t b, const float* base,
+                              float* out) {
+  const std::size_t end = L.elements() - b * kLanes < kLanes ? L.elements() - b * kLanes : kLanes;
+  for (std::size_t l = 0; l < end; ++l) {
+    const std::size_t v = (b * kLanes + l) * 3;
+    for (std::size_t c = 0; c < 3; ++c) out[v + c] = base[v + c] + lanes[c][l];
+  }
+}
+
 // out[v] = base[v] + sum_k z_k L[v, k] for the vertices of blocks [b0, b1) (width-3 tensor).
 void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out,
                     Kernel kernel = Kernel::Best);

@@ -170,13 +170,7 @@ void write_offsets(const Lanes* a, const HyperTensor& L, std::size_t b, const fl
     vst1q_f32(acc[c], a[c].lo);
     vst1q_f32(acc[c] + 4, a[c].hi);
   }
-  const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
-  for (std::size_t l = 0; l < end; ++l) {
-    const std::size_t v = (b * kLanes + l) * 3;
-    out[v] = base_pos[v] + acc[0][l];
-    out[v + 1] = base_pos[v + 1] + acc[1][l];
-    out[v + 2] = base_pos[v + 2] + acc[2][l];
-  }
+  add_block_offsets(acc, L, b, base_pos, out);
 }
 
 template <Precision P>
