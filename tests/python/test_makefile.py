@@ -7,7 +7,10 @@ import subprocess
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
-RULE = re.compile(r"^([a-zA-Z][a-zA-Z0-9_-]*):(?!=)")
+# a rule line, not a variable (`X :=`) nor a target-specific variable (`target: X := value`)
+RULE = re.compile(
+    r"^([a-zA-Z][a-zA-Z0-9_-]*):(?!=)(?!\s*[A-Za-z_][A-Za-z0-9_]*\s*[:+?]?=)"
+)
 
 
 def rule_targets() -> list[str]:
