@@ -9,8 +9,9 @@ import os
 from pathlib import Path
 
 from softdeca_train.commands import Command, add_ict_argument
-from softdeca_train.data.config import GenerateConfig, RunSettings, default_takes_path
+from softdeca_train.data.config import GenerateConfig, RunSettings
 from softdeca_train.data.ranges import FROM_DEFINITION, PROFILES
+from softdeca_train.paths import default_recordings_path
 
 D = GenerateConfig()
 
@@ -76,7 +77,7 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         "--takes",
         default=None,
         help="folder of takes, searched recursively (Live Link Face CSV, LLV recordings) "
-        f"(default: $SOFTDECA_RECORDINGS or {default_takes_path()})",
+        f"(default: $SOFTDECA_RECORDINGS or {default_recordings_path()})",
     )
     g = p.add_argument_group("what to generate (fixes the dataset; a resume must match)")
     _add_config_options(g, _COUNTS)
@@ -152,7 +153,7 @@ def run_generate(args: argparse.Namespace) -> int:
         threads=args.threads,
         ray_address=args.ray_address,
         ict=args.ict,
-        takes=Path(args.takes) if args.takes else default_takes_path(),
+        takes=Path(args.takes) if args.takes else default_recordings_path(),
         progress=not args.no_progress,
     )
     try:

@@ -16,11 +16,6 @@ TRAIN, TEST = 0, 1
 PAPER_STATIC_SHARE = 0.75  # paper 4.2.1: 75 % static instances, 25 % dynamic (by frames)
 
 
-def default_takes_path() -> Path:
-    """$SOFTDECA_RECORDINGS, else every source's takes in the data folder."""
-    return paths.default_recordings_path()
-
-
 @dataclass(frozen=True)
 class GenerateConfig:
     """A dataset's definition. Counts: static and sparse instances are frames; dynamic
@@ -155,5 +150,5 @@ class RunSettings:
     threads: int = 1  # simulator threads per worker (measured: 1 per process is faster)
     ray_address: str | None = None  # "local" starts a local Ray instance
     ict: str | None = None
-    takes: Path = field(default_factory=default_takes_path)
+    takes: Path = field(default_factory=paths.default_recordings_path)
     progress: bool = True

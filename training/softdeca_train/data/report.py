@@ -21,8 +21,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from softdeca_train import paths
 from softdeca_train.data.blend import SkinBlend
-from softdeca_train.data.config import KINDS, GenerateConfig, default_takes_path
+from softdeca_train.data.config import KINDS, GenerateConfig
 from softdeca_train.data.expressions import expression_sources, load_takes
 from softdeca_train.data.offset_structure import RIDGE, offset_structure
 from softdeca_train.data.ranges import sampling_parameters
@@ -558,7 +559,7 @@ def write_report(
     tables_all = {k: st.disp[k].table() for k in kinds}
     h = np.stack(st.h_rows)
     spread = _identity_spread(template, h)
-    takes_dir = takes_dir or default_takes_path()
+    takes_dir = takes_dir or paths.default_recordings_path()
     pn = {k: np.concatenate(st.p_norm[k]) for k in kinds}
     _plot_parameters(pn, manifest, out / "parameters.png")
     w = np.concatenate(st.weights)

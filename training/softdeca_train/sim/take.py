@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softdeca_train.streaming.livelinkface import read_csv
+from softdeca_train.streaming import takes as recorded
 
 
 @dataclass(frozen=True)
@@ -29,7 +29,7 @@ def read_take(path: Path, start: int = 0, frames: int | None = None, stride: int
         raise FileNotFoundError(f"take not found: {path}")
     if start < 0 or stride < 1 or (frames is not None and frames < 1):
         raise ValueError("need --start >= 0, --stride >= 1 and --frames >= 1")
-    csv = read_csv(path)
+    csv = recorded.read_take(path)  # a Live Link Face CSV or an LLV recording
     if not csv.frames:
         raise ValueError(f"{path}: no tracked frames ({csv.face_lost_rows} face-lost rows)")
     if start >= len(csv.frames):
