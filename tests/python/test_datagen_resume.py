@@ -12,11 +12,12 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from softdeca_train.data.config import KINDS, GenerateConfig, RunSettings
-from softdeca_train.data.generate import generate
+from softdeca_train.data.generate import generate, made_first
 from softdeca_train.data.shards import verify
 
 TINY = GenerateConfig(
@@ -124,3 +125,17 @@ def test_ray_local_cluster_makes_the_same_shards(reference, tmp_path) -> None:
         == "ray:local"
     )
     _same(out, reference)
+
+
+def test_kinds_made_first_change_the_order_not_the_data(reference, tmp_path) -> None:
+    out = tmp_path / "sparse-first"
+    summary = generate(
+        TINY,
+        RunSettings(out=out, workers=1, progress=False, first=("sparse", "dynamic")),
+    )
+    assert summary["complete"]
+    _same(out, reference)
+    plan = [SimpleNamespace(kind=k, index=i) for i in range(2) for k in KINDS]
+    order = [(s.kind, s.index) for s in made_first(plan, ("sparse", "dynamic"))]
+    assert order == [("sparse", 0), ("sparse", 1), ("dynamic", 0), ("dynamic", 1),
+                     ("static", 0), ("static", 1)]  # fmt: skip

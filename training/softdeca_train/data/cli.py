@@ -9,7 +9,7 @@ import os
 from pathlib import Path
 
 from softdeca_train.commands import Command, add_ict_argument
-from softdeca_train.data.config import GenerateConfig, RunSettings
+from softdeca_train.data.config import KINDS, GenerateConfig, RunSettings
 from softdeca_train.data.ranges import FROM_DEFINITION, PROFILES
 from softdeca_train.paths import default_recordings_path
 
@@ -130,6 +130,14 @@ def add_generate_args(p: argparse.ArgumentParser) -> None:
         default=None,
         help="run the shards on Ray: a cluster address, or 'local' for a local instance",
     )
+    r.add_argument(
+        "--first",
+        action="append",
+        choices=KINDS,
+        default=[],
+        help="make this kind's missing shards before the others' (repeatable; the data is "
+        "the same, only the order changes)",
+    )
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.add_argument("--report", action="store_true", help="write the report when done")
 
@@ -155,6 +163,7 @@ def run_generate(args: argparse.Namespace) -> int:
         ict=args.ict,
         takes=Path(args.takes) if args.takes else default_recordings_path(),
         progress=not args.no_progress,
+        first=tuple(args.first),
     )
     try:
         summary = generate(cfg, run)

@@ -152,3 +152,6 @@ class RunSettings:
     ict: str | None = None
     takes: Path = field(default_factory=paths.default_recordings_path)
     progress: bool = True
+    # Kinds whose missing shards run before the others (the order only: the dataset is the
+    # same), so that one kind is ready for training while the rest is still being made.
+    first: tuple[str, ...] = ()

@@ -196,12 +196,19 @@ def _frames(spec: ShardSpec) -> int:
     return sum(len(g.frames.weights) for g in spec.groups)
 
 
+def made_first(todo: list[ShardSpec], first: tuple[str, ...]) -> list[ShardSpec]:
+    """The shards of the kinds in `first` (in that order) before the rest, each kind's
+    shards in plan order."""
+    return sorted(todo, key=lambda s: first.index(s.kind) if s.kind in first else len(first))
+
+
 def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
     """Generate (or resume) the dataset in run.out; returns the manifest's summary."""
     m, plan, header = _prepare(cfg, run)
     digest = _digest(header)
     done = {k: m.done(k) for k in KINDS}
     todo = [s for s in plan if s.index not in done[s.kind]]
+    todo = made_first(todo, run.first)
     # Progress in solved frames: a dynamic instance costs lead-in + sequence frames.
     total = sum(_frames(s) for s in plan)
     started = time.time()
