@@ -283,3 +283,56 @@ def test_contrast_pairs_join_each_frame_to_its_base() -> None:
     # identity 7, weights a: base param 1 (frame 2); weights b alone; identity 8: base frame 6
     assert pairs == {(1, 2), (3, 2), (5, 6)}
     assert contrast_pairs([(-1, -1, b"")]).shape == (0, 2)
+
+
+def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
+    run: Run, tmp_path
+) -> None:
+    """bundle-sparse: the run's SparseSoftDECA (here the code-noise variant) replaces the
+    bundle's landmark encoder and per-vertex hypernetwork, what onnxruntime runs agrees with
+    torch, SoftDECA's files are untouched, and the manifest says what trained the new ones."""
+    from softdeca_train.models.bundle import replace_networks
+    from softdeca_train.models.networks import LandmarkEncoder
+    from softdeca_train.train.bundle import replace_sparse
+
+    bundle = train_bundle(
+        run, tmp_path / "bundle", BundleBudget(steps=4), "test", False
+    )
+    before = read_manifest(bundle)
+    run.train("sparse-code-noise", LoopConfig(steps=6, lr=3e-4, seed=1), progress=False)
+    replace_sparse(run, bundle, "sparse-code-noise", "replace", progress=False)
+    after = read_manifest(bundle)
+    _check_export_deviation(after)
+    for name, spec in after["networks"].items():
+        changed = spec["sha256"] != before["networks"][name]["sha256"]
+        assert changed == (name in ("sparse.f_l", "sparse.f_ph_v")), name
+    record = after["training"]["replaced"][-1]
+    assert record["model"] == "sparse-code-noise" and record["command"] == "replace"
+    assert after["errors"]["sparse_other_head"] == record["errors"]["sparse_other_head"]
+    assert after["errors"]["softdeca_static"] == before["errors"]["softdeca_static"]
+    model = run.load("sparse-code-noise")
+    nets = OnnxNetworks(bundle)
+    x = np.random.default_rng(0).standard_normal(
+        (3, 3 * len(model.lm_bary)), np.float32
+    )
+    with torch.no_grad():
+        want = model.f_l(torch.from_numpy(x)).numpy()
+    assert np.abs(nets.f_l(x) - want).max() < 1e-3
+    # the contract stays the manifest's: a network of another shape, or one the bundle does
+    # not have, is refused and leaves the bundle as it was
+    wrong = LandmarkEncoder(len(model.lm_bary) + 1, run.sizes)
+    for modules in ({"sparse.f_l": wrong}, {"softdeca.f_nothing": model.f_l}):
+        with pytest.raises(ValueError):
+            replace_networks(bundle, modules, {})
+    assert read_manifest(bundle) == after
+
+
+def test_code_noise_perturbs_training_only(run: Run) -> None:
+    from softdeca_train.train.registry import MODELS
+
+    model = MODELS["sparse-code-noise"].make(run.definition, run.specs, run.sizes)
+    batch = next(iter(run.data.batches("sparse", "train", None, 4)))
+    model.train()
+    assert not torch.equal(model.predict(batch), model.predict(batch))
+    model.eval()
+    assert torch.equal(model.predict(batch), model.predict(batch))

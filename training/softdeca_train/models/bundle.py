@@ -385,6 +385,59 @@ def export_bundle(
     return folder
 
 
+def replace_networks(
+    folder: str | Path,
+    modules: dict[str, nn.Module],
+    record: dict[str, Any],
+    errors: dict[str, Any] | None = None,
+) -> dict[str, float]:
+    """Replace networks of an existing bundle (e.g. SparseSoftDECA's, retrained on more data)
+    by `modules`, keyed as the manifest's `networks`; each is exported against the contract
+    the manifest already states (inputs, outputs, parameter columns), stored and checked as
+    export_bundle does. `record` (what trained them) is appended to the manifest's
+    training.replaced and `errors` (their test errors) replace the manifest's entries of the
+    same keys; the deviations of the export check are returned."""
+    folder = Path(folder)
+    manifest = read_manifest(folder)
+    unknown = sorted(set(modules) - set(manifest["networks"]))
+    if unknown:
+        raise ValueError(f"{folder}: the bundle has no network {', '.join(unknown)}")
+    defaults = torch.tensor([[p["default"] for p in manifest["parameters"]]], dtype=torch.float32)
+    deviations: dict[str, float] = {}
+    for name, module in modules.items():
+        spec = manifest["networks"][name]
+        example = list(_example(spec))
+        for i, t in enumerate(spec["inputs"]):
+            if t["name"] == "parameters":
+                example[i] = defaults.repeat(t["shape"][0], 1)
+        stored = copy.deepcopy(module).eval()
+        _round_tables(stored)
+        try:
+            with torch.no_grad():
+                got = stored(*example)
+        except RuntimeError as e:  # inputs of other sizes than the contract's
+            raise ValueError(f"{name}: does not take the bundle's inputs ({e})") from e
+        for t, y in zip(spec["outputs"], got if isinstance(got, tuple) else (got,), strict=True):
+            fixed = [(a, b) for a, b in zip(t["shape"], y.shape, strict=True) if isinstance(a, int)]
+            if len(y.shape) != len(t["shape"]) or any(a != b for a, b in fixed):
+                raise ValueError(f"{name}: output {t['name']} {list(y.shape)}, not {t['shape']}")
+        data, half = _store_half(_export_onnx(module.eval(), spec, tuple(example)))
+        deviations[name] = _check_onnx(data, stored, spec, tuple(example))
+        (folder / spec["file"]).write_bytes(data)
+        spec["sha256"] = hashlib.sha256(data).hexdigest()
+        spec["float16_initialisers"] = half
+    manifest["export_check_max_abs"] = {
+        **(manifest.get("export_check_max_abs") or {}),
+        **deviations,
+    }
+    training = manifest.get("training") or {}
+    training["replaced"] = [*training.get("replaced", []), {"networks": sorted(modules), **record}]
+    manifest["training"] = training
+    manifest["errors"] = {**(manifest.get("errors") or {}), **(errors or {})}
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+    return deviations
+
+
 def add_template_head(folder: str | Path, head: TemplateHead) -> None:
     """Add (or replace) a bundle's template head: template_head.bin and the manifest's
     `template_head` entry; the format version becomes 5."""

@@ -26,9 +26,10 @@ from softdeca_train.avatars.build import make_avatar
 from softdeca_train.avatars.config import HELD_OUT_IDENTITIES, AvatarConfig
 from softdeca_train.avatars.mesh import AvatarMesh
 from softdeca_train.landmarks.arkit_reference import ArkitFace
-from softdeca_train.paths import REPO_ROOT, default_takes_path
+from softdeca_train.paths import REPO_ROOT, default_recordings_path
 from softdeca_train.runtime.native import AvatarArrays, NativeAvatar, NativeFit, NativeModel
 from softdeca_train.sim.take import read_take
+from softdeca_train.streaming.takes import take_paths
 from softdeca_train.template import Template
 from softdeca_train.template.identities import identity_coefficients
 
@@ -179,11 +180,11 @@ def run_fit_check(config: FitCheckConfig, progress: bool = True) -> dict:
     started = time.perf_counter()
     model = NativeModel(config.bundle)
     template, arkit = Template.load(), ArkitFace.load()
-    takes = sorted(default_takes_path().glob("*.csv"))
+    takes = take_paths(default_recordings_path())
     if config.takes:
         takes = [p for p in takes if p.stem in config.takes]
     if not takes:
-        raise FileNotFoundError(f"no takes in {default_takes_path()}")
+        raise FileNotFoundError(f"no takes in {default_recordings_path()}")
     results = []
     for identity in config.identities:
         if progress:

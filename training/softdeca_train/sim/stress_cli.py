@@ -76,6 +76,7 @@ def run_stress_cli(args: argparse.Namespace) -> int:
         run_stress_parallel,
         write_report,
     )
+    from softdeca_train.streaming.takes import take_paths
     from softdeca_train.template import Template
 
     if args.level < 1 or args.fine_level < 0 or args.take_stride < 1 or args.workers < 1:
@@ -85,7 +86,7 @@ def run_stress_cli(args: argparse.Namespace) -> int:
         folder = Path(args.recordings)
         if not folder.is_dir():
             raise FileNotFoundError(f"recordings folder not found: {folder}")
-        takes = tuple(sorted(folder.rglob("*.csv")))
+        takes = tuple(take_paths(folder))
     plan = StressPlan(
         identities=tuple(args.identities),
         level=args.level,

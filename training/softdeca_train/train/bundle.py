@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from softdeca_train.data.generate import code_version
-from softdeca_train.models.bundle import BundleInfo, export_bundle
+from softdeca_train.models.bundle import BundleInfo, export_bundle, replace_networks
 from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, SparseNetworks
 from softdeca_train.models.rest_head import rest_head_for_bundle
 from softdeca_train.models.template_head import template_head_from
@@ -148,3 +148,32 @@ def _dataset_summary(data: Dataset | None) -> dict | None:
 
 def default_command() -> str:
     return "python -m softdeca_train " + " ".join(sys.argv[1:])
+
+
+def replace_sparse(
+    run: Run, bundle: Path, name: str, command: str, progress: bool = True
+) -> dict[str, float]:
+    """Put the run's trained SparseSoftDECA (`name`, a registry entry of that kind) into an
+    existing bundle: its landmark encoder and per-vertex hypernetwork replace the bundle's,
+    the bundle's SparseSoftDECA test errors become this model's on the run's dataset, and the
+    manifest records what trained it. SparseSoftDECA's dynamics network stays the bundle's
+    (it gives per-vertex inertia and damping from p and h, and does not read the static
+    model)."""
+    model = run.load(name)
+    if not isinstance(model, SparseSoftDeca):
+        raise ValueError(f"{name} is no SparseSoftDECA model")
+    errors = {
+        k: v
+        for k, v in test_errors(run, {"sparse": model}, progress).items()
+        if k.startswith("sparse_")
+    }
+    record = {
+        "command": command,
+        "code_version": code_version(),
+        "model": name,
+        "dataset": _dataset_summary(run.data),
+        "stage": json.loads((run.folder / f"{name}.summary.json").read_text()),
+        "errors": errors,
+    }
+    modules = {"sparse.f_l": model.f_l, "sparse.f_ph_v": model.f_ph_v}
+    return replace_networks(bundle, modules, record, errors)

@@ -1,6 +1,7 @@
 """Command lines of the training: `train-bundle` (every bundle network, then the bundle),
-`train-model` (one model of the registry, e.g. a baseline), `evaluate` (the report),
-`linear-baseline` (closed-form linear fits of the data)."""
+`bundle-sparse` (a retrained SparseSoftDECA into a bundle), `train-model` (one model of the
+registry, e.g. a baseline), `evaluate` (the report), `linear-baseline` (closed-form linear
+fits of the data)."""
 
 from __future__ import annotations
 
@@ -94,6 +95,29 @@ def run_bundle(args: argparse.Namespace) -> int:
     ).scaled(args.scale)
     out = train_bundle(run, Path(args.bundle), budget, default_command(), not args.no_progress)
     print(f"bundle written to {out}")
+    return 0
+
+
+def add_replace_sparse_args(p: argparse.ArgumentParser) -> None:
+    _run_args(p)
+    p.add_argument(
+        "--bundle", default=DEFAULT_BUNDLE, help=f"bundle to change in place ({DEFAULT_BUNDLE})"
+    )
+    sparse = sorted(k for k in MODELS if k.startswith("sparse") and "dynamics" not in k)
+    p.add_argument(
+        "--model", choices=sparse, default="sparse", help="the run's trained model (sparse)"
+    )
+
+
+def run_replace_sparse(args: argparse.Namespace) -> int:
+    from softdeca_train.train.bundle import default_command, replace_sparse
+
+    run = _open_run(args)
+    deviations = replace_sparse(
+        run, Path(args.bundle), args.model, default_command(), not args.no_progress
+    )
+    checks = ", ".join(f"{k} {v:.1e}" for k, v in deviations.items())
+    print(f"{args.bundle}: SparseSoftDECA replaced by {args.model} (export check: {checks})")
     return 0
 
 
@@ -250,6 +274,13 @@ COMMANDS = [
         "their dynamics) on a generated dataset, resumably, and export the bundle.",
         add_bundle_args,
         run_bundle,
+    ),
+    Command(
+        "bundle-sparse",
+        "Replace a bundle's SparseSoftDECA (landmark encoder and per-vertex hypernetwork) by "
+        "a run's trained one, with its test errors and training record in the manifest.",
+        add_replace_sparse_args,
+        run_replace_sparse,
     ),
     Command(
         "train-model",

@@ -489,9 +489,14 @@ class SparseSoftDeca(Trainable):
         specs: Sequence[ParameterSpec],
         sizes: NetworkSizes,
         noisy: bool = True,
+        code_noise: float = 0.0,
     ):
         super().__init__()
         self.noisy = noisy  # train on sigma(L) with noise (eq. 24) or on the clean landmarks
+        # Training only: N(0, code_noise^2) added to each identity coefficient (h is N(0, I)),
+        # so that the basis does not hang on a code read off an imperfect head (a fitted
+        # avatar's registered template reads h with an error of that size).
+        self.code_noise = code_noise
         self.f_l = LandmarkEncoder(len(d.landmarks), sizes)
         self.f_ph_v = HyperNetwork(d.skin_vertices, specs, sizes, 3, 1e-5, unit=CM, base=True)
         self.n_vertices = d.skin_vertices
@@ -526,7 +531,10 @@ class SparseSoftDeca(Trainable):
     def predict(self, batch: Batch) -> torch.Tensor:
         offsets = self.offsets(batch)
         z = self.f_l(offsets)
-        hyper = self.f_ph_v(batch.vertex_parameters(self.n_vertices), batch.h)
+        h = batch.h
+        if self.training and self.code_noise > 0:
+            h = h + self.code_noise * torch.randn_like(h)
+        hyper = self.f_ph_v(batch.vertex_parameters(self.n_vertices), h)
         return batch.neutral + torch.einsum("bk,vkn->bvn", z, hyper)
 
 
