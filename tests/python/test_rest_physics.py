@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from softdeca_train.contact_rules import ContactRules
 from softdeca_train.models.rest_head import (
-    ContactRules,
+    contact_sets,
     embedding_weights,
     inert_parameters,
     read_rest_head,
@@ -80,19 +81,22 @@ def test_rest_inert_parameters_are_those_that_move_nothing_unloaded(head, rest):
 
 def test_the_contact_rules_find_the_datas_sets(template):
     from softdeca_train.sim.collision_spec import collision_sets
-    from softdeca_train.sim.lids import lid_candidates, lid_sets
-    from softdeca_train.sim.lips import lip_sets
+    from softdeca_train.sim.lids import lid_candidates, lid_sets_of
+    from softdeca_train.sim.lips import lip_sets_of
     from softdeca_train.template.model import N_SKIN
 
     rules = ContactRules(template.landmarks68, lid_candidates(template))
     none = np.zeros((0, 3), np.int32)
     for seed in (None, 7):
-        head = template.identity_neutral(
+        skin = template.identity_neutral(
             None if seed is None else template.sample_identity(seed)
-        )
-        ours = rules.sets(head[:N_SKIN], template.skin_triangles, none, none)
+        )[:N_SKIN]
+        ours = contact_sets(rules, skin, template.skin_triangles, none, none)
         data = collision_sets(
-            lip_sets(template, head), lid_sets(template, head), none, none
+            lip_sets_of(skin, template.skin_triangles, rules),
+            lid_sets_of(skin, rules),
+            none,
+            none,
         )
         assert [c.name for c in ours] == [c.name for c in data]
         for a, b in zip(ours, data, strict=True):

@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, fields
 
+import numpy as np
+
 from softdeca_train.paths import REPO_ROOT
 
 DEFINITION = REPO_ROOT / "plugin" / "data" / "contact_rules.json"
@@ -34,3 +36,17 @@ def _load() -> ContactDistances:
 
 
 CONTACT_RULES = _load()
+
+
+@dataclass(frozen=True)
+class ContactRules:
+    """How the lip and lid sets are found on a head (sim/lips.py, sim/lids.py): its landmarks
+    and lid candidates, and the distances (this file's unless a bundle carries its own)."""
+
+    landmarks68: np.ndarray  # (68,) skin vertex indices of the 68 Multi-PIE landmarks
+    lid_candidates: np.ndarray  # skin vertices that may belong to a lid
+    lip_radius: float = CONTACT_RULES.lip_radius
+    lip_corner_radius: float = CONTACT_RULES.lip_corner_radius
+    lid_reach: float = CONTACT_RULES.lid_reach
+    lid_corner_radius: float = CONTACT_RULES.lid_corner_radius
+    eye_zone_share: float = CONTACT_RULES.eye_zone_share

@@ -12,33 +12,23 @@ root=$(cd "$(dirname "$0")/../../.." && pwd)
 cd "$root"
 say() { printf '\033[1m[arm64]\033[0m %s\n' "$*"; }
 
-source "$root/plugin/platforms/apt-install.sh"
+source "$root/plugin/platforms/cross-setup.sh"
 apt_install g++-aarch64-linux-gnu gcc-aarch64-linux-gnu qemu-user
 
-linux_ort=.deps/onnxruntime
-[ -f "$linux_ort/VERSION" ] || { echo "arm64: no $linux_ort/VERSION; run \`make setup\` first" >&2; exit 1; }
-ver=$(cat "$linux_ort/VERSION")
-ort=.deps/onnxruntime-arm64
-if [ ! -f "$ort/.stamp-$ver" ]; then
-  say "assembling the ONNX Runtime $ver root for arm64 in $ort"
-  tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-  # Recent releases are tagged manylinux_2_28 (glibc 2.28; the cross sysroot has 2.36).
-  .venv/bin/python -m pip download -q --no-deps --only-binary=:all: --platform manylinux_2_28_aarch64 \
-    --platform manylinux_2_27_aarch64 --platform manylinux2014_aarch64 --python-version 3.11 "onnxruntime==$ver" -d "$tmp"
-  whl=$(ls "$tmp"/onnxruntime-"$ver"-*aarch64.whl | head -n1)
-  unzip -q -j "$whl" 'onnxruntime/capi/libonnxruntime.so.*' -d "$tmp/lib"
-  lib=$(ls "$tmp"/lib/libonnxruntime.so.* | head -n1)
-  # The headers are the x86-64 root's: the same version's C API serves every architecture.
+# unpack_arm64 WHEEL LIBDIR: the wheel's libonnxruntime.so.<version>, with the links the linker
+# (libonnxruntime.so) and the loader (its SONAME) look for.
+unpack_arm64() {
+  unzip -q -j "$1" 'onnxruntime/capi/libonnxruntime.so.*' -d "$2"
+  local lib soname
+  lib=$(ls "$2"/libonnxruntime.so.* | head -n1)
   [ "${lib##*.so.}" = "$ver" ] || { echo "arm64: the wheel holds $(basename "$lib"), not ONNX Runtime $ver" >&2; exit 1; }
-  rm -rf "$ort"; mkdir -p "$ort/include" "$ort/lib"
-  cp "$linux_ort"/include/*.h "$ort/include/"
-  cp "$lib" "$ort/lib/"
-  ln -sf "$(basename "$lib")" "$ort/lib/libonnxruntime.so"
+  ln -sf "$(basename "$lib")" "$2/libonnxruntime.so"
   soname=$(aarch64-linux-gnu-objdump -p "$lib" | awk '/SONAME/{print $2}')
-  [ -z "$soname" ] || [ -e "$ort/lib/$soname" ] || ln -sf "$(basename "$lib")" "$ort/lib/$soname"
-  echo "$ver" > "$ort/VERSION"
-  touch "$ort/.stamp-$ver"
-fi
+  [ -z "$soname" ] || [ -e "$2/$soname" ] || ln -sf "$(basename "$lib")" "$2/$soname"
+}
+ort=.deps/onnxruntime-arm64
+# Recent releases are tagged manylinux_2_28 (glibc 2.28; the cross sysroot has 2.36).
+ort_wheel_root arm64 "$ort" unpack_arm64 manylinux_2_28_aarch64 manylinux_2_27_aarch64 manylinux2014_aarch64
 # 3. qemu's library prefix (-L) in .deps/arm64-qemu-prefix: the sysroot's lib/, and a
 #    /proc/cpuinfo of the CPU qemu emulates (-cpu cortex-a76). Debian 12's qemu-user (7.2) passes the
 #    host's x86 /proc/cpuinfo through, and ONNX Runtime's CPU detection crashes on it (a null

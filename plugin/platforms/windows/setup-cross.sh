@@ -13,23 +13,12 @@ root=$(cd "$(dirname "$0")/../../.." && pwd)
 cd "$root"
 say() { printf '\033[1m[windows]\033[0m %s\n' "$*"; }
 
-source "$root/plugin/platforms/apt-install.sh"
+source "$root/plugin/platforms/cross-setup.sh"
 apt_install g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix mingw-w64-tools wine wine64
 
-linux_ort=.deps/onnxruntime
-[ -f "$linux_ort/VERSION" ] || { echo "windows: no $linux_ort/VERSION; run \`make setup\` first" >&2; exit 1; }
-ver=$(cat "$linux_ort/VERSION")
+unpack_windows() {  # unpack_windows WHEEL LIBDIR
+  unzip -q -j "$1" 'onnxruntime/capi/onnxruntime.dll' -d "$2"
+}
 ort=.deps/onnxruntime-win
-if [ ! -f "$ort/.stamp-$ver" ]; then
-  say "assembling the ONNX Runtime $ver root for Windows in $ort"
-  tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-  .venv/bin/python -m pip download -q --no-deps --only-binary=:all: --platform win_amd64 \
-    --python-version 3.11 "onnxruntime==$ver" -d "$tmp"
-  unzip -q -j "$tmp"/onnxruntime-"$ver"-*win_amd64.whl 'onnxruntime/capi/onnxruntime.dll' -d "$tmp/dll"
-  rm -rf "$ort"; mkdir -p "$ort/include" "$ort/lib"
-  cp "$linux_ort"/include/*.h "$ort/include/"
-  cp "$tmp/dll/onnxruntime.dll" "$ort/lib/"
-  echo "$ver" > "$ort/VERSION"
-  touch "$ort/.stamp-$ver"
-fi
+ort_wheel_root Windows "$ort" unpack_windows win_amd64
 say "ready: $(x86_64-w64-mingw32-g++-posix --version | head -n1), $(wine --version), ONNX Runtime $ver ($ort)"

@@ -49,4 +49,13 @@ void require_struct(const T* s, const char* name) {
                                                      ": set struct_size to sizeof the struct before the call");
 }
 
+// A struct the library fills for its caller (after require_struct): every field reset to its
+// zero default but struct_size, which keeps the caller's value, the size it was built with.
+template <class T>
+void reset_struct(T* s) {
+  const uint32_t struct_size = s->struct_size;
+  *s = T{};
+  s->struct_size = struct_size;
+}
+
 }  // namespace softdeca

@@ -68,9 +68,7 @@ extern "C" {
 SOFTDECA_API softdeca_status softdeca_fit_options_init(softdeca_fit_options* options) {
   return guarded(__func__, [&] {
     require_struct(options, "options");
-    const uint32_t size = options->struct_size;
-    *options = softdeca_fit_options{};
-    options->struct_size = size;
+    reset_struct(options);
   });
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 #include "stream/rotation.h"
@@ -29,9 +28,7 @@ stream::Pose pose_in(const softdeca_pose& in, const char* name) {
 }  // namespace
 
 void frame_to_abi(const stream::Frame& f, softdeca_frame* out) {
-  const uint32_t struct_size = out->struct_size;
-  std::memset(out, 0, sizeof(softdeca_frame));
-  out->struct_size = struct_size;
+  reset_struct(out);
   out->flags = (f.has_head ? SOFTDECA_FRAME_HAS_HEAD : 0u) | (f.has_eyes ? SOFTDECA_FRAME_HAS_EYES : 0u) |
                (f.has_sequence ? SOFTDECA_FRAME_HAS_SEQUENCE : 0u);
   out->session_id = f.session_id;

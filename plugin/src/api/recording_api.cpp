@@ -45,9 +45,7 @@ void copy_text(const std::string& s, char (&out)[64]) {
 void report_out(const recording::ConversionReport& r, softdeca_convert_report* out) {
   if (!out) return;
   require_struct(out, "out_report");
-  const uint32_t struct_size = out->struct_size;
-  *out = softdeca_convert_report{};
-  out->struct_size = struct_size;
+  reset_struct(out);
   out->frames = static_cast<uint32_t>(r.frames);
   out->rows = static_cast<uint32_t>(r.rows);
   out->face_lost_rows = static_cast<uint32_t>(r.face_lost_rows);
@@ -141,9 +139,7 @@ SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player,
     const auto& p = player_of(player);
     require_struct(out, "out_info");
     const auto& rec = p.recording();
-    const uint32_t struct_size = out->struct_size;
-    *out = softdeca_recording_info{};
-    out->struct_size = struct_size;
+    reset_struct(out);
     out->frame_count = static_cast<uint32_t>(p.frame_count());
     out->duration = p.duration();
     out->start_unix_time = rec.header.start_unix_time;

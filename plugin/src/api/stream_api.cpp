@@ -46,9 +46,7 @@ SOFTDECA_API softdeca_status softdeca_blendshape_index(const char* name, int32_t
 SOFTDECA_API softdeca_status softdeca_receiver_config_init(softdeca_receiver_config* config) {
   return guarded(__func__, [&] {
     require_struct(config, "config");
-    const uint32_t struct_size = config->struct_size;
-    *config = softdeca_receiver_config{};
-    config->struct_size = struct_size;
+    reset_struct(config);
     config->format = SOFTDECA_FORMAT_AUTO;
     config->bind_address = nullptr;
     config->port = stream::default_port(stream::Format::softdeca);
@@ -127,9 +125,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
     const auto& r = receiver_of(receiver);
     require_struct(out, "out_stats");
     const live::ReceiverStats s = r.stats();
-    const uint32_t struct_size = out->struct_size;
-    *out = softdeca_receiver_stats{};
-    out->struct_size = struct_size;
+    reset_struct(out);
     out->datagrams = s.datagrams;
     out->frames = s.frames;
     out->control_messages = s.control_messages;

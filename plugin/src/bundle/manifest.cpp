@@ -37,6 +37,21 @@ std::string sha256_of(const Json& j, const std::string& what) {
   return h;
 }
 
+// A bundle file a section names: its name (what.file) and its checked sha256 (what.sha256).
+void file_entry(const Json& j, const std::string& what, std::string& file, std::string& sha256) {
+  file = j.at("file", what).string(what + ".file");
+  sha256 = sha256_of(j, what);
+}
+
+// The optional top-level section `what`, which needs format version `version` (`purpose`, what
+// it is for, goes into the refusal), or null when the manifest has none.
+const Json* optional_section(const Json& doc, const std::string& what, int version, const char* purpose, const Manifest& m) {
+  if (!doc.has(what)) return nullptr;
+  check(m.format_version >= version,
+        what + " (" + purpose + ") needs bundle format version " + std::to_string(version));
+  return &doc.at(what, "manifest");
+}
+
 std::vector<std::int64_t> shape_of(const Json& j, const std::string& what) {
   std::vector<std::int64_t> shape;
   for (const Json& d : j.array(what)) {
@@ -252,8 +267,7 @@ NetworkSpec parse_network(const Json& j, const char* key, const Manifest& m) {
   const std::string what = std::string("networks.") + key;
   NetworkSpec n;
   n.key = key;
-  n.file = j.at("file", what).string(what + ".file");
-  n.sha256 = sha256_of(j, what);
+  file_entry(j, what, n.file, n.sha256);
   if (j.has("parameter_columns")) {
     for (const Json& c : j.at("parameter_columns", what).array(what + ".parameter_columns")) {
       const int idx = m.find_parameter(c.string(what + ".parameter_columns"));
@@ -317,15 +331,11 @@ void parse_networks(const Json& doc, Manifest& m) {
 }  // namespace
 
 namespace {
-void parse_rest_physics(const Json& doc, Manifest& m) {
-  if (!doc.has("rest_physics")) return;
+void parse_rest_physics(const Json& r, Manifest& m) {
   const std::string what = "rest_physics";
-  check(m.format_version >= 4, "rest_physics (the physics at prepare) needs bundle format version 4");
   check(m.has_softdeca, "rest_physics corrects the SoftDECA model: the bundle has none");
-  const Json& r = doc.at("rest_physics", "manifest");
   RestPhysicsSpec& s = m.rest_physics;
-  s.file = r.at("file", what).string(what + ".file");
-  s.sha256 = sha256_of(r, what);
+  file_entry(r, what, s.file, s.sha256);
   const auto count = [&](const Json& j, const char* key, long long lo) {
     return bounded_int(j.at(key, what), what + "." + key, lo, kMaxElements);
   };
@@ -370,13 +380,9 @@ void parse_rest_physics(const Json& doc, Manifest& m) {
 }  // namespace
 
 namespace {
-void parse_template_head(const Json& doc, Manifest& m) {
-  if (!doc.has("template_head")) return;
+void parse_template_head(const Json& t, Manifest& m) {
   const std::string what = "template_head";
-  check(m.format_version >= 5, "template_head (fitting users' avatars) needs bundle format version 5");
-  const Json& t = doc.at(what.c_str(), "manifest");
-  m.template_head_file = t.at("file", what).string(what + ".file");
-  m.template_head_sha256 = sha256_of(t, what);
+  file_entry(t, what, m.template_head_file, m.template_head_sha256);
   const Json& modes = t.at("identity_modes", what).at("shape", what);
   const auto& mdims = modes.array(what + ".identity_modes.shape");
   check(!mdims.empty(), what + ".identity_modes.shape has the wrong rank");
@@ -406,8 +412,8 @@ Manifest parse_manifest(const std::string& text) {
   parse_files(doc, m);
   parse_deformation_and_dynamics(doc, m);
   parse_networks(doc, m);
-  parse_rest_physics(doc, m);
-  parse_template_head(doc, m);
+  if (const Json* r = optional_section(doc, "rest_physics", 4, "the physics at prepare", m)) parse_rest_physics(*r, m);
+  if (const Json* t = optional_section(doc, "template_head", 5, "fitting users' avatars", m)) parse_template_head(*t, m);
   return m;
 }
 

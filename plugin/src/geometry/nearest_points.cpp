@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "geometry/grid_ring.h"
+
 namespace softdeca::geometry {
 
 namespace {
@@ -63,21 +65,17 @@ std::vector<int32_t> nearest_sites(const Sites& sites, const Sites& queries) {
     // at least (r + dist to c's cell walls) away, so stop once that bound passes the best.
     const int rings = g.dims.maxCoeff();
     for (int r = 0; r <= rings; ++r) {
-      for (int z = c[2] - r; z <= c[2] + r; ++z)
-        for (int y = c[1] - r; y <= c[1] + r; ++y)
-          for (int x = c[0] - r; x <= c[0] + r; ++x) {
-            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r) continue;
-            if (x < 0 || y < 0 || z < 0 || x >= g.dims[0] || y >= g.dims[1] || z >= g.dims[2]) continue;
-            const int cell = g.index(x, y, z);
-            for (int32_t k = g.start[static_cast<std::size_t>(cell)]; k < g.start[static_cast<std::size_t>(cell) + 1]; ++k) {
-              const int32_t i = g.items[static_cast<std::size_t>(k)];
-              const double d = (sites.row(i).transpose() - p).squaredNorm();
-              if (d < best || (d == best && i < best_i)) {
-                best = d;
-                best_i = i;
-              }
-            }
+      for_each_ring_cell(c, r, g.dims, [&](int x, int y, int z) {
+        const int cell = g.index(x, y, z);
+        for (int32_t k = g.start[static_cast<std::size_t>(cell)]; k < g.start[static_cast<std::size_t>(cell) + 1]; ++k) {
+          const int32_t i = g.items[static_cast<std::size_t>(k)];
+          const double d = (sites.row(i).transpose() - p).squaredNorm();
+          if (d < best || (d == best && i < best_i)) {
+            best = d;
+            best_i = i;
           }
+        }
+      });
       // Distance from p to the outside of the (2r+1)^3 block of cells around c.
       double wall = std::numeric_limits<double>::infinity();
       for (int k = 0; k < 3; ++k) {

@@ -6,6 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "geometry/grid_ring.h"
+
 namespace softdeca::geometry {
 namespace {
 
@@ -154,19 +156,15 @@ Embedding embed_points(const Points& v, const Tets& t, const Points& points) {
       const int max_ring = std::max({g.n[0], g.n[1], g.n[2]});
       for (int r = 0; r <= max_ring; ++r) {
         if (best < (r - 1) * h) break;
-        for (int k = c[2] - r; k <= c[2] + r; ++k)
-          for (int j = c[1] - r; j <= c[1] + r; ++j)
-            for (int i = c[0] - r; i <= c[0] + r; ++i) {
-              if (std::max({std::abs(i - c[0]), std::abs(j - c[1]), std::abs(k - c[2])}) != r) continue;
-              if (i < 0 || j < 0 || k < 0 || i >= g.n[0] || j >= g.n[1] || k >= g.n[2]) continue;
-              const int ci = g.index(i, j, k);
-              for (int32_t m = g.start[ci]; m < g.start[ci + 1]; ++m) {
-                const int32_t e = g.items[m];
-                const double d = point_tet_distance(p, row(v, t(e, 0)), row(v, t(e, 1)),
-                                                    row(v, t(e, 2)), row(v, t(e, 3)));
-                if (d < best) { best = d; found = e; }
-              }
-            }
+        for_each_ring_cell(c, r, g.n, [&](int i, int j, int k) {
+          const int ci = g.index(i, j, k);
+          for (int32_t m = g.start[ci]; m < g.start[ci + 1]; ++m) {
+            const int32_t e = g.items[m];
+            const double d = point_tet_distance(p, row(v, t(e, 0)), row(v, t(e, 1)),
+                                                row(v, t(e, 2)), row(v, t(e, 3)));
+            if (d < best) { best = d; found = e; }
+          }
+        });
       }
       lam = bary_of(p, found);
       dist = best;

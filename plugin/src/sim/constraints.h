@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <utility>
 #include <vector>
 
 #include "sim/mesh.h"
@@ -32,6 +33,21 @@ class ConstraintGroup {
   // the projection is constant, and returns their energy at x.
   virtual double project(const Positions& x, Eigen::Index begin, Eigen::Index end,
                          RowBlock P) const = 0;
+};
+
+// A group of like elements, `kRowsPerElement` rows each: the name and element bookkeeping
+// every group shares.
+template <class Element, int kRowsPerElement>
+class ElementGroup : public ConstraintGroup {
+ public:
+  const char* name() const override { return name_; }
+  Eigen::Index rows() const override { return kRowsPerElement * elements(); }
+  Eigen::Index elements() const override { return static_cast<Eigen::Index>(el_.size()); }
+
+ protected:
+  ElementGroup(const char* name, std::vector<Element> elements) : name_(name), el_(std::move(elements)) {}
+  const char* name_;
+  std::vector<Element> el_;
 };
 
 // A linear combination of simulated vertices (an embedded point or a difference of them).

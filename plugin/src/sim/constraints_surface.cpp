@@ -11,7 +11,7 @@ namespace softdeca::sim {
 
 TriangleStrainGroup::TriangleStrainGroup(const char* name, std::vector<TriangleElement> elements,
                                          double pascal_per_unit)
-    : name_(name), el_(std::move(elements)), pa_(pascal_per_unit) {}
+    : ElementGroup(name, std::move(elements)), pa_(pascal_per_unit) {}
 
 void TriangleStrainGroup::set_rest(TriangleElement& e, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                    const Eigen::Vector3d& c) {
@@ -61,7 +61,7 @@ double TriangleStrainGroup::project(const Positions& x, Eigen::Index begin, Eige
 }
 
 BendingGroup::BendingGroup(std::vector<BendingElement> elements, double pascal_per_unit)
-    : el_(std::move(elements)), pa_(pascal_per_unit) {}
+    : ElementGroup("skull bending", std::move(elements)), pa_(pascal_per_unit) {}
 
 void BendingGroup::jacobian(Triplets& out, Eigen::Index row_offset) const {
   for (std::size_t i = 0; i < el_.size(); ++i)

@@ -17,12 +17,9 @@ struct TriangleElement {
   double weight;           // kPa * thickness (m): energy weight * Pa * area * |F - R|^2
 };
 
-class TriangleStrainGroup final : public ConstraintGroup {
+class TriangleStrainGroup final : public ElementGroup<TriangleElement, 2> {
  public:
   TriangleStrainGroup(const char* name, std::vector<TriangleElement> elements, double pascal_per_unit);
-  const char* name() const override { return name_; }
-  Eigen::Index rows() const override { return 2 * elements(); }
-  Eigen::Index elements() const override { return static_cast<Eigen::Index>(el_.size()); }
   void jacobian(Triplets& out, Eigen::Index row_offset) const override;
   void weights(Eigen::Ref<Eigen::VectorXd> w) const override;
   double project(const Positions& x, Eigen::Index begin, Eigen::Index end, RowBlock P) const override;
@@ -32,8 +29,6 @@ class TriangleStrainGroup final : public ConstraintGroup {
                        const Eigen::Vector3d& c);
 
  private:
-  const char* name_;
-  std::vector<TriangleElement> el_;
   double pa_;
 };
 
@@ -43,18 +38,14 @@ struct BendingElement {
   double weight;          // kPa * A_i * h^3
 };
 
-class BendingGroup final : public ConstraintGroup {
+class BendingGroup final : public ElementGroup<BendingElement, 1> {
  public:
   BendingGroup(std::vector<BendingElement> elements, double pascal_per_unit);
-  const char* name() const override { return "skull bending"; }
-  Eigen::Index rows() const override { return elements(); }
-  Eigen::Index elements() const override { return static_cast<Eigen::Index>(el_.size()); }
   void jacobian(Triplets& out, Eigen::Index row_offset) const override;
   void weights(Eigen::Ref<Eigen::VectorXd> w) const override;
   double project(const Positions& x, Eigen::Index begin, Eigen::Index end, RowBlock P) const override;
 
  private:
-  std::vector<BendingElement> el_;
   double pa_;
 };
 

@@ -3,7 +3,7 @@
 namespace softdeca::sim {
 
 TargetGroup::TargetGroup(const char* name, std::vector<TargetElement> elements)
-    : name_(name), el_(std::move(elements)) {}
+    : ElementGroup(name, std::move(elements)) {}
 
 void TargetGroup::jacobian(Triplets& out, Eigen::Index row_offset) const {
   for (std::size_t i = 0; i < el_.size(); ++i)

@@ -13,22 +13,15 @@ struct TargetElement {
   double weight;  // W / 2 (J/m^2): energy weight * |point(x) - target|^2
 };
 
-class TargetGroup final : public ConstraintGroup {
+class TargetGroup final : public ElementGroup<TargetElement, 1> {
  public:
   TargetGroup(const char* name, std::vector<TargetElement> elements);
-  const char* name() const override { return name_; }
-  Eigen::Index rows() const override { return elements(); }
-  Eigen::Index elements() const override { return static_cast<Eigen::Index>(el_.size()); }
   bool constant_projection() const override { return true; }
   void jacobian(Triplets& out, Eigen::Index row_offset) const override;
   void weights(Eigen::Ref<Eigen::VectorXd> w) const override;
   // Reads the targets from P (filled by the frame) and returns the energy.
   double project(const Positions& x, Eigen::Index begin, Eigen::Index end, RowBlock P) const override;
   const TargetElement& element(Eigen::Index i) const { return el_[static_cast<std::size_t>(i)]; }
-
- private:
-  const char* name_;
-  std::vector<TargetElement> el_;
 };
 
 }  // namespace softdeca::sim

@@ -6,7 +6,7 @@
 namespace softdeca::sim {
 
 TetGroup::TetGroup(const char* name, std::vector<TetElement> elements, StrainLimit mode, double pascal_per_unit)
-    : name_(name), el_(std::move(elements)), mode_(mode), pa_(pascal_per_unit) {}
+    : ElementGroup(name, std::move(elements)), mode_(mode), pa_(pascal_per_unit) {}
 
 std::vector<TetElement> TetGroup::make_elements(const Positions& rest, const TetIndices& tets, bool reorient) {
   std::vector<TetElement> out(static_cast<std::size_t>(tets.rows()));

@@ -21,13 +21,10 @@ struct TetElement {
   double max_strain;       // eps; -inf: strain always on (rotation)
 };
 
-class TetGroup final : public ConstraintGroup {
+class TetGroup final : public ElementGroup<TetElement, 3> {
  public:
   TetGroup(const char* name, std::vector<TetElement> elements, StrainLimit mode,
            double pascal_per_unit);
-  const char* name() const override { return name_; }
-  Eigen::Index rows() const override { return 3 * elements(); }
-  Eigen::Index elements() const override { return static_cast<Eigen::Index>(el_.size()); }
   void jacobian(Triplets& out, Eigen::Index row_offset) const override;
   void weights(Eigen::Ref<Eigen::VectorXd> w) const override;
   double project(const Positions& x, Eigen::Index begin, Eigen::Index end, RowBlock P) const override;
@@ -37,8 +34,6 @@ class TetGroup final : public ConstraintGroup {
   static std::vector<TetElement> make_elements(const Positions& rest, const TetIndices& tets, bool reorient);
 
  private:
-  const char* name_;
-  std::vector<TetElement> el_;
   StrainLimit mode_;
   double pa_;
 };

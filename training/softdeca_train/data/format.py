@@ -58,22 +58,28 @@ SPARSE = {
 }
 
 
+def _axis(shape: str, size: str) -> str:
+    """`shape` with an axis of `size` after the rows: (n, 52) -> (n, size, 52)."""
+    return shape.replace("(n,", f"(n, {size},").replace(f"(n, {size},)", f"(n, {size})")
+
+
 def _sequence(d: dict) -> dict:
-    return {
-        k: (t, s.replace("(n,", "(n, L,").replace("(n, L,)", "(n, L)"), a)
-        for k, (t, s, a) in d.items()
-    }
+    return {k: (t, _axis(s, "L"), a) for k, (t, s, a) in d.items()}
+
+
+def _lead_in(key: str, about: str) -> tuple[str, str, str]:
+    """FRAME's array `key` for the two lead-in frames before a sequence."""
+    t, s, _ = FRAME[key]
+    return t, _axis(s, "2"), about
 
 
 DYNAMIC = {
-    **_sequence({k: v for k, v in FRAME.items()}),
-    "prev_weights": ("float32", "(n, 2, 52)", "w of the two lead-in frames before the sequence"),
-    "prev_offsets": (
-        "float16",
-        f"(n, 2, {N_SKIN}, 3)",
-        "T - S of those frames: T_{-2}, T_{-1} (the sequence's starting velocity)",
+    **_sequence(FRAME),
+    "prev_weights": _lead_in("weights", "w of the two lead-in frames before the sequence"),
+    "prev_offsets": _lead_in(
+        "offsets", "T - S of those frames: T_{-2}, T_{-1} (the sequence's starting velocity)"
     ),
-    "prev_source_index": ("int32", "(n, 2)", "their frame indices in the same take"),
+    "prev_source_index": _lead_in("source_index", "their frame indices in the same take"),
 }
 
 ARRAYS = {

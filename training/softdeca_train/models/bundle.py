@@ -29,7 +29,6 @@ from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.reference import Model
 from softdeca_train.models.residual import ResidualCoefficients, ResidualCondition
 from softdeca_train.models.rest_head import (
-    REST_HEAD_FILE,
     RestHead,
     read_rest_head,
     rest_head_file,
@@ -438,6 +437,37 @@ def replace_networks(
     return deviations
 
 
+def _add_file(
+    folder: Path,
+    manifest: dict[str, Any],
+    key: str,
+    data: bytes,
+    entry: dict[str, Any],
+    version: int,
+) -> None:
+    """Write one of a bundle's optional files and its manifest entry `key` (entry, with the
+    file's sha256), and raise the format version to the one that entry needs (a bundle that
+    already holds a later version's entry keeps that version)."""
+    (folder / entry["file"]).write_bytes(data)
+    manifest[key] = {**entry, "sha256": hashlib.sha256(data).hexdigest()}
+    manifest["format_version"] = max(version, manifest["format_version"])
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+
+
+def _read_file(
+    folder: str | Path, manifest: dict[str, Any], key: str
+) -> tuple[dict[str, Any], bytes] | None:
+    """The manifest entry `key` and its file's bytes (checked against the entry's sha256), or
+    None when the bundle has no such entry."""
+    entry = manifest.get(key)
+    if entry is None:
+        return None
+    data = (Path(folder) / entry["file"]).read_bytes()
+    if hashlib.sha256(data).hexdigest() != entry["sha256"]:
+        raise ValueError(f"{entry['file']}: sha256 does not match the manifest")
+    return entry, data
+
+
 def add_template_head(folder: str | Path, head: TemplateHead) -> None:
     """Add (or replace) a bundle's template head: template_head.bin and the manifest's
     `template_head` entry; the format version becomes 5."""
@@ -446,49 +476,33 @@ def add_template_head(folder: str | Path, head: TemplateHead) -> None:
     t = manifest["template"]
     if head.neutral.shape[0] != t["head_vertices"] or head.shapes.shape[1] != t["skin_vertices"]:
         raise ValueError("the template head does not match the bundle's template sizes")
-    data, entry = template_head_file(head)
-    (folder / entry["file"]).write_bytes(data)
-    manifest["template_head"] = {**entry, "sha256": hashlib.sha256(data).hexdigest()}
-    manifest["format_version"] = 5
-    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+    _add_file(folder, manifest, "template_head", *template_head_file(head), version=5)
 
 
 def read_bundle_template_head(folder: str | Path, manifest: dict[str, Any]) -> TemplateHead | None:
     """A bundle's template head, or None when it has none."""
-    entry = manifest.get("template_head")
-    if entry is None:
-        return None
-    data = (Path(folder) / entry["file"]).read_bytes()
-    if hashlib.sha256(data).hexdigest() != entry["sha256"]:
-        raise ValueError(f"{entry['file']}: sha256 does not match the manifest")
-    return read_template_head(entry, data)
+    found = _read_file(folder, manifest, "template_head")
+    return None if found is None else read_template_head(*found)
 
 
 def add_rest_physics(folder: str | Path, head: RestHead) -> None:
     """Add (or replace) a bundle's physics at prepare: rest_head.bin and the manifest's
-    `rest_physics` entry; the format version becomes 4."""
+    `rest_physics` entry; the format version becomes at least 4."""
     folder = Path(folder)
     manifest = read_manifest(folder)
     if manifest["template"]["skin_vertices"] != head.skin_count:
         raise ValueError("the rest head's skin does not match the bundle's template")
     if "softdeca.f_w" not in manifest["networks"]:
         raise ValueError("the physics at prepare corrects SoftDECA: the bundle has no SoftDECA")
-    data, entry = rest_head_file(head)
-    (folder / REST_HEAD_FILE).write_bytes(data)
-    manifest["rest_physics"] = {**entry, "sha256": hashlib.sha256(data).hexdigest()}
-    manifest["format_version"] = 4
-    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+    _add_file(folder, manifest, "rest_physics", *rest_head_file(head), version=4)
 
 
 def read_rest_physics(folder: str | Path, manifest: dict[str, Any]) -> RestHead | None:
     """A bundle's rest head, or None when it has none."""
-    entry = manifest.get("rest_physics")
-    if entry is None:
+    found = _read_file(folder, manifest, "rest_physics")
+    if found is None:
         return None
-    data = (Path(folder) / entry["file"]).read_bytes()
-    if hashlib.sha256(data).hexdigest() != entry["sha256"]:
-        raise ValueError(f"{entry['file']}: sha256 does not match the manifest")
-    return read_rest_head(entry, data, manifest["template"]["skin_vertices"])
+    return read_rest_head(*found, manifest["template"]["skin_vertices"])
 
 
 def _residual_sizes(nets: BundleNetworks) -> dict[str, Any]:

@@ -21,7 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from softdeca_train.contact_rules import CONTACT_RULES
+from softdeca_train.contact_rules import ContactRules
 from softdeca_train.lhm import LhmConfig, eyes
 from softdeca_train.lhm.eyes import EYE_ZONE_SHARE
 from softdeca_train.sim.collision_spec import CollisionSpec, collision_sets
@@ -31,31 +31,19 @@ from softdeca_train.sim.lips import lip_sets_of
 REST_HEAD_FILE = "rest_head.bin"
 
 
-@dataclass(frozen=True)
-class ContactRules:
-    """How the lip and lid sets are found on a head (sim/lips.py, sim/lids.py)."""
-
-    landmarks68: np.ndarray  # (68,) skin vertex indices of the 68 Multi-PIE landmarks
-    lid_candidates: np.ndarray  # skin vertices that may belong to a lid
-    lip_radius: float = CONTACT_RULES.lip_radius
-    lip_corner_radius: float = CONTACT_RULES.lip_corner_radius
-    lid_reach: float = CONTACT_RULES.lid_reach
-    lid_corner_radius: float = CONTACT_RULES.lid_corner_radius
-    eye_zone_share: float = CONTACT_RULES.eye_zone_share
-
-    def sets(
-        self,
-        skin: np.ndarray,
-        skin_triangles: np.ndarray,
-        upper_teeth: np.ndarray,
-        lower_teeth: np.ndarray,
-    ) -> list[CollisionSpec]:
-        if self.eye_zone_share != eyes.EYE_ZONE_SHARE:
-            raise ValueError("the bundle's eye_zone_share differs from the physics'")
-        lm = self.landmarks68
-        lips = lip_sets_of(skin, lm, skin_triangles, self.lip_radius, self.lip_corner_radius)
-        lids = lid_sets_of(skin, lm, self.lid_candidates, self.lid_reach, self.lid_corner_radius)
-        return collision_sets(lips, lids, upper_teeth, lower_teeth)
+def contact_sets(
+    rules: ContactRules,
+    skin: np.ndarray,
+    skin_triangles: np.ndarray,
+    upper_teeth: np.ndarray,
+    lower_teeth: np.ndarray,
+) -> list[CollisionSpec]:
+    """The collision sets the rules find on a head's skin, as data generation finds them
+    (sim/head.py)."""
+    if rules.eye_zone_share != eyes.EYE_ZONE_SHARE:
+        raise ValueError("the bundle's eye_zone_share differs from the physics'")
+    lips = lip_sets_of(skin, skin_triangles, rules)
+    return collision_sets(lips, lid_sets_of(skin, rules), upper_teeth, lower_teeth)
 
 
 @dataclass
@@ -123,8 +111,8 @@ class RestHead:
         collisions = []
         if self.contacts is not None:
             n, nu = len(fill), len(self.teeth_upper)
-            specs = self.contacts.sets(
-                skin, skin_triangles, self.upper_teeth_triangles + n,
+            specs = contact_sets(
+                self.contacts, skin, skin_triangles, self.upper_teeth_triangles + n,
                 self.lower_teeth_triangles + n + nu,
             )  # fmt: skip
             collisions = [

@@ -9,13 +9,14 @@ from dataclasses import dataclass
 import numpy as np
 import softdeca_native as native
 
+from softdeca_train.contact_rules import ContactRules
 from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
 from softdeca_train.lhm.carried import tissue_mesh
 from softdeca_train.lhm.fit import embed_skin_by_side, jaw_motion
 from softdeca_train.lhm.model import JAW
 from softdeca_train.sim.collision_spec import collision_sets
-from softdeca_train.sim.lids import LidSets, lid_sets
-from softdeca_train.sim.lips import LipSets, lip_sets
+from softdeca_train.sim.lids import LidSets, lid_candidates, lid_sets_of
+from softdeca_train.sim.lips import LipSets, lip_sets_of
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
@@ -164,7 +165,9 @@ def build_head_simulation(
     skin_vertices, skin_weights = native.skin_embedding_from_tets(
         tissue.soft_tets, tissue.skin_tet.tolist(), tissue.skin_bary
     )
-    lips, lids = lip_sets(template, head), lid_sets(template, head)
+    rules = ContactRules(template.landmarks68, lid_candidates(template))
+    skin = head[:N_SKIN]
+    lips, lids = lip_sets_of(skin, template.skin_triangles, rules), lid_sets_of(skin, rules)
     upper_teeth = template.component_triangles("teeth_upper") - up.start + teeth_upper[0]
     lower_teeth = template.component_triangles("teeth_lower") - lo.start + teeth_lower[0]
     collisions = [

@@ -12,9 +12,9 @@ without them, still leaving 13 points 40 µm inside. Where the linear blend driv
 past the lower one (`eyeBlink` with `eyeLookDown`) it passes in front of it, as in the linear
 blend.
 
-Each lid's points lie on the face or its eye socket within `reach` of the eye's fissure line;
-points within `corner_radius` of the eye corners belong to neither lid (the lids are one
-surface there; they follow the volumetric solve)."""
+Each lid's points lie on the face or its eye socket within the rules' `lid_reach` of the eye's
+fissure line; points within `lid_corner_radius` of the eye corners belong to neither lid (the
+lids are one surface there; they follow the volumetric solve)."""
 
 from __future__ import annotations
 
@@ -22,11 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softdeca_train.contact_rules import CONTACT_RULES
+from softdeca_train.contact_rules import ContactRules
 from softdeca_train.lhm.eyes import EYES, fissure_line, lid_side_of_points
 from softdeca_train.lhm.mouth import closest_on_polyline
 from softdeca_train.template import Template
-from softdeca_train.template.model import N_SKIN
 
 
 @dataclass(frozen=True)
@@ -43,31 +42,15 @@ def lid_candidates(template: Template) -> np.ndarray:
     ])  # fmt: skip
 
 
-def lid_sets(
-    template: Template,
-    head: np.ndarray,
-    reach: float = CONTACT_RULES.lid_reach,
-    corner_radius: float = CONTACT_RULES.lid_corner_radius,
-) -> LidSets:
-    """The lid sets of a head of the template (lid_sets_of)."""
-    skin = np.asarray(head)[:N_SKIN]
-    return lid_sets_of(skin, template.landmarks68, lid_candidates(template), reach, corner_radius)
-
-
-def lid_sets_of(
-    skin: np.ndarray,
-    lm68: np.ndarray,
-    candidates: np.ndarray,
-    reach: float = CONTACT_RULES.lid_reach,
-    corner_radius: float = CONTACT_RULES.lid_corner_radius,
-) -> LidSets:
-    """`lm68`: the 68 landmarks' skin vertex indices; `candidates`: lid_candidates."""
+def lid_sets_of(skin: np.ndarray, rules: ContactRules) -> LidSets:
+    """The lid sets of a head's skin `skin` (rules.lid_candidates: lid_candidates)."""
+    lm68, candidates = rules.landmarks68, rules.lid_candidates
     side = lid_side_of_points(skin, lm68)
     chosen = np.zeros(len(skin), bool)
     for eye in EYES:
         line = fissure_line(skin, lm68, eye)
         p = skin[candidates]
-        near = np.linalg.norm(p - closest_on_polyline(p, line), axis=1) < reach
+        near = np.linalg.norm(p - closest_on_polyline(p, line), axis=1) < rules.lid_reach
         corners = np.linalg.norm(p[:, None] - line[None, [0, -1]], axis=2).min(axis=1)
-        chosen[candidates[near & (corners > corner_radius)]] = True
+        chosen[candidates[near & (corners > rules.lid_corner_radius)]] = True
     return LidSets(np.flatnonzero(chosen & (side > 0)), np.flatnonzero(chosen & (side < 0)))
