@@ -46,6 +46,12 @@ class Entry:
 MLP_EQUAL = (400,)
 MLP_LARGE = (768, 768)
 
+
+def _sparse(name: str, description: str, **options: float | bool) -> Entry:
+    """A SparseSoftDECA variant: the model with these training options."""
+    return Entry(name, description, lambda d, s, z, b: m.SparseSoftDeca(d, s, z, **options))  # type: ignore[arg-type]
+
+
 # The identity code's error on fitted avatars, per coefficient (h is N(0, I)): RMS 0.54-0.81
 # over seeds 111, 222, 333 and 444 remeshed to 8,000 vertices and fitted (none of the fit
 # check's identities).
@@ -71,15 +77,11 @@ MODELS: dict[str, Entry] = {
             lambda d, s, z, b: m.Dynamics(b, d.skin_vertices, s, z),  # type: ignore[arg-type]
             base="softdeca",
         ),
-        Entry(
-            "sparse",
-            "SparseSoftDECA, trained with noise augmentation (eq. 24)",
-            lambda d, s, z, b: m.SparseSoftDeca(d, s, z, noisy=True),
-        ),
-        Entry(
+        _sparse("sparse", "SparseSoftDECA, trained with noise augmentation (eq. 24)"),
+        _sparse(
             "sparse-code-noise",
             "SparseSoftDECA trained with noise augmentation and a perturbed identity code",
-            lambda d, s, z, b: m.SparseSoftDeca(d, s, z, noisy=True, code_noise=CODE_NOISE),
+            code_noise=CODE_NOISE,
         ),
         Entry(
             "sparse-dynamics",
@@ -87,10 +89,10 @@ MODELS: dict[str, Entry] = {
             lambda d, s, z, b: m.Dynamics(b, d.skin_vertices, s, z, 0.6, 0.25),  # type: ignore[arg-type]
             base="sparse",
         ),
-        Entry(
+        _sparse(
             "sparse-no-noise",
             "SparseSoftDECA trained on clean personalised landmarks (Table 2 ablation)",
-            lambda d, s, z, b: m.SparseSoftDeca(d, s, z, noisy=False),
+            noisy=False,
         ),
         Entry(
             "softdeca-vertex",
