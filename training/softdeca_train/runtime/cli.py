@@ -193,10 +193,11 @@ def _fit_check_run(args: argparse.Namespace) -> int:
     out = write_report(report, Path(args.out))
     worst = max(t["softdeca_ratio"] for i in report["identities"] for t in i["takes"])
     residual = max(i["fit"]["face_residual_mm_mean"] for i in report["identities"])
+    codes = ", ".join(f"{i['code_error_rms']:.2f}" for i in report["identities"])
     print(
         f"wrote {out}: face residual at most {residual:.3f} mm; SoftDECA's correction off by "
-        f"at most {100 * worst:.1f} % of its mean over the face (per take); "
-        f"{report['seconds']:.0f} s"
+        f"at most {100 * worst:.1f} % of its mean over the face (per take); identity code "
+        f"error (RMS per coefficient) {codes}; {report['seconds']:.0f} s"
     )
     return 0
 

@@ -6,7 +6,8 @@ path, at the same surface points (the avatar's truth, avatars/mesh.py):
 - SoftDECA: the correction (SoftDECA - linear blend), per frame the mean distance between the
   two over the face, over the template path's mean magnitude there;
 - SparseSoftDECA: its deformation (output - neutral) from the same tracked ARKit face, likewise;
-- the largest distance of any avatar vertex from its own linear blend (mm).
+- the largest distance of any avatar vertex from its own linear blend (mm);
+- the fitted avatar's identity code against the identity's own.
 
 `python -m softdeca_train avatar-fit-check` runs it on every held-out identity and every take
 (every 10th frame) and writes the report; tests/python/test_fit_avatars.py holds one reduced
@@ -64,6 +65,10 @@ class IdentityResult:
     identity: str
     avatar_vertices: int
     fit: dict
+    # the fitted avatar's identity code against the identity's own (h is N(0, I)): the RMS
+    # over the coefficients, and over each tenth of them in order
+    code_error_rms: float = float("nan")
+    code_error_rms_by_tenth: list[float] = field(default_factory=list)
     takes: list[TakeResult] = field(default_factory=list)
 
 
@@ -148,7 +153,14 @@ def check_identity(
         if model.info.has_sparse:
             a.calibrate_landmarks(arkit.neutral.astype(np.float32))
     face = face_mask(avatar, deltas)
-    result = IdentityResult(identity, len(avatar.neutral), fit.report())
+    error = fitted.identity() - identity_coefficients(template, identity)
+    result = IdentityResult(
+        identity,
+        len(avatar.neutral),
+        fit.report(),
+        float(np.sqrt(np.mean(error**2))),
+        [float(np.sqrt(np.mean(e**2))) for e in np.array_split(error, 10)],
+    )
     mm_per_unit = 1000.0 * avatar.truth.metres_per_unit
     for path in takes:
         take = read_take(path, stride=config.stride)

@@ -52,9 +52,10 @@ def _sparse(name: str, description: str, **options: float | bool) -> Entry:
     return Entry(name, description, lambda d, s, z, b: m.SparseSoftDeca(d, s, z, **options))  # type: ignore[arg-type]
 
 
-# The identity code's error on fitted avatars, per coefficient (h is N(0, I)): RMS 0.54-0.81
-# over seeds 111, 222, 333 and 444 remeshed to 8,000 vertices and fitted (none of the fit
-# check's identities).
+# The identity code's error on fitted avatars, per coefficient (h is N(0, I)): RMS 0.54, 0.56,
+# 0.81 and 0.64 for seeds 111, 222, 333 and 444 remeshed to 8,000 vertices and fitted
+# (`avatar-fit-check --identity "seed 111" ... --take S07-001 --max-frames 2`), none of them
+# an identity the fit check judges by.
 CODE_NOISE = 0.65
 
 MODELS: dict[str, Entry] = {
