@@ -325,6 +325,30 @@ def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
         with pytest.raises(ValueError):
             replace_networks(bundle, modules, {})
     assert read_manifest(bundle) == after
+    # the report's SparseSoftDECA rows are measured again on this run; the rest stays
+    from softdeca_train.train.report import SPARSE_HEADING, refresh_sparse
+
+    report = tmp_path / "report"
+    report.mkdir()
+    kept = {"mean_mm": 0.1, "frames": 3}
+    doc = {"errors": {"softdeca": kept, "sparse/same_head": kept}, "ms_per_frame": {}}
+    (report / "evaluation.json").write_text(
+        json.dumps({**doc, "bundle": {"softdeca": kept}})
+    )
+    (report / "README.md").write_text(
+        f"# R\n\n{SPARSE_HEADING}\n\nold\n\n## Next\n\nkept\n"
+    )
+    refresh_sparse(run, bundle, report, progress=False)
+    doc = json.loads((report / "evaluation.json").read_text())
+    assert doc["errors"]["softdeca"] == kept and doc["bundle"]["softdeca"] == kept
+    assert (
+        doc["errors"]["sparse-exact-code/other_head"]
+        == record["errors"]["sparse_other_head"]
+    )
+    assert doc["errors"]["sparse/same_head"] != kept and "sparse" in doc["bundle"]
+    text = (report / "README.md").read_text()
+    assert "old" not in text and text.endswith("## Next\n\nkept\n")
+    assert "the same on the exact identity code" in text
 
 
 def test_code_noise_perturbs_training_only(run: Run) -> None:

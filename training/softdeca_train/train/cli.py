@@ -107,6 +107,12 @@ def add_replace_sparse_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--model", choices=sparse, default="sparse", help="the run's trained model (sparse)"
     )
+    p.add_argument(
+        "--report",
+        default=None,
+        help="also re-measure this evaluation report's SparseSoftDECA rows on the run "
+        "(e.g. docs/evaluation)",
+    )
 
 
 def run_replace_sparse(args: argparse.Namespace) -> int:
@@ -118,6 +124,11 @@ def run_replace_sparse(args: argparse.Namespace) -> int:
     )
     checks = ", ".join(f"{k} {v:.1e}" for k, v in deviations.items())
     print(f"{args.bundle}: SparseSoftDECA replaced by {args.model} (export check: {checks})")
+    if args.report:
+        from softdeca_train.train.report import refresh_sparse
+
+        path = refresh_sparse(run, Path(args.bundle), Path(args.report), not args.no_progress)
+        print(f"{path}: SparseSoftDECA's rows re-measured")
     return 0
 
 
