@@ -288,7 +288,7 @@ def test_contrast_pairs_join_each_frame_to_its_base() -> None:
 def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
     run: Run, tmp_path
 ) -> None:
-    """bundle-sparse: the run's SparseSoftDECA (here the exact-code ablation) replaces the
+    """bundle-sparse: the run's SparseSoftDECA (here the code-noise variant) replaces the
     bundle's landmark encoder and per-vertex hypernetwork, what onnxruntime runs agrees with
     torch, SoftDECA's files are untouched, and the manifest says what trained the new ones."""
     from softdeca_train.models.bundle import replace_networks
@@ -299,18 +299,18 @@ def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
         run, tmp_path / "bundle", BundleBudget(steps=4), "test", False
     )
     before = read_manifest(bundle)
-    run.train("sparse-exact-code", LoopConfig(steps=6, lr=3e-4, seed=1), progress=False)
-    replace_sparse(run, bundle, "sparse-exact-code", "replace", progress=False)
+    run.train("sparse-code-noise", LoopConfig(steps=6, lr=3e-4, seed=1), progress=False)
+    replace_sparse(run, bundle, "sparse-code-noise", "replace", progress=False)
     after = read_manifest(bundle)
     _check_export_deviation(after)
     for name, spec in after["networks"].items():
         changed = spec["sha256"] != before["networks"][name]["sha256"]
         assert changed == (name in ("sparse.f_l", "sparse.f_ph_v")), name
     record = after["training"]["replaced"][-1]
-    assert record["model"] == "sparse-exact-code" and record["command"] == "replace"
+    assert record["model"] == "sparse-code-noise" and record["command"] == "replace"
     assert after["errors"]["sparse_other_head"] == record["errors"]["sparse_other_head"]
     assert after["errors"]["softdeca_static"] == before["errors"]["softdeca_static"]
-    model = run.load("sparse-exact-code")
+    model = run.load("sparse-code-noise")
     nets = OnnxNetworks(bundle)
     x = np.random.default_rng(0).standard_normal(
         (3, 3 * len(model.lm_bary)), np.float32
@@ -342,19 +342,19 @@ def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
     doc = json.loads((report / "evaluation.json").read_text())
     assert doc["errors"]["softdeca"] == kept and doc["bundle"]["softdeca"] == kept
     assert (
-        doc["errors"]["sparse-exact-code/other_head"]
+        doc["errors"]["sparse-code-noise/other_head"]
         == record["errors"]["sparse_other_head"]
     )
     assert doc["errors"]["sparse/same_head"] != kept and "sparse" in doc["bundle"]
     text = (report / "README.md").read_text()
     assert "old" not in text and text.endswith("## Next\n\nkept\n")
-    assert "the same on the exact identity code" in text
+    assert "the same on a perturbed identity code" in text
 
 
 def test_code_noise_perturbs_training_only(run: Run) -> None:
     from softdeca_train.train.registry import MODELS
 
-    model = MODELS["sparse"].make(run.definition, run.specs, run.sizes)
+    model = MODELS["sparse-code-noise"].make(run.definition, run.specs, run.sizes)
     batch = next(iter(run.data.batches("sparse", "train", None, 4)))
     model.train()
     assert not torch.equal(model.predict(batch), model.predict(batch))

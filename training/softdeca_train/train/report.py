@@ -378,7 +378,7 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
 
 SPARSE_ROWS = (
     ("sparse", "with noise augmentation (the bundle's)"),
-    ("sparse-exact-code", "the same on the exact identity code"),
+    ("sparse-code-noise", "the same on a perturbed identity code"),
     ("sparse-no-noise", "without"),
 )
 SPARSE_HEADING = "## Table 2 analogue: SparseSoftDECA"
