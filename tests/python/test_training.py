@@ -338,7 +338,7 @@ def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
     (report / "README.md").write_text(
         f"# R\n\n{SPARSE_HEADING}\n\nold\n\n## Next\n\nkept\n"
     )
-    refresh_sparse(run, bundle, report, progress=False)
+    refresh_sparse(run, bundle, report, "sparse-code-noise", progress=False)
     doc = json.loads((report / "evaluation.json").read_text())
     assert doc["errors"]["softdeca"] == kept and doc["bundle"]["softdeca"] == kept
     assert (

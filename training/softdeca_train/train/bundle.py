@@ -19,7 +19,7 @@ from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, Spa
 from softdeca_train.models.rest_head import rest_head_for_bundle
 from softdeca_train.models.template_head import template_head_from
 from softdeca_train.train.batches import Dataset
-from softdeca_train.train.evaluate import test_errors
+from softdeca_train.train.evaluate import SPARSE_INPUTS, measure, test_errors
 from softdeca_train.train.identity import IdentityConfig
 from softdeca_train.train.loop import LoopConfig
 from softdeca_train.train.models import Dynamics, SoftDecaHybrid, SparseSoftDeca
@@ -162,11 +162,8 @@ def replace_sparse(
     model = run.load(name)
     if not isinstance(model, SparseSoftDeca):
         raise ValueError(f"{name} is no SparseSoftDECA model")
-    errors = {
-        k: v
-        for k, v in test_errors(run, {"sparse": model}, progress).items()
-        if k.startswith("sparse_")
-    }
+    # keyed as train_bundle's errors name the bundle's SparseSoftDECA
+    errors = {f"sparse_{w}": measure(run, name, model, w).summary() for w in SPARSE_INPUTS}
     record = {
         "command": command,
         "code_version": code_version(),

@@ -127,7 +127,9 @@ def run_replace_sparse(args: argparse.Namespace) -> int:
     if args.report:
         from softdeca_train.train.report import refresh_sparse
 
-        path = refresh_sparse(run, Path(args.bundle), Path(args.report), not args.no_progress)
+        path = refresh_sparse(
+            run, Path(args.bundle), Path(args.report), args.model, not args.no_progress
+        )
         print(f"{path}: SparseSoftDECA's rows re-measured")
     return 0
 

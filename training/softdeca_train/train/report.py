@@ -377,7 +377,7 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
 
 
 SPARSE_ROWS = (
-    ("sparse", "with noise augmentation (the bundle's)"),
+    ("sparse", "with noise augmentation"),
     ("sparse-code-noise", "the same on a perturbed identity code"),
     ("sparse-no-noise", "without"),
 )
@@ -410,22 +410,28 @@ def sparse_section(run: Run, e: dict, bundle_sparse: dict | None) -> list[str]:
     return lines
 
 
-def refresh_sparse(run: Run, bundle: Path, out: Path, progress: bool = True) -> Path:
+def refresh_sparse(
+    run: Run, bundle: Path, out: Path, name: str = "sparse", progress: bool = True
+) -> Path:
     """Re-measure a report's SparseSoftDECA rows (evaluation.json and README.md's Table 2)
-    on `run`, after its SparseSoftDECA went into the bundle (bundle-sparse); the rest of the
-    report stays as its own run measured it."""
+    on `run`, after its SparseSoftDECA `name` went into the bundle (bundle-sparse); the rest
+    of the report stays as its own run measured it."""
     doc = json.loads((out / "evaluation.json").read_text())
     errors = {k: v for k, v in doc["errors"].items() if not k.startswith("sparse/")}
-    for name, _ in SPARSE_ROWS:
-        if run.finished(name):
-            model = run.load(name)
+    for row, _ in SPARSE_ROWS:
+        if run.finished(row):
+            model = run.load(row)
             for which in SPARSE_INPUTS:
-                errors[f"{name}/{which}"] = measure(run, name, model, which).summary()
+                errors[f"{row}/{which}"] = measure(run, row, model, which).summary()
     doc["errors"] = errors
     doc["bundle"] = {**doc.get("bundle", {}), **_bundle_errors(run, bundle, progress, ("sparse",))}
     batch = next(run.data.batches("sparse", "test", None, 8))
-    doc["ms_per_frame"]["sparse"] = time_per_frame(run.load("sparse"), batch)
-    doc["sparse_run"] = {"run": str(run.folder), "dataset": Path(run.config.dataset).name}
+    doc["ms_per_frame"]["sparse"] = time_per_frame(run.load(name), batch)
+    doc["sparse_run"] = {
+        "run": str(run.folder),
+        "model": name,
+        "dataset": Path(run.config.dataset).name,
+    }
     (out / "evaluation.json").write_text(json.dumps(doc, indent=1) + "\n")
     readme = out / "README.md"
     text = readme.read_text()
