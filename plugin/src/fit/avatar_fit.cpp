@@ -409,6 +409,11 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   RegistrationSettings settings;
   if (options.iterations > 0) settings.iterations = options.iterations;
   const Registration reg = register_rounds(s, guides, settings, [&](double share) { step("registering the template", 0.1 + 0.65 * share); });
+  if (t.identity_count) {
+    step("reading the identity", 0.75);
+    s.identity = refine_identity(t, s.matcher->neutral(), std::vector<uint8_t>(vs, 1),
+                                 [&](const geometry::SurfacePoint& p) { return s.matcher->on_boundary(p); }, s.identity);
+  }
 
   AvatarFit fit;
   fit.mesh_sha256 = mesh_sha256(a.neutral, a.vertex_count, a.triangles, a.triangle_count);

@@ -84,8 +84,8 @@ struct AvatarFit {
   std::size_t vertex_count = 0, triangle_count = 0;
   Placement placement;
   std::vector<float> registered;  // head_vertices x 3: the registered template head (metres)
-  // The template identity closest to the avatar (K coefficients over the identity modes): its
-  // head is where the registration started and what the identity code is read off.
+  // The template identity closest to the avatar's surface (K coefficients over the identity
+  // modes): what the identity code is read off.
   std::vector<float> identity;
   ShapeSource source;
   std::array<ShapeOrigin, kShapes> origin{};

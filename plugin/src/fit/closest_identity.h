@@ -1,12 +1,15 @@
 // The template identity closest to an avatar: the bundle's identity modes (template head)
-// fitted to where the template's skin vertices land on the avatar. Its head is where the
-// registration starts and what the identity code is read off (fit/avatar_fit.h).
+// fitted to where the template's skin vertices land on the avatar (where the registration
+// starts), then to the avatar's surface itself (what the identity code is read off).
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "fit/avatar_fit.h"
 #include "fit/registration.h"
+#include "geometry/surface_query.h"
 
 namespace softdeca::fit {
 
@@ -18,5 +21,15 @@ Points identity_points(const TemplateData& t, const std::vector<float>& h);
 // `prior`: a match's error, squared (metres^2). Reweighted (Cauchy): a part the identity modes
 // cannot explain (a remesh's cut ears, a stylised nose) does not pull the whole head.
 std::vector<float> fit_identity(const TemplateData& t, const std::vector<Match>& matches, const Points& tskin, double prior);
+
+// The identity refined against the avatar's surface itself: point-to-plane ICP over the
+// coefficients and a small rigid motion (discarded: the placement's error, not the identity's).
+// Point targets carry the registration's sliding along the skin, which the modes then take for
+// shape; distances to the surface do not. `use`: the template skin vertices that take part (the
+// face); `outside`: surface points to ignore (the avatar's open boundary).
+std::vector<float> refine_identity(const TemplateData& t, const geometry::SurfaceQuery& surface,
+                                   const std::vector<uint8_t>& use,
+                                   const std::function<bool(const geometry::SurfacePoint&)>& outside,
+                                   std::vector<float> h);
 
 }  // namespace softdeca::fit
