@@ -77,6 +77,48 @@ def test_static_models_learn(run: Run, name: str) -> None:
     )
 
 
+def _mean_mm(offsets: torch.Tensor) -> float:
+    """Mean vertex distance (mm) of (frames, V * 3) offsets in metres."""
+    return float(offsets.reshape(len(offsets), -1, 3).norm(dim=2).mean()) * 1000
+
+
+def test_sparsesoftdeca_starts_at_its_closed_form(run: Run) -> None:
+    """Before any step, SparseSoftDECA on clean landmarks is the deformations' principal
+    components read off the landmarks by ridge regression: with fewer train frames than landmark
+    coordinates the regression interpolates, so on those frames it is as close to the physics as
+    the components themselves, where the untrained model is far."""
+    from softdeca_train.train.registry import MODELS
+
+    torch.manual_seed(0)
+    model = MODELS["sparse-no-noise"].make(run.definition, run.specs, run.sizes)
+    batches = list(run.data.batches("sparse", "train", None, 8))
+    y = torch.cat([(b.T - b.neutral).reshape(b.frames, -1) for b in batches]).double()
+    assert len(y) < 3 * len(run.definition.landmarks.triangle)
+    _, _, vt = torch.linalg.svd(y, full_matrices=False)
+    modes = vt[: run.sizes.latent]
+    floor = _mean_mm(y - (y @ modes.T) @ modes)
+
+    def error() -> float:
+        with torch.no_grad():
+            return _mean_mm(
+                torch.cat([model.predict(b) - b.neutral for b in batches]).reshape(
+                    y.shape
+                )
+                - y
+            )
+
+    before = error()
+    model.init_from_dataset(run.data, progress=False)
+    start = error()
+    below(
+        start,
+        1.05 * floor + 1e-3,
+        "the regression interpolates the modes' coefficients (ridge 1e-6 of the inputs' scale)",
+        what="mm",
+    )
+    below(start, 0.5 * before, "the untrained model is nowhere near", what="mm")
+
+
 def test_dynamics_learn_and_stay_stable(run: Run) -> None:
     if not run.finished("softdeca"):
         run.train("softdeca", LoopConfig(steps=20, seed=1), progress=False)
@@ -310,6 +352,11 @@ def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
     assert record["model"] == "sparse-code-noise" and record["command"] == "replace"
     assert after["errors"]["sparse_other_head"] == record["errors"]["sparse_other_head"]
     assert after["errors"]["softdeca_static"] == before["errors"]["softdeca_static"]
+    assert after["description"].startswith(before["description"])
+    assert after["description"].endswith(
+        "replaced since: sparse.f_l, sparse.f_ph_v (sparse-code-noise on "
+        f"{record['dataset']['name']}), see training.replaced"
+    )
     model = run.load("sparse-code-noise")
     nets = OnnxNetworks(bundle)
     x = np.random.default_rng(0).standard_normal(

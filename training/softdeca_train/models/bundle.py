@@ -10,6 +10,7 @@ import io
 import json
 import tarfile
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -433,8 +434,20 @@ def replace_networks(
     training["replaced"] = [*training.get("replaced", []), {"networks": sorted(modules), **record}]
     manifest["training"] = training
     manifest["errors"] = {**(manifest.get("errors") or {}), **(errors or {})}
+    manifest["description"] = replaced_description(manifest.get("description", ""), modules, record)
     (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
     return deviations
+
+
+REPLACED = "; replaced since: "
+
+
+def replaced_description(description: str, modules: Iterable[str], record: dict) -> str:
+    """The bundle's description with its latest replacement named (the full history is in
+    training.replaced): a description that says what trained the bundle stays true."""
+    dataset = (record.get("dataset") or {}).get("name", "another dataset")
+    what = f"{', '.join(sorted(modules))} ({record.get('model', 'a model')} on {dataset})"
+    return f"{description.split(REPLACED)[0]}{REPLACED}{what}, see training.replaced"
 
 
 def _add_file(

@@ -101,15 +101,21 @@ class WeightEncoder(nn.Module):
 
 
 class LandmarkEncoder(nn.Module):
-    """f_L: landmark offsets from the avatar's neutral landmarks (metres) -> z (per frame)."""
+    """f_L: landmark offsets from the avatar's neutral landmarks (metres) -> z (per frame): a
+    linear map (what a ridge regression reads off the landmarks, set in closed form) plus an
+    MLP for what is not linear in them."""
 
     def __init__(self, n_landmarks: int, sizes: NetworkSizes, offset_scale: float = 100.0) -> None:
         super().__init__()
         self.offset_scale = offset_scale  # metres -> centimetres: inputs of order one
         self.net = mlp([3 * n_landmarks, *sizes.f_l_hidden, sizes.latent])
+        self.skip = nn.Linear(3 * n_landmarks, sizes.latent)
+        nn.init.zeros_(self.skip.weight)
+        nn.init.zeros_(self.skip.bias)
 
     def forward(self, landmark_offsets: torch.Tensor) -> torch.Tensor:
-        return self.net(landmark_offsets * self.offset_scale)
+        x = landmark_offsets * self.offset_scale
+        return self.skip(x) + self.net(x)
 
 
 class ElementMLP(nn.Module):

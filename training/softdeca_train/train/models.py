@@ -107,11 +107,12 @@ def init_basis(
     unit: float,
     ridge_scale: float = 0.1,
     readout: bool = True,
-) -> None:
+) -> torch.Tensor:
     """Start a model "output = z(inputs) . L" at the data's principal components: L's base
     table = the leading modes of `targets` (n, elements * k, in `unit`s), and the encoder's
     last layer = the ridge least-squares readout of the mode coefficients from its (random)
-    features. Training then refines both instead of discovering the modes from noise."""
+    features (`readout`; else zero). Training then refines both instead of discovering the
+    modes from noise. Returns the frames' mode coefficients (n, k)."""
     assert hyper.base is not None
     n, k = len(targets), hyper.latent
     m = targets.reshape(n, -1).double() / unit
@@ -123,12 +124,12 @@ def init_basis(
     hyper.base.copy_(base)
     last = encoder[-1]
     assert isinstance(last, nn.Linear)
+    target = torch.zeros(n, k, dtype=torch.float64)
+    target[:, :k_data] = u[:, :k_data] * np.sqrt(n)
     if not readout:  # z = 0: the model starts exactly at its input (no correction)
         last.weight.zero_()
         last.bias.zero_()
-        return
-    target = torch.zeros(n, k, dtype=torch.float64)
-    target[:, :k_data] = u[:, :k_data] * np.sqrt(n)
+        return target
     feats = encoder[:-1](inputs).double()
     a = torch.cat([feats, torch.ones(n, 1, dtype=torch.float64)], 1)
     # a strong ridge (relative to the features' scale): the readout must generalise from a
@@ -137,6 +138,7 @@ def init_basis(
     w = torch.linalg.solve(a.T @ a + ridge, a.T @ target)  # (hidden + 1, k)
     last.weight.copy_(w[:-1].T.float())
     last.bias.copy_(w[-1].float())
+    return target
 
 
 def expand(p: torch.Tensor, n: int) -> torch.Tensor:
@@ -523,10 +525,56 @@ class SparseSoftDeca(Trainable):
         off = self.inputs(batch) - self.neutral_landmarks(batch.neutral)
         return off.reshape(len(off), -1)
 
-    def init_from_data(self, batches: Sequence[Batch]) -> None:
-        x = torch.cat([self.offsets(b) * self.f_l.offset_scale for b in batches])
-        off = torch.cat([b.T - b.neutral for b in batches])
-        init_basis(self.f_ph_v, self.f_l.net, x, off.reshape(len(off), -1), CM)
+    @torch.no_grad()
+    def init_from_dataset(
+        self, data: Dataset, *_: object, progress: bool = True, **__: object
+    ) -> None:
+        """The closed-form start over every kept sparse train frame (the order of frames, other
+        datasets and contrasts do not matter to it): L_v's base = the leading
+        principal components of the deformations, f_L's linear path = the ridge regression of
+        their coefficients on the clean landmark offsets, with the ridge that training on
+        landmarks noisy by the dataset's sigma amounts to (n sigma^2; Bishop 1995); the MLPs'
+        output layers at zero. On softdeca-l3-d1's test split such a regression (64 global
+        modes) is 0.54 mm from the physics on noisy landmarks, where the random-feature start
+        trained 40 minutes was 0.67."""
+        x, y = [], []
+        kept = data.left_out("sparse", "train")["kept"]
+        bar = tqdm(total=kept, desc="sparse closed form", unit="frame", disable=not progress)
+        for b in data.batches("sparse", "train"):
+            lm = b.landmarks_clean if b.landmarks_clean is not None else self.landmarks_on(b.S)
+            x.append((lm - self.neutral_landmarks(b.neutral)).reshape(b.frames, -1).double())
+            y.append((b.T - b.neutral).reshape(b.frames, -1))
+            bar.update(b.frames)
+        bar.close()
+        if not x:
+            raise ValueError(f"the dataset {data.folder} has no usable sparse training frames")
+        inputs = torch.cat(x) * self.f_l.offset_scale
+        coefficients = init_basis(
+            self.f_ph_v, self.f_l.net, inputs, torch.cat(y), CM, readout=False
+        )
+        del y
+        sigma = (
+            float(data.manifest["header"]["config"].get("landmark_noise_mm", 0.0))
+            if self.noisy
+            else 0.0
+        )
+        sigma_units = sigma * 1e-3 * self.f_l.offset_scale
+        n = len(inputs)
+        a = torch.cat([inputs, torch.ones(n, 1, dtype=torch.float64)], 1)
+        gram = a.T @ a
+        # n sigma^2 on the offsets (the bias free); a floor relative to the inputs' scale keeps
+        # the clean-landmark ablation well posed
+        ridge = (n * sigma_units**2 + 1e-6 * float(gram.diagonal().mean())) * torch.eye(
+            len(gram), dtype=torch.float64
+        )
+        ridge[-1, -1] = 0
+        w = torch.linalg.solve(gram + ridge, a.T @ coefficients)
+        self.f_l.skip.weight.copy_(w[:-1].T.float())
+        self.f_l.skip.bias.copy_(w[-1].float())
+        last = self.f_ph_v.body.rest[-1][-1]
+        assert isinstance(last, nn.Linear)
+        last.weight.zero_()
+        last.bias.zero_()
 
     def predict(self, batch: Batch) -> torch.Tensor:
         offsets = self.offsets(batch)

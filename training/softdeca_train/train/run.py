@@ -170,7 +170,9 @@ class Run:
         fresh = not self.checkpoint(name).is_file()
         if fresh:
             rng = np.random.default_rng(cfg.seed)
-            model.init_from_dataset(self.data, rng, progress, self.contrasts, self.more_static)
+            model.init_from_dataset(
+                self.data, rng, progress=progress, contrasts=self.contrasts, more=self.more_static
+            )
         summary = train(model, self.data, cfg, self.folder, name, progress)
         summary["config"] = asdict(cfg)
         (self.folder / f"{name}.summary.json").write_text(json.dumps(summary, indent=1) + "\n")
