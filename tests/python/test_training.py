@@ -84,39 +84,52 @@ def _mean_mm(offsets: torch.Tensor) -> float:
 
 def test_sparsesoftdeca_starts_at_its_closed_form(run: Run) -> None:
     """Before any step, SparseSoftDECA on clean landmarks is the deformations' principal
-    components read off the landmarks by ridge regression: with fewer train frames than landmark
-    coordinates the regression interpolates, so on those frames it is as close to the physics as
-    the components themselves, where the untrained model is far."""
+    components read off the landmarks by ridge regression, each frame from the data's donor and
+    from ARKit's reference face: with fewer such rows than landmark coordinates the regression
+    interpolates, so on those frames it is as close to the physics as the components themselves
+    from either donor, where the untrained model is far."""
+    from dataclasses import replace
+
+    from softdeca_train.landmarks.arkit_reference import ArkitFace
     from softdeca_train.train.registry import MODELS
 
     torch.manual_seed(0)
     model = MODELS["sparse-no-noise"].make(run.definition, run.specs, run.sizes)
     batches = list(run.data.batches("sparse", "train", None, 8))
     y = torch.cat([(b.T - b.neutral).reshape(b.frames, -1) for b in batches]).double()
-    assert len(y) < 3 * len(run.definition.landmarks.triangle)
+    assert 2 * len(y) < 3 * len(run.definition.landmarks.triangle)
     _, _, vt = torch.linalg.svd(y, full_matrices=False)
     modes = vt[: run.sizes.latent]
     floor = _mean_mm(y - (y @ modes.T) @ modes)
+    face = ArkitFace.load()
+    phone = [
+        replace(b, landmarks_clean=model.arkit_landmarks(b, face)) for b in batches
+    ]
 
-    def error() -> float:
+    def error(frames: list) -> float:
         with torch.no_grad():
-            return _mean_mm(
-                torch.cat([model.predict(b) - b.neutral for b in batches]).reshape(
-                    y.shape
-                )
-                - y
-            )
+            out = torch.cat([model.predict(b) - b.neutral for b in frames])
+            return _mean_mm(out.reshape(y.shape) - y)
 
-    before = error()
+    before = error(batches)
     model.init_from_dataset(run.data, progress=False)
-    start = error()
+    for frames, donor in ((batches, "the data's donor"), (phone, "ARKit's face")):
+        below(
+            error(frames),
+            1.05 * floor + 1e-3,
+            "the regression interpolates the modes' coefficients (ridge 1e-6 of the inputs' "
+            "scale)",
+            what=f"mm, {donor}",
+        )
     below(
-        start,
-        1.05 * floor + 1e-3,
-        "the regression interpolates the modes' coefficients (ridge 1e-6 of the inputs' scale)",
-        what="mm",
+        error(batches), 0.5 * before, "the untrained model is nowhere near", what="mm"
     )
-    below(start, 0.5 * before, "the untrained model is nowhere near", what="mm")
+    # at rest ARKit's face lands on the head's own neutral landmarks
+    rest = replace(batches[0], weights=torch.zeros_like(batches[0].weights))
+    own = model.neutral_landmarks(rest.neutral)
+    assert torch.allclose(
+        model.arkit_landmarks(rest, face), own.expand(rest.frames, -1, -1), atol=1e-6
+    )
 
 
 def test_dynamics_learn_and_stay_stable(run: Run) -> None:

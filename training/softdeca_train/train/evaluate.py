@@ -15,6 +15,7 @@ import torch
 from tqdm import tqdm
 
 from softdeca_train.data.config import GenerateConfig
+from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.train.batches import EVERY_FRAME, Batch
 from softdeca_train.train.models import (
@@ -34,8 +35,9 @@ from softdeca_train.train.models import (
 from softdeca_train.train.run import Run
 
 # SparseSoftDECA inputs for Table 2: the simulated head's own landmarks (on its S_t), another
-# head's expression personalised to it (clean), and the same with the augmentation's noise.
-SPARSE_INPUTS = ("same_head", "other_head", "other_head_noise")
+# head's expression personalised to it (clean), the same with the augmentation's noise, and
+# ARKit's reference face making the expression, personalised to it (what a phone sends).
+SPARSE_INPUTS = ("same_head", "other_head", "other_head_noise", "arkit_face")
 
 
 @dataclass
@@ -71,12 +73,18 @@ class ErrorSum:
         return None if self.per_vertex is None else 1e3 * self.per_vertex / self.frames
 
 
-def _with_landmarks(batch: Batch, which: str, model: SparseSoftDeca) -> Batch:
+def _with_landmarks(
+    batch: Batch, which: str, model: SparseSoftDeca, face: ArkitFace | None
+) -> Batch:
     if which == "same_head":
         own = model.landmarks_on(batch.S)
         return replace(batch, landmarks=own, landmarks_clean=own)
     if which == "other_head":
         return replace(batch, landmarks=batch.landmarks_clean)
+    if which == "arkit_face":
+        assert face is not None
+        phone = model.arkit_landmarks(batch, face)
+        return replace(batch, landmarks=phone, landmarks_clean=phone)
     return batch
 
 
@@ -108,11 +116,12 @@ def measure(
     # groups: the datasets have 2 or 8 frames per group). A test split is judged on every
     # frame; a train split on the frames training saw.
     max_error = EVERY_FRAME if split == "test" else None
+    face = ArkitFace.load() if which == "arkit_face" else None
     for batch in run.data.batches(model.kind, split, None, 8, max_error):
         if isinstance(model, GroupOffsetOracle) and len(batch.T) < 2:
             continue  # a group of one frame: its own T is its offset, nothing is measured
         if isinstance(model, SparseSoftDeca) and which:
-            batch = _with_landmarks(batch, which, model)
+            batch = _with_landmarks(batch, which, model, face)
         acc.add(vertex_error(model.predict(batch), batch.T), batch.source_take, take)
     return acc  # may hold no frame: the dataset has none of the kind
 

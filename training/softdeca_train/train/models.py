@@ -14,7 +14,9 @@ import torch
 from torch import nn
 from tqdm import tqdm
 
+from softdeca_train.data.personalise import personalise
 from softdeca_train.data.plan import FIXED
+from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.models.networks import (
     EXPRESSION_SLOTS,
@@ -507,6 +509,8 @@ class SparseSoftDeca(Trainable):
         self.register_buffer(
             "lm_bary", torch.as_tensor(d.landmarks.bary, dtype=torch.float32), persistent=False
         )
+        self.arkit_vertex = np.asarray(d.landmarks.arkit_vertex, dtype=np.int64)
+        self.arkit_vertex_count = d.landmarks.arkit_vertex_count
 
     def neutral_landmarks(self, neutral: torch.Tensor) -> torch.Tensor:
         return (neutral[self.lm_corners] * self.lm_bary[..., None]).sum(1)  # (K, 3)
@@ -520,6 +524,22 @@ class SparseSoftDeca(Trainable):
         lm = batch.landmarks if self.noisy else batch.landmarks_clean
         return self.landmarks_on(batch.S) if lm is None else lm
 
+    def arkit_landmarks(self, batch: Batch, face: ArkitFace) -> torch.Tensor:
+        """ARKit's reference face making the batch's expressions (its own shapes at the frames'
+        weights), personalised to the batch's head as the runtime calibrates a phone's face:
+        what a phone sends, where the data's donors are other ICT heads. (B, K, 3)."""
+        if len(face.neutral) != self.arkit_vertex_count:
+            raise ValueError(
+                f"the landmarks are vertices of a {self.arkit_vertex_count}-vertex face, "
+                f"not of ARKit's reference face ({len(face.neutral)} vertices)"
+            )
+        k = self.arkit_vertex
+        frames = face.neutral[k] + np.tensordot(
+            batch.weights.double().numpy(), face.deltas[:, k], 1
+        )
+        own = self.neutral_landmarks(batch.neutral).double().numpy()
+        return torch.as_tensor(personalise(face.neutral[k], frames, own), dtype=torch.float32)
+
     def offsets(self, batch: Batch) -> torch.Tensor:
         """The encoder's input: tracked landmarks minus the neutral ones, (B, 3K)."""
         off = self.inputs(batch) - self.neutral_landmarks(batch.neutral)
@@ -532,7 +552,8 @@ class SparseSoftDeca(Trainable):
         """The closed-form start over every kept sparse train frame (the order of frames, other
         datasets and contrasts do not matter to it): L_v's base = the leading
         principal components of the deformations, f_L's linear path = the ridge regression of
-        their coefficients on the clean landmark offsets, with the ridge that training on
+        their coefficients on the clean landmark offsets (each frame's from the data's donor
+        and, when the landmarks are ARKit's face's, from that face), with the ridge that training on
         landmarks noisy by the dataset's sigma amounts to (n sigma^2; Bishop 1995); the MLPs'
         output layers at zero. On softdeca-l3-d1's test split such a regression (64 global
         modes) is 0.54 mm from the physics on noisy landmarks, where the random-feature start
@@ -540,10 +561,21 @@ class SparseSoftDeca(Trainable):
         x, y = [], []
         kept = data.left_out("sparse", "train")["kept"]
         bar = tqdm(total=kept, desc="sparse closed form", unit="frame", disable=not progress)
+        face: ArkitFace | None = ArkitFace.load()
+        if len(face.neutral) != self.arkit_vertex_count:
+            face = None  # landmarks on another face (a synthetic definition)
         for b in data.batches("sparse", "train"):
-            lm = b.landmarks_clean if b.landmarks_clean is not None else self.landmarks_on(b.S)
-            x.append((lm - self.neutral_landmarks(b.neutral)).reshape(b.frames, -1).double())
-            y.append((b.T - b.neutral).reshape(b.frames, -1))
+            own = self.neutral_landmarks(b.neutral)
+            # every frame twice, when the landmarks are ARKit's face's: from the data's donor
+            # (another ICT head) and from ARKit's reference face, what phones send
+            donors = [
+                b.landmarks_clean if b.landmarks_clean is not None else self.landmarks_on(b.S)
+            ]
+            if face is not None:
+                donors.append(self.arkit_landmarks(b, face))
+            for lm in donors:
+                x.append((lm - own).reshape(b.frames, -1).double())
+                y.append((b.T - b.neutral).reshape(b.frames, -1))
             bar.update(b.frames)
         bar.close()
         if not x:

@@ -394,10 +394,12 @@ def sparse_section(run: Run, e: dict, bundle_sparse: dict | None) -> list[str]:
         f"Run `{run.folder}` on dataset `{Path(run.config.dataset).name}` ({cfg['sparse']} "
         "sparse frames, its test split). Inputs: the simulated head's own landmarks on S_t "
         "(same head); another head's expression personalised to this head (other head); the "
-        f"same with the augmentation's coordinate noise (sigma {cfg['landmark_noise_mm']} mm).",
+        f"same with the augmentation's coordinate noise (sigma {cfg['landmark_noise_mm']} mm); "
+        "ARKit's reference face making the expression with its own shapes, personalised to "
+        "this head as the runtime calibrates a phone's face (ARKit face).",
         "",
-        "| trained | same head | other head | other head + noise | training |",
-        "| --- | ---: | ---: | ---: | ---: |",
+        "| trained | same head | other head | other head + noise | ARKit face | training |",
+        "| --- | ---: | ---: | ---: | ---: | ---: |",
     ]
     for name, label in SPARSE_ROWS:
         if f"{name}/same_head" in e:
@@ -405,7 +407,7 @@ def sparse_section(run: Run, e: dict, bundle_sparse: dict | None) -> list[str]:
             lines.append(f"| {label} | {cells} | {_training(run, name)} |")
     if bundle_sparse is not None:
         lines.append(
-            f"| the bundle end to end (ONNX, encoder's h) | – | – | {_row(bundle_sparse)} | – |"
+            f"| the bundle end to end (ONNX, encoder's h) | – | – | {_row(bundle_sparse)} | – | – |"
         )
     return lines
 
@@ -504,5 +506,6 @@ def _write_bench(folder: Path, r: dict, run: Run) -> None:
     fig("no_correction_static_mm", get("no-correction"), "mm", None)
     fig("mlp_equal_time_static_mm", get("mlp-equal-time"), "mm", None)
     fig("sparse_other_head_noise_mm", get("sparse/other_head_noise"), "mm", 1.5)
+    fig("sparse_arkit_face_mm", get("sparse/arkit_face"), "mm", None)
     fig("softdeca_torch_ms_per_frame", ms.get("softdeca"), "ms", None)
     write_area(folder, "models", figs)
