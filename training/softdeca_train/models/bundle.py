@@ -160,6 +160,13 @@ def _modules(nets: BundleNetworks) -> dict[str, nn.Module]:
     return out
 
 
+# The export check's inputs in the networks' domain, in metres: a head's points span about 20 cm
+# and its landmarks move up to about 2 cm either way. Random points in a metre's cube would judge
+# the encoders' float32 sums far outside it (codes in the thousands, float32 steps of 1e-3).
+HEAD_SPAN_M = 0.2
+LANDMARK_OFFSET_SPAN_M = 0.04
+
+
 def _example(spec: dict[str, Any]) -> tuple[torch.Tensor, ...]:
     out = []
     for t in spec["inputs"]:
@@ -167,6 +174,10 @@ def _example(spec: dict[str, Any]) -> tuple[torch.Tensor, ...]:
         x = torch.rand(*shape)
         if t["name"] == "parameters":
             x = x * 0  # replaced by in-range values in export_bundle
+        elif t["name"] == "neutral":
+            x = x * HEAD_SPAN_M
+        elif t["name"] == "landmark_offsets":
+            x = (x - 0.5) * LANDMARK_OFFSET_SPAN_M
         out.append(x)
     return tuple(out)
 
