@@ -555,9 +555,8 @@ class SparseSoftDeca(Trainable):
         their coefficients on the clean landmark offsets (each frame's from the data's donor
         and, when the landmarks are ARKit's face's, from that face), with the ridge that training on
         landmarks noisy by the dataset's sigma amounts to (n sigma^2; Bishop 1995); the MLPs'
-        output layers at zero. On softdeca-l3-d1's test split such a regression (64 global
-        modes) is 0.54 mm from the physics on noisy landmarks, where the random-feature start
-        trained 40 minutes was 0.67."""
+        output layers at zero. It is nearer the physics than the random-feature start after
+        40 minutes of steps, and steps from it make it worse (docs/training.md)."""
         x, y = [], []
         kept = data.left_out("sparse", "train")["kept"]
         bar = tqdm(total=kept, desc="sparse closed form", unit="frame", disable=not progress)
