@@ -132,6 +132,19 @@ def test_sparsesoftdeca_starts_at_its_closed_form(run: Run) -> None:
     )
 
 
+def test_a_runs_summary_says_how_many_train_frames_it_could_read(run: Run) -> None:
+    """The stage summary (and so a bundle's training record) counts the train frames the
+    dataset listed when the run started and when it ended."""
+    summary = run.train("sparse-no-noise", LoopConfig(steps=2, seed=1), progress=False)
+    kept = run.data.left_out("sparse", "train")["kept"]
+    assert summary["train_frames_listed"] == {
+        "kind": "sparse",
+        "at_start": kept,
+        "at_end": kept,
+    }
+    assert kept > 0
+
+
 def test_dynamics_learn_and_stay_stable(run: Run) -> None:
     if not run.finished("softdeca"):
         run.train("softdeca", LoopConfig(steps=20, seed=1), progress=False)

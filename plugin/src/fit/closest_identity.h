@@ -26,7 +26,7 @@ std::vector<float> fit_identity(const TemplateData& t, const std::vector<Match>&
 // coefficients and a small rigid motion (discarded: the placement's error, not the identity's).
 // Point targets carry the registration's sliding along the skin, which the modes then take for
 // shape; distances to the surface do not. `use`: the template skin vertices that take part (the
-// face); `outside`: surface points to ignore (the avatar's open boundary).
+// fit takes the whole skin); `outside`: surface points to ignore (the avatar's open boundary).
 std::vector<float> refine_identity(const TemplateData& t, const geometry::SurfaceQuery& surface,
                                    const std::vector<uint8_t>& use,
                                    const std::function<bool(const geometry::SurfacePoint&)>& outside,

@@ -173,7 +173,19 @@ class Run:
             model.init_from_dataset(
                 self.data, rng, progress=progress, contrasts=self.contrasts, more=self.more_static
             )
+        # the train frames the run could read, when it started and when it ended: a dataset
+        # still being generated lists more finished shards each pass (loop.endless), and the
+        # training record's dataset summary is of the dataset as it is later
+        self.data.refresh()
+        at_start = self.data.left_out(model.kind, "train")["kept"]
         summary = train(model, self.data, cfg, self.folder, name, progress)
+        self.data.refresh()
+        at_end = self.data.left_out(model.kind, "train")["kept"]
+        summary["train_frames_listed"] = {
+            "kind": model.kind,
+            "at_start": at_start,
+            "at_end": at_end,
+        }
         summary["config"] = asdict(cfg)
         (self.folder / f"{name}.summary.json").write_text(json.dumps(summary, indent=1) + "\n")
         return summary
