@@ -411,8 +411,8 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   const Registration reg = register_rounds(s, guides, settings, [&](double share) { step("registering the template", 0.1 + 0.65 * share); });
   if (t.identity_count) {
     step("reading the identity", 0.75);
-    s.identity = refine_identity(t, s.matcher->neutral(), std::vector<uint8_t>(vs, 1),
-                                 [&](const geometry::SurfacePoint& p) { return s.matcher->on_boundary(p); }, s.identity);
+    s.identity = refine_identity(
+        t, s.matcher->neutral(), [&](const geometry::SurfacePoint& p) { return s.matcher->on_boundary(p); }, s.identity);
   }
 
   AvatarFit fit;

@@ -55,7 +55,6 @@ std::vector<float> fit_identity(const TemplateData& t, const std::vector<Match>&
 }
 
 std::vector<float> refine_identity(const TemplateData& t, const geometry::SurfaceQuery& surface,
-                                   const std::vector<uint8_t>& use,
                                    const std::function<bool(const geometry::SurfacePoint&)>& outside,
                                    std::vector<float> h) {
   // Ten Gauss-Newton steps; a point farther than kReach from the surface is no match, and the
@@ -76,7 +75,6 @@ std::vector<float> refine_identity(const TemplateData& t, const geometry::Surfac
     Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
     std::size_t matched = 0;
     for (std::size_t v = 0; v < vs; ++v) {
-      if (!use[v]) continue;
       const Eigen::Vector3d x = rotation * p.row(static_cast<Eigen::Index>(v)).transpose() + shift;
       const geometry::SurfacePoint c = surface.closest(x, kReach);
       if (c.triangle < 0 || outside(c)) continue;

@@ -3,7 +3,6 @@
 // starts), then to the avatar's surface itself (what the identity code is read off).
 #pragma once
 
-#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -25,10 +24,9 @@ std::vector<float> fit_identity(const TemplateData& t, const std::vector<Match>&
 // The identity refined against the avatar's surface itself: point-to-plane ICP over the
 // coefficients and a small rigid motion (discarded: the placement's error, not the identity's).
 // Point targets carry the registration's sliding along the skin, which the modes then take for
-// shape; distances to the surface do not. `use`: the template skin vertices that take part (the
-// fit takes the whole skin); `outside`: surface points to ignore (the avatar's open boundary).
+// shape; distances to the surface do not. Every skin vertex takes part; `outside`: surface
+// points to ignore (the avatar's open boundary).
 std::vector<float> refine_identity(const TemplateData& t, const geometry::SurfaceQuery& surface,
-                                   const std::vector<uint8_t>& use,
                                    const std::function<bool(const geometry::SurfacePoint&)>& outside,
                                    std::vector<float> h);
 

@@ -557,7 +557,7 @@ class SparseSoftDeca(Trainable):
         landmarks noisy by the dataset's sigma amounts to (n sigma^2; Bishop 1995); the MLPs'
         output layers at zero. It is nearer the physics than the random-feature start after
         40 minutes of steps, and steps from it make it worse (docs/training.md)."""
-        x, y = [], []
+        clean, phone, y = [], [], []
         kept = data.left_out("sparse", "train")["kept"]
         bar = tqdm(total=kept, desc="sparse closed form", unit="frame", disable=not progress)
         face: ArkitFace | None = ArkitFace.load()
@@ -565,25 +565,24 @@ class SparseSoftDeca(Trainable):
             face = None  # landmarks on another face (a synthetic definition)
         for b in data.batches("sparse", "train"):
             own = self.neutral_landmarks(b.neutral)
-            # every frame twice, when the landmarks are ARKit's face's: from the data's donor
-            # (another ICT head) and from ARKit's reference face, what phones send
-            donors = [
-                b.landmarks_clean if b.landmarks_clean is not None else self.landmarks_on(b.S)
-            ]
-            if face is not None:
-                donors.append(self.arkit_landmarks(b, face))
-            for lm in donors:
-                x.append((lm - own).reshape(b.frames, -1).double())
-                y.append((b.T - b.neutral).reshape(b.frames, -1))
+            lm = b.landmarks_clean if b.landmarks_clean is not None else self.landmarks_on(b.S)
+            clean.append((lm - own).reshape(b.frames, -1).double())
+            if face is not None:  # what phones send: ARKit's face making the same expression
+                phone.append((self.arkit_landmarks(b, face) - own).reshape(b.frames, -1).double())
+            y.append((b.T - b.neutral).reshape(b.frames, -1))
             bar.update(b.frames)
         bar.close()
-        if not x:
+        if not y:
             raise ValueError(f"the dataset {data.folder} has no usable sparse training frames")
-        inputs = torch.cat(x) * self.f_l.offset_scale
-        coefficients = init_basis(
-            self.f_ph_v, self.f_l.net, inputs, torch.cat(y), CM, readout=False
+        scale = self.f_l.offset_scale
+        # the basis and each frame's coefficients once; the regression reads them from each donor
+        per_frame = init_basis(
+            self.f_ph_v, self.f_l.net, torch.cat(clean) * scale, torch.cat(y), CM, readout=False
         )
         del y
+        donors = [torch.cat(clean)] + ([torch.cat(phone)] if phone else [])
+        inputs = torch.cat(donors) * scale
+        coefficients = per_frame.repeat(len(donors), 1)
         sigma = (
             float(data.manifest["header"]["config"].get("landmark_noise_mm", 0.0))
             if self.noisy
