@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "avatar_file.h"
+#include "imported_avatar.h"
 #include "bench_figures.h"
 #include "command.h"
 #include "json.h"

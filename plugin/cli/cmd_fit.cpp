@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "avatar_file.h"
+#include "imported_avatar.h"
 #include "command.h"
 #include "fit/avatar_frame.h"
 #include "fit_folder.h"

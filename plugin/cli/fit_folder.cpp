@@ -134,7 +134,7 @@ std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std
   return o.str(true) + "\n";
 }
 
-AvatarFile read_fitted_mesh(const std::string& dir, const AvatarLimits& limits) {
+AvatarFile read_fitted_mesh(const std::string& dir, const ImportLimits& limits) {
   const std::string report = (fs::path(dir) / "fit.json").string();
   std::string recorded, from_fit, names_file, want;
   try {

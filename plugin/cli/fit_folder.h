@@ -11,7 +11,7 @@
 
 #include <string>
 
-#include "avatar_file.h"
+#include "imported_avatar.h"
 
 namespace softdeca::cli {
 
@@ -23,6 +23,6 @@ std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std
 
 // The mesh a fit folder was made for, read again as the fit read it (its names file too);
 // throws std::runtime_error when it cannot be found or is not the mesh that was fitted.
-AvatarFile read_fitted_mesh(const std::string& dir, const AvatarLimits& limits = {});
+AvatarFile read_fitted_mesh(const std::string& dir, const ImportLimits& limits = {});
 
 }  // namespace softdeca::cli

@@ -2,9 +2,9 @@
 // the spot): the rig-name mapping file and the fit's own options.
 #pragma once
 
+#include "imported_avatar.h"
 #include "options.h"
 #include "runtime_session.h"
-#include "shape_names.h"
 
 namespace softdeca::cli {
 

@@ -8,50 +8,6 @@
 
 namespace softdeca::cli {
 
-ObjMesh read_obj(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot open " + path);
-  ObjMesh m;
-  std::string line;
-  std::vector<std::int32_t> poly;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const char* s = line.c_str();
-    while (*s == ' ' || *s == '\t') ++s;
-    if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
-      char* end = nullptr;
-      const char* p = s + 2;
-      for (int k = 0; k < 3; ++k) {
-        const float v = std::strtof(p, &end);
-        if (end == p) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad vertex");
-        m.vertices.push_back(v);
-        p = end;
-      }
-    } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t')) {
-      poly.clear();
-      const char* p = s + 2;
-      for (;;) {
-        while (*p == ' ' || *p == '\t') ++p;
-        if (!*p || *p == '\r') break;
-        char* end = nullptr;
-        long idx = std::strtol(p, &end, 10);
-        if (end == p) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": bad face");
-        const long n = static_cast<long>(m.vertex_count());
-        idx = idx < 0 ? n + idx : idx - 1;
-        if (idx < 0 || idx > 0x7fffffffL) throw std::runtime_error(path + ":" + std::to_string(line_no) + ": face index out of range");
-        poly.push_back(static_cast<std::int32_t>(idx));
-        p = end;
-        while (*p && *p != ' ' && *p != '\t') ++p;  // skip /vt/vn
-      }
-      for (std::size_t k = 1; k + 1 < poly.size(); ++k) m.triangles.insert(m.triangles.end(), {poly[0], poly[k], poly[k + 1]});
-    }
-  }
-  for (const std::int32_t i : m.triangles)
-    if (static_cast<std::size_t>(i) >= m.vertex_count()) throw std::runtime_error(path + ": face index beyond the vertices");
-  return m;
-}
-
 void write_obj(const std::string& path, const float* v, std::size_t nv, const float* n, const std::int32_t* t, std::size_t nt,
                const std::string& comment, const std::vector<ObjGroup>& groups) {
   std::FILE* f = std::fopen(path.c_str(), "wb");

@@ -1,5 +1,6 @@
-// Mesh files of the runtime tools: OBJ in and out (vertices, triangles, optional normals) and
-// PC2 point caches (Blender's Mesh Cache modifier reads them onto the neutral OBJ).
+// Mesh files the runtime tools write: OBJ (vertices, triangles, optional normals) and PC2 point
+// caches (Blender's Mesh Cache modifier reads them onto the neutral OBJ). OBJ files are read by
+// the import layer (plugin/import/obj_reader.h), named here for the tools.
 #pragma once
 
 #include <cstdint>
@@ -7,13 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "obj_reader.h"
+
 namespace softdeca::cli {
 
-struct ObjMesh {
-  std::vector<float> vertices;       // xyz
-  std::vector<std::int32_t> triangles;  // polygons fan-triangulated
-  std::size_t vertex_count() const { return vertices.size() / 3; }
-};
+using avatar_import::ObjMesh;
+using avatar_import::read_obj;
 
 // A named part of an OBJ: an `o <name>` line before its first triangle.
 struct ObjGroup {
@@ -21,8 +21,6 @@ struct ObjGroup {
   std::size_t first_triangle = 0;
 };
 
-// Reads `v` and `f` records (f may use v/vt/vn and negative indices). Throws std::runtime_error.
-ObjMesh read_obj(const std::string& path);
 void write_obj(const std::string& path, const float* vertices, std::size_t vertex_count, const float* normals,
                const std::int32_t* triangles, std::size_t triangle_count, const std::string& comment,
                const std::vector<ObjGroup>& groups = {});

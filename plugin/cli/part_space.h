@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "avatar_file.h"
+#include "imported_avatar.h"
 
 namespace softdeca::cli {
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "avatar_file.h"
+#include "imported_avatar.h"
 #include "part_space.h"
 #include "runtime_session.h"
 #include "surface_points.h"

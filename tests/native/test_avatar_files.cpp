@@ -1,4 +1,4 @@
-// Users' avatars in glTF and FBX read into the fit's one mesh (plugin/cli/avatar_file.h): which
+// Users' avatars in glTF and FBX read into the fit's one mesh (plugin/import/avatar_file.h): which
 // meshes are included, their vertex order, the ARKit shapes found under rigs' names and their
 // deltas, the parts' transforms and the way back to each part's own coordinates; hostile files.
 #include <gtest/gtest.h>
@@ -19,6 +19,7 @@
 #include "softdeca/softdeca.h"
 
 using namespace softdeca::cli;
+using namespace softdeca::avatar_import;
 using softdeca::test::expected_transform;
 using softdeca::test::TempDir;
 constexpr auto shape = softdeca::test::arkit_index;
@@ -115,7 +116,7 @@ bool has_unused(const AvatarFile& a, const std::string& mesh, const std::string&
   return false;
 }
 
-std::string error_of(const std::string& path, const AvatarLimits& limits = {}) {
+std::string error_of(const std::string& path, const ImportLimits& limits = {}) {
   try {
     read_avatar_file(path, ShapeNames(), limits);
   } catch (const std::exception& e) {
@@ -277,7 +278,7 @@ TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
   const std::string garbage = dir.write("garbage.fbx", std::string(4096, '\x5a'));
   EXPECT_NE(error_of(garbage).find(garbage), std::string::npos) << error_of(garbage);
   EXPECT_NE(error_of(dir.write("mesh.stl", "solid")).find("not an avatar"), std::string::npos);
-  EXPECT_NE(error_of(dir.file("missing.glb")).find("cannot read"), std::string::npos);
+  EXPECT_NE(error_of(dir.file("missing.glb")).find("cannot open"), std::string::npos);
 
   TestScene nan = avatar_scene();
   nan.meshes[0].vertices[4] = std::numeric_limits<float>::quiet_NaN();
@@ -297,14 +298,14 @@ TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
       << no_arkit_error;
 
   const std::string ok = dir.write("ok.glb", glb);
-  AvatarLimits small_file;
+  ImportLimits small_file;
   small_file.max_file_bytes = 100;
   EXPECT_NE(error_of(ok, small_file).find("more than the 100"), std::string::npos);
-  AvatarLimits few_vertices;
+  ImportLimits few_vertices;
   few_vertices.max_vertices = 5;
   const std::string too_many = error_of(ok, few_vertices);
   EXPECT_NE(too_many.find("mesh 'Head': 6 vertices, more than the 5"), std::string::npos) << too_many;
-  AvatarLimits few_in_all;
+  ImportLimits few_in_all;
   few_in_all.max_vertices = 8;
   EXPECT_NE(error_of(ok, few_in_all).find("the meshes with ARKit shapes have more than the 8"), std::string::npos);
 }

@@ -1,16 +1,20 @@
 // Avatar folders (neutral.obj, blendshapes/<rig name>.obj) and mapping files of rig names
-// (plugin/cli/avatar_file.h, shape_names.h).
+// (plugin/import/avatar_file.h, shape_names.h).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <filesystem>
 
 #include <string>
 #include <vector>
 
 #include "avatar_file.h"
 #include "avatar_test_files.h"
+#include "input_files.h"
 #include "shape_names.h"
 #include "softdeca/softdeca.h"
 
-using namespace softdeca::cli;
+using namespace softdeca::avatar_import;
 using softdeca::test::TempDir;
 constexpr auto shape = softdeca::test::arkit_index;
 
@@ -72,7 +76,7 @@ TEST(AvatarFolder, BadFoldersGetErrorsNamingTheFile) {
 
   dir.write("nan/neutral.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
   dir.write("nan/blendshapes/jawOpen.obj", quad(0.1f, 3));
-  EXPECT_NE(error_of(dir.file("nan")).find("mesh 'nan': vertex 1 is not finite"), std::string::npos) << error_of(dir.file("nan"));
+  EXPECT_NE(error_of(dir.file("nan")).find("nan/neutral.obj:2: a vertex coordinate is not finite"), std::string::npos) << error_of(dir.file("nan"));
 
   dir.write("none/neutral.obj", quad(0));
   dir.write("none/blendshapes/smile.obj", quad(0.1f));
@@ -119,4 +123,51 @@ TEST(AvatarFolder, TheMeshHashNamesTheMeshAsRead) {
   EXPECT_EQ(avatar_mesh_sha256(read_avatar_file(dir.file("head"))), first);
   dir.write("head/blendshapes/jawOpen.obj", quad(0.25f));
   EXPECT_NE(avatar_mesh_sha256(read_avatar_file(dir.file("head"))), first);
+}
+
+TEST(InputFiles, AnAvatarsOwnPathsStayInItsFolder) {
+  using softdeca::avatar_import::confined_steps;
+  EXPECT_EQ(confined_steps("a/./b/../c.bin"), (std::vector<std::string>{"a", "c.bin"}));
+  const auto refusal = [](const std::string& path) {
+    try {
+      confined_steps(path);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal("../outside/buf.bin").find("leads out of the avatar's folder"), std::string::npos);
+  EXPECT_NE(refusal("a/../../b").find("leads out"), std::string::npos);
+  EXPECT_NE(refusal("/etc/passwd").find("absolute path"), std::string::npos);
+  EXPECT_NE(refusal("file:buf.bin").find("drive or a scheme"), std::string::npos);
+  EXPECT_NE(refusal("C:/x").find("drive or a scheme"), std::string::npos);
+  EXPECT_NE(refusal("..\\x").find("backslash"), std::string::npos);
+  EXPECT_NE(refusal("a/..").find("folder itself"), std::string::npos);
+  EXPECT_NE(refusal("").find("empty path"), std::string::npos);
+}
+
+TEST(InputFiles, LinksFifosAndFoldersAreRefusedAtOnce) {
+  const TempDir dir("input-files");
+  dir.write("avatar/buf.bin", "abc");
+  dir.write("secret.txt", "SECRET");
+  std::filesystem::create_symlink(dir.file("secret.txt"), dir.file("avatar/link.bin"));
+  std::filesystem::create_directory_symlink(dir.dir, dir.file("avatar/up"));
+  ASSERT_EQ(::mkfifo(dir.file("avatar/pipe.bin").c_str(), 0600), 0);
+  const softdeca::avatar_import::InputFolder folder(dir.file("avatar"));
+  EXPECT_EQ(folder.read("buf.bin", 100, "a buffer"), "abc");
+  const auto refusal = [&](const std::string& path, std::uint64_t max = 100) {
+    try {
+      folder.read(path, max, "a buffer");
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("read");
+  };
+  EXPECT_NE(refusal("link.bin").find("is a symbolic link"), std::string::npos) << refusal("link.bin");
+  EXPECT_NE(refusal("up/secret.txt").find("'up' is a symbolic link"), std::string::npos) << refusal("up/secret.txt");
+  EXPECT_NE(refusal("pipe.bin").find("is a FIFO"), std::string::npos) << refusal("pipe.bin");
+  EXPECT_NE(refusal("missing.bin").find("does not exist"), std::string::npos);
+  EXPECT_NE(refusal("buf.bin", 2).find("more than the 2"), std::string::npos);
+  EXPECT_FALSE(folder.has_folder("up"));
+  EXPECT_EQ(folder.list(".", 10).size(), 1u);  // buf.bin: links, FIFOs and folders are not listed
 }

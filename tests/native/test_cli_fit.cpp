@@ -72,7 +72,7 @@ class CliFit : public ::testing::Test {
  protected:
   void SetUp() override {
     if (rt::data_dir().empty()) GTEST_SKIP() << "SOFTDECA_TEST_DATA is not set (ctest's runtime_test_data fixture)";
-    if (!softdeca::cli::scene_files_supported()) GTEST_SKIP() << "built without assimp";
+    if (!softdeca::avatar_import::scene_files_supported()) GTEST_SKIP() << "built without assimp";
     head_ = rt::Head::load();
     bundle_ = rt::data_dir() + "/bundle";
     take_ = rt::data_dir() + "/take.csv";

@@ -1,6 +1,6 @@
 """The native library's layers (NATIVE_LAYERS): core/ below everything, the C ABI (api/) on
 top, nothing below api/ including it, and every area including only areas of lower layers.
-The training package's layers (PYTHON_LAYERS): no import cycle, areas importing only
+The import layer (plugin/import) below every host. The training package's layers (PYTHON_LAYERS): no import cycle, areas importing only
 downwards, and imports at module top but for a few explained ones."""
 
 from __future__ import annotations
@@ -33,6 +33,34 @@ def test_nothing_below_the_c_abi_includes_it() -> None:
         if inc.startswith("api/")
     ]
     assert offenders == []
+
+
+IMPORT = SRC.parent / "import"
+CLI = SRC.parent / "cli"
+# What the import layer (plugin/import) may include: the library's lower areas it reads with
+# (core's file opening and errors, the bundle's JSON parser and hash), the public header for
+# the names rule, and its own files; never the C ABI's internals or a host (the command line).
+IMPORT_MAY_INCLUDE = (
+    "core/",
+    "bundle/json.h",
+    "bundle/sha256.h",
+    "softdeca/softdeca.h",
+)
+
+
+def test_the_import_layer_includes_no_host() -> None:
+    own = {p.name for p in IMPORT.iterdir() if p.suffix in (".h", ".cpp")}
+    cli = {p.name for p in CLI.iterdir() if p.suffix in (".h", ".cpp")}
+    files = [p for p in IMPORT.iterdir() if p.suffix in (".h", ".cpp")]
+    assert files
+    offenders = [
+        f"{p.name} includes {inc}"
+        for p in files
+        for inc in local_includes(p)
+        if inc not in own and not inc.startswith(IMPORT_MAY_INCLUDE)
+    ]
+    assert offenders == []
+    assert not own & cli, f"files in both plugin/import and plugin/cli: {own & cli}"
 
 
 def test_core_depends_on_nothing_but_the_public_header() -> None:

@@ -6,10 +6,10 @@
 
 #include "avatar_source.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 // Merges the vertices of `mesh` that are bitwise equal in the neutral and in every shape whose
 // size matches the mesh; triangles and shapes follow.
 void weld_corners(SourceMesh& mesh);
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

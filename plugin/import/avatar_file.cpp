@@ -10,8 +10,9 @@
 #include <stdexcept>
 
 #include "bundle/sha256.h"
+#include "file_format.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 namespace {
 using Matrix = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
@@ -19,14 +20,6 @@ using Matrix = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
 bool is_directory(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-std::string lower_extension(const std::string& path) {
-  const std::size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || path.find_first_of("/\\", dot) != std::string::npos) return "";
-  std::string ext = path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
 }
 
 // Where a mesh goes wrong, in the words of the error messages: "<file>: mesh '<name>': ".
@@ -102,18 +95,6 @@ AvatarPart append(AvatarFile& avatar, const SourceMesh& mesh, const ShapeChoice&
 }
 }  // namespace
 
-std::uint64_t require_file_within(const std::string& path, const AvatarLimits& limits) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw std::runtime_error("cannot read " + path);
-  if (!S_ISREG(st.st_mode)) throw std::runtime_error(path + " is not a regular file");
-  const auto size = static_cast<std::uint64_t>(st.st_size);
-  if (size == 0) throw std::runtime_error(path + " is empty");
-  if (size > limits.max_file_bytes)
-    throw std::runtime_error(path + ": " + std::to_string(size) + " bytes, more than the " +
-                             std::to_string(limits.max_file_bytes) + " an avatar file may have");
-  return size;
-}
-
 std::size_t AvatarFile::shape_count() const {
   std::size_t n = 0;
   for (const auto& s : shape_sources) n += !s.empty();
@@ -132,7 +113,7 @@ softdeca_avatar_mesh AvatarFile::abi_mesh() const {
   return m;
 }
 
-AvatarFile assemble_avatar(SourceScene scene, const std::string& path, const ShapeNames& names, const AvatarLimits& limits) {
+AvatarFile assemble_avatar(SourceScene scene, const std::string& path, const ShapeNames& names, const ImportLimits& limits) {
   AvatarFile avatar;
   avatar.path = path;
   avatar.format = scene.format;
@@ -184,10 +165,9 @@ AvatarFile assemble_avatar(SourceScene scene, const std::string& path, const Sha
   return avatar;
 }
 
-AvatarFile read_avatar_file(const std::string& path, const ShapeNames& names, const AvatarLimits& limits) {
+AvatarFile read_avatar_file(const std::string& path, const ShapeNames& names, const ImportLimits& limits) {
   if (is_directory(path)) return assemble_avatar(read_avatar_folder(path, names, limits), path, names, limits);
-  const std::string ext = lower_extension(path);
-  if (ext != "gltf" && ext != "glb" && ext != "vrm" && ext != "fbx")
+  if (!is_avatar_file_name(path))
     throw std::runtime_error(path + ": not an avatar (a .gltf, .glb, .vrm or .fbx file, or a folder with neutral.obj)");
   return assemble_avatar(read_scene_file(path, limits), path, names, limits);
 }
@@ -200,4 +180,4 @@ std::string avatar_mesh_sha256(const AvatarFile& avatar) {
   return runtime::sha256_hex(reinterpret_cast<const std::uint8_t*>(all.data()), all.size());
 }
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -20,7 +20,7 @@
 #include "shape_names.h"
 #include "softdeca/softdeca.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 struct AvatarPart {
   std::string name;
@@ -65,13 +65,13 @@ struct AvatarFile {
 // and an optional mapping file). Throws std::runtime_error naming the file, and the mesh where
 // one is at fault: unreadable or truncated files, NaN vertices, shapes of another vertex count,
 // files or meshes beyond the limits, no mesh with an ARKit shape.
-AvatarFile read_avatar_file(const std::string& path, const ShapeNames& names = {}, const AvatarLimits& limits = {});
+AvatarFile read_avatar_file(const std::string& path, const ShapeNames& names = {}, const ImportLimits& limits = {});
 
 // The chosen meshes of a scene joined into one (what read_avatar_file does after reading).
-AvatarFile assemble_avatar(SourceScene scene, const std::string& path, const ShapeNames& names, const AvatarLimits& limits);
+AvatarFile assemble_avatar(SourceScene scene, const std::string& path, const ShapeNames& names, const ImportLimits& limits);
 
 // SHA-256 of the mesh as read (its neutral, triangles and 52 shapes): names the exact mesh a
 // fit was made for, however it was stored.
 std::string avatar_mesh_sha256(const AvatarFile& avatar);
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

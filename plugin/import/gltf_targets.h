@@ -7,10 +7,10 @@
 
 #include "avatar_source.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 // Throws std::runtime_error "<path>: mesh '<name>': shape '<target>' has N vertices, the mesh M".
 // A JSON part it cannot read is left to assimp, which reports it.
-void check_gltf_targets(const std::string& path, const AvatarLimits& limits);
+void check_gltf_targets(const std::string& bytes, const std::string& path);
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -3,7 +3,7 @@
 #include <cstring>
 #include <unordered_map>
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 namespace {
 // The neutral position's bits: corners of one control point share them.
@@ -61,4 +61,4 @@ void weld_corners(SourceMesh& mesh) {
     if (t >= 0 && static_cast<std::size_t>(t) < n) t = remap[static_cast<std::size_t>(t)];  // others: refused later
 }
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 class ShapeNames {
  public:
@@ -42,4 +42,4 @@ struct ShapeChoice {
 };
 ShapeChoice choose_shapes(const std::vector<std::string>& names, const ShapeNames& rule);
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -1,13 +1,16 @@
 #include "shape_names.h"
 
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
+#include "input_files.h"
 #include "softdeca/softdeca.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 namespace {
+constexpr std::uint64_t kMaxNamesFileBytes = 4u << 20;
+
 int rule_index(const std::string& name) {
   int32_t index = -1;
   if (softdeca_blendshape_index(name.c_str(), &index) != SOFTDECA_OK) return -1;
@@ -22,8 +25,8 @@ std::string trim(const std::string& s) {
 }  // namespace
 
 ShapeNames ShapeNames::from_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read the names file " + path);
+  // Read once, as a regular file within its bound: a FIFO or /dev/zero is refused, not waited on.
+  std::istringstream in(read_named_file(path, kMaxNamesFileBytes, "a names file"));
   ShapeNames names;
   names.file_ = path;
   std::string line;
@@ -80,4 +83,4 @@ ShapeChoice choose_shapes(const std::vector<std::string>& names, const ShapeName
   return choice;
 }
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -9,17 +9,11 @@
 #include <utility>
 #include <vector>
 
+#include "import_limits.h"
 #include "shape_names.h"
 #include "softdeca/softdeca.h"
 
-namespace softdeca::cli {
-
-// Bounds on what a reader accepts (hostile files): the file's size before parsing, vertices
-// per mesh and in all included meshes after.
-struct AvatarLimits {
-  std::uint64_t max_file_bytes = std::uint64_t{2} << 30;
-  std::size_t max_vertices = SOFTDECA_MAX_AVATAR_VERTICES;
-};
+namespace softdeca::avatar_import {
 
 struct SourceShape {
   std::string name;           // the rig's own name, as the file spells it
@@ -46,16 +40,13 @@ struct SourceScene {
 // glTF 2.0 (.gltf, .glb, .vrm) and FBX through assimp, triangulated only (each mesh keeps its
 // vertex order; FBX's per-corner vertices are welded back, avatar_weld.h). Throws
 // std::runtime_error naming the file, and the mesh where one is at fault.
-SourceScene read_scene_file(const std::string& path, const AvatarLimits& limits);
+SourceScene read_scene_file(const std::string& path, const ImportLimits& limits);
 
 // An avatar folder (avatar_file.h): neutral.obj and the shapes of blendshapes/ that `names`
 // chooses (choose_shapes), one mesh; the other shape files are listed by name, unread.
-SourceScene read_avatar_folder(const std::string& dir, const ShapeNames& names, const AvatarLimits& limits);
-
-// Throws unless `path` is a regular file within limits.max_file_bytes; returns its size.
-std::uint64_t require_file_within(const std::string& path, const AvatarLimits& limits);
+SourceScene read_avatar_folder(const std::string& dir, const ShapeNames& names, const ImportLimits& limits);
 
 // False when this build has no assimp: read_scene_file then throws, saying so.
 bool scene_files_supported();
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -8,20 +8,20 @@
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
-#include <cctype>
-#include <fstream>
 #include <stdexcept>
 
 #include "avatar_source.h"
 #include "avatar_weld.h"
+#include "file_format.h"
 #include "gltf_targets.h"
+#include "input_files.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 namespace {
 struct Reader {
   const std::string& path;
-  const AvatarLimits& limits;
+  const ImportLimits& limits;
   const aiScene& scene;
   SourceScene out;
 
@@ -77,11 +77,6 @@ struct Reader {
   }
 };
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
 // FBX says how many centimetres a unit is (UnitScaleFactor); assimp keeps the raw units and
 // passes the factor on as metadata.
 void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
@@ -105,26 +100,19 @@ void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
 
 bool scene_files_supported() { return true; }
 
-SourceScene read_scene_file(const std::string& path, const AvatarLimits& limits) {
-  const std::uint64_t size = require_file_within(path, limits);
-  const std::string ext = lower(path.substr(path.find_last_of('.') + 1));
-  const bool fbx = ext == "fbx";
-  if (!fbx) check_gltf_targets(path, limits);
+SourceScene read_scene_file(const std::string& path, const ImportLimits& limits) {
+  // The file is read once, checked on its open descriptor; assimp parses those bytes.
+  const std::string bytes = read_named_file(path, limits.max_file_bytes, "an avatar file");
+  const FileFormat format = agreed_format(path, bytes);
+  const bool fbx = format == FileFormat::fbx;
+  if (!fbx) check_gltf_targets(bytes, path);
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);  // one node per FBX model
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
   const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate;
-  const aiScene* scene = nullptr;
-  if (ext == "vrm") {
-    // VRM is a binary glTF under its own extension, which assimp does not know.
-    std::ifstream in(path, std::ios::binary);
-    std::string bytes(static_cast<std::size_t>(size), '\0');
-    if (!in.read(&bytes[0], static_cast<std::streamsize>(size))) throw std::runtime_error("cannot read " + path);
-    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, "glb");
-  } else {
-    scene = importer.ReadFile(path, flags);
-  }
+  const char* hint = format == FileFormat::gltf_binary ? "glb" : fbx ? "fbx" : "gltf";
+  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, hint);
   if (!scene || !scene->mRootNode)
     throw std::runtime_error(path + ": not a readable " + (fbx ? "FBX" : "glTF 2.0") + " file (" + importer.GetErrorString() + ")");
   Reader reader{path, limits, *scene, {}};
@@ -138,4 +126,4 @@ SourceScene read_scene_file(const std::string& path, const AvatarLimits& limits)
   return std::move(reader.out);
 }
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -3,13 +3,13 @@
 
 #include "avatar_source.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 bool scene_files_supported() { return false; }
 
-SourceScene read_scene_file(const std::string& path, const AvatarLimits&) {
+SourceScene read_scene_file(const std::string& path, const ImportLimits&) {
   throw std::runtime_error(path + ": this softdeca was built without assimp, which glTF and FBX avatars need; "
                            "give an avatar folder (neutral.obj, blendshapes/<name>.obj) instead");
 }
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import

@@ -1,33 +1,22 @@
 #include "gltf_targets.h"
 
 #include <cstdint>
-#include <fstream>
 #include <stdexcept>
 
 #include "bundle/json.h"
 
-namespace softdeca::cli {
+namespace softdeca::avatar_import {
 
 namespace {
 using runtime::Json;
 
 // The JSON of a .gltf, or the first chunk of a binary glTF (.glb, .vrm); "" when there is none.
-std::string gltf_json(const std::string& path, const AvatarLimits& limits) {
-  const std::uint64_t size = require_file_within(path, limits);
-  std::ifstream in(path, std::ios::binary);
-  char header[20];
-  if (!in.read(header, sizeof header)) return "";
-  if (std::string(header, 4) != "glTF") {
-    in.seekg(0);
-    std::string text(static_cast<std::size_t>(size), '\0');
-    in.read(&text[0], static_cast<std::streamsize>(text.size()));
-    return text;
-  }
+std::string gltf_json(const std::string& bytes) {
+  if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0) return bytes;
   std::uint32_t length = 0;
-  for (int k = 3; k >= 0; --k) length = (length << 8) | static_cast<unsigned char>(header[12 + k]);
-  if (std::string(header + 16, 4) != "JSON" || length > size - sizeof header) return "";  // a length the file cannot hold
-  std::string text(length, '\0');
-  return in.read(&text[0], static_cast<std::streamsize>(length)) ? text : "";
+  for (int k = 3; k >= 0; --k) length = (length << 8) | static_cast<unsigned char>(bytes[12 + static_cast<std::size_t>(k)]);
+  if (bytes.compare(16, 4, "JSON") != 0 || length > bytes.size() - 20) return "";  // a length the file cannot hold
+  return bytes.substr(20, length);
 }
 
 // accessors[index].count, or -1 where the file does not say.
@@ -70,10 +59,10 @@ void check_mesh(const std::string& path, const Json& root, const Json& mesh, std
 }
 }  // namespace
 
-void check_gltf_targets(const std::string& path, const AvatarLimits& limits) {
+void check_gltf_targets(const std::string& bytes, const std::string& path) {
   Json root;
   try {
-    root = Json::parse(gltf_json(path, limits));
+    root = Json::parse(gltf_json(bytes));
   } catch (const std::exception&) {
     return;  // not JSON we can read: assimp says what is wrong
   }
@@ -85,4 +74,4 @@ void check_gltf_targets(const std::string& path, const AvatarLimits& limits) {
   }
 }
 
-}  // namespace softdeca::cli
+}  // namespace softdeca::avatar_import
