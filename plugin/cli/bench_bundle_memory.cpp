@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "bench_process_memory.h"
 #include "bundle/bundle_files.h"
 #include "bundle/sha256.h"
 #include "core/error.h"
@@ -116,27 +117,6 @@ void splice(const fs::path& bundle, const fs::path& copy, const std::string& fra
   manifest.replace(at, 64, sha(spliced));
   write_file(copy / "manifest.json", manifest);
   write_file(network, spliced);
-}
-
-// A line of /proc/self/status in bytes ("VmRSS", "VmHWM").
-std::uint64_t status_bytes(const char* key) {
-  std::FILE* f = std::fopen("/proc/self/status", "r");
-  if (!f) return 0;
-  char line[256];
-  std::uint64_t kib = 0;
-  const std::size_t n = std::strlen(key);
-  while (std::fgets(line, sizeof line, f))
-    if (std::strncmp(line, key, n) == 0 && line[n] == ':') kib = std::strtoull(line + n + 1, nullptr, 10);
-  std::fclose(f);
-  return kib * 1024;
-}
-
-// Resets VmHWM to the current RSS (Linux 4.0 and later); false where that is refused.
-bool reset_peak() {
-  std::FILE* f = std::fopen("/proc/self/clear_refs", "w");
-  if (!f) return false;
-  const bool ok = std::fputs("5", f) >= 0;
-  return std::fclose(f) == 0 && ok;
 }
 
 struct Load {
