@@ -1,0 +1,173 @@
+#include "bench_fit_cost.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "bench_process_memory.h"
+#include "imported_avatar.h"
+
+namespace softdeca::cli {
+
+std::uint64_t AvatarArrays::bytes() const {
+  return (neutral.size() + blendshapes.size()) * sizeof(float) + triangles.size() * sizeof(std::int32_t);
+}
+
+softdeca_avatar_mesh AvatarArrays::mesh() const {
+  softdeca_avatar_mesh m{};
+  m.struct_size = sizeof m;
+  m.neutral = neutral.data();
+  m.vertex_count = static_cast<uint32_t>(vertices());
+  m.triangles = triangles.data();
+  m.triangle_count = static_cast<uint32_t>(triangle_count());
+  m.blendshapes = blendshapes.data();
+  m.blendshape_count = 52;
+  return m;
+}
+
+namespace {
+double cpu_seconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// One level of subdivision: a vertex at every edge's midpoint, four triangles for each.
+AvatarArrays split_once(const AvatarArrays& a) {
+  const std::size_t n = a.vertices();
+  std::unordered_map<std::uint64_t, std::int32_t> midpoint;
+  midpoint.reserve(a.triangles.size());
+  std::vector<std::pair<std::int32_t, std::int32_t>> ends;
+  const auto middle = [&](std::int32_t u, std::int32_t v) {
+    const std::uint64_t key = (std::uint64_t(std::uint32_t(std::min(u, v))) << 32) | std::uint32_t(std::max(u, v));
+    const auto [it, added] = midpoint.emplace(key, static_cast<std::int32_t>(n + ends.size()));
+    if (added) ends.emplace_back(u, v);
+    return it->second;
+  };
+  AvatarArrays out;
+  out.triangles.reserve(4 * a.triangles.size());
+  for (std::size_t t = 0; t < a.triangle_count(); ++t) {
+    const std::int32_t* c = a.triangles.data() + 3 * t;
+    const std::int32_t ab = middle(c[0], c[1]), bc = middle(c[1], c[2]), ca = middle(c[2], c[0]);
+    out.triangles.insert(out.triangles.end(), {c[0], ab, ca, ab, c[1], bc, ca, bc, c[2], ab, bc, ca});
+  }
+  const std::size_t total = n + ends.size();
+  const auto fill = [&](const float* from, float* to) {
+    std::copy(from, from + 3 * n, to);
+    for (std::size_t e = 0; e < ends.size(); ++e)
+      for (std::size_t k = 0; k < 3; ++k)
+        to[3 * (n + e) + k] = 0.5f * (from[3 * std::size_t(ends[e].first) + k] + from[3 * std::size_t(ends[e].second) + k]);
+  };
+  out.neutral.resize(3 * total);
+  fill(a.neutral.data(), out.neutral.data());
+  out.blendshapes.resize(52 * 3 * total);
+  for (std::size_t s = 0; s < 52; ++s) fill(a.blendshapes.data() + s * 3 * n, out.blendshapes.data() + s * 3 * total);
+  return out;
+}
+}  // namespace
+
+AvatarArrays subdivided(AvatarArrays a, std::size_t vertices) {
+  while (a.vertices() < vertices && !a.triangles.empty()) a = split_once(a);
+  return a;
+}
+
+AvatarArrays with_slivers(AvatarArrays a, std::size_t count, unsigned seed) {
+  std::mt19937 random(seed);
+  const std::size_t triangles = a.triangle_count();
+  std::uniform_int_distribution<std::size_t> any_triangle(0, triangles - 1), any_corner(0, 2);
+  std::uniform_int_distribution<std::int32_t> any_vertex(0, static_cast<std::int32_t>(a.vertices()) - 1);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::int32_t* t = a.triangles.data() + 3 * any_triangle(random);
+    const std::size_t k = any_corner(random);
+    a.triangles.insert(a.triangles.end(), {t[k], t[(k + 1) % 3], any_vertex(random)});
+  }
+  return a;
+}
+
+FitRun fit_in_child(const std::string& bundle, const AvatarArrays& a, double metres_per_unit) {
+  int ends[2];
+  if (::pipe(ends) != 0) throw std::runtime_error("bench-reliability: cannot make a pipe");
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error("bench-reliability: cannot fork");
+  if (pid == 0) {
+    ::close(ends[0]);
+    std::string report;
+    softdeca_model* model = nullptr;
+    if (softdeca_model_load(bundle.c_str(), nullptr, &model) != SOFTDECA_OK) {
+      report = "0 0 0 0 cannot load " + bundle + ": " + softdeca_last_error();
+    } else {
+      softdeca_fit_options options{};
+      options.struct_size = sizeof options;
+      softdeca_fit_options_init(&options);
+      options.metres_per_unit = metres_per_unit;
+      const softdeca_avatar_mesh mesh = a.mesh();
+      reset_peak();
+      const std::uint64_t before = status_bytes("VmRSS");
+      softdeca_avatar_fit* fit = nullptr;
+      const auto t0 = std::chrono::steady_clock::now();
+      const double cpu0 = cpu_seconds();
+      const softdeca_status status = softdeca_avatar_fit_create(model, &mesh, &options, &fit);
+      const double cpu = cpu_seconds() - cpu0;
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const std::uint64_t peak = status_bytes("VmHWM");
+      char head[96];
+      std::snprintf(head, sizeof head, "%d %.6f %.6f %llu ", status == SOFTDECA_OK ? 1 : 0, seconds, cpu,
+                    static_cast<unsigned long long>(peak > before ? peak - before : 0));
+      report = head + std::string(status == SOFTDECA_OK ? "" : softdeca_last_error());
+      softdeca_avatar_fit_destroy(fit);
+      softdeca_model_destroy(model);
+    }
+    const ssize_t written = ::write(ends[1], report.data(), report.size());
+    ::_exit(written == static_cast<ssize_t>(report.size()) ? 0 : 1);
+  }
+  ::close(ends[1]);
+  std::string report;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(ends[0], buf, sizeof buf)) > 0;) report.append(buf, static_cast<std::size_t>(n));
+  ::close(ends[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || report.empty())
+    throw std::runtime_error("bench-reliability: the fit of " + std::to_string(a.vertices()) + " vertices killed its process");
+  FitRun out;
+  char* rest = nullptr;
+  out.fitted = std::strtol(report.c_str(), &rest, 10) == 1;
+  out.seconds = std::strtod(rest, &rest);
+  out.cpu_seconds = std::strtod(rest, &rest);
+  out.peak_increase = std::strtoull(rest, &rest, 10);
+  if (*rest == ' ') out.error = rest + 1;
+  return out;
+}
+
+double FitCost::memory_over_target() const {
+  const double input = double(large_input_bytes);
+  return (input + double(large.peak_increase)) / (4 * input + 500e6);
+}
+
+FitCost fit_cost_run(const std::string& bundle, const std::string& avatar, std::size_t vertices, double metres_per_unit) {
+  const AvatarFile file = read_avatar_file(avatar);
+  AvatarArrays base{file.neutral, file.blendshapes, file.triangles};
+  FitCost out;
+  out.base_vertices = base.vertices();
+  {
+    const AvatarArrays large = subdivided(base, vertices);
+    out.vertices = large.vertices();
+    out.large_input_bytes = large.bytes();
+    out.large = fit_in_child(bundle, large, metres_per_unit);
+  }
+  if (!out.large.fitted)
+    throw std::runtime_error("bench-reliability: the subdivided avatar was not fitted: " + out.large.error);
+  out.slivers = 20000;
+  out.sliver = fit_in_child(bundle, with_slivers(base, out.slivers, 7), metres_per_unit);
+  return out;
+}
+
+}  // namespace softdeca::cli
