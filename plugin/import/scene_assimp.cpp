@@ -2,6 +2,7 @@
 // vertices, which would reorder them): each mesh keeps the vertex order its file gives, so a
 // point cache written in that order loads onto the mesh. assimp reads FBX one vertex per polygon
 // corner; those corners are welded back into the file's vertices (avatar_weld.h).
+#include <assimp/Exceptional.h>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -12,6 +13,7 @@
 
 #include "avatar_source.h"
 #include "avatar_weld.h"
+#include "fbx_bounds.h"
 #include "file_format.h"
 #include "gltf_targets.h"
 #include "input_files.h"
@@ -96,34 +98,78 @@ void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
   out.declared_unit = text;
   out.declared_metres_per_unit = centimetres / 100.0;
 }
-}  // namespace
 
-bool scene_files_supported() { return true; }
+constexpr const char* kTooLarge = "too large to read: the reader ran out of memory";
+constexpr const char* kDamaged = "its structure is damaged (the reader failed inside it)";
 
-SourceScene read_scene_file(const std::string& path, const ImportLimits& limits) {
+// Why assimp failed, in the user's terms: its own messages ("FBX-Parser ...") pass; a C++
+// library's ("std::bad_alloc", "vector::_M_range_check") do not.
+std::string reader_failure(const std::exception_ptr& failure, const std::string& otherwise) {
+  if (!failure) return otherwise;
+  try {
+    std::rethrow_exception(failure);
+  } catch (const std::bad_alloc&) {
+    return kTooLarge;
+  } catch (const DeadlyErrorBase& e) {
+    return e.what();
+  } catch (...) {
+    return kDamaged;
+  }
+}
+
+// assimp's parse of `bytes`; throws std::runtime_error naming the file and why, never a C++
+// library's own text.
+const aiScene* parse(Assimp::Importer& importer, const std::string& bytes, const char* hint, const std::string& path, bool fbx) {
+  const std::string what = std::string(": not a readable ") + (fbx ? "FBX" : "glTF 2.0") + " file (";
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_ValidateDataStructure | aiProcess_Triangulate, hint);
+  } catch (...) {
+    throw std::runtime_error(path + what + reader_failure(std::current_exception(), kDamaged) + ")");
+  }
+  if (!scene || !scene->mRootNode)
+    throw std::runtime_error(path + what + reader_failure(importer.GetException(), importer.GetErrorString()) + ")");
+  return scene;
+}
+
+SourceScene read_scene(const std::string& path, const ImportLimits& limits) {
   // The file is read once, checked on its open descriptor; assimp parses those bytes.
   const std::string bytes = read_named_file(path, limits.max_file_bytes, "an avatar file");
   const FileFormat format = agreed_format(path, bytes);
   const bool fbx = format == FileFormat::fbx;
+  FbxSummary fbx_summary;
+  if (fbx) fbx_summary = check_fbx_bounds(bytes, path, limits);  // assimp trusts what the file declares
   if (!fbx) check_gltf_targets(bytes, path);
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);  // one node per FBX model
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
-  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate;
   const char* hint = format == FileFormat::gltf_binary ? "glb" : fbx ? "fbx" : "gltf";
-  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, hint);
-  if (!scene || !scene->mRootNode)
-    throw std::runtime_error(path + ": not a readable " + (fbx ? "FBX" : "glTF 2.0") + " file (" + importer.GetErrorString() + ")");
+  const aiScene* scene = parse(importer, bytes, hint, path, fbx);
   Reader reader{path, limits, *scene, {}};
   reader.out.format = fbx ? "FBX" : "glTF 2.0";
   reader.out.vertex_order = fbx ? "the FBX file's vertices in the order its polygons first use them"
                                 : "as in the file's vertex buffers";
   declared_unit(*scene, fbx, reader.out);
   reader.walk(*scene->mRootNode, aiMatrix4x4(), 0);
+  // assimp leaves out a mesh whose data does not add up, saying nothing.
+  if (fbx && reader.out.meshes.empty() && fbx_summary.meshes > 0)
+    throw std::runtime_error(path + ": none of its " + std::to_string(fbx_summary.meshes) +
+                             " meshes could be read (their data is damaged or empty)");
   if (fbx)
     for (SourceMesh& mesh : reader.out.meshes) weld_corners(mesh);
   return std::move(reader.out);
+}
+}  // namespace
+
+bool scene_files_supported() { return true; }
+
+SourceScene read_scene_file(const std::string& path, const ImportLimits& limits) {
+  try {
+    return read_scene(path, limits);
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(path + ": " + kTooLarge);
+  }
 }
 
 }  // namespace softdeca::avatar_import

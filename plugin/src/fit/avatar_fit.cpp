@@ -15,6 +15,7 @@
 #include "fit/placement.h"
 #include "fit/registration.h"
 #include "fit/shape_matcher.h"
+#include "fit/value_bounds.h"
 #include "geometry/nearest_points.h"
 #include "stream/arkit_names.h"
 
@@ -67,6 +68,20 @@ void check_mesh(const AvatarMesh& a) {
         if (!std::isfinite(a.deltas[k][i]))
           throw Error(SOFTDECA_ERROR_NON_FINITE, std::string("the avatar's blendshape ") + stream::blendshape_name(k) +
                                                      " has a non-finite value at vertex " + std::to_string(i / 3));
+  // Values bounded by the mesh's own size (fit/value_bounds.h).
+  const MeshExtent extent = mesh_extent(a.neutral, a.vertex_count);
+  const std::int64_t stray = stray_vertex(a.neutral, a.vertex_count, extent);
+  expect(stray < 0, [&] {
+    return "the avatar's vertex " + std::to_string(stray) + " lies far outside the mesh (more than " +
+           std::to_string(static_cast<int>(kStrayReach)) + " times the size of the box its other vertices fill from it): a stray vertex?";
+  });
+  for (std::size_t k = 0; k < kShapes; ++k) {
+    const std::int64_t moved = a.deltas[k] ? long_delta(a.deltas[k], a.vertex_count, extent) : -1;
+    expect(moved < 0, [&] {
+      return std::string("the avatar's blendshape ") + stream::blendshape_name(k) + " moves vertex " + std::to_string(moved) +
+             " by more than " + std::to_string(static_cast<int>(kMaxDeltaReach)) + " times the mesh's size";
+    });
+  }
 }
 
 std::string json_string(const std::string& s) {

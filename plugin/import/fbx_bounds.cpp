@@ -1,0 +1,385 @@
+#include "fbx_bounds.h"
+
+#include <zlib.h>
+
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace softdeca::avatar_import {
+
+namespace {
+constexpr char kBinaryMagic[] = "Kaydara FBX Binary  ";  // then NUL, 0x1A, NUL and the version
+constexpr std::size_t kBinaryHeader = 27;
+
+// "1.5 GiB", "640 MiB", "12 KiB", "900 bytes".
+std::string size_text(std::uint64_t bytes) {
+  const char* units[] = {"KiB", "MiB", "GiB", "TiB"};
+  if (bytes < 1024) return std::to_string(bytes) + " bytes";
+  double v = static_cast<double>(bytes) / 1024;
+  int u = 0;
+  while (v >= 1024 && u < 3) v /= 1024, ++u;
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g %s", v, units[u]);
+  return text;
+}
+
+// The error messages: "<path>: <what>".
+struct Refuse {
+  const std::string& path;
+  [[noreturn]] void operator()(const std::string& what) const { throw std::runtime_error(path + ": " + what); }
+};
+
+// What all the file's values and arrays cost the reader, against the one bound.
+struct Budget {
+  const ImportLimits& limits;
+  const Refuse& refuse;
+  std::uint64_t values = 0, decoded = 0;
+
+  void add_values(std::uint64_t n, const char* kind) {
+    values += n;
+    if (values > limits.max_decoded_bytes / kFbxBytesPerValue)
+      refuse(std::string(kind) + " FBX of more than " + std::to_string(values) +
+             " values: reading them would take more than the " + size_text(limits.max_decoded_bytes) +
+             " an avatar may decode (about " + std::to_string(kFbxBytesPerValue) + " bytes each)");
+  }
+  // `where` (a callable) names the array, only when it is refused.
+  template <class Where>
+  void add_array(std::uint64_t bytes, const Where& where) {
+    if (bytes > limits.max_decoded_bytes)
+      refuse(where() + ": an array that would expand to " + size_text(bytes) + ", more than the " +
+             size_text(limits.max_decoded_bytes) + " an avatar may decode");
+    decoded += bytes;
+    if (decoded > limits.max_decoded_bytes)
+      refuse("its arrays would expand to more than the " + size_text(limits.max_decoded_bytes) +
+             " an avatar may decode (" + size_text(decoded) + " by " + where() + ")");
+  }
+};
+
+// ---- binary FBX ---------------------------------------------------------------------------
+
+// Little-endian reads at checked offsets.
+struct Bytes {
+  const unsigned char* data;
+  std::uint64_t size;
+  std::uint64_t u32(std::uint64_t at) const {
+    std::uint32_t v;
+    std::memcpy(&v, data + at, 4);
+    return v;
+  }
+  std::uint64_t u64(std::uint64_t at) const {
+    std::uint64_t v;
+    std::memcpy(&v, data + at, 8);
+    return v;
+  }
+  std::int32_t i32(std::uint64_t at) const {
+    std::int32_t v;
+    std::memcpy(&v, data + at, 4);
+    return v;
+  }
+};
+
+// Decompresses the zlib stream in[0, n) to exactly `size` bytes, handing them to `take` in
+// pieces; false when the stream is damaged, ends early or holds more.
+bool inflate_exactly(const unsigned char* in, std::uint64_t n, std::uint64_t size,
+                     const std::function<void(const unsigned char*, std::size_t)>& take) {
+  z_stream z{};
+  if (inflateInit(&z) != Z_OK) return false;
+  z.next_in = const_cast<unsigned char*>(in);
+  z.avail_in = static_cast<uInt>(n);
+  unsigned char out[1 << 16];
+  std::uint64_t total = 0;
+  int status = Z_OK;
+  while (status == Z_OK) {
+    z.next_out = out;
+    z.avail_out = sizeof out;
+    status = inflate(&z, Z_NO_FLUSH);  // Z_BUF_ERROR: no progress, the stream cut short
+    const std::size_t got = sizeof out - z.avail_out;
+    total += got;
+    if (total > size) break;
+    if (got && take) take(out, got);
+  }
+  inflateEnd(&z);
+  return status == Z_STREAM_END && total == size;
+}
+
+// The int32 values of an array's bytes, however they arrive in pieces.
+struct Int32Reader {
+  std::function<void(std::int32_t)> each;
+  unsigned char carry[4];
+  int held = 0;
+  void operator()(const unsigned char* p, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      carry[held++] = p[i];
+      if (held == 4) {
+        std::int32_t v;
+        std::memcpy(&v, carry, 4);
+        each(v);
+        held = 0;
+      }
+    }
+  }
+};
+
+// A node being read: where its children end (then the empty record) and where it ends; for a
+// Geometry object, what its arrays add up to.
+struct Open {
+  std::string name;
+  std::uint64_t children_end = 0, end = 0;
+  enum class Geometry { none, mesh, shape } geometry = Geometry::none;
+  std::uint64_t coordinates = 0, indexes = 0;  // Vertices' and a shape's Indexes' lengths
+  bool has_coordinates = false, has_indexes = false;
+  std::int64_t top_index = -1;  // the largest vertex a polygon names
+};
+
+class BinaryWalk {
+ public:
+  BinaryWalk(const Bytes& b, const Refuse& refuse, const ImportLimits& limits)
+      : b_(b), refuse_(refuse), limits_(limits), budget_{limits, refuse} {}
+
+  FbxSummary run() {
+    if (b_.size < kBinaryHeader) refuse_("a binary FBX header cut short");
+    const std::uint64_t version = b_.u32(23);
+    wide_ = version >= 7500;
+    const std::uint64_t header = wide_ ? 25 : 13;  // of a node record, and the empty record
+    std::uint64_t pos = kBinaryHeader;
+    for (;;) {
+      if (!open_.empty() && pos == open_.back().children_end) {
+        if (pos + header > b_.size || !zeros(pos, header)) refuse_(where() + ": its children do not end with an empty record");
+        pos += header;
+        close();
+        continue;
+      }
+      const std::uint64_t limit = open_.empty() ? b_.size : open_.back().children_end;
+      if (open_.empty() && pos == b_.size) break;  // the top level ends with the file
+      if (pos + header > limit) {
+        if (open_.empty()) refuse_("it ends inside a node record (truncated?)");
+        refuse_(where() + ": a child node runs past the end of its parent");
+      }
+      const std::uint64_t end = wide_ ? b_.u64(pos) : b_.u32(pos);
+      const std::uint64_t count = wide_ ? b_.u64(pos + 8) : b_.u32(pos + 4);
+      const std::uint64_t length = wide_ ? b_.u64(pos + 16) : b_.u32(pos + 8);
+      const std::uint64_t name_length = b_.data[pos + header - 1];
+      if (end == 0) {
+        if (open_.empty()) break;  // the top level's end; a footer follows
+        refuse_(where() + ": a child node without an end");
+      }
+      if (end <= pos || end > limit) refuse_(where() + ": a node's end lies outside its parent (byte " + std::to_string(pos) + ")");
+      const std::uint64_t name_at = pos + header, first = name_at + name_length;
+      if (first > end || length > end - first) refuse_(where() + ": a node's properties run past its end");
+      Open node;
+      node.name.assign(reinterpret_cast<const char*>(b_.data + name_at), name_length);
+      const std::uint64_t last = first + length;
+      if (count > length / 2) refuse_(where(node.name) + ": " + std::to_string(count) + " properties in " + std::to_string(length) + " bytes");
+      budget_.add_values(1 + 2 * count, "a binary");  // its name, each property and a separator
+      const std::string kind = properties(node, first, last, count);
+      if (node.name == "Geometry") {
+        node.geometry = kind == "Mesh" ? Open::Geometry::mesh : kind == "Shape" ? Open::Geometry::shape : Open::Geometry::none;
+        meshes_ += node.geometry == Open::Geometry::mesh;
+      }
+      pos = last;
+      if (pos == end) {
+        finish(node);
+        continue;
+      }
+      if (end - pos < header) refuse_(where(node.name) + ": a node's children do not fit before its end");
+      if (static_cast<int>(open_.size()) >= limits_.max_fbx_depth)
+        refuse_("nested more than " + std::to_string(limits_.max_fbx_depth) + " deep (at byte " + std::to_string(pos) + ")");
+      node.children_end = end - header;
+      node.end = end;
+      open_.push_back(std::move(node));
+      budget_.add_values(2, "a binary");  // the braces of its children
+    }
+    FbxSummary s;
+    s.binary = true;
+    s.meshes = meshes_;
+    s.values = budget_.values;
+    s.decoded_bytes = budget_.decoded;
+    return s;
+  }
+
+ private:
+  bool zeros(std::uint64_t at, std::uint64_t n) const {
+    for (std::uint64_t i = 0; i < n; ++i)
+      if (b_.data[at + i]) return false;
+    return true;
+  }
+
+  // "Objects/Geometry/Vertices": the nodes open, then `name`.
+  std::string where(const std::string& name = "") const {
+    std::string w;
+    for (const Open& o : open_) w += (w.empty() ? "" : "/") + o.name;
+    if (!name.empty()) w += (w.empty() ? "" : "/") + name;
+    return "node '" + (w.empty() ? std::string("(top)") : w) + "'";
+  }
+
+  // Reads `count` properties in [at, last) exactly; returns the last string property (a
+  // Geometry's class).
+  std::string properties(Open& node, std::uint64_t at, std::uint64_t last, std::uint64_t count) {
+    std::string last_string;
+    for (std::uint64_t i = 0; i < count; ++i) {
+      if (at >= last) refuse_(where(node.name) + ": its properties run past their length");
+      const char type = static_cast<char>(b_.data[at++]);
+      const auto need = [&](std::uint64_t n) {
+        if (n > last - at) refuse_(where(node.name) + ": a property of type '" + std::string(1, type) + "' runs past its node");
+      };
+      switch (type) {
+        case 'C': need(1), at += 1; break;
+        case 'Y': need(2), at += 2; break;
+        case 'I': case 'F': need(4), at += 4; break;
+        case 'D': case 'L': need(8), at += 8; break;
+        case 'S': case 'R': {
+          need(4);
+          const std::uint64_t n = b_.u32(at);
+          at += 4;
+          need(n);
+          if (type == 'S' && n <= 16) last_string.assign(reinterpret_cast<const char*>(b_.data + at), n);
+          at += n;
+          break;
+        }
+        case 'f': case 'd': case 'l': case 'i': case 'b': case 'c': at = array(node, type, at, last); break;
+        default: refuse_(where(node.name) + ": a property of unknown type (byte " + std::to_string(at - 1) + ")");
+      }
+    }
+    if (at != last) refuse_(where(node.name) + ": its properties do not fill their declared length");
+    return last_string;
+  }
+
+  std::uint64_t array(Open& node, char type, std::uint64_t at, std::uint64_t last) {
+    const auto here = [&] { return where(node.name); };
+    if (12 > last - at) refuse_(here() + ": an array's header runs past its node");
+    const std::uint64_t length = b_.u32(at), encoding = b_.u32(at + 4), stored = b_.u32(at + 8);
+    at += 12;
+    if (stored > last - at) refuse_(here() + ": an array's data runs past its node");
+    const std::uint64_t element = type == 'd' || type == 'l' ? 8 : type == 'f' || type == 'i' ? 4 : 1;
+    const std::uint64_t bytes = length * element;  // at most 2^35: no overflow
+    budget_.add_array(bytes, here);
+    // The reader sizes its buffer in 32 bits.
+    if (bytes > std::numeric_limits<std::uint32_t>::max()) refuse_(here() + ": an array of " + size_text(bytes));
+    Open* geometry = open_.empty() ? nullptr : &open_.back();
+    if (geometry && geometry->geometry == Open::Geometry::none) geometry = nullptr;
+    std::function<void(const unsigned char*, std::size_t)> take;
+    Int32Reader ints;
+    if (geometry && node.name == "Vertices") geometry->coordinates = length, geometry->has_coordinates = true;
+    if (geometry && node.name == "Indexes") geometry->indexes = length, geometry->has_indexes = true;
+    if (geometry && geometry->geometry == Open::Geometry::mesh && node.name == "PolygonVertexIndex" && type == 'i') {
+      ints.each = [geometry](std::int32_t v) {
+        const std::int64_t vertex = v < 0 ? ~static_cast<std::int64_t>(v) : v;  // a polygon's last corner is stored negated
+        geometry->top_index = std::max(geometry->top_index, vertex);
+      };
+      take = std::ref(ints);
+    }
+    if (encoding == 0) {
+      if (stored != bytes)
+        refuse_(here() + ": an array of " + std::to_string(length) + " elements that holds " + std::to_string(stored) + " bytes");
+      if (take) take(b_.data + at, static_cast<std::size_t>(stored));
+    } else if (encoding == 1) {
+      if (!inflate_exactly(b_.data + at, stored, bytes, take))
+        refuse_(here() + ": an array whose compressed data is damaged or not the " + size_text(bytes) + " it declares");
+    } else {
+      refuse_(here() + ": an array of unknown encoding " + std::to_string(encoding));
+    }
+    return at + stored;
+  }
+
+  // A node read to its end: a Geometry's arrays must add up.
+  void finish(const Open& node) {
+    if (node.geometry == Open::Geometry::mesh) {
+      if (node.coordinates % 3)
+        refuse_(where(node.name) + ": a mesh's Vertices hold " + std::to_string(node.coordinates) + " numbers, not a multiple of 3");
+      if (node.top_index >= static_cast<std::int64_t>(node.coordinates / 3))
+        refuse_(where(node.name) + ": a polygon names vertex " + std::to_string(node.top_index) + " of a mesh of " +
+                std::to_string(node.coordinates / 3));
+    }
+    if (node.geometry == Open::Geometry::shape && node.has_indexes && node.has_coordinates && node.indexes * 3 != node.coordinates)
+      refuse_(where(node.name) + ": a blend shape of " + std::to_string(node.indexes) + " indexes and " +
+              std::to_string(node.coordinates) + " numbers (3 per index)");
+  }
+
+  void close() {
+    const Open node = std::move(open_.back());
+    open_.pop_back();
+    finish(node);
+  }
+
+  const Bytes& b_;
+  const Refuse& refuse_;
+  const ImportLimits& limits_;
+  Budget budget_;
+  bool wide_ = false;
+  std::vector<Open> open_;
+  std::size_t meshes_ = 0;
+};
+
+// ---- ASCII FBX ----------------------------------------------------------------------------
+
+FbxSummary ascii_walk(const std::string& text, const Refuse& refuse, const ImportLimits& limits) {
+  Budget budget{limits, refuse};
+  int depth = 0;
+  std::uint64_t line = 1, values = 0;
+  bool in_token = false;
+  const auto count_values = [&] {
+    budget.add_values(values, "an ASCII");
+    values = 0;
+  };
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (c == ';') {  // a comment, to the line's end
+      while (i + 1 < text.size() && text[i + 1] != '\n' && text[i + 1] != '\r') ++i;
+      in_token = false;
+      continue;
+    }
+    if (c == '"') {  // a string, one value
+      const std::size_t close = text.find('"', i + 1);
+      if (close == std::string::npos) refuse("line " + std::to_string(line) + ": a string that never ends");
+      for (std::size_t k = i + 1; k < close; ++k) line += text[k] == '\n';
+      i = close;
+      ++values;
+      in_token = false;
+      continue;
+    }
+    const bool separator = c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == ',' || c == '{' || c == '}' || c == ':';
+    if (!separator) {
+      if (!in_token) {
+        ++values;
+        // An array's declared count: the reader reserves room for it before reading a value.
+        if (c == '*') {
+          const std::uint64_t declared = std::strtoull(text.c_str() + i + 1, nullptr, 10);
+          if (declared > (text.size() - i) / 2)
+            refuse("line " + std::to_string(line) + ": an array that declares " + std::to_string(declared) +
+                   " values, more than the rest of the file can hold");
+          budget.add_array(8 * declared, [&] { return "line " + std::to_string(line); });
+        }
+      }
+      in_token = true;
+      continue;
+    }
+    in_token = false;
+    if (c == ',' || c == '{' || c == '}') ++values;
+    if (values >= (1u << 16)) count_values();
+    if (c == '{' && ++depth > limits.max_fbx_depth)
+      refuse("nested more than " + std::to_string(limits.max_fbx_depth) + " deep (line " + std::to_string(line) + ")");
+    if (c == '}') --depth;
+  }
+  count_values();
+  FbxSummary s;
+  s.values = budget.values;
+  s.decoded_bytes = budget.decoded;
+  return s;
+}
+}  // namespace
+
+FbxSummary check_fbx_bounds(const std::string& bytes, const std::string& path, const ImportLimits& limits) {
+  const Refuse refuse{path};
+  if (bytes.compare(0, std::strlen(kBinaryMagic), kBinaryMagic) == 0) {
+    const Bytes b{reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()};
+    return BinaryWalk(b, refuse, limits).run();
+  }
+  return ascii_walk(bytes, refuse, limits);
+}
+
+}  // namespace softdeca::avatar_import
