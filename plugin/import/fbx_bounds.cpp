@@ -165,13 +165,14 @@ class BinaryWalk {
       const std::uint64_t name_length = b_.data[pos + header - 1];
       if (end == 0) {
         if (open_.empty()) break;  // the top level's end; a footer follows
-        refuse_(where() + ": a child node without an end");
+        refuse_(at(pos) + ": a node without an end");
       }
-      if (end <= pos || end > limit) refuse_(where() + ": a node's end lies outside its parent (byte " + std::to_string(pos) + ")");
+      if (end <= pos || end > limit) refuse_(at(pos) + ": its end lies outside " + (open_.empty() ? "the file" : "its parent"));
       const std::uint64_t name_at = pos + header, first = name_at + name_length;
-      if (first > end || length > end - first) refuse_(where() + ": a node's properties run past its end");
+      if (first > end) refuse_(at(pos) + ": its name runs past its end");
       Open node;
       node.name.assign(reinterpret_cast<const char*>(b_.data + name_at), name_length);
+      if (length > end - first) refuse_(where(node.name) + ": its properties run past its end");
       const std::uint64_t last = first + length;
       if (count > length / 2) refuse_(where(node.name) + ": " + std::to_string(count) + " properties in " + std::to_string(length) + " bytes");
       budget_.add_values(1 + 2 * count, "a binary");  // its name, each property and a separator
@@ -185,7 +186,7 @@ class BinaryWalk {
         finish(node);
         continue;
       }
-      if (end - pos < header) refuse_(where(node.name) + ": a node's children do not fit before its end");
+      if (end - pos < header) refuse_(where(node.name) + ": its children do not fit before its end");
       if (static_cast<int>(open_.size()) >= limits_.max_fbx_depth)
         refuse_("nested more than " + std::to_string(limits_.max_fbx_depth) + " deep (at byte " + std::to_string(pos) + ")");
       node.children_end = end - header;
@@ -208,12 +209,17 @@ class BinaryWalk {
     return true;
   }
 
-  // "Objects/Geometry/Vertices": the nodes open, then `name`.
+  // "node 'Objects/Geometry/Vertices'": the nodes open, then `name`.
   std::string where(const std::string& name = "") const {
     std::string w;
     for (const Open& o : open_) w += (w.empty() ? "" : "/") + o.name;
     if (!name.empty()) w += (w.empty() ? "" : "/") + name;
-    return "node '" + (w.empty() ? std::string("(top)") : w) + "'";
+    return "node '" + w + "'";
+  }
+  // A node not yet named: "the node at byte 123", "node 'Objects': the child at byte 123".
+  std::string at(std::uint64_t pos) const {
+    const std::string here = "the node at byte " + std::to_string(pos);
+    return open_.empty() ? here : where() + ": " + here.substr(4);
   }
 
   // Reads `count` properties in [at, last) exactly; returns the last string property (a
