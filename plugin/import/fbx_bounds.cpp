@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <unordered_map>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -58,6 +59,60 @@ struct Budget {
              " an avatar may decode (" + size_text(decoded) + " by " + where() + ")");
   }
 };
+
+// ---- the model hierarchy --------------------------------------------------------------------
+
+// What makes the scene's nodes: Model objects and the object-object connections between them.
+// assimp turns them into nodes by recursion from the scene's root (id 0), once per path: a
+// chain of 10,000 overflows its stack, a ladder of 30 pairs makes a billion nodes.
+struct ModelGraph {
+  std::vector<std::int64_t> models;
+  std::vector<std::pair<std::int64_t, std::int64_t>> links;  // (child, parent), "OO"
+};
+
+void check_model_graph(const ModelGraph& g, const Refuse& refuse, const ImportLimits& limits) {
+  std::unordered_map<std::int64_t, std::size_t> index;  // model id -> 1 + its place; 0 the root
+  index.reserve(g.models.size() + 1);
+  index.emplace(0, 0);
+  for (const std::int64_t id : g.models) index.emplace(id, index.size());
+  const std::size_t n = index.size();
+  std::vector<std::vector<std::size_t>> children(n);
+  for (const auto& [child, parent] : g.links) {
+    const auto c = index.find(child), p = index.find(parent);
+    if (c != index.end() && p != index.end() && c->second != 0) children[p->second].push_back(c->second);
+  }
+  // The models the root reaches, each with how many links lead to it from reached models.
+  std::vector<std::size_t> waiting(n, 0), order{0};
+  std::vector<uint8_t> reached(n, 0);
+  reached[0] = 1;
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (const std::size_t c : children[order[i]]) {
+      ++waiting[c];
+      if (!reached[c]) reached[c] = 1, order.push_back(c);
+    }
+  // In topological order: the longest chain to each and the paths to it (the nodes made of it).
+  std::vector<std::uint64_t> depth(n, 0), paths(n, 0);
+  paths[0] = 1;
+  std::vector<std::size_t> ready{0};
+  std::size_t done = 0;
+  std::uint64_t nodes = 0;
+  while (!ready.empty()) {
+    const std::size_t m = ready.back();
+    ready.pop_back();
+    ++done;
+    nodes += paths[m];
+    if (nodes > limits.max_nodes)
+      refuse("its models make more than " + std::to_string(limits.max_nodes) + " scene nodes (a model connected to many parents makes a node for each path to it)");
+    if (depth[m] > static_cast<std::uint64_t>(limits.max_node_depth))
+      refuse("its models are nested more than " + std::to_string(limits.max_node_depth) + " deep");
+    for (const std::size_t c : children[m]) {
+      depth[c] = std::max(depth[c], depth[m] + 1);
+      paths[c] = std::min<std::uint64_t>(paths[c] + paths[m], std::uint64_t{1} << 62);
+      if (--waiting[c] == 0) ready.push_back(c);
+    }
+  }
+  if (done != order.size()) refuse("its models' connections form a loop");
+}
 
 // ---- binary FBX ---------------------------------------------------------------------------
 
@@ -176,11 +231,16 @@ class BinaryWalk {
       const std::uint64_t last = first + length;
       if (count > length / 2) refuse_(where(node.name) + ": " + std::to_string(count) + " properties in " + std::to_string(length) + " bytes");
       budget_.add_values(1 + 2 * count, "a binary");  // its name, each property and a separator
-      const std::string kind = properties(node, first, last, count);
+      const Firsts firsts = properties(node, first, last, count);
+      const std::string& kind = firsts.last_string;
       if (node.name == "Geometry") {
         node.geometry = kind == "Mesh" ? Open::Geometry::mesh : kind == "Shape" ? Open::Geometry::shape : Open::Geometry::none;
         meshes_ += node.geometry == Open::Geometry::mesh;
       }
+      const bool top_child = open_.size() == 1;
+      if (top_child && open_[0].name == "Objects" && node.name == "Model" && count > 0) graph_.models.push_back(firsts.number[0]);
+      if (top_child && open_[0].name == "Connections" && node.name == "C" && count >= 3 && firsts.text[0] == "OO")
+        graph_.links.emplace_back(firsts.number[1], firsts.number[2]);
       pos = last;
       if (pos == end) {
         finish(node);
@@ -194,6 +254,7 @@ class BinaryWalk {
       open_.push_back(std::move(node));
       budget_.add_values(2, "a binary");  // the braces of its children
     }
+    check_model_graph(graph_, refuse_, limits_);
     FbxSummary s;
     s.binary = true;
     s.meshes = meshes_;
@@ -222,10 +283,18 @@ class BinaryWalk {
     return open_.empty() ? here : where() + ": " + here.substr(4);
   }
 
-  // Reads `count` properties in [at, last) exactly; returns the last string property (a
-  // Geometry's class).
-  std::string properties(Open& node, std::uint64_t at, std::uint64_t last, std::uint64_t count) {
+  // A node's first properties, as far as the walk needs them: ids, a connection's type, a
+  // Geometry's class (its last short string).
+  struct Firsts {
+    std::int64_t number[3] = {0, 0, 0};
+    std::string text[3];
     std::string last_string;
+  };
+
+  // Reads `count` properties in [at, last) exactly.
+  Firsts properties(Open& node, std::uint64_t at, std::uint64_t last, std::uint64_t count) {
+    Firsts firsts;
+    std::string& last_string = firsts.last_string;
     for (std::uint64_t i = 0; i < count; ++i) {
       if (at >= last) refuse_(where(node.name) + ": its properties run past their length");
       const char type = static_cast<char>(b_.data[at++]);
@@ -236,13 +305,18 @@ class BinaryWalk {
         case 'C': need(1), at += 1; break;
         case 'Y': need(2), at += 2; break;
         case 'I': case 'F': need(4), at += 4; break;
-        case 'D': case 'L': need(8), at += 8; break;
+        case 'D': case 'L':
+          need(8);
+          if (type == 'L' && i < 3) std::memcpy(&firsts.number[i], b_.data + at, 8);
+          at += 8;
+          break;
         case 'S': case 'R': {
           need(4);
           const std::uint64_t n = b_.u32(at);
           at += 4;
           need(n);
           if (type == 'S' && n <= 16) last_string.assign(reinterpret_cast<const char*>(b_.data + at), n);
+          if (type == 'S' && n <= 16 && i < 3) firsts.text[i] = last_string;
           at += n;
           break;
         }
@@ -251,7 +325,7 @@ class BinaryWalk {
       }
     }
     if (at != last) refuse_(where(node.name) + ": its properties do not fill their declared length");
-    return last_string;
+    return firsts;
   }
 
   std::uint64_t array(Open& node, char type, std::uint64_t at, std::uint64_t last) {
@@ -318,65 +392,105 @@ class BinaryWalk {
   bool wide_ = false;
   std::vector<Open> open_;
   std::size_t meshes_ = 0;
+  ModelGraph graph_;
 };
 
 // ---- ASCII FBX ----------------------------------------------------------------------------
 
-FbxSummary ascii_walk(const std::string& text, const Refuse& refuse, const ImportLimits& limits) {
-  Budget budget{limits, refuse};
-  int depth = 0;
-  std::uint64_t line = 1, values = 0;
-  bool in_token = false;
-  const auto count_values = [&] {
-    budget.add_values(values, "an ASCII");
-    values = 0;
-  };
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c == '\n') ++line;
-    if (c == ';') {  // a comment, to the line's end
-      while (i + 1 < text.size() && text[i + 1] != '\n' && text[i + 1] != '\r') ++i;
-      in_token = false;
-      continue;
-    }
-    if (c == '"') {  // a string, one value
-      const std::size_t close = text.find('"', i + 1);
-      if (close == std::string::npos) refuse("line " + std::to_string(line) + ": a string that never ends");
-      for (std::size_t k = i + 1; k < close; ++k) line += text[k] == '\n';
-      i = close;
-      ++values;
-      in_token = false;
-      continue;
-    }
-    const bool separator = c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == ',' || c == '{' || c == '}' || c == ':';
-    if (!separator) {
-      if (!in_token) {
-        ++values;
-        // An array's declared count: the reader reserves room for it before reading a value.
-        if (c == '*') {
-          const std::uint64_t declared = std::strtoull(text.c_str() + i + 1, nullptr, 10);
-          if (declared > (text.size() - i) / 2)
-            refuse("line " + std::to_string(line) + ": an array that declares " + std::to_string(declared) +
-                   " values, more than the rest of the file can hold");
-          budget.add_array(8 * declared, [&] { return "line " + std::to_string(line); });
-        }
+// Text: "Key: value, value {" lines; ';' starts a comment, '"' a string.
+class AsciiWalk {
+ public:
+  AsciiWalk(const std::string& text, const Refuse& refuse, const ImportLimits& limits)
+      : text_(text), refuse_(refuse), limits_(limits), budget_{limits, refuse} {}
+
+  FbxSummary run() {
+    std::size_t token = std::string::npos;  // where the token being read began
+    for (std::size_t i = 0; i < text_.size(); ++i) {
+      const char c = text_[i];
+      const bool separator = c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == ',' || c == '{' || c == '}' || c == ':' ||
+                             c == ';' || c == '"';
+      if (!separator) {
+        if (token == std::string::npos) token = i;
+        continue;
       }
-      in_token = true;
-      continue;
+      if (token != std::string::npos) {
+        ended(token, i, false, c == ':');
+        token = std::string::npos;
+      }
+      if (c == '\n') ++line_;
+      if (c == ';') {  // a comment, to the line's end
+        while (i + 1 < text_.size() && text_[i + 1] != '\n' && text_[i + 1] != '\r') ++i;
+      } else if (c == '"') {  // a string, one value
+        const std::size_t close = text_.find('"', i + 1);
+        if (close == std::string::npos) refuse_("line " + std::to_string(line_) + ": a string that never ends");
+        for (std::size_t k = i + 1; k < close; ++k) line_ += text_[k] == '\n';
+        ended(i + 1, close, true, false);
+        i = close;
+      } else if (c == ',' || c == '{' || c == '}') {
+        ++values_;
+        if (c == '{') {
+          if (++depth_ > limits_.max_fbx_depth)
+            refuse_("nested more than " + std::to_string(limits_.max_fbx_depth) + " deep (line " + std::to_string(line_) + ")");
+          if (depth_ == 1) block_ = key_;
+        }
+        if (c == '}') --depth_;
+      }
+      if (values_ >= (1u << 16)) count_values();
     }
-    in_token = false;
-    if (c == ',' || c == '{' || c == '}') ++values;
-    if (values >= (1u << 16)) count_values();
-    if (c == '{' && ++depth > limits.max_fbx_depth)
-      refuse("nested more than " + std::to_string(limits.max_fbx_depth) + " deep (line " + std::to_string(line) + ")");
-    if (c == '}') --depth;
+    if (token != std::string::npos) ended(token, text_.size(), false, false);
+    count_values();
+    check_model_graph(graph_, refuse_, limits_);
+    FbxSummary s;
+    s.values = budget_.values;
+    s.decoded_bytes = budget_.decoded;
+    return s;
   }
-  count_values();
-  FbxSummary s;
-  s.values = budget.values;
-  s.decoded_bytes = budget.decoded;
-  return s;
-}
+
+ private:
+  void count_values() {
+    budget_.add_values(values_, "an ASCII");
+    values_ = 0;
+  }
+
+  // A token [begin, end): a key ("Model" of "Model:"), a string's text or a value.
+  void ended(std::size_t begin, std::size_t end, bool string, bool key) {
+    ++values_;
+    if (key) {
+      if (depth_ <= 1) key_.assign(text_, begin, end - begin), field_ = 0;
+      return;
+    }
+    // An array's declared count: the reader reserves room for it before reading a value.
+    if (!string && text_[begin] == '*') {
+      const std::uint64_t declared = std::strtoull(text_.c_str() + begin + 1, nullptr, 10);
+      if (declared > (text_.size() - begin) / 2)
+        refuse_("line " + std::to_string(line_) + ": an array that declares " + std::to_string(declared) +
+                " values, more than the rest of the file can hold");
+      budget_.add_array(8 * declared, [&] { return "line " + std::to_string(line_); });
+    }
+    if (depth_ != 1) return;
+    // The model hierarchy: "Model: id, ..." in Objects, "C: "OO", child, parent" in Connections.
+    const int field = field_++;
+    if (block_ == "Objects" && key_ == "Model" && field == 0) graph_.models.push_back(number(begin));
+    if (block_ == "Connections" && key_ == "C") {
+      if (field == 0) link_type_.assign(text_, begin, end - begin);
+      if (field == 1) link_child_ = number(begin);
+      if (field == 2 && link_type_ == "OO") graph_.links.emplace_back(link_child_, number(begin));
+    }
+  }
+
+  std::int64_t number(std::size_t at) const { return std::strtoll(text_.c_str() + at, nullptr, 10); }
+
+  const std::string& text_;
+  const Refuse& refuse_;
+  const ImportLimits& limits_;
+  Budget budget_;
+  int depth_ = 0;
+  std::uint64_t line_ = 1, values_ = 0;
+  std::string key_, block_, link_type_;  // the last key at the top two levels; the top-level block open
+  int field_ = 0;                        // values since that key
+  std::int64_t link_child_ = 0;
+  ModelGraph graph_;
+};
 }  // namespace
 
 FbxSummary check_fbx_bounds(const std::string& bytes, const std::string& path, const ImportLimits& limits) {
@@ -385,7 +499,7 @@ FbxSummary check_fbx_bounds(const std::string& bytes, const std::string& path, c
     const Bytes b{reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()};
     return BinaryWalk(b, refuse, limits).run();
   }
-  return ascii_walk(bytes, refuse, limits);
+  return AsciiWalk(bytes, refuse, limits).run();
 }
 
 }  // namespace softdeca::avatar_import

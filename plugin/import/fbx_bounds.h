@@ -14,7 +14,9 @@
 // ASCII FBX: braces outside strings and comments nested at most max_fbx_depth; an array's
 //   declared count (*N) no more than the file can hold;
 // both: the values the reader makes a token of, at about kFbxBytesPerValue each, within
-//   max_decoded_bytes.
+//   max_decoded_bytes; the Model objects and their object-object connections, which assimp
+//   turns into scene nodes by recursion once per path from the root, at most
+//   ImportLimits::max_node_depth deep, max_nodes nodes in all, without a loop.
 //
 // Any violation throws std::runtime_error naming the file and what is wrong ("nested more than
 // 64 deep", "an array that would expand to 1.5 GiB, more than the 1 GiB an avatar may decode").

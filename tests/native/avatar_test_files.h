@@ -331,9 +331,10 @@ inline std::string glb_bytes(const TestScene& scene) {
 }
 
 // Binary FBX 7.4: a Model, a Mesh geometry and a BlendShape deformer per mesh, under a Null
-// model for the root; the file's unit is UnitScaleFactor centimetres. `edit` (a test's) may
-// change the Objects node before it is written.
-inline std::string fbx_bytes(const TestScene& scene, const std::function<void(files_detail::FbxNode& objects)>& edit = {}) {
+// model for the root; the file's unit is UnitScaleFactor centimetres. `edit` and `edit_links`
+// (a test's) may change the Objects and the Connections node before they are written.
+inline std::string fbx_bytes(const TestScene& scene, const std::function<void(files_detail::FbxNode& objects)>& edit = {},
+                             const std::function<void(files_detail::FbxNode& connections)>& edit_links = {}) {
   using namespace files_detail;
   std::vector<FbxNode> top;
   top.push_back({"FBXHeaderExtension", {}, {{"FBXHeaderVersion", {fbx_int(1003)}, {}}, {"FBXVersion", {fbx_int(7400)}, {}}}});
@@ -385,6 +386,7 @@ inline std::string fbx_bytes(const TestScene& scene, const std::function<void(fi
     }
   }
   if (edit) edit(objects);
+  if (edit_links) edit_links(connections);
   top.push_back(objects);
   top.push_back(connections);
   std::string out("Kaydara FBX Binary  \0\x1a\0", 23);

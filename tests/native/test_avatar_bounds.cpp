@@ -99,6 +99,55 @@ TEST(AvatarBounds, FbxNestedDeepIsRefusedWithoutRecursion) {
   expect_error(error_of(ok, shallow), ok, "nested more than 2 deep");
 }
 
+TEST(AvatarBounds, ModelHierarchiesDeepOrExplodingAreRefused) {
+  REQUIRE_SCENE_FILES();
+  const TempDir dir("bounds-models");
+  const double zero[3] = {0, 0, 0}, one[3] = {1, 1, 1};
+  // `count` bones under the root; `link` connects bone i (id 5000 + i) to its parents.
+  const auto skeleton = [&](const std::string& name, int count, const std::function<void(files::FbxNode&, int)>& link) {
+    return dir.write(name, softdeca::test::fbx_bytes(
+                               scene(),
+                               [&](files::FbxNode& objects) {
+                                 for (int i = 0; i < count; ++i)
+                                   objects.children.push_back(files::fbx_model(5000 + i, "Bone" + std::to_string(i), "LimbNode", zero, zero, one));
+                               },
+                               [&](files::FbxNode& connections) {
+                                 for (int i = 0; i < count; ++i) link(connections, i);
+                               }));
+  };
+  const auto oo = [](std::int64_t child, std::int64_t parent) {
+    return files::FbxNode{"C", {files::fbx_string("OO"), files::fbx_long(child), files::fbx_long(parent)}, {}};
+  };
+  // A chain of 10,000 bones: assimp's recursion over it overflows its stack.
+  const std::string chain = skeleton("chain.fbx", 10000, [&](files::FbxNode& c, int i) { c.children.push_back(oo(5000 + i, i ? 4999 + i : 0)); });
+  expect_error(error_of(chain), chain, "its models are nested more than 256 deep");
+  // A ladder of 40 rungs, each bone a child of both bones of the rung above: 2^40 paths.
+  const std::string ladder = skeleton("ladder.fbx", 80, [&](files::FbxNode& c, int i) {
+    if (i < 2) {
+      c.children.push_back(oo(5000 + i, 0));
+    } else {
+      c.children.push_back(oo(5000 + i, 5000 + 2 * (i / 2 - 1)));
+      c.children.push_back(oo(5000 + i, 5001 + 2 * (i / 2 - 1)));
+    }
+  });
+  expect_error(error_of(ladder), ladder, "its models make more than 100000 scene nodes");
+  const std::string loop = skeleton("loop.fbx", 3, [&](files::FbxNode& c, int i) {
+    c.children.push_back(oo(5000 + i, 5000 + (i + 1) % 3));
+    if (i == 0) c.children.push_back(oo(5000, 0));
+  });
+  expect_error(error_of(loop), loop, "its models' connections form a loop");
+  // A skeleton of 300 bones, 20 deep, reads.
+  const std::string bones = skeleton("bones.fbx", 300, [&](files::FbxNode& c, int i) { c.children.push_back(oo(5000 + i, i < 15 ? 0 : 4985 + i)); });
+  EXPECT_EQ(error_of(bones), "");
+  // The same chain in ASCII.
+  std::string text = "; FBX 7.4.0 project file\nFBXHeaderExtension:  {\n\tFBXHeaderVersion: 1003\n}\nObjects:  {\n";
+  for (int i = 0; i < 1000; ++i) text += "\tModel: " + std::to_string(5000 + i) + ", \"Model::B\", \"LimbNode\" {\n\t}\n";
+  text += "}\nConnections:  {\n";
+  for (int i = 0; i < 1000; ++i) text += "\tC: \"OO\"," + std::to_string(5000 + i) + "," + std::to_string(i ? 4999 + i : 0) + "\n";
+  const std::string ascii = dir.write("chain_ascii.fbx", text + "}\n");
+  expect_error(error_of(ascii), ascii, "its models are nested more than 256 deep");
+}
+
 TEST(AvatarBounds, AZlibBombIsRefusedByItsDeclaredSize) {
   REQUIRE_SCENE_FILES();
   const TempDir dir("bounds-bomb");
