@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <unordered_map>
@@ -60,17 +61,37 @@ struct Budget {
   }
 };
 
-// ---- the model hierarchy --------------------------------------------------------------------
+// ---- the objects and their connections ------------------------------------------------------
 
-// What makes the scene's nodes: Model objects and the object-object connections between them.
-// assimp turns them into nodes by recursion from the scene's root (id 0), once per path: a
-// chain of 10,000 overflows its stack, a ladder of 30 pairs makes a billion nodes.
-struct ModelGraph {
-  std::vector<std::int64_t> models;
-  std::vector<std::pair<std::int64_t, std::int64_t>> links;  // (child, parent), "OO"
+// What assimp makes of the objects once it has parsed them, bounded before it does: scene
+// nodes of the Model objects by recursion from the root (id 0), once per path (a chain of
+// 10,000 overflows its stack, a ladder of 30 pairs makes a billion nodes); and per blend shape
+// of a mesh, a copy of the mesh's per-corner vertices and normals (a thousand tiny shapes on a
+// mesh of ten million corners make a quarter of a terabyte).
+struct SceneGraph {
+  std::vector<std::int64_t> models, shapes, channels, blend_shapes;  // ids by class
+  std::unordered_map<std::int64_t, std::pair<std::string, std::uint64_t>> meshes;  // id -> name, corners
+  std::vector<std::pair<std::int64_t, std::int64_t>> links;  // object-object connections (child, parent)
+
+  // An object of `kind` (Model, Geometry, Deformer) and `cls` (its class: Mesh, Shape, ...).
+  void object(const std::string& kind, std::int64_t id, const std::string& cls, const std::string& name) {
+    if (kind == "Model") models.push_back(id);
+    if (kind == "Geometry" && cls == "Mesh") meshes[id] = {name, 0};
+    if (kind == "Geometry" && cls == "Shape") shapes.push_back(id);
+    if (kind == "Deformer" && cls == "BlendShapeChannel") channels.push_back(id);
+    if (kind == "Deformer" && cls == "BlendShape") blend_shapes.push_back(id);
+  }
 };
 
-void check_model_graph(const ModelGraph& g, const Refuse& refuse, const ImportLimits& limits) {
+// An object's name as FBX stores it ("Head\0\1Geometry" in binary, "Geometry::Head" in ASCII).
+std::string object_name(const std::string& stored) {
+  const std::size_t nul = stored.find('\0');
+  if (nul != std::string::npos) return stored.substr(0, nul);
+  const std::size_t colons = stored.find("::");
+  return colons == std::string::npos ? stored : stored.substr(colons + 2);
+}
+
+void check_models(const SceneGraph& g, const Refuse& refuse, const ImportLimits& limits) {
   std::unordered_map<std::int64_t, std::size_t> index;  // model id -> 1 + its place; 0 the root
   index.reserve(g.models.size() + 1);
   index.emplace(0, 0);
@@ -102,7 +123,8 @@ void check_model_graph(const ModelGraph& g, const Refuse& refuse, const ImportLi
     ++done;
     nodes += paths[m];
     if (nodes > limits.max_nodes)
-      refuse("its models make more than " + std::to_string(limits.max_nodes) + " scene nodes (a model connected to many parents makes a node for each path to it)");
+      refuse("its models make more than " + std::to_string(limits.max_nodes) +
+             " scene nodes (a model connected to many parents makes a node for each path to it)");
     if (depth[m] > static_cast<std::uint64_t>(limits.max_node_depth))
       refuse("its models are nested more than " + std::to_string(limits.max_node_depth) + " deep");
     for (const std::size_t c : children[m]) {
@@ -112,6 +134,50 @@ void check_model_graph(const ModelGraph& g, const Refuse& refuse, const ImportLi
     }
   }
   if (done != order.size()) refuse("its models' connections form a loop");
+}
+
+// Per mesh, the shapes assimp copies it for: each link of a shape to a channel of a blend
+// shape deformer of the mesh, counted (saturating) over every path.
+void check_blend_shapes(const SceneGraph& g, const Refuse& refuse, const ImportLimits& limits) {
+  constexpr std::uint64_t kCap = std::uint64_t{1} << 40;
+  const auto counted = [](const std::vector<std::int64_t>& ids) {
+    std::unordered_map<std::int64_t, std::uint64_t> m;
+    for (const std::int64_t id : ids) m.emplace(id, 0);
+    return m;
+  };
+  std::unordered_map<std::int64_t, std::uint64_t> shapes = counted(g.shapes), per_channel = counted(g.channels),
+                                                  per_blend = counted(g.blend_shapes);
+  const auto add = [&](std::unordered_map<std::int64_t, std::uint64_t>& into, const std::unordered_map<std::int64_t, std::uint64_t>& from,
+                       bool one) {
+    for (const auto& [child, parent] : g.links) {
+      const auto c = from.find(child);
+      const auto p = into.find(parent);
+      if (c != from.end() && p != into.end()) p->second = std::min(kCap, p->second + (one ? 1 : c->second));
+    }
+  };
+  add(per_channel, shapes, true);
+  add(per_blend, per_channel, false);
+  std::unordered_map<std::int64_t, std::uint64_t> per_mesh;
+  for (const auto& [id, mesh] : g.meshes) per_mesh.emplace(id, 0);
+  add(per_mesh, per_blend, false);
+  // What the reader holds per polygon corner: the mesh's own (positions, normals, texture
+  // coordinates, 48 bytes) and, per shape, positions and normals (24).
+  std::uint64_t total = 0;
+  for (const auto& [id, mesh] : g.meshes) {
+    const std::uint64_t corners = mesh.second, copies = per_mesh[id];
+    const double bytes = static_cast<double>(corners) * (48.0 + 24.0 * static_cast<double>(copies));
+    total += static_cast<std::uint64_t>(std::min(bytes, 1e18));
+    if (total > limits.max_decoded_bytes)
+      refuse("mesh '" + mesh.first + "': its " + std::to_string(copies) + " blend shapes over " + std::to_string(corners) +
+             " polygon corners would take the reader " + size_text(static_cast<std::uint64_t>(std::min(bytes, 1e18))) +
+             " (a copy of the corners for each), more than the " + size_text(limits.max_decoded_bytes) +
+             " an avatar may decode");
+  }
+}
+
+void check_scene_graph(const SceneGraph& g, const Refuse& refuse, const ImportLimits& limits) {
+  check_models(g, refuse, limits);
+  check_blend_shapes(g, refuse, limits);
 }
 
 // ---- binary FBX ---------------------------------------------------------------------------
@@ -188,6 +254,7 @@ struct Open {
   std::uint64_t coordinates = 0, indexes = 0;  // Vertices' and a shape's Indexes' lengths
   bool has_coordinates = false, has_indexes = false;
   std::int64_t top_index = -1;  // the largest vertex a polygon names
+  std::int64_t id = 0;          // an object's
 };
 
 class BinaryWalk {
@@ -238,7 +305,10 @@ class BinaryWalk {
         meshes_ += node.geometry == Open::Geometry::mesh;
       }
       const bool top_child = open_.size() == 1;
-      if (top_child && open_[0].name == "Objects" && node.name == "Model" && count > 0) graph_.models.push_back(firsts.number[0]);
+      if (top_child && open_[0].name == "Objects" && count > 0) {
+        node.id = firsts.number[0];
+        graph_.object(node.name, node.id, kind, object_name(firsts.text[1]));
+      }
       if (top_child && open_[0].name == "Connections" && node.name == "C" && count >= 3 && firsts.text[0] == "OO")
         graph_.links.emplace_back(firsts.number[1], firsts.number[2]);
       pos = last;
@@ -254,7 +324,7 @@ class BinaryWalk {
       open_.push_back(std::move(node));
       budget_.add_values(2, "a binary");  // the braces of its children
     }
-    check_model_graph(graph_, refuse_, limits_);
+    check_scene_graph(graph_, refuse_, limits_);
     FbxSummary s;
     s.binary = true;
     s.meshes = meshes_;
@@ -315,8 +385,8 @@ class BinaryWalk {
           const std::uint64_t n = b_.u32(at);
           at += 4;
           need(n);
-          if (type == 'S' && n <= 16) last_string.assign(reinterpret_cast<const char*>(b_.data + at), n);
-          if (type == 'S' && n <= 16 && i < 3) firsts.text[i] = last_string;
+          if (type == 'S' && n <= 64) last_string.assign(reinterpret_cast<const char*>(b_.data + at), n);
+          if (type == 'S' && n <= 64 && i < 3) firsts.text[i] = last_string;
           at += n;
           break;
         }
@@ -345,6 +415,8 @@ class BinaryWalk {
     Int32Reader ints;
     if (geometry && node.name == "Vertices") geometry->coordinates = length, geometry->has_coordinates = true;
     if (geometry && node.name == "Indexes") geometry->indexes = length, geometry->has_indexes = true;
+    if (geometry && geometry->geometry == Open::Geometry::mesh && node.name == "PolygonVertexIndex")
+      graph_.meshes[geometry->id].second = length;
     if (geometry && geometry->geometry == Open::Geometry::mesh && node.name == "PolygonVertexIndex" && type == 'i') {
       ints.each = [geometry](std::int32_t v) {
         const std::int64_t vertex = v < 0 ? ~static_cast<std::int64_t>(v) : v;  // a polygon's last corner is stored negated
@@ -392,7 +464,7 @@ class BinaryWalk {
   bool wide_ = false;
   std::vector<Open> open_;
   std::size_t meshes_ = 0;
-  ModelGraph graph_;
+  SceneGraph graph_;
 };
 
 // ---- ASCII FBX ----------------------------------------------------------------------------
@@ -439,7 +511,7 @@ class AsciiWalk {
     }
     if (token != std::string::npos) ended(token, text_.size(), false, false);
     count_values();
-    check_model_graph(graph_, refuse_, limits_);
+    check_scene_graph(graph_, refuse_, limits_);
     FbxSummary s;
     s.values = budget_.values;
     s.decoded_bytes = budget_.decoded;
@@ -457,6 +529,7 @@ class AsciiWalk {
     ++values_;
     if (key) {
       if (depth_ <= 1) key_.assign(text_, begin, end - begin), field_ = 0;
+      if (depth_ == 2) inner_key_.assign(text_, begin, end - begin);
       return;
     }
     // An array's declared count: the reader reserves room for it before reading a value.
@@ -466,11 +539,21 @@ class AsciiWalk {
         refuse_("line " + std::to_string(line_) + ": an array that declares " + std::to_string(declared) +
                 " values, more than the rest of the file can hold");
       budget_.add_array(8 * declared, [&] { return "line " + std::to_string(line_); });
+      // A mesh's polygon corners: "PolygonVertexIndex: *N {" inside its Geometry.
+      if (depth_ == 2 && inner_key_ == "PolygonVertexIndex" && block_ == "Objects" && key_ == "Geometry" && class_ == "Mesh")
+        graph_.meshes[object_id_].second = declared;
     }
     if (depth_ != 1) return;
-    // The model hierarchy: "Model: id, ..." in Objects, "C: "OO", child, parent" in Connections.
+    // Objects: "Model: id, "Model::name", "class" {"; connections: "C: "OO", child, parent".
     const int field = field_++;
-    if (block_ == "Objects" && key_ == "Model" && field == 0) graph_.models.push_back(number(begin));
+    if (block_ == "Objects") {
+      if (field == 0) object_id_ = number(begin), class_.clear(), name_.clear();
+      if (field == 1) name_ = object_name(text_.substr(begin, end - begin));
+      if (field == 2) {
+        class_.assign(text_, begin, end - begin);
+        graph_.object(key_, object_id_, class_, name_);
+      }
+    }
     if (block_ == "Connections" && key_ == "C") {
       if (field == 0) link_type_.assign(text_, begin, end - begin);
       if (field == 1) link_child_ = number(begin);
@@ -486,10 +569,11 @@ class AsciiWalk {
   Budget budget_;
   int depth_ = 0;
   std::uint64_t line_ = 1, values_ = 0;
-  std::string key_, block_, link_type_;  // the last key at the top two levels; the top-level block open
-  int field_ = 0;                        // values since that key
-  std::int64_t link_child_ = 0;
-  ModelGraph graph_;
+  std::string key_, block_, inner_key_;  // the last key at the top two levels, and below; the block open
+  int field_ = 0;                         // values since that key
+  std::string link_type_, class_, name_;  // of the connection, of the object being read
+  std::int64_t link_child_ = 0, object_id_ = 0;
+  SceneGraph graph_;
 };
 }  // namespace
 

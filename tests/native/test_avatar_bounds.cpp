@@ -148,6 +148,23 @@ TEST(AvatarBounds, ModelHierarchiesDeepOrExplodingAreRefused) {
   expect_error(error_of(ascii), ascii, "its models are nested more than 256 deep");
 }
 
+TEST(AvatarBounds, BlendShapesTheReaderWouldCopyPerCornerAreBounded) {
+  REQUIRE_SCENE_FILES();
+  const TempDir dir("bounds-shapes");
+  // 100 shapes on a mesh of a million polygon corners (4 MB of indexes, 4 KB compressed):
+  // assimp would copy the corners' positions and normals for each, 2.3 GiB.
+  TestScene many = scene();
+  for (int k = 0; k < 98; ++k) many.meshes[0].shapes.push_back({"extra" + std::to_string(k), std::vector<float>(36, 0.0f), {}});
+  const std::string path = dir.write("corners.fbx", softdeca::test::fbx_bytes(many, [](files::FbxNode& objects) {
+    softdeca::test::fbx_find(objects, "PolygonVertexIndex")->properties[0] = files::fbx_array_declared('i', 1000000, 1, files::zlib_zeros(4000000));
+  }));
+  expect_error(error_of(path), path,
+               "mesh 'Head': its 100 blend shapes over 1000000 polygon corners would take the reader 2.28 GiB (a copy of the "
+               "corners for each), more than the 1 GiB an avatar may decode");
+  // The same shapes on the head's own 60 corners read.
+  EXPECT_EQ(error_of(dir.write("head.fbx", softdeca::test::fbx_bytes(many))), "");
+}
+
 TEST(AvatarBounds, AZlibBombIsRefusedByItsDeclaredSize) {
   REQUIRE_SCENE_FILES();
   const TempDir dir("bounds-bomb");
