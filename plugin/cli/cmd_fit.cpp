@@ -7,8 +7,8 @@
 #include <stdexcept>
 
 #include "imported_avatar.h"
+#include "avatar_view.h"
 #include "command.h"
-#include "fit/avatar_frame.h"
 #include "fit_folder.h"
 #include "fit_options_arg.h"
 #include "fit_picture.h"
@@ -32,19 +32,12 @@ void describe(const AvatarFile& a) {
 
 // The picture's axes: the subject's frame as the library reads it off the avatar's shapes.
 PictureAxes picture_axes(const AvatarFile& a) {
-  fit::AvatarShapes shapes;
-  shapes.neutral = a.neutral.data();
-  shapes.vertex_count = a.vertex_count();
-  for (std::size_t k = 0; k < 52; ++k)
-    shapes.deltas[k] = a.shape_sources[k].empty() ? nullptr : a.blendshapes.data() + 3 * k * a.vertex_count();
-  shapes.triangles = a.triangles.data();
-  shapes.triangle_count = a.triangles.size() / 3;
-  const fit::AvatarFrame frame = fit::avatar_frame(shapes);
+  const AvatarView view = avatar_view(a, 1.0);
   PictureAxes axes{};
   for (int k = 0; k < 3; ++k) {
-    axes.left[k] = frame.left[k];
-    axes.up[k] = frame.up[k];
-    axes.forward[k] = frame.forward[k];
+    axes.left[k] = view.left[k];
+    axes.up[k] = view.up[k];
+    axes.forward[k] = view.forward[k];
   }
   return axes;
 }
