@@ -12,7 +12,6 @@
 #include "fit_folder.h"
 #include "fit_options_arg.h"
 #include "fit_picture.h"
-#include "json.h"
 #include "options.h"
 #include "runtime_session.h"
 #include "staged_folder.h"
