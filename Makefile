@@ -257,10 +257,10 @@ bench-stress: build ## the stress suite's figures -> build/bench/physics_stress.
 # into UNITY_BINARIES on their machines, `make unity-package` packs too.
 WINDOWS        := build/windows
 WINDOWS_ORT    := $(CURDIR)/.deps/onnxruntime-win
-WINDOWS_TESTS  := test_c_abi test_stream test_bundle_folder abi_header_check_c abi_header_check_cpp replay_check
+WINDOWS_TESTS  := test_c_abi test_atomic_write test_stream test_bundle_folder abi_header_check_c abi_header_check_cpp replay_check
 # The Windows tests that run under wine: the C ABI, the streaming and recording stack (UDP over
 # loopback included), bundle folders (links, sizes, file kinds), the header checks against softdeca.dll, its export table.
-WINDOWS_CTEST  := ^(BundleFolder|OnnxConstantSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines)\.|^abi_header_check_|^dll_exports_only_c_abi$$
+WINDOWS_CTEST  := ^(AtomicWrite|BundleFolder|OnnxConstantSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines)\.|^abi_header_check_|^dll_exports_only_c_abi$$
 # The replay check: frames of a real take through models/softdeca-default on the identity of
 # seed 1, by the Linux CLI and by the Windows DLL under wine, compared vertex by vertex.
 CHECK          := build/platform-check

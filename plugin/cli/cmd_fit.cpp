@@ -12,9 +12,9 @@
 #include "fit_folder.h"
 #include "fit_options_arg.h"
 #include "fit_picture.h"
-#include "json.h"
 #include "options.h"
 #include "runtime_session.h"
+#include "staged_folder.h"
 
 namespace softdeca::cli {
 
@@ -42,13 +42,14 @@ PictureAxes picture_axes(const AvatarFile& a) {
   return axes;
 }
 
-void draw(const std::string& path, const Model& model, const Fit& fit, const AvatarFile& a) {
+// fit.png's bytes: the registered template on the avatar.
+std::string draw(const Model& model, const Fit& fit, const AvatarFile& a) {
   const std::vector<float> registered = fit.registered(model);
   std::vector<std::int32_t> skin(3 * std::size_t{model.info.skin_triangle_count});
   check(softdeca_model_get_skin_triangles(model.handle, skin.data(), model.info.skin_triangle_count), "skin triangles");
   const PictureMesh avatar{a.neutral.data(), a.vertex_count(), a.triangles.data(), a.triangles.size() / 3};
   const PictureMesh templ{registered.data(), model.info.skin_vertex_count, skin.data(), model.info.skin_triangle_count};
-  write_fit_picture(path, avatar, templ, picture_axes(a));
+  return fit_picture_png(avatar, templ, picture_axes(a));
 }
 }  // namespace
 
@@ -63,7 +64,8 @@ int run_fit(const Args& args) {
                    "rig names, the names not used) and DIR/fit.png (front and side views: the template in colour on the\n"
                    "avatar). Then: softdeca replay TAKE --bundle B --avatar DIR.");
   o.positional("MESH", "the avatar: .gltf, .glb, .vrm, .fbx, or an avatar folder");
-  o.option("--bundle", "DIR", "model bundle folder or .tar (with the template head)").option("--out", "DIR", "the fit folder to write");
+  o.option("--bundle", "DIR", "model bundle folder or .tar (with the template head)")
+      .option("--out", "DIR", "the fit folder to write (new, or an earlier fit folder: replaced whole)");
   declare_fit_options(o);
   if (!o.parse(args)) return 0;
   if (!o.given("--bundle")) throw UsageError("--bundle is required");
@@ -81,11 +83,13 @@ int run_fit(const Args& args) {
   const Fit fit(model, avatar.abi_mesh(), options);
   std::fprintf(stderr, "fitted in %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 
-  make_directories(out);
-  fit.save(fit_file(out));
-  write_text_file(out + "/fit.json", fit_json(avatar, out, fit.report()));
+  // Written whole beside DIR and renamed into place: DIR is the previous fit folder or this one.
+  StagedFolder folder(out, fit_folder_files());
+  fit.save(fit_file(folder.path()));
+  folder.write("fit.json", fit_json(avatar, out, fit.report()));
   std::fprintf(stderr, "drawing %s/fit.png\n", out.c_str());
-  draw(out + "/fit.png", model, fit, avatar);
+  folder.write("fit.png", draw(model, fit, avatar));
+  folder.commit();
   std::printf("wrote %s/avatar.fit, %s/fit.json and %s/fit.png\n", out.c_str(), out.c_str(), out.c_str());
   return 0;
 }

@@ -113,6 +113,8 @@ std::string locate_mesh(const std::string& dir, const std::string& recorded, con
 }
 }  // namespace
 
+std::vector<std::string> fit_folder_files() { return {"avatar.fit", "fit.json", "fit.png"}; }
+
 bool is_fit_folder(const std::string& dir) {
   std::error_code error;
   return fs::is_directory(dir, error) && fs::is_regular_file(fit_file(dir), error);

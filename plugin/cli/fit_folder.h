@@ -6,14 +6,19 @@
 //                    the names not used
 //   DIR/fit.png      front and side views of the template on the avatar (fit_picture.h)
 // The fit holds no copy of the mesh: the replay reads the mesh again and checks its SHA-256, so a
-// changed mesh is refused before the library's own check.
+// changed mesh is refused before the library's own check. `softdeca fit` writes the folder whole
+// beside DIR and renames it into place (staged_folder.h): DIR is one fit's folder, never a mix.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "imported_avatar.h"
 
 namespace softdeca::cli {
+
+// The files of a fit folder: what replacing one removes.
+std::vector<std::string> fit_folder_files();
 
 bool is_fit_folder(const std::string& dir);
 std::string fit_file(const std::string& dir);  // DIR/avatar.fit

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "fit/closest_identity.h"
+#include "fit/limits.h"
 #include "fit/mesh_hash.h"
 #include "fit/mesh_topology.h"
 #include "fit/placement.h"
@@ -35,7 +36,7 @@ constexpr const char* kSkinShapes[] = {
 // Distances of the embedding (metres): an avatar vertex within kNear of the registered skin
 // follows it fully, beyond kFar not at all; the template's face weight falls to zero over
 // kFaceFade away from the vertices its shapes move.
-constexpr double kNear = 0.003, kFar = 0.010, kFaceFade = 0.03;
+constexpr double kNear = 0.003, kFar = kEmbeddingReach, kFaceFade = 0.03;
 // A template vertex takes the avatar's shapes fully within kShapeNear of the avatar's surface,
 // its own beyond kShapeFar.
 constexpr double kShapeNear = 0.004, kShapeFar = 0.015;
