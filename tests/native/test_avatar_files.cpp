@@ -131,12 +131,11 @@ std::vector<std::size_t> identity_order(std::size_t n) {
   return order;
 }
 
-#define REQUIRE_SCENE_FILES() \
-  if (!scene_files_supported()) GTEST_SKIP() << "built without assimp"
+#define REQUIRE_FBX_FILES() \
+  if (!fbx_files_supported()) GTEST_SKIP() << "built without assimp"
 }  // namespace
 
 TEST(AvatarFiles, GlbKeepsVertexOrderPlacesPartsAndFindsArkitShapes) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-glb");
   const TestScene scene = avatar_scene();
   const AvatarFile a = read_avatar_file(dir.write("avatar.glb", softdeca::test::glb_bytes(scene)));
@@ -176,7 +175,6 @@ TEST(AvatarFiles, GlbKeepsVertexOrderPlacesPartsAndFindsArkitShapes) {
 }
 
 TEST(AvatarFiles, FramesGoBackToEachPartsOwnCoordinates) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-local");
   const TestScene scene = avatar_scene();
   const AvatarFile a = read_avatar_file(dir.write("avatar.glb", softdeca::test::glb_bytes(scene)));
@@ -203,7 +201,6 @@ TEST(AvatarFiles, FramesGoBackToEachPartsOwnCoordinates) {
 }
 
 TEST(AvatarFiles, VrmIsReadAsBinaryGltf) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-vrm");
   const AvatarFile a = read_avatar_file(dir.write("avatar.vrm", softdeca::test::glb_bytes(avatar_scene())));
   EXPECT_EQ(a.format, "glTF 2.0");
@@ -211,7 +208,7 @@ TEST(AvatarFiles, VrmIsReadAsBinaryGltf) {
 }
 
 TEST(AvatarFiles, FbxWeldsCornersBackAndTakesTheFullShapeOfAnInBetween) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX_FILES();
   const TempDir dir("avatar-fbx");
   TestScene scene = avatar_scene();
   scene.fbx_unit_cm = 1;
@@ -244,7 +241,6 @@ TEST(AvatarFiles, FbxWeldsCornersBackAndTakesTheFullShapeOfAnInBetween) {
 }
 
 TEST(AvatarFiles, AMirroringTransformTurnsTheTrianglesOverAndBack) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-mirror");
   TestScene scene;
   scene.meshes = {head()};
@@ -268,7 +264,6 @@ TEST(AvatarFiles, WeldingKeepsCornersApartThatAShapeMovesApart) {
 }
 
 TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-hostile");
   const std::string glb = softdeca::test::glb_bytes(avatar_scene());
 
@@ -311,7 +306,6 @@ TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
 }
 
 TEST(AvatarFiles, AShapeOfAnotherVertexCountIsRefused) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-shape-size");
   TestScene scene = avatar_scene();
   scene.meshes[1].shapes[0].deltas.resize(9);  // 3 of the teeth's 4 vertices
