@@ -117,7 +117,8 @@ Geometry read_geometry(AccessorReader& reader, const Primitive& p, const ImportL
   Geometry g;
   g.mode = p.mode;
   const Accessor& position = doc.accessor(p.position);
-  const bool compressed = p.draco && (draco_supported() || !position.view);
+  const bool uncompressed_copy = position.view && (!p.indices || doc.accessor(*p.indices).view);
+  const bool compressed = p.draco && (draco_supported() || !uncompressed_copy);
   if (compressed) {
     const Object& ext = *p.draco;
     const std::size_t view = ext.index("bufferView", doc.count("bufferViews"), "bufferViews");
@@ -156,11 +157,6 @@ std::uint64_t declared_vertices(Document& doc, std::size_t index) {
   for (const Primitive& p : triangle_primitives(doc, doc.item("meshes", index)))
     total = std::min(total + doc.accessor(p.position).count, kMaxExactInteger);
   return total;
-}
-
-std::size_t target_count(Document& doc, std::size_t index) {
-  const std::vector<Primitive> primitives = triangle_primitives(doc, doc.item("meshes", index));
-  return primitives.empty() ? 0 : primitives[0].target_count();
 }
 
 MeshData read_mesh(AccessorReader& reader, std::size_t index, const ImportLimits& limits) {

@@ -29,9 +29,6 @@ struct MeshData {
 // known before anything is decoded: what bounds instancing.
 std::uint64_t declared_vertices(Document& doc, std::size_t index);
 
-// The morph target count of meshes[index] (the first triangle primitive's).
-std::size_t target_count(Document& doc, std::size_t index);
-
 // Reads meshes[index]. Throws Problem naming the mesh (and primitive): more vertices, triangles
 // or morph targets than `limits` allow, primitives whose targets disagree, an index not below its
 // primitive's vertex count, a target of another vertex count.

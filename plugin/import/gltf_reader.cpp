@@ -47,8 +47,8 @@ SourceMesh instance_mesh(MeshData& data, bool last_use, DecodeBudget& budget, co
     mesh.shapes = std::move(data.shapes);
     return mesh;
   }
-  std::uint64_t bytes = 4 * (data.vertices.size() + data.triangles.size());
-  for (const SourceShape& s : data.shapes) bytes += 4 * s.deltas.size();
+  std::uint64_t bytes = sizeof(SourceMesh) + 4 * (data.vertices.size() + data.triangles.size());
+  for (const SourceShape& s : data.shapes) bytes += sizeof(SourceShape) + s.name.size() + 4 * s.deltas.size();
   budget.take(bytes, "mesh instance '" + name + "'");
   mesh.vertices = data.vertices;
   mesh.triangles = data.triangles;
@@ -71,7 +71,7 @@ SourceScene read(const std::string& path, const ImportLimits& limits) {
   BinaryData data(doc, container, bytes, folder_of(path), limits, budget, bytes.size());
   AccessorReader reader(doc, data, budget);
   const std::vector<Instance> instances = scene_instances(reader, limits);
-  const std::vector<Expression> expressions = vrm_expressions(doc);
+  const Expressions expressions(doc);
 
   std::map<std::size_t, std::size_t> uses;
   for (const Instance& i : instances) ++uses[i.mesh];
@@ -90,7 +90,7 @@ SourceScene read(const std::string& path, const ImportLimits& limits) {
     if (last_use) meshes.erase(it);
     out.name = instance.name;
     std::copy(instance.transform, instance.transform + 16, out.transform);
-    add_expression_shapes(expressions, instance.mesh, instance.node, label_of_mesh, out, budget);
+    expressions.add_shapes(instance.mesh, instance.node, label_of_mesh, out, limits.max_morph_targets, budget);
     scene.meshes.push_back(std::move(out));
   }
   return scene;
