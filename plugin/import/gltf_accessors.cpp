@@ -17,7 +17,8 @@ double raw_component(const unsigned char* p, std::uint32_t component) {
     case kUnsignedShort: return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
     case kUnsignedInt:
     case kFloat: {
-      const std::uint32_t bits = std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) | (std::uint32_t{p[3]} << 24);
+      const std::uint32_t bits =
+          std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) | (std::uint32_t{p[3]} << 24);
       if (component == kUnsignedInt) return bits;
       float f;
       std::memcpy(&f, &bits, sizeof f);

@@ -124,7 +124,8 @@ std::string_view BinaryData::buffer(std::size_t index) {
     if (!cached) {
       std::string data = load(index, b);
       if (data.size() > limits_.max_total_bytes - std::min(read_, limits_.max_total_bytes))
-        throw Problem(where, "reading it would take the avatar's files past the " + text(limits_.max_total_bytes) + " bytes an import may read");
+        throw Problem(where, "reading it would take the avatar's files past the " + text(limits_.max_total_bytes) +
+                                 " bytes an import may read");
       read_ += data.size();
       cached = std::move(data);
     }

@@ -57,10 +57,12 @@ MeshoptView meshopt_of(const Object& ext, Document& doc, const BufferView& paren
   if (parent.stride != 0 && parent.stride != m.stride)
     ext.fail("byteStride " + text(m.stride) + " is not the bufferView's byteStride " + text(parent.stride));
   if (m.mode == MeshoptView::Mode::attributes) {
-    if (m.stride % 4 != 0 || m.stride == 0 || m.stride > 256) ext.fail("byteStride " + text(m.stride) + " of ATTRIBUTES is not a multiple of 4 up to 256");
+    if (m.stride % 4 != 0 || m.stride == 0 || m.stride > 256)
+      ext.fail("byteStride " + text(m.stride) + " of ATTRIBUTES is not a multiple of 4 up to 256");
   } else {
     if (m.stride != 2 && m.stride != 4) ext.fail("byteStride " + text(m.stride) + " of indices is not 2 or 4");
-    if (m.mode == MeshoptView::Mode::triangles && m.count % 3 != 0) ext.fail("count " + text(m.count) + " of TRIANGLES is not a multiple of 3");
+    if (m.mode == MeshoptView::Mode::triangles && m.count % 3 != 0)
+      ext.fail("count " + text(m.count) + " of TRIANGLES is not a multiple of 3");
     if (m.filter != MeshoptView::Filter::none) ext.fail("indices take no filter");
   }
   if (m.filter == MeshoptView::Filter::octahedral && m.stride != 4 && m.stride != 8) ext.fail("OCTAHEDRAL needs byteStride 4 or 8");

@@ -20,8 +20,12 @@ DracoPrimitive decode_draco(std::string_view bytes, std::uint32_t position_id, s
     throw Problem(where, std::string("its KHR_draco_mesh_compression data does not decode (") + decoded.status().error_msg() + ")");
   const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
   const std::uint64_t points = mesh->num_points(), faces = mesh->num_faces();
-  if (points > max_points) throw Problem(where, "its Draco mesh has " + std::to_string(points) + " points, more than the " + std::to_string(max_points) + " it may have");
-  if (faces > max_faces) throw Problem(where, "its Draco mesh has " + std::to_string(faces) + " faces, more than the " + std::to_string(max_faces) + " it may have");
+  if (points > max_points)
+    throw Problem(where, "its Draco mesh has " + std::to_string(points) + " points, more than its POSITION accessor's " +
+                             std::to_string(max_points));
+  if (faces > max_faces)
+    throw Problem(where, "its Draco mesh has " + std::to_string(faces) + " faces, more than the " + std::to_string(max_faces) +
+                             " triangles an avatar may have");
   const draco::PointAttribute* position = mesh->GetAttributeByUniqueId(position_id);
   if (!position) throw Problem(where, "its Draco mesh has no attribute " + std::to_string(position_id) + " (its POSITION)");
   if (position->num_components() != 3)
@@ -38,7 +42,9 @@ DracoPrimitive decode_draco(std::string_view bytes, std::uint32_t position_id, s
     const draco::Mesh::Face& face = mesh->face(f);
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t corner = face[k].value();
-      if (corner >= points) throw Problem(where, "its Draco face " + std::to_string(f.value()) + " refers to point " + std::to_string(corner) + " of " + std::to_string(points));
+      if (corner >= points)
+        throw Problem(where, "its Draco face " + std::to_string(f.value()) + " refers to point " + std::to_string(corner) + " of " +
+                                 std::to_string(points));
       out.indices[3 * std::size_t{f.value()} + static_cast<std::size_t>(k)] = corner;
     }
   }

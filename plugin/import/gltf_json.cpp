@@ -30,7 +30,8 @@ std::uint64_t as_size(const Json& value, const std::string& where) {
   if (!value.is_number()) throw Problem(where, std::string("is ") + kind(value) + ", not a number");
   const double number = value.number(where);
   if (number < 0 || number != std::floor(number)) throw Problem(where, shown(number) + " is not a whole number of at least 0");
-  if (number > static_cast<double>(kMaxExactInteger)) throw Problem(where, shown(number) + " is more than 2^53, the most a glTF index or size may be");
+  if (number > static_cast<double>(kMaxExactInteger))
+    throw Problem(where, shown(number) + " is more than 2^53, the most a glTF index or size may be");
   return static_cast<std::uint64_t>(number);
 }
 

@@ -130,7 +130,8 @@ Geometry read_geometry(AccessorReader& reader, const Primitive& p, const ImportL
     DracoPrimitive d = decode_draco(bytes, static_cast<std::uint32_t>(id), position.count, limits.max_triangles, ext.where());
     reader.budget().take(4 * (d.positions.size() + d.indices.size()), ext.where());
     if (d.positions.size() / 3 != position.count)
-      throw Problem(p.where, "its Draco mesh has " + text(d.positions.size() / 3) + " points, its POSITION accessor " + text(position.count));
+      throw Problem(p.where, "its Draco mesh has " + text(d.positions.size() / 3) + " points, its POSITION accessor " +
+                                 text(position.count));
     if (p.indices && doc.accessor(*p.indices).count != d.indices.size())
       throw Problem(p.where, "its Draco mesh has " + text(d.indices.size()) + " face corners, its indices accessor " +
                                  text(doc.accessor(*p.indices).count));
@@ -222,7 +223,8 @@ MeshData read_mesh(AccessorReader& reader, std::size_t index, const ImportLimits
     }
   }
   if (out.triangles.size() / 3 > limits.max_triangles)
-    throw Problem(out.label, text(out.triangles.size() / 3) + " triangles, more than the " + text(limits.max_triangles) + " an avatar may have");
+    throw Problem(out.label, text(out.triangles.size() / 3) + " triangles, more than the " + text(limits.max_triangles) +
+                                 " an avatar may have");
   return out;
 }
 

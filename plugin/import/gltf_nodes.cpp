@@ -181,7 +181,8 @@ std::optional<Matrix> skin_placement(AccessorReader& reader, std::size_t skin, c
     const double linear = first->topLeftCorner<3, 3>().cwiseAbs().maxCoeff();
     const double offset = std::max(linear, first->topRightCorner<3, 1>().cwiseAbs().maxCoeff());
     const Matrix d = (placement - *first).cwiseAbs();
-    if (!(d.topLeftCorner<3, 3>().maxCoeff() <= 1e-4 * linear) || !(d.topRightCorner<3, 1>().maxCoeff() <= 1e-4 * offset)) return std::nullopt;
+    if (!(d.topLeftCorner<3, 3>().maxCoeff() <= 1e-4 * linear) || !(d.topRightCorner<3, 1>().maxCoeff() <= 1e-4 * offset))
+      return std::nullopt;
   }
   return first;
 }

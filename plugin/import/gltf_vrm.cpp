@@ -89,7 +89,8 @@ void Expressions::add_shapes(std::size_t mesh_index, std::size_t node, const std
       SourceShape shape{name, std::vector<float>(floats, 0.0f)};
       for (std::size_t b = first; b < end; ++b) {
         if (binds[b]->target >= own)
-          throw Problem(binds[b]->where, "index " + text(binds[b]->target) + " is not one of the " + text(own) + " morph targets of " + label);
+          throw Problem(binds[b]->where,
+                        "index " + text(binds[b]->target) + " is not one of the " + text(own) + " morph targets of " + label);
         const std::vector<float>& delta = mesh.shapes[binds[b]->target].deltas;
         for (std::size_t i = 0; i < delta.size() && i < floats; ++i) shape.deltas[i] += static_cast<float>(binds[b]->weight * delta[i]);
       }

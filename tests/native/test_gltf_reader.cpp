@@ -287,33 +287,84 @@ std::string draco_bytes(const std::vector<float>& positions, const std::vector<s
 }
 #endif
 
-// One primitive of `s`, its accessors and views added to `g`; returns the primitive's JSON.
+// A VEC3 accessor of `count` elements (`view` < 0: none), its bounds those of `values`.
+int vec3_accessor(Gltf& g, int view, const std::string& component, std::size_t count, const std::vector<float>& values,
+                  const std::string& more = "") {
+  return g.accessor("{" + (view >= 0 ? "\"bufferView\":" + std::to_string(view) + "," : std::string()) + "\"componentType\":" + component +
+                    ",\"count\":" + std::to_string(count) + ",\"type\":\"VEC3\"" + min_max(values) + more + "}");
+}
+
+int index_accessor(Gltf& g, int view, std::size_t count) {
+  return g.accessor("{" + (view >= 0 ? "\"bufferView\":" + std::to_string(view) + "," : std::string()) +
+                    "\"componentType\":5125,\"count\":" + std::to_string(count) + ",\"type\":\"SCALAR\"}");
+}
+
+// Morph target deltas (`local`, the mesh's own units) as a sparse accessor: the vertices they
+// move, or with `sparse_over_view` a view of the even vertices and sparse values for the odd.
+int sparse_target(Gltf& g, const std::vector<float>& local, const Encoding& e) {
+  const std::size_t n = local.size() / 3;
+  std::vector<std::uint32_t> moved;
+  for (std::size_t i = 0; i < n; ++i)
+    if ((local[3 * i] != 0 || local[3 * i + 1] != 0 || local[3 * i + 2] != 0) && (!e.sparse_over_view || i % 2 == 1))
+      moved.push_back(static_cast<std::uint32_t>(i));
+  int base = -1;
+  if (e.sparse_over_view) {
+    std::vector<float> even = local;
+    for (std::size_t i = 1; i < n; i += 2) even[3 * i] = even[3 * i + 1] = even[3 * i + 2] = 0;
+    base = g.view(bytes_of(even), 12);
+  }
+  if (moved.empty()) return vec3_accessor(g, base, "5126", n, local);
+  std::string indices;
+  std::vector<float> picked;
+  for (const std::uint32_t i : moved) {
+    picked.insert(picked.end(), {local[3 * i], local[3 * i + 1], local[3 * i + 2]});
+    if (e.sparse_indices == 5121) indices += static_cast<char>(i);
+    if (e.sparse_indices == 5123) indices += bytes_of(std::vector<std::uint16_t>{static_cast<std::uint16_t>(i)});
+    if (e.sparse_indices == 5125) indices += bytes_of(std::vector<std::uint32_t>{i});
+  }
+  std::string values = bytes_of(picked), component = "5126";
+  if (e.sparse_values == 5120) values = bytes_of(quantize<std::int8_t>(picked, 1, 127, 3, 3)), component = "5120,\"normalized\":true";
+  if (e.sparse_values == 5122) values = bytes_of(quantize<std::int16_t>(picked, 1, 32767, 3, 3)), component = "5122,\"normalized\":true";
+  const int iv = g.view(indices), vv = g.view(values);
+  return vec3_accessor(g, base, component, n, local,
+                       ",\"sparse\":{\"count\":" + std::to_string(moved.size()) + ",\"indices\":{\"bufferView\":" + std::to_string(iv) +
+                           ",\"componentType\":" + std::to_string(e.sparse_indices) + "},\"values\":{\"bufferView\":" + std::to_string(vv) + "}}");
+}
+
+// Morph target deltas in a view of their own: floats, or normalized bytes (KHR_mesh_quantization).
+int dense_target(Gltf& g, const std::vector<float>& local, const Encoding& e) {
+  const std::size_t n = local.size() / 3;
+  const std::size_t stride = e.quantized_deltas ? 4 : 12;
+  const int view = e.quantized_deltas ? g.view(bytes_of(quantize<std::int8_t>(local, 1, 127, 3, 4)), 4) : g.view(bytes_of(local), 12);
+#if SOFTDECA_TEST_MESHOPT
+  if (e.meshopt) compress_view(g, view, n, stride, false, e.exponential && !e.quantized_deltas);
+#else
+  (void)stride;
+#endif
+  return vec3_accessor(g, view, e.quantized_deltas ? "5120,\"normalized\":true" : "5126", n, local);
+}
+
+// One primitive of `s` (positions divided by `q` where quantized), its accessors and views added
+// to `g`; returns the primitive's JSON.
 std::string write_primitive(Gltf& g, const Slice& s, const Encoding& e, float q, const std::vector<std::string>& names) {
   const std::size_t n = s.vertices.size() / 3;
-  std::string position, indices, draco;
+  int position = -1, indices = -1;
+  std::string draco;
   if (e.draco) {
 #if SOFTDECA_TEST_DRACO
-    const int v = g.view(draco_bytes(s.vertices, s.triangles));
-    position = std::to_string(g.accessor("{\"componentType\":5126,\"count\":" + std::to_string(n) + ",\"type\":\"VEC3\"" + min_max(s.vertices) + "}"));
-    indices = std::to_string(g.accessor("{\"componentType\":5125,\"count\":" + std::to_string(s.triangles.size()) + ",\"type\":\"SCALAR\"}"));
-    draco = ",\"extensions\":{\"KHR_draco_mesh_compression\":{\"bufferView\":" + std::to_string(v) + ",\"attributes\":{\"POSITION\":0}}}";
+    const int view = g.view(draco_bytes(s.vertices, s.triangles));
+    position = vec3_accessor(g, -1, "5126", n, s.vertices);
+    indices = index_accessor(g, -1, s.triangles.size());
+    draco = ",\"extensions\":{\"KHR_draco_mesh_compression\":{\"bufferView\":" + std::to_string(view) + ",\"attributes\":{\"POSITION\":0}}}";
 #endif
   } else {
-    int pv = 0;
-    std::string component = "5126";
-    if (e.quantized_positions) {
-      pv = g.view(bytes_of(quantize<std::int16_t>(s.vertices, q, 32767, 3, 4)), 8);
-      component = "5122,\"normalized\":true";
-    } else {
-      pv = g.view(bytes_of(s.vertices), 12);
-    }
     std::vector<float> local = s.vertices;
-    for (float& x : local) x /= e.quantized_positions ? q : 1.0f;
-    position = std::to_string(g.accessor("{\"bufferView\":" + std::to_string(pv) + ",\"componentType\":" + component + ",\"count\":" +
-                                         std::to_string(n) + ",\"type\":\"VEC3\"" + min_max(local) + "}"));
+    for (float& x : local) x /= q;
+    const int pv = e.quantized_positions ? g.view(bytes_of(quantize<std::int16_t>(s.vertices, q, 32767, 3, 4)), 8)
+                                         : g.view(bytes_of(s.vertices), 12);
+    position = vec3_accessor(g, pv, e.quantized_positions ? "5122,\"normalized\":true" : "5126", n, local);
     const int iv = g.view(bytes_of(s.triangles));
-    indices = std::to_string(g.accessor("{\"bufferView\":" + std::to_string(iv) + ",\"componentType\":5125,\"count\":" +
-                                        std::to_string(s.triangles.size()) + ",\"type\":\"SCALAR\"}"));
+    indices = index_accessor(g, iv, s.triangles.size());
 #if SOFTDECA_TEST_MESHOPT
     if (e.meshopt) {
       compress_view(g, pv, n, e.quantized_positions ? 8 : 12, false, false);
@@ -323,68 +374,11 @@ std::string write_primitive(Gltf& g, const Slice& s, const Encoding& e, float q,
   }
   std::vector<std::string> targets;
   for (std::size_t t = 0; t < s.deltas.size(); ++t) {
-    const std::vector<float>& d = s.deltas[t];
-    std::string extras = e.names == "target" ? ",\"extras\":{\"name\":\"" + names[t] + "\"}" : "";
-    const float scale = e.quantized_positions ? q : 1.0f;
-    std::vector<float> local = d;
-    for (float& x : local) x /= scale;
-    if (e.sparse) {
-      std::vector<std::uint32_t> moved;
-      for (std::size_t i = 0; i < n; ++i)
-        if ((local[3 * i] != 0 || local[3 * i + 1] != 0 || local[3 * i + 2] != 0) && (!e.sparse_over_view || i % 2 == 1))
-          moved.push_back(static_cast<std::uint32_t>(i));
-      std::string idx, values;
-      std::vector<float> picked;
-      for (const std::uint32_t i : moved) picked.insert(picked.end(), {local[3 * i], local[3 * i + 1], local[3 * i + 2]});
-      for (const std::uint32_t i : moved) {
-        if (e.sparse_indices == 5121) idx += static_cast<char>(i);
-        if (e.sparse_indices == 5123) idx += bytes_of(std::vector<std::uint16_t>{static_cast<std::uint16_t>(i)});
-        if (e.sparse_indices == 5125) idx += bytes_of(std::vector<std::uint32_t>{i});
-      }
-      std::string value_type = "5126";
-      if (e.sparse_values == 5126) values = bytes_of(picked);
-      if (e.sparse_values == 5120) values = bytes_of(quantize<std::int8_t>(picked, 1, 127, 3, 3)), value_type = "5120,\"normalized\":true";
-      if (e.sparse_values == 5122) values = bytes_of(quantize<std::int16_t>(picked, 1, 32767, 3, 3)), value_type = "5122,\"normalized\":true";
-      std::string base;
-      if (e.sparse_over_view) {
-        std::vector<float> even = local;
-        for (std::size_t i = 1; i < n; i += 2) even[3 * i] = even[3 * i + 1] = even[3 * i + 2] = 0;
-        base = "\"bufferView\":" + std::to_string(g.view(bytes_of(even), 12)) + ",";
-        value_type = "5126";
-        values = bytes_of(picked);
-      }
-      if (moved.empty()) {
-        targets.push_back("{\"POSITION\":" + std::to_string(g.accessor("{" + base + "\"componentType\":5126,\"count\":" + std::to_string(n) +
-                                                                      ",\"type\":\"VEC3\"" + min_max(local) + "}")) + extras + "}");
-        continue;
-      }
-      const int iv = g.view(idx), vv = g.view(values);
-      targets.push_back("{\"POSITION\":" +
-                        std::to_string(g.accessor("{" + base + "\"componentType\":" + (e.sparse_over_view ? std::string("5126") : value_type) +
-                                                  ",\"count\":" + std::to_string(n) + ",\"type\":\"VEC3\"" + min_max(local) +
-                                                  ",\"sparse\":{\"count\":" + std::to_string(moved.size()) + ",\"indices\":{\"bufferView\":" +
-                                                  std::to_string(iv) + ",\"componentType\":" + std::to_string(e.sparse_indices) +
-                                                  "},\"values\":{\"bufferView\":" + std::to_string(vv) + "}}}")) +
-                        extras + "}");
-      continue;
-    }
-    int dv = 0;
-    std::string component = "5126";
-    std::size_t stride = 12;
-    if (e.quantized_deltas) {
-      dv = g.view(bytes_of(quantize<std::int8_t>(local, 1, 127, 3, 4)), 4);
-      component = "5120,\"normalized\":true";
-      stride = 4;
-    } else {
-      dv = g.view(bytes_of(local), 12);
-    }
-#if SOFTDECA_TEST_MESHOPT
-    if (e.meshopt) compress_view(g, dv, n, stride, false, e.exponential && !e.quantized_deltas);
-#endif
-    (void)stride;
-    targets.push_back("{\"POSITION\":" + std::to_string(g.accessor("{\"bufferView\":" + std::to_string(dv) + ",\"componentType\":" + component +
-                                                                  ",\"count\":" + std::to_string(n) + ",\"type\":\"VEC3\"" + min_max(local) + "}")) +
-                      extras + "}");
+    std::vector<float> local = s.deltas[t];
+    for (float& x : local) x /= q;
+    const int accessor = e.sparse ? sparse_target(g, local, e) : dense_target(g, local, e);
+    targets.push_back("{\"POSITION\":" + std::to_string(accessor) +
+                      (e.names == "target" ? ",\"extras\":{\"name\":\"" + names[t] + "\"}" : "") + "}");
   }
   std::string extras;
   if (e.names == "primitive") {
@@ -392,7 +386,7 @@ std::string write_primitive(Gltf& g, const Slice& s, const Encoding& e, float q,
     for (const std::string& name : names) quoted.push_back("\"" + name + "\"");
     extras = ",\"extras\":{\"targetNames\":[" + join(quoted) + "]}";
   }
-  return "{\"attributes\":{\"POSITION\":" + position + "},\"indices\":" + indices + ",\"mode\":4" +
+  return "{\"attributes\":{\"POSITION\":" + std::to_string(position) + "},\"indices\":" + std::to_string(indices) + ",\"mode\":4" +
          (targets.empty() ? "" : ",\"targets\":[" + join(targets) + "]") + draco + extras + "}";
 }
 
@@ -678,8 +672,10 @@ TEST_F(GltfReader, GltfpackOutputReads) {
   const char* gltfpack = "/usr/bin/gltfpack";
   if (::access(gltfpack, X_OK) != 0) GTEST_SKIP() << "gltfpack is not installed";
   const std::string packed = dir_.file("packed.glb");
-  const std::string command = std::string(gltfpack) + " -i '" + dir_.file("plain.glb") + "' -o '" + packed + "' -cc -kn -km > '" +
-                              dir_.file("gltfpack.log") + "' 2>&1";
+  // Compressed (EXT_meshopt_compression) where this build decodes it, else quantized only.
+  const std::string compress = softdeca::avatar_import::gltf::meshopt_supported() ? " -cc" : "";
+  const std::string command = std::string(gltfpack) + " -i '" + dir_.file("plain.glb") + "' -o '" + packed + "'" + compress +
+                              " -kn -km > '" + dir_.file("gltfpack.log") + "' 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   const SourceScene got = read_gltf(packed, {});
   // gltfpack reorders vertices and quantizes positions to 14 bits of each mesh's extent: every
@@ -750,21 +746,52 @@ TEST_F(GltfReader, Vrm1ExpressionsNameShapesByNode) {
 
 // ---- skins ---------------------------------------------------------------------------------
 
-TEST_F(GltfReader, ASkinnedMeshIsPlacedByItsJoints) {
-  // The teeth's node carries a transform the specification says to ignore; its joint (scaled
-  // by 3, inverse bind identity) places it.
+TEST_F(GltfReader, ASkinnedMeshIsPlacedByItsJointsWhereTheyAgree) {
+  // The teeth's node carries a transform the specification says to ignore; its joints (one
+  // scaled by 3, a child of it moved by 1 whose inverse bind matrix moves back) place it.
+  const auto skinned = [&](const std::string& name, float bind_back) {
+    Gltf g;
+    const std::string primitive = teeth_primitive(g);
+    std::vector<float> binds(32, 0.0f);
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 4; ++k) binds[static_cast<std::size_t>(16 * j + 5 * k)] = 1;
+    binds[16 + 12] = -bind_back;  // column-major: the translation is the last column
+    const int ibm = g.accessor("{\"bufferView\":" + std::to_string(g.view(bytes_of(binds))) + ",\"componentType\":5126,\"count\":2,\"type\":\"MAT4\"}");
+    g.meshes.push_back("{\"primitives\":[" + primitive + "]}");
+    g.nodes = {"{\"children\":[1,2]}", "{\"name\":\"T\",\"mesh\":0,\"skin\":0,\"translation\":[5,5,5]}",
+               "{\"name\":\"jaw\",\"scale\":[3,3,3],\"children\":[3]}", "{\"name\":\"tip\",\"translation\":[1,0,0]}"};
+    g.root_members = ",\"skins\":[{\"joints\":[2,3],\"inverseBindMatrices\":" + std::to_string(ibm) + "}]";
+    return read_gltf(dir_.write(name, g.glb()), {});
+  };
+  const SourceScene bound = skinned("bound.glb", 1);
+  ASSERT_EQ(bound.meshes.size(), 1u);
+  EXPECT_EQ(bound.meshes[0].transform[0], 3);
+  EXPECT_EQ(bound.meshes[0].transform[3], 0);
+  // Joints posed away from their bind pose would deform the mesh: it is placed by its node.
+  const SourceScene posed = skinned("posed.glb", 0);
+  EXPECT_EQ(posed.meshes[0].transform[0], 1);
+  EXPECT_EQ(posed.meshes[0].transform[3], 5);
+}
+
+// ---- nodes and scenes ----------------------------------------------------------------------
+
+TEST_F(GltfReader, MatricesScenesAndTargetsWithoutPositions) {
   Gltf g;
-  const std::string primitive = teeth_primitive(g);
-  std::vector<float> identity(16, 0.0f);
-  identity[0] = identity[5] = identity[10] = identity[15] = 1;
-  const int ibm = g.accessor("{\"bufferView\":" + std::to_string(g.view(bytes_of(identity))) + ",\"componentType\":5126,\"count\":1,\"type\":\"MAT4\"}");
-  g.meshes.push_back("{\"primitives\":[" + primitive + "]}");
-  g.nodes = {"{\"children\":[1,2]}", "{\"name\":\"T\",\"mesh\":0,\"skin\":0,\"translation\":[5,5,5]}", "{\"name\":\"joint\",\"scale\":[3,3,3]}"};
-  g.root_members = ",\"skins\":[{\"joints\":[2],\"inverseBindMatrices\":" + std::to_string(ibm) + "}]";
-  const SourceScene s = read_gltf(dir_.write("skinned.glb", g.glb()), {});
-  ASSERT_EQ(s.meshes.size(), 1u);
-  EXPECT_EQ(s.meshes[0].transform[0], 3);
-  EXPECT_EQ(s.meshes[0].transform[3], 0);
+  g.meshes.push_back("{\"name\":\"Teeth\",\"primitives\":[" + teeth_primitive(g, ",\"targets\":[{\"NORMAL\":0}]") + "]}");
+  // Column-major: a scale of 2 and a move of (1, 2, 3).
+  g.nodes = {"{\"name\":\"A\",\"mesh\":0,\"matrix\":[2,0,0,0,0,2,0,0,0,0,2,0,1,2,3,1]}", "{\"name\":\"B\",\"mesh\":0}"};
+  std::string json = g.json();
+  // No scenes: every root node.
+  json.replace(json.find("\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"), std::strlen("\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"), "");
+  const SourceScene s = read_gltf(dir_.write("matrix.glb", Gltf::glb_of(json, g.bin)), {});
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_EQ(s.meshes[0].name, "A");
+  EXPECT_EQ(s.meshes[0].transform[0], 2);
+  EXPECT_EQ(s.meshes[0].transform[7], 2);
+  EXPECT_EQ(s.meshes[0].transform[11], 3);
+  EXPECT_EQ(s.meshes[1].name, "B");
+  ASSERT_EQ(s.meshes[1].shapes.size(), 1u);
+  EXPECT_EQ(s.meshes[1].shapes[0].deltas, std::vector<float>(12, 0.0f));  // a target of normals alone moves nothing
 }
 
 // ---- hostile files -------------------------------------------------------------------------
@@ -947,6 +974,98 @@ TEST_F(GltfHostile, ShortBuffersAndBadVersionsAreRefused) {
                "bufferViews[0]: 480 bytes from byteOffset 0 run past the 72 bytes of buffers[0]"));
   EXPECT_TRUE(fails_with(write_edited("v1.glb", [](std::string& j) { replace(j, "\"version\":\"2.0\"", "\"version\":\"1.0\""); }),
                "asset.version: '1.0': only glTF 2.0 is read"));
+}
+
+TEST_F(GltfHostile, PrimitivesWhoseTargetsDisagreeAreRefused) {
+  Gltf g;
+  const std::string first = teeth_primitive(g, ",\"targets\":[{\"POSITION\":0},{\"POSITION\":0}]");
+  const std::string second = teeth_primitive(g, ",\"targets\":[{\"POSITION\":0}]");
+  g.meshes.push_back("{\"name\":\"Teeth\",\"primitives\":[" + first + "," + second + "]}");
+  g.nodes.push_back("{\"mesh\":0}");
+  EXPECT_TRUE(fails_with(dir_.write("targets.glb", g.glb()), "mesh 'Teeth': primitive 1 has 1 morph targets, primitive 0 2"));
+}
+
+TEST_F(GltfHostile, VrmExpressionsAreBounded) {
+  std::string groups;
+  for (int k = 0; k < 2000; ++k)
+    groups += std::string(k ? "," : "") + "{\"name\":\"g" + std::to_string(k) + "\",\"binds\":[{\"mesh\":0,\"index\":0,\"weight\":100}]}";
+  const std::string path = write_edited("groups.vrm", [&](std::string& j) {
+    replace(j, "},\"indices\":1}", "},\"indices\":1,\"targets\":[{\"POSITION\":0}]}");
+    j.insert(j.size() - 1, ",\"extensions\":{\"VRM\":{\"blendShapeMaster\":{\"blendShapeGroups\":[" + groups + "]}}}");
+  });
+  EXPECT_TRUE(fails_with(path, "mesh 'Teeth': more than 1024 VRM expressions bind its morph targets"));
+  ImportLimits tight;
+  tight.max_decoded_bytes = 20000;
+  EXPECT_TRUE(fails_with(path, "the VRM expression 'g", tight));
+}
+
+TEST_F(GltfHostile, CompressedDataThatDoesNotDecodeIsRefused) {
+  // Garbage where compressed data belongs, and no uncompressed copy: a build with the decoders
+  // says the data does not decode, a build without them that it cannot decode the extension.
+  using softdeca::avatar_import::gltf::draco_supported;
+  using softdeca::avatar_import::gltf::meshopt_supported;
+  Gltf g;
+  const int garbage = g.view(std::string(64, '\x5a'));
+  g.views[static_cast<std::size_t>(garbage)] =
+      "{\"buffer\":1,\"byteLength\":48,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":{\"buffer\":0,\"byteLength\":64,"
+      "\"byteStride\":12,\"count\":4,\"mode\":\"ATTRIBUTES\"}}}";
+  g.fallback_length = 48;
+  g.accessor("{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"}");
+  g.meshes.push_back("{\"name\":\"Teeth\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}");
+  g.accessor("{\"bufferView\":" + std::to_string(g.view(bytes_of(std::vector<std::uint32_t>{0, 1, 2}))) +
+             ",\"componentType\":5125,\"count\":3,\"type\":\"SCALAR\"}");
+  g.nodes.push_back("{\"mesh\":0}");
+  EXPECT_TRUE(fails_with(dir_.write("meshopt.glb", g.glb()),
+                         meshopt_supported() ? "bufferViews[0]: its EXT_meshopt_compression data does not decode"
+                                             : "bufferViews[0]: this build cannot decode EXT_meshopt_compression"));
+  Gltf d;
+  const int view = d.view(std::string(64, '\x5a'));
+  d.accessor("{\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"}");
+  d.accessor("{\"componentType\":5125,\"count\":3,\"type\":\"SCALAR\"}");
+  d.meshes.push_back("{\"name\":\"Teeth\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"extensions\":"
+                     "{\"KHR_draco_mesh_compression\":{\"bufferView\":" + std::to_string(view) + ",\"attributes\":{\"POSITION\":0}}}}]}");
+  d.nodes.push_back("{\"mesh\":0}");
+  EXPECT_TRUE(fails_with(dir_.write("draco.glb", d.glb()),
+                         draco_supported() ? "its KHR_draco_mesh_compression data does not decode"
+                                           : "meshes[0].primitives[0]: this build cannot decode KHR_draco_mesh_compression"));
+}
+
+#ifndef SOFTDECA_GLTF_DAMAGED_FILES
+#define SOFTDECA_GLTF_DAMAGED_FILES 300
+#endif
+TEST_F(GltfHostile, DamagedFilesGiveErrorsNotCrashes) {
+  constexpr int kDamaged = SOFTDECA_GLTF_DAMAGED_FILES;  // per encoding
+  // Each encoding of the avatar with a few random bytes changed (in its JSON or its binary data)
+  // or cut short: read whole or refused with an error naming the file, never a crash.
+  std::vector<Encoding> encodings(4);
+  encodings[1].sparse = encodings[1].quantized_positions = true;
+  encodings[2].meshopt = softdeca::avatar_import::gltf::meshopt_supported();
+  encodings[3].draco = softdeca::avatar_import::gltf::draco_supported();
+  std::uint64_t state = 12345;
+  const auto next = [&] { return (state = state * 6364136223846793005ULL + 1442695040888963407ULL) >> 33; };
+  int refused = 0, read = 0;
+  for (const Encoding& e : encodings) {
+    const std::string clean = write(avatar(), e);
+    for (int k = 0; k < kDamaged; ++k) {
+      std::string bytes = clean;
+      if (k % 10 == 9) {
+        bytes.resize(12 + next() % (bytes.size() - 12));
+      } else {
+        for (int flips = 1 + static_cast<int>(next() % 4); flips > 0; --flips)
+          bytes[12 + next() % (bytes.size() - 12)] = static_cast<char>(next());
+      }
+      const std::string path = dir_.write("damaged.glb", bytes);
+      const std::string error = error_of(path);
+      if (error.empty()) {
+        ++read;
+      } else {
+        ++refused;
+        EXPECT_EQ(error.rfind(path + ": ", 0), 0u) << error;
+      }
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(read, 0);
 }
 
 TEST(GltfBuild, CompressionSupportIsReported) {
