@@ -7,18 +7,6 @@
 namespace softdeca::avatar_import::gltf {
 
 namespace {
-const char* kind(const Json& value) {
-  switch (value.type()) {
-    case Json::Type::Null: return "null";
-    case Json::Type::Bool: return "a boolean";
-    case Json::Type::Number: return "a number";
-    case Json::Type::String: return "a string";
-    case Json::Type::Array: return "an array";
-    case Json::Type::Object: return "an object";
-  }
-  return "?";
-}
-
 std::string shown(double number) {
   char text[64];
   std::snprintf(text, sizeof text, "%.17g", number);
@@ -27,7 +15,7 @@ std::string shown(double number) {
 }  // namespace
 
 std::uint64_t as_size(const Json& value, const std::string& where) {
-  if (!value.is_number()) throw Problem(where, std::string("is ") + kind(value) + ", not a number");
+  if (!value.is_number()) throw Problem(where, std::string("is ") + value.kind() + ", not a number");
   const double number = value.number(where);
   if (number < 0 || number != std::floor(number)) throw Problem(where, shown(number) + " is not a whole number of at least 0");
   if (number > static_cast<double>(kMaxExactInteger))
@@ -43,12 +31,12 @@ std::size_t as_index(const Json& value, std::size_t count, const char* array, co
 }
 
 std::string as_string(const Json& value, const std::string& where) {
-  if (!value.is_string()) throw Problem(where, std::string("is ") + kind(value) + ", not a string");
+  if (!value.is_string()) throw Problem(where, std::string("is ") + value.kind() + ", not a string");
   return value.string(where);
 }
 
 Object::Object(const Json& value, std::string where) : value_(&value), where_(std::move(where)) {
-  if (!value.is_object()) throw Problem(where_, std::string(where_.empty() ? "its JSON is " : "is ") + kind(value) + ", not an object");
+  if (!value.is_object()) throw Problem(where_, std::string(where_.empty() ? "its JSON is " : "is ") + value.kind() + ", not an object");
 }
 
 const Json* Object::find(const std::string& key) const {
@@ -92,14 +80,14 @@ std::optional<std::size_t> Object::optional_index(const std::string& key, std::s
 double Object::number_or(const std::string& key, double absent) const {
   const Json* v = find(key);
   if (!v) return absent;
-  if (!v->is_number()) throw Problem(at(key), std::string("is ") + kind(*v) + ", not a number");
+  if (!v->is_number()) throw Problem(at(key), std::string("is ") + v->kind() + ", not a number");
   return v->number(key);
 }
 
 bool Object::boolean_or(const std::string& key, bool absent) const {
   const Json* v = find(key);
   if (!v) return absent;
-  if (v->type() != Json::Type::Bool) throw Problem(at(key), std::string("is ") + kind(*v) + ", not true or false");
+  if (v->type() != Json::Type::Bool) throw Problem(at(key), std::string("is ") + v->kind() + ", not true or false");
   return v->boolean(key);
 }
 
@@ -129,7 +117,7 @@ const std::vector<Json>& Object::array(const std::string& key) const {
 const std::vector<Json>* Object::optional_array(const std::string& key) const {
   const Json* v = find(key);
   if (!v) return nullptr;
-  if (!v->is_array()) throw Problem(at(key), std::string("is ") + kind(*v) + ", not an array");
+  if (!v->is_array()) throw Problem(at(key), std::string("is ") + v->kind() + ", not an array");
   return &v->array(key);
 }
 
@@ -139,7 +127,7 @@ std::vector<double> Object::numbers_or(const std::string& key, std::size_t count
   if (a->size() != count) throw Problem(at(key), "has " + std::to_string(a->size()) + " numbers, not " + std::to_string(count));
   std::vector<double> out;
   for (std::size_t i = 0; i < count; ++i) {
-    if (!(*a)[i].is_number()) throw Problem(at(key) + "[" + std::to_string(i) + "]", std::string("is ") + kind((*a)[i]) + ", not a number");
+    if (!(*a)[i].is_number()) throw Problem(at(key) + "[" + std::to_string(i) + "]", std::string("is ") + (*a)[i].kind() + ", not a number");
     out.push_back((*a)[i].number(key));
   }
   return out;

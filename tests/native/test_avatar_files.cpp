@@ -23,19 +23,12 @@ using namespace softdeca::avatar_import;
 using softdeca::test::expected_transform;
 using softdeca::test::TempDir;
 constexpr auto shape = softdeca::test::arkit_index;
+using softdeca::test::deltas;
 using softdeca::test::TestMesh;
 using softdeca::test::TestScene;
 using softdeca::test::TestShape;
 
 namespace {
-// Deltas that differ per vertex and per shape, so a reordering or a mix-up shows.
-std::vector<float> deltas(std::size_t vertices, float scale, std::size_t only_from = 0) {
-  std::vector<float> d(3 * vertices, 0.0f);
-  for (std::size_t i = only_from; i < vertices; ++i)
-    for (std::size_t c = 0; c < 3; ++c) d[3 * i + c] = scale * static_cast<float>(1 + i + 10 * c);
-  return d;
-}
-
 // An octahedron whose vertex order differs from the order its triangles first use them.
 TestMesh head() {
   TestMesh m;

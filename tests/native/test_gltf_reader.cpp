@@ -38,6 +38,7 @@ using softdeca::avatar_import::read_gltf;
 using softdeca::avatar_import::SourceMesh;
 using softdeca::avatar_import::SourceScene;
 using softdeca::avatar_import::SourceShape;
+using softdeca::test::deltas;
 using softdeca::test::TempDir;
 using softdeca::test::TestMesh;
 using softdeca::test::TestScene;
@@ -45,16 +46,9 @@ using softdeca::test::TestScene;
 namespace {
 // ---- the avatar ----------------------------------------------------------------------------
 
-std::vector<float> deltas(std::size_t vertices, float scale, std::size_t from = 0) {
-  std::vector<float> d(3 * vertices, 0.0f);
-  for (std::size_t i = from; i < vertices; ++i)
-    for (std::size_t c = 0; c < 3; ++c) d[3 * i + c] = scale * static_cast<float>(static_cast<int>((i + 3 * c) % 7) - 3) / 3.0f;
-  return d;
-}
-
 // A head of two parts (an octahedron, vertices 0-5, and a tetrahedron, 6-9) and teeth, under a
-// root node that scales them to metres; deltas up to half a unit, so an 8-bit normalized delta
-// holds them.
+// root node that scales them to metres; deltas up to half a unit (deltas() grows to 30 times its
+// scale over 10 vertices), so an 8-bit normalized delta holds them.
 TestScene avatar() {
   TestMesh head;
   head.name = "Head";
@@ -62,14 +56,15 @@ TestScene avatar() {
                    2, 0, 0, 3, 0, 0, 2, 1, 0, 2, 0, 1};                     // tetrahedron
   head.triangles = {4, 1, 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 1, 4, 5, 2, 1, 5, 3, 2, 5, 4, 3, 5,  // octahedron
                     6, 7, 8, 7, 9, 8, 8, 9, 6, 9, 7, 6};                                     // tetrahedron (a strip's order)
-  head.shapes = {{"eyeBlinkLeft", deltas(10, 0.5f), {}}, {"jawOpen", deltas(10, -0.25f, 4), {}}, {"mouthSmileLeft", deltas(10, 0.125f), {}}};
+  head.shapes = {{"eyeBlinkLeft", deltas(10, 0.5f / 30), {}}, {"jawOpen", deltas(10, -0.25f / 30, 4), {}},
+                 {"mouthSmileLeft", deltas(10, 0.125f / 30), {}}};
   head.translation[1] = 150;
   head.rotation_y_degrees = 90;
   TestMesh teeth;
   teeth.name = "Teeth";
   teeth.vertices = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
   teeth.triangles = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
-  teeth.shapes = {{"jawOpen", deltas(4, -0.5f), {}}};
+  teeth.shapes = {{"jawOpen", deltas(4, -0.5f / 24), {}}};
   teeth.translation[1] = 145;
   teeth.scale[0] = teeth.scale[1] = teeth.scale[2] = 2;
   TestScene scene;

@@ -197,6 +197,8 @@ class JsonParser {
   }
 };
 
+const char* Json::kind() const { return type_name(type_); }
+
 Json Json::parse(const std::string& text, const JsonLimits& limits) { return JsonParser(text, limits).document(); }
 
 namespace {

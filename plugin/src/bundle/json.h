@@ -13,7 +13,7 @@
 namespace softdeca::runtime {
 
 struct JsonLimits {
-  int max_depth = 64;                                              // arrays and objects nested
+  int max_depth = 64;                                              // how deep a value lies (the document: 0)
   std::size_t max_values = std::numeric_limits<std::size_t>::max();  // values of the document, members and elements included
 };
 
@@ -26,6 +26,7 @@ class Json {
   static Json parse(const std::string& text, const JsonLimits& limits = {});
 
   Type type() const { return type_; }
+  const char* kind() const;  // what it is, in words: "a number", "an object", ...
   bool is_null() const { return type_ == Type::Null; }
   bool is_number() const { return type_ == Type::Number; }
   bool is_string() const { return type_ == Type::String; }
