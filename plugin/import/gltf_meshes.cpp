@@ -1,7 +1,9 @@
 #include "gltf_meshes.h"
 
 #include <algorithm>
+#include <map>
 #include <optional>
+#include <set>
 
 #include "gltf_draco.h"
 
@@ -106,58 +108,86 @@ std::uint64_t triangles_of(std::uint64_t mode, std::uint64_t indices) {
   return indices >= 2 ? indices - 2 : 0;
 }
 
+// Whether the primitive's positions and indices come from its Draco data: always where this
+// build decodes Draco, else only where the file has no uncompressed copy (then refused).
+bool draco_decoded(Document& doc, const Primitive& p) {
+  if (!p.draco) return false;
+  const bool uncompressed_copy = doc.accessor(p.position).view && (!p.indices || doc.accessor(*p.indices).view);
+  return draco_supported() || !uncompressed_copy;
+}
+
+// What a primitive's vertices are: its POSITION accessor and its targets' (-1: none). Exporters
+// write a mesh of several materials as primitives that share these; they share their vertices
+// here too. Draco primitives have vertices of their own.
+std::optional<std::vector<long long>> vertex_source(Document& doc, const Primitive& p) {
+  if (draco_decoded(doc, p)) return std::nullopt;
+  std::vector<long long> key{static_cast<long long>(p.position)};
+  for (std::size_t t = 0; t < p.target_count(); ++t) {
+    const Object target((*p.targets)[t], p.where + ".targets[" + text(t) + "]");
+    const auto accessor = target.optional_index("POSITION", doc.count("accessors"), "accessors");
+    key.push_back(accessor ? static_cast<long long>(*accessor) : -1);
+  }
+  return key;
+}
+
+// The vertices the primitives have, those they share counted once; at most 2^53 each, and the
+// sum stops past `bound`.
+std::uint64_t distinct_vertices(Document& doc, const std::vector<Primitive>& primitives, std::uint64_t bound) {
+  std::set<std::vector<long long>> seen;
+  std::uint64_t total = 0;
+  for (const Primitive& p : primitives) {
+    const auto source = vertex_source(doc, p);
+    if (source && !seen.insert(*source).second) continue;
+    total += doc.accessor(p.position).count;
+    if (total > bound) break;
+  }
+  return total;
+}
+
+// A primitive's vertex indices: its indices accessor's, or 0 to n - 1 without one.
+std::vector<std::uint32_t> read_indices(AccessorReader& reader, const Primitive& p, std::uint64_t n) {
+  if (p.indices) return reader.indices(*p.indices, "indices of " + p.where);
+  reader.budget().take(4 * n, p.where);
+  std::vector<std::uint32_t> indices(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < indices.size(); ++i) indices[i] = static_cast<std::uint32_t>(i);
+  return indices;
+}
+
 struct Geometry {
   std::vector<float> positions;
   std::vector<std::uint32_t> indices;
   std::uint64_t mode = kTriangles;
 };
 
-Geometry read_geometry(AccessorReader& reader, const Primitive& p, const ImportLimits& limits) {
+Geometry read_draco(AccessorReader& reader, const Primitive& p, const ImportLimits& limits) {
   Document& doc = reader.document();
-  Geometry g;
-  g.mode = p.mode;
   const Accessor& position = doc.accessor(p.position);
-  const bool uncompressed_copy = position.view && (!p.indices || doc.accessor(*p.indices).view);
-  const bool compressed = p.draco && (draco_supported() || !uncompressed_copy);
-  if (compressed) {
-    const Object& ext = *p.draco;
-    const std::size_t view = ext.index("bufferView", doc.count("bufferViews"), "bufferViews");
-    const std::uint64_t id = ext.object("attributes").size("POSITION");
-    if (id > 0xFFFFFFFFu) ext.fail("attributes.POSITION " + text(id) + " is not a Draco attribute id");
-    if (!draco_supported()) throw Problem(p.where, "this build cannot decode KHR_draco_mesh_compression (it was built without Draco), "
-                                                   "and the primitive has no uncompressed copy");
-    const std::string_view bytes = reader.data().view(view);
-    DracoPrimitive d = decode_draco(bytes, static_cast<std::uint32_t>(id), position.count, limits.max_triangles, ext.where());
-    reader.budget().take(4 * (d.positions.size() + d.indices.size()), ext.where());
-    if (d.positions.size() / 3 != position.count)
-      throw Problem(p.where, "its Draco mesh has " + text(d.positions.size() / 3) + " points, its POSITION accessor " +
-                                 text(position.count));
-    if (p.indices && doc.accessor(*p.indices).count != d.indices.size())
-      throw Problem(p.where, "its Draco mesh has " + text(d.indices.size()) + " face corners, its indices accessor " +
-                                 text(doc.accessor(*p.indices).count));
-    g.positions = std::move(d.positions);
-    g.indices = std::move(d.indices);
-    g.mode = kTriangles;  // Draco decodes every mode to a triangle list
-    return g;
-  }
-  g.positions = reader.floats(p.position, "VEC3", false, "POSITION of " + p.where);
-  const std::uint64_t n = g.positions.size() / 3;
-  if (p.indices) {
-    g.indices = reader.indices(*p.indices, "indices of " + p.where);
-  } else {
-    reader.budget().take(4 * n, p.where);
-    g.indices.resize(static_cast<std::size_t>(n));
-    for (std::size_t i = 0; i < g.indices.size(); ++i) g.indices[i] = static_cast<std::uint32_t>(i);
-  }
+  const Object& ext = *p.draco;
+  const std::size_t view = ext.index("bufferView", doc.count("bufferViews"), "bufferViews");
+  const std::uint64_t id = ext.object("attributes").size("POSITION");
+  if (id > 0xFFFFFFFFu) ext.fail("attributes.POSITION " + text(id) + " is not a Draco attribute id");
+  if (!draco_supported())
+    throw Problem(p.where, "this build cannot decode KHR_draco_mesh_compression (it was built without Draco), "
+                           "and the primitive has no uncompressed copy");
+  DracoPrimitive d = decode_draco(reader.data().view(view), static_cast<std::uint32_t>(id), position.count, limits.max_triangles,
+                                  ext.where());
+  reader.budget().take(4 * (d.positions.size() + d.indices.size()), ext.where());
+  if (d.positions.size() / 3 != position.count)
+    throw Problem(p.where, "its Draco mesh has " + text(d.positions.size() / 3) + " points, its POSITION accessor " +
+                               text(position.count));
+  if (p.indices && doc.accessor(*p.indices).count != d.indices.size())
+    throw Problem(p.where, "its Draco mesh has " + text(d.indices.size()) + " face corners, its indices accessor " +
+                               text(doc.accessor(*p.indices).count));
+  Geometry g;
+  g.positions = std::move(d.positions);
+  g.indices = std::move(d.indices);
+  g.mode = kTriangles;  // Draco decodes every mode to a triangle list
   return g;
 }
 }  // namespace
 
 std::uint64_t declared_vertices(Document& doc, std::size_t index) {
-  std::uint64_t total = 0;  // at most 2^53 per primitive, and saturating
-  for (const Primitive& p : triangle_primitives(doc, doc.item("meshes", index)))
-    total = std::min(total + doc.accessor(p.position).count, kMaxExactInteger);
-  return total;
+  return distinct_vertices(doc, triangle_primitives(doc, doc.item("meshes", index)), kMaxExactInteger);
 }
 
 MeshData read_mesh(AccessorReader& reader, std::size_t index, const ImportLimits& limits) {
@@ -168,16 +198,15 @@ MeshData read_mesh(AccessorReader& reader, std::size_t index, const ImportLimits
   out.label = label_of(out.name, index);
   const std::vector<Primitive> primitives = triangle_primitives(doc, mesh);
 
-  // Everything the JSON states is checked before anything is decoded.
-  // Each count is at most 2^53 and each sum is checked as it grows: no sum wraps.
-  std::uint64_t vertices = 0, triangles = 0;
+  // Everything the JSON states is checked before anything is decoded. Each count is at most
+  // 2^53 and each sum is checked as it grows: no sum wraps.
+  const std::uint64_t vertices = distinct_vertices(doc, primitives, limits.max_vertices);
+  if (vertices > limits.max_vertices)
+    throw Problem(out.label, (primitives.size() == 1 ? text(vertices) : "over " + text(limits.max_vertices)) + " vertices, more than the " +
+                                 text(limits.max_vertices) + " an avatar may have");
+  std::uint64_t triangles = 0;
   for (const Primitive& p : primitives) {
-    const std::uint64_t n = doc.accessor(p.position).count;
-    vertices += n;
-    if (vertices > limits.max_vertices)
-      throw Problem(out.label, (primitives.size() == 1 ? text(vertices) : "over " + text(limits.max_vertices)) +
-                                   " vertices, more than the " + text(limits.max_vertices) + " an avatar may have");
-    triangles += triangles_of(p.mode, p.indices ? doc.accessor(*p.indices).count : n);
+    triangles += triangles_of(p.mode, p.indices ? doc.accessor(*p.indices).count : doc.accessor(p.position).count);
     if (triangles > limits.max_triangles)
       throw Problem(out.label, "over " + text(limits.max_triangles) + " triangles, more than an avatar may have");
   }
@@ -192,16 +221,37 @@ MeshData read_mesh(AccessorReader& reader, std::size_t index, const ImportLimits
   out.shapes.resize(targets);
   for (std::size_t t = 0; t < targets; ++t) out.shapes[t].name = names[t];
 
+  struct Placed {
+    std::int32_t base;
+    std::uint64_t count;
+  };
+  std::map<std::vector<long long>, Placed> placed;  // vertex data already in the mesh
   for (const Primitive& p : primitives) {
     const std::string primitive = out.label + " primitive " + text(p.number);
-    Geometry g = read_geometry(reader, p, limits);
-    const std::uint64_t n = g.positions.size() / 3;
+    const auto source = vertex_source(doc, p);
+    const auto shared = source ? placed.find(*source) : placed.end();
+    Geometry g;
+    Placed at{static_cast<std::int32_t>(out.vertices.size() / 3), 0};
+    if (shared != placed.end()) {
+      at = shared->second;
+      g.mode = p.mode;
+      g.indices = read_indices(reader, p, at.count);
+    } else if (!source) {
+      g = read_draco(reader, p, limits);
+      at.count = g.positions.size() / 3;
+    } else {
+      g.mode = p.mode;
+      g.positions = reader.floats(p.position, "VEC3", false, "POSITION of " + p.where);
+      at.count = g.positions.size() / 3;
+      g.indices = read_indices(reader, p, at.count);
+      placed.emplace(*source, at);
+    }
     for (std::size_t i = 0; i < g.indices.size(); ++i)
-      if (g.indices[i] >= n)
-        throw Problem(primitive, "its vertex index " + text(g.indices[i]) + " (number " + text(i) + ") is not below its " + text(n) +
+      if (g.indices[i] >= at.count)
+        throw Problem(primitive, "its vertex index " + text(g.indices[i]) + " (number " + text(i) + ") is not below its " + text(at.count) +
                                      " vertices");
-    const auto base = static_cast<std::int32_t>(out.vertices.size() / 3);
-    append_triangles(g.mode, g.indices, base, out.triangles, primitive);
+    append_triangles(g.mode, g.indices, at.base, out.triangles, primitive);
+    if (g.positions.empty()) continue;  // shared: its vertices and their deltas are in already
     out.vertices.insert(out.vertices.end(), g.positions.begin(), g.positions.end());
     for (std::size_t t = 0; t < targets; ++t) {
       const Object target((*p.targets)[t], p.where + ".targets[" + text(t) + "]");
@@ -216,7 +266,7 @@ MeshData read_mesh(AccessorReader& reader, std::size_t index, const ImportLimits
       if (deltas.size() != g.positions.size())
         throw Problem(primitives.size() == 1 ? out.label : primitive,
                       "shape '" + names[t] + "' has " + text(deltas.size() / 3) + " vertices, the " +
-                          (primitives.size() == 1 ? "mesh " : "primitive ") + text(n));
+                          (primitives.size() == 1 ? "mesh " : "primitive ") + text(at.count));
       std::vector<float>& joined = out.shapes[t].deltas;
       if (joined.empty()) joined = std::move(deltas);
       else joined.insert(joined.end(), deltas.begin(), deltas.end());

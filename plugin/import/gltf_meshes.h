@@ -1,6 +1,8 @@
 // One glTF mesh as the import takes it: the positions of its triangle primitives (modes 4, 5 and
 // 6: triangle lists, strips and fans as lists) joined in primitive order, each primitive's
-// indices offset by the vertices before it; points and lines left out. Morph targets become
+// indices offset by the vertices before it; primitives that share their vertex data (one POSITION
+// accessor and the same target accessors, as exporters write a mesh of several materials) share
+// their vertices; points and lines left out. Morph targets become
 // shapes of position deltas under the names the file gives them (mesh.extras.targetNames, else
 // the first primitive's extras.targetNames, else each target's extras.name); a target without
 // POSITION moves nothing. KHR_draco_mesh_compression primitives are decoded (gltf_draco.h).
@@ -25,8 +27,8 @@ struct MeshData {
   std::vector<SourceShape> shapes;
 };
 
-// The vertices meshes[index]'s triangle primitives declare (their POSITION accessors' counts),
-// known before anything is decoded: what bounds instancing.
+// The vertices meshes[index]'s triangle primitives declare (their POSITION accessors' counts,
+// shared vertex data once), known before anything is decoded: what bounds instancing.
 std::uint64_t declared_vertices(Document& doc, std::size_t index);
 
 // Reads meshes[index]. Throws Problem naming the mesh (and primitive): more vertices, triangles

@@ -585,6 +585,32 @@ TEST_F(GltfReader, SeveralPrimitivesJoinInFileOrder) {
   expect_same(read("split.glb", e), plain_, 1e-9);
 }
 
+TEST_F(GltfReader, PrimitivesSharingTheirVertexDataShareVertices) {
+  // The head as exporters write a mesh of two materials: two primitives over one POSITION
+  // accessor and the same targets, each with its own triangles (a range of one index view).
+  const TestMesh head = avatar().meshes[0];
+  Gltf g;
+  const int position = vec3_accessor(g, g.view(bytes_of(head.vertices), 12), "5126", 10, head.vertices);
+  std::vector<std::string> targets;
+  for (const auto& shape : head.shapes)
+    targets.push_back("{\"POSITION\":" + std::to_string(vec3_accessor(g, g.view(bytes_of(shape.deltas), 12), "5126", 10, shape.deltas)) + "}");
+  const int view = g.view(bytes_of(std::vector<std::uint32_t>(head.triangles.begin(), head.triangles.end())));
+  const int first = g.accessor("{\"bufferView\":" + std::to_string(view) + ",\"componentType\":5125,\"count\":24,\"type\":\"SCALAR\"}");
+  const int second = g.accessor("{\"bufferView\":" + std::to_string(view) + ",\"byteOffset\":96,\"componentType\":5125,\"count\":12,\"type\":\"SCALAR\"}");
+  const auto primitive = [&](int indices) {
+    return "{\"attributes\":{\"POSITION\":" + std::to_string(position) + "},\"indices\":" + std::to_string(indices) + ",\"targets\":[" +
+           join(targets) + "]}";
+  };
+  g.meshes.push_back("{\"name\":\"Head\",\"primitives\":[" + primitive(first) + "," + primitive(second) + "]}");
+  g.nodes.push_back("{\"mesh\":0}");
+  const SourceScene s = read_gltf(dir_.write("shared.glb", g.glb()), {});
+  ASSERT_EQ(s.meshes.size(), 1u);
+  EXPECT_EQ(s.meshes[0].vertices, head.vertices);
+  EXPECT_EQ(s.meshes[0].triangles, head.triangles);
+  ASSERT_EQ(s.meshes[0].shapes.size(), 3u);
+  EXPECT_EQ(s.meshes[0].shapes[1].deltas, head.shapes[1].deltas);
+}
+
 TEST_F(GltfReader, StripsAndFansBecomeTrianglesAndPointsAreLeftOut) {
   // The head's tetrahedron as a strip over its own vertices, a fan of two triangles, and points.
   Gltf g;
@@ -600,9 +626,9 @@ TEST_F(GltfReader, StripsAndFansBecomeTrianglesAndPointsAreLeftOut) {
   const SourceScene s = read_gltf(dir_.write("modes.glb", g.glb()), {});
   ASSERT_EQ(s.meshes.size(), 1u);
   EXPECT_EQ(s.meshes[0].name, "Parts");  // the mesh's name where the node has none
-  EXPECT_EQ(s.meshes[0].vertex_count(), 8u);
-  // The strip p_i = {v_i, v_i+(1+i%2), v_i+(2-i%2)}, then the fan {v_i+1, v_i+2, v_0} after the strip's 4 vertices.
-  EXPECT_EQ(s.meshes[0].triangles, (std::vector<std::int32_t>{0, 1, 2, 1, 3, 2, 2, 3, 0, 3, 1, 0, 5, 6, 4, 6, 7, 4}));
+  EXPECT_EQ(s.meshes[0].vertex_count(), 4u);  // the primitives share their POSITION accessor
+  // The strip p_i = {v_i, v_i+(1+i%2), v_i+(2-i%2)}, then the fan {v_i+1, v_i+2, v_0}.
+  EXPECT_EQ(s.meshes[0].triangles, (std::vector<std::int32_t>{0, 1, 2, 1, 3, 2, 2, 3, 0, 3, 1, 0, 1, 2, 0, 2, 3, 0}));
 }
 
 TEST_F(GltfReader, DataUrisAndBuffersBesideTheFileRead) {
@@ -664,12 +690,19 @@ TEST_F(GltfReader, DracoPrimitivesReadWithPlainMorphTargets) {
 #endif
 
 TEST_F(GltfReader, GltfpackOutputReads) {
-  const char* gltfpack = "/usr/bin/gltfpack";
-  if (::access(gltfpack, X_OK) != 0) GTEST_SKIP() << "gltfpack is not installed";
+  std::string gltfpack;  // on the PATH
+  const char* path = std::getenv("PATH");
+  for (std::string dirs = path ? path : ""; gltfpack.empty() && !dirs.empty();) {
+    const std::size_t colon = dirs.find(':');
+    const std::string candidate = dirs.substr(0, colon) + "/gltfpack";
+    if (::access(candidate.c_str(), X_OK) == 0) gltfpack = candidate;
+    dirs = colon == std::string::npos ? "" : dirs.substr(colon + 1);
+  }
+  if (gltfpack.empty()) GTEST_SKIP() << "gltfpack is not installed (.ci/setup installs it)";
   const std::string packed = dir_.file("packed.glb");
   // Compressed (EXT_meshopt_compression) where this build decodes it, else quantized only.
   const std::string compress = softdeca::avatar_import::gltf::meshopt_supported() ? " -cc" : "";
-  const std::string command = std::string(gltfpack) + " -i '" + dir_.file("plain.glb") + "' -o '" + packed + "'" + compress +
+  const std::string command = gltfpack + " -i '" + dir_.file("plain.glb") + "' -o '" + packed + "'" + compress +
                               " -kn -km > '" + dir_.file("gltfpack.log") + "' 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   const SourceScene got = read_gltf(packed, {});
