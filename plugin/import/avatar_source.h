@@ -21,7 +21,7 @@ struct SourceShape {
 };
 
 struct SourceMesh {
-  std::string name;  // the node's name, else the mesh's
+  std::string name;  // the node's name, else the mesh's (glTF: else the nearest named ancestor's)
   std::vector<float> vertices;          // local coordinates, the file's vertex order
   std::vector<std::int32_t> triangles;  // points and lines dropped
   std::vector<SourceShape> shapes;
