@@ -1,7 +1,8 @@
-// glTF 2.0 and FBX avatars through assimp. Only triangulation runs (no joining of identical
-// vertices, which would reorder them): each mesh keeps the vertex order its file gives, so a
-// point cache written in that order loads onto the mesh. assimp reads FBX one vertex per polygon
-// corner; those corners are welded back into the file's vertices (avatar_weld.h).
+// FBX avatars through assimp (glTF has a reader of its own, gltf_reader.h). Only triangulation
+// runs (no joining of identical vertices, which would reorder them): each mesh keeps the vertex
+// order its file gives, so a point cache written in that order loads onto the mesh. assimp reads
+// FBX one vertex per polygon corner; those corners are welded back into the file's vertices
+// (avatar_weld.h).
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -13,7 +14,6 @@
 #include "avatar_source.h"
 #include "avatar_weld.h"
 #include "file_format.h"
-#include "gltf_targets.h"
 #include "input_files.h"
 
 namespace softdeca::avatar_import {
@@ -79,12 +79,7 @@ struct Reader {
 
 // FBX says how many centimetres a unit is (UnitScaleFactor); assimp keeps the raw units and
 // passes the factor on as metadata.
-void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
-  if (!fbx) {
-    out.declared_unit = "metre (glTF 2.0)";
-    out.declared_metres_per_unit = 1;
-    return;
-  }
+void declared_unit(const aiScene& scene, SourceScene& out) {
   double centimetres = 0;
   float as_float = 0;
   if (!scene.mMetaData) return;
@@ -98,31 +93,25 @@ void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
 }
 }  // namespace
 
-bool scene_files_supported() { return true; }
+bool fbx_files_supported() { return true; }
 
-SourceScene read_scene_file(const std::string& path, const ImportLimits& limits) {
+SourceScene read_fbx_file(const std::string& path, const ImportLimits& limits) {
   // The file is read once, checked on its open descriptor; assimp parses those bytes.
   const std::string bytes = read_named_file(path, limits.max_file_bytes, "an avatar file");
-  const FileFormat format = agreed_format(path, bytes);
-  const bool fbx = format == FileFormat::fbx;
-  if (!fbx) check_gltf_targets(bytes, path);
+  if (agreed_format(path, bytes) != FileFormat::fbx) throw std::runtime_error(path + ": not an FBX file");
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);  // one node per FBX model
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
   const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate;
-  const char* hint = format == FileFormat::gltf_binary ? "glb" : fbx ? "fbx" : "gltf";
-  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, hint);
-  if (!scene || !scene->mRootNode)
-    throw std::runtime_error(path + ": not a readable " + (fbx ? "FBX" : "glTF 2.0") + " file (" + importer.GetErrorString() + ")");
+  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, "fbx");
+  if (!scene || !scene->mRootNode) throw std::runtime_error(path + ": not a readable FBX file (" + importer.GetErrorString() + ")");
   Reader reader{path, limits, *scene, {}};
-  reader.out.format = fbx ? "FBX" : "glTF 2.0";
-  reader.out.vertex_order = fbx ? "the FBX file's vertices in the order its polygons first use them"
-                                : "as in the file's vertex buffers";
-  declared_unit(*scene, fbx, reader.out);
+  reader.out.format = "FBX";
+  reader.out.vertex_order = "the FBX file's vertices in the order its polygons first use them";
+  declared_unit(*scene, reader.out);
   reader.walk(*scene->mRootNode, aiMatrix4x4(), 0);
-  if (fbx)
-    for (SourceMesh& mesh : reader.out.meshes) weld_corners(mesh);
+  for (SourceMesh& mesh : reader.out.meshes) weld_corners(mesh);
   return std::move(reader.out);
 }
 

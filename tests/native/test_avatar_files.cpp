@@ -23,19 +23,12 @@ using namespace softdeca::avatar_import;
 using softdeca::test::expected_transform;
 using softdeca::test::TempDir;
 constexpr auto shape = softdeca::test::arkit_index;
+using softdeca::test::deltas;
 using softdeca::test::TestMesh;
 using softdeca::test::TestScene;
 using softdeca::test::TestShape;
 
 namespace {
-// Deltas that differ per vertex and per shape, so a reordering or a mix-up shows.
-std::vector<float> deltas(std::size_t vertices, float scale, std::size_t only_from = 0) {
-  std::vector<float> d(3 * vertices, 0.0f);
-  for (std::size_t i = only_from; i < vertices; ++i)
-    for (std::size_t c = 0; c < 3; ++c) d[3 * i + c] = scale * static_cast<float>(1 + i + 10 * c);
-  return d;
-}
-
 // An octahedron whose vertex order differs from the order its triangles first use them.
 TestMesh head() {
   TestMesh m;
@@ -131,12 +124,11 @@ std::vector<std::size_t> identity_order(std::size_t n) {
   return order;
 }
 
-#define REQUIRE_SCENE_FILES() \
-  if (!scene_files_supported()) GTEST_SKIP() << "built without assimp"
+#define REQUIRE_FBX_FILES() \
+  if (!fbx_files_supported()) GTEST_SKIP() << "built without assimp"
 }  // namespace
 
 TEST(AvatarFiles, GlbKeepsVertexOrderPlacesPartsAndFindsArkitShapes) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-glb");
   const TestScene scene = avatar_scene();
   const AvatarFile a = read_avatar_file(dir.write("avatar.glb", softdeca::test::glb_bytes(scene)));
@@ -176,7 +168,6 @@ TEST(AvatarFiles, GlbKeepsVertexOrderPlacesPartsAndFindsArkitShapes) {
 }
 
 TEST(AvatarFiles, FramesGoBackToEachPartsOwnCoordinates) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-local");
   const TestScene scene = avatar_scene();
   const AvatarFile a = read_avatar_file(dir.write("avatar.glb", softdeca::test::glb_bytes(scene)));
@@ -203,7 +194,6 @@ TEST(AvatarFiles, FramesGoBackToEachPartsOwnCoordinates) {
 }
 
 TEST(AvatarFiles, VrmIsReadAsBinaryGltf) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-vrm");
   const AvatarFile a = read_avatar_file(dir.write("avatar.vrm", softdeca::test::glb_bytes(avatar_scene())));
   EXPECT_EQ(a.format, "glTF 2.0");
@@ -211,7 +201,7 @@ TEST(AvatarFiles, VrmIsReadAsBinaryGltf) {
 }
 
 TEST(AvatarFiles, FbxWeldsCornersBackAndTakesTheFullShapeOfAnInBetween) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX_FILES();
   const TempDir dir("avatar-fbx");
   TestScene scene = avatar_scene();
   scene.fbx_unit_cm = 1;
@@ -244,7 +234,6 @@ TEST(AvatarFiles, FbxWeldsCornersBackAndTakesTheFullShapeOfAnInBetween) {
 }
 
 TEST(AvatarFiles, AMirroringTransformTurnsTheTrianglesOverAndBack) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-mirror");
   TestScene scene;
   scene.meshes = {head()};
@@ -268,7 +257,6 @@ TEST(AvatarFiles, WeldingKeepsCornersApartThatAShapeMovesApart) {
 }
 
 TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-hostile");
   const std::string glb = softdeca::test::glb_bytes(avatar_scene());
 
@@ -311,7 +299,6 @@ TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
 }
 
 TEST(AvatarFiles, AShapeOfAnotherVertexCountIsRefused) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-shape-size");
   TestScene scene = avatar_scene();
   scene.meshes[1].shapes[0].deltas.resize(9);  // 3 of the teeth's 4 vertices
