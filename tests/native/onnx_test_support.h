@@ -81,4 +81,55 @@ inline std::string model(const std::string& graph_fields, std::uint64_t opset = 
   return field(1, 8) + field(8, field(2, opset)) + field(7, field(2, std::string("g")) + graph_fields);
 }
 
+// Constants of int64 values inside the graph, and a float tensor filled to constant dims.
+inline std::string vector_constant(const std::string& name, const std::vector<std::int64_t>& values) {
+  return constant(name, int64_vector("", values));
+}
+inline std::string scalar_constant(const std::string& name, std::int64_t value) {
+  return constant(name, tensor("", kInt64, {}, int64s({value})));
+}
+inline std::string filled(const std::string& name, const std::vector<std::int64_t>& dims) {
+  return vector_constant(name + "_dims", dims) + node("ConstantOfShape", {name + "_dims"}, name);
+}
+
+// Graphs of a few hundred bytes that ONNX Runtime's constant folding would turn into 2 to 4 GiB
+// (docs/security.md): each is refused for an operator off the list, or counted at its size
+// (its largest tensor is 'red_big'). Names start with "red_", so they can join a real graph.
+struct RedTeamGraph {
+  const char* what;
+  std::string fields;
+  const char* refused_operator;  // null: refused by the memory budget
+};
+inline std::vector<RedTeamGraph> red_team_graphs() {
+  constexpr std::int64_t n = 3 << 13;  // n x n floats: 2.25 GiB
+  std::string concat = filled("red_x0", {1 << 20});
+  for (int i = 1; i <= 9; ++i)
+    concat += node("Concat", {"red_x" + std::to_string(i - 1), "red_x" + std::to_string(i - 1)},
+                   i == 9 ? "red_big" : "red_x" + std::to_string(i), int_attribute("axis", 0));
+  return {
+      {"Range to Add(c, c)",
+       scalar_constant("red_0", 0) + scalar_constant("red_c", n * n / 2) + scalar_constant("red_1", 1) +
+           node("Add", {"red_c", "red_c"}, "red_limit") + node("Range", {"red_0", "red_limit", "red_1"}, "red_big"),
+       "Range"},
+      {"ConstantOfShape of a Mul", vector_constant("red_s", {n}) + node("Mul", {"red_s", "red_s"}, "red_dims") +
+                                        node("ConstantOfShape", {"red_dims"}, "red_big"),
+       nullptr},
+      {"ConstantOfShape of a Reshape",
+       vector_constant("red_s", {n, n}) + vector_constant("red_to", {2}) + node("Reshape", {"red_s", "red_to"}, "red_dims") +
+           node("ConstantOfShape", {"red_dims"}, "red_big"),
+       nullptr},
+      {"ConstantOfShape of a Squeeze",
+       constant("red_s", tensor("", kInt64, {1, 2}, int64s({n, n}))) + node("Squeeze", {"red_s"}, "red_dims") +
+           node("ConstantOfShape", {"red_dims"}, "red_big"),
+       "Squeeze"},
+      {"ConstantOfShape of a Gather",
+       vector_constant("red_s", {n, 7, n}) + vector_constant("red_at", {0, 2}) +
+           node("Gather", {"red_s", "red_at"}, "red_dims") + node("ConstantOfShape", {"red_dims"}, "red_big"),
+       nullptr},
+      {"a Concat of itself, nine times", concat, nullptr},
+      {"a MatMul outer product", filled("red_a", {n, 1}) + filled("red_b", {1, n}) + node("MatMul", {"red_a", "red_b"}, "red_big"),
+       nullptr},
+  };
+}
+
 }  // namespace softdeca::test
