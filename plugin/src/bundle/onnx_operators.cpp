@@ -314,6 +314,13 @@ Tensor gather(const Node& n, const Inputs& in) {
   return t;
 }
 
+// The same elements in new dims (Reshape, Unsqueeze): the values carry over.
+Tensor rearranged(const Tensor& data, Dims dims) {
+  Tensor t{data.dtype, std::move(dims)};
+  if (data.known) set_values(t, data.values);
+  return t;
+}
+
 Tensor reshape(const Node& n, const Inputs& in) {
   const Tensor& data = *in[0];
   const Values& shape = deciding_values(in[1], "its shape");
@@ -347,9 +354,7 @@ Tensor reshape(const Node& n, const Inputs& in) {
     product = total;
   }
   if (product != total) refuse(std::to_string(total) + " elements do not fit the shape " + text(out));
-  Tensor t{data.dtype, out};
-  if (data.known) set_values(t, data.values);
-  return t;
+  return rearranged(data, out);
 }
 
 Tensor unsqueeze(const Node&, const Inputs& in) {
@@ -360,9 +365,7 @@ Tensor unsqueeze(const Node&, const Inputs& in) {
   const std::vector<bool> added = axes_of(axes, rank);
   Dims out;
   for (std::size_t i = 0, from = 0; i < rank; ++i) out.push_back(added[i] ? 1 : data.dims[from++]);
-  Tensor t{data.dtype, out};
-  if (data.known) set_values(t, data.values);
-  return t;
+  return rearranged(data, out);
 }
 
 Tensor slice(const Node&, const Inputs& in) {
