@@ -260,7 +260,7 @@ WINDOWS_ORT    := $(CURDIR)/.deps/onnxruntime-win
 WINDOWS_TESTS  := test_c_abi test_atomic_write test_stream test_bundle_folder abi_header_check_c abi_header_check_cpp replay_check
 # The Windows tests that run under wine: the C ABI, the streaming and recording stack (UDP over
 # loopback included), bundle folders (links, sizes, file kinds), the header checks against softdeca.dll, its export table.
-WINDOWS_CTEST  := ^(AtomicWrite|BundleFolder|OnnxConstantSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines)\.|^abi_header_check_|^dll_exports_only_c_abi$$
+WINDOWS_CTEST  := ^(AtomicWrite|BundleFolder|OnnxStaticSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines)\.|^abi_header_check_|^dll_exports_only_c_abi$$
 # The replay check: frames of a real take through models/softdeca-default on the identity of
 # seed 1, by the Linux CLI and by the Windows DLL under wine, compared vertex by vertex.
 CHECK          := build/platform-check
@@ -308,7 +308,7 @@ ARM64          := build/arm64
 ARM64_ORT      := $(CURDIR)/.deps/onnxruntime-arm64
 ARM64_TESTS    := test_c_abi test_stream test_bundle_folder test_runtime test_runtime_math test_cpu_features test_neon_kernels \
                   abi_header_check_c abi_header_check_cpp replay_check
-ARM64_CTEST    := ^(BundleFolder|OnnxConstantSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines|Runtime|Threads|Worker|HyperTensor|SparseLdlt|DeformationTransfer|CpuFeatures|NeonKernels|Half|Blendshapes|BundleFiles|Dynamics|Json|Normals|Rigid)\.|^abi_header_check_|^shared_library_exports
+ARM64_CTEST    := ^(BundleFolder|OnnxStaticSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines|Runtime|Threads|Worker|HyperTensor|SparseLdlt|DeformationTransfer|CpuFeatures|NeonKernels|Half|Blendshapes|BundleFiles|Dynamics|Json|Normals|Rigid)\.|^abi_header_check_|^shared_library_exports
 ARM64_FRAMES   ?= 8
 .PHONY: arm64 test-arm64 test-arm64-quick arm64-check-inputs count-arm64
 

@@ -65,29 +65,34 @@ std::string node(const std::string& op, const std::vector<std::string>& inputs, 
 }
 std::int64_t count(std::uint64_t bytes, std::uint64_t per) { return static_cast<std::int64_t>(std::max<std::uint64_t>(bytes / per, 1)); }
 
-// The graph fragment of one producer family whose output takes about `bytes`.
-std::string producer(const std::string& family, std::uint64_t bytes) {
-  if (family == "range")  // int64 0, 1, ..., n - 1
-    return initializer("sdb_a", 7, {}, {0}) + initializer("sdb_b", 7, {}, {count(bytes, 8)}) +
-           initializer("sdb_c", 7, {}, {1}) + node("Range", {"sdb_a", "sdb_b", "sdb_c"}, "sdb_out");
-  if (family == "tile")  // 4 floats repeated
-    return initializer("sdb_x", 1, {4}, {1, 2, 3, 4}) + initializer("sdb_r", 7, {1}, {count(bytes, 16)}) +
-           node("Tile", {"sdb_x", "sdb_r"}, "sdb_out");
+// The graph fragment of one family whose tensors take about `bytes` in all (the budget counts
+// every tensor of a graph, docs/security.md): a shape computed inside the graph, then filled,
+// expanded, joined or multiplied out. Every operator is one a bundle's networks may use.
+std::string fragment(const std::string& family, std::uint64_t bytes) {
+  const auto side = static_cast<std::int64_t>(std::floor(std::sqrt(double(bytes) / 4)));
+  const std::string axis0 = pb(5, pb(1, std::string("axis")) + pb(3, 0) + pb(20, 2));
   if (family == "constant_of_shape")
     return initializer("sdb_s", 7, {1}, {count(bytes, 4)}) + node("ConstantOfShape", {"sdb_s"}, "sdb_out");
   if (family == "expand")  // [1, 4] floats to [n, 4]
     return initializer("sdb_x", 1, {1, 4}, {1, 2, 3, 4}) + initializer("sdb_s", 7, {2}, {count(bytes, 16), 1}) +
            node("Expand", {"sdb_x", "sdb_s"}, "sdb_out");
-  if (family == "resize") {  // 2 x 2 floats to n x n
-    const auto side = static_cast<std::int64_t>(std::floor(std::sqrt(double(bytes) / 4)));
-    return initializer("sdb_x", 1, {1, 1, 2, 2}, {1, 2, 3, 4}) + initializer("sdb_s", 7, {4}, {1, 1, side, side}) +
-           node("Resize", {"sdb_x", "", "", "sdb_s"}, "sdb_out");
-  }
+  if (family == "mul")  // a side squared, filled
+    return initializer("sdb_s", 7, {1}, {side}) + node("Mul", {"sdb_s", "sdb_s"}, "sdb_n") +
+           node("ConstantOfShape", {"sdb_n"}, "sdb_out");
+  if (family == "gather")  // the first of [n, 7], filled
+    return initializer("sdb_s", 7, {2}, {count(bytes, 4), 7}) + initializer("sdb_i", 7, {1}, {0}) +
+           node("Gather", {"sdb_s", "sdb_i"}, "sdb_n") + node("ConstantOfShape", {"sdb_n"}, "sdb_out");
+  if (family == "concat")  // a third of the bytes joined with itself
+    return initializer("sdb_s", 7, {1}, {count(bytes, 12)}) + node("ConstantOfShape", {"sdb_s"}, "sdb_x") +
+           node("Concat", {"sdb_x", "sdb_x"}, "sdb_out", axis0);
+  if (family == "matmul")  // the outer product of [side, 1] and [1, side]
+    return initializer("sdb_a", 7, {2}, {side, 1}) + initializer("sdb_b", 7, {2}, {1, side}) +
+           node("ConstantOfShape", {"sdb_a"}, "sdb_x") + node("ConstantOfShape", {"sdb_b"}, "sdb_y") +
+           node("MatMul", {"sdb_x", "sdb_y"}, "sdb_out");
   // shape: the shape of 256 floats with n appended, filled: [256, n] floats
   std::vector<std::int64_t> x(256, 1);
   return initializer("sdb_x", 1, {256}, x) + initializer("sdb_k", 7, {1}, {count(bytes, 1024)}) +
-         node("Shape", {"sdb_x"}, "sdb_shape") +
-         node("Concat", {"sdb_shape", "sdb_k"}, "sdb_dims", pb(5, pb(1, std::string("axis")) + pb(3, 0) + pb(20, 2))) +
+         node("Shape", {"sdb_x"}, "sdb_shape") + node("Concat", {"sdb_shape", "sdb_k"}, "sdb_dims", axis0) +
          node("ConstantOfShape", {"sdb_dims"}, "sdb_out");
 }
 
@@ -226,9 +231,9 @@ BundleMemory bundle_memory_run(const std::string& bundle, const std::string& scr
   if (!start.loaded) throw std::runtime_error("bench-reliability: the bundle does not load: " + start.error);
   out.runtime_start_bytes = start.peak_increase;
   const fs::path copy = fs::path(scratch) / "bench-reliability-bundle";
-  for (const char* family : {"range", "tile", "constant_of_shape", "expand", "resize", "shape"})
+  for (const char* family : {"constant_of_shape", "expand", "mul", "gather", "concat", "matmul", "shape"})
     for (const Size& size : sizes) {
-      splice(bundle, copy, producer(family, size.bytes));
+      splice(bundle, copy, fragment(family, size.bytes));
       const Load l = load_in_child(copy, budget, bundle);
       if (l.error.rfind("warming up", 0) == 0 || l.error.rfind("cannot reset", 0) == 0)
         throw std::runtime_error("bench-reliability: " + l.error);

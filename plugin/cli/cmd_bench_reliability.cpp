@@ -185,7 +185,7 @@ int run_bench_reliability(const Args& args) {
             "consumer's poll while the recording's disk cannot keep up (p99 poll time), and how long every\n"
             "path that opens a recording or CSV take takes to refuse a FIFO, and the memory an opened\n"
             "recording holds per frame; with --bundle, the peak memory of loading copies of that bundle\n"
-            "grown by one constant-foldable producer each, just under, just over and far over a budget.");
+            "grown by one constant-foldable fragment each, just under, just over and far over a budget.");
   declare_output_options(o, "reliability", "where the runs write their files");
   o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
@@ -259,10 +259,11 @@ int run_bench_reliability(const Args& args) {
   out.raw("reliability.recording_bytes_per_frame_in_memory",
           figure(memory.heap_bytes_per_frame, "bytes/frame", "64", "lower", how + memory_text));
   if (bundles.bundles > 0) {
-    char bundle_text[700];
+    char bundle_text[1024];
     std::snprintf(bundle_text, sizeof bundle_text,
-                  "%d copies of %s, each grown by one Range, Tile, ConstantOfShape, Expand, Resize or Shape-derived "
-                  "ConstantOfShape of constant inputs sized just under, just over and 64 times over a %ld MiB budget, "
+                  "%d copies of %s, each grown by one fragment of constant inputs (a ConstantOfShape, an Expand, a "
+                  "ConstantOfShape of a shape made by a Mul, a Gather or a Shape and Concat, a self-Concat, a MatMul "
+                  "outer product) sized just under, just over and 64 times over a %ld MiB budget, "
                   "loaded in a child process each (%d loaded, %d refused) after the unchanged bundle warmed ONNX "
                   "Runtime up; the worst peak RSS increase while loading (VmHWM, reset before, over VmRSS before) "
                   "over the budget: %s",
