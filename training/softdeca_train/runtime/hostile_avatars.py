@@ -239,9 +239,10 @@ def fbx_ascii_nested(depth: int) -> bytes:
 
 
 def fbx_zlib_bomb(head: Head, inflated_bytes: int) -> bytes:
-    """The head's mesh whose Vertices array, compressed, inflates to `inflated_bytes` of zeros
-    (and says it holds that many doubles)."""
-    count = inflated_bytes // 8
+    """The head's mesh whose Vertices array, compressed, inflates to about `inflated_bytes` of
+    zeros (and says it holds that many doubles: whole vertices, or assimp skips the mesh)."""
+    count = inflated_bytes // 24 * 3
+    inflated_bytes = 8 * count
     z = zlib.compressobj(1)  # zeros compress about 230:1 even so, and in a fraction of the time
     chunk = bytes(64 << 20)
     data = b"".join(z.compress(chunk) for _ in range(inflated_bytes // len(chunk)))
