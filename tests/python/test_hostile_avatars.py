@@ -47,8 +47,8 @@ INTERNAL = (
 DEEP = ("deep", "nested", "depth")
 
 # What a refusal says (any one of the phrases) where the attack decides it; the other attacks
-# are refused in the reader's own words, which name the avatar's file (NAMES_FILE) or, for
-# values out of range, at least something (a clean "error:" line).
+# are refused in the reader's own words, which name the avatar's file as given (NAMES_FILE) or,
+# for values out of range, whichever check meets them first (a clean "error:" line).
 SAYS: dict[str, tuple[str, ...]] = {
     "gltf_uri_escape": ("leads out of the avatar's folder",),
     "gltf_uri_absolute": ("absolute path",),
@@ -212,7 +212,7 @@ def check_refusal(attack: Attack, run: Run) -> None:
     if attack.name in SAYS:
         assert any(s in message for s in SAYS[attack.name]), f"{attack.name}: {message}"
     elif attack.name in NAMES_FILE:
-        assert Path(attack.avatar).name in message, f"{attack.name}: {message}"
+        assert attack.avatar in message, f"{attack.name}: {message}"
 
 
 @pytest.mark.parametrize(("name", "command"), RUNS)
