@@ -66,6 +66,12 @@ test-python: build ## pytest (the numerical bounds' margins -> build/bounds/nati
 
 test: lint test-native test-fuzz test-python test-kernels test-swift test-unity ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, other CPUs' kernels, Swift, Unity
 
+# tests/python/test_hostile_avatars.py runs every hostile avatar through `softdeca fit` in
+# test-python; the full form also replays each one and adds the FBX zlib bomb (docs/security.md).
+.PHONY: test-hostile-full
+test-hostile-full: build ## the hostile-avatar suite in full: every attack through fit and replay, and the zlib bomb
+	@SOFTDECA_HOSTILE=full $(PY) -m pytest -q tests/python/test_hostile_avatars.py
+
 # ---- Kernel families: the numerics another x86-64 CPU computes -----------------------------
 # tests/cpu/run-as.sh caps every numerical library (this one, numpy, OpenBLAS, torch) at one
 # kernel family (docs/platforms.md, "Kernel families"). test-kernels runs the native kernel and
@@ -129,7 +135,9 @@ bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(PY) -m softdeca_train runtime-test-data --out build/bench/runtime_test_data > /dev/null
-	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json --bundle build/bench/runtime_test_data/bundle
+	@rm -rf build/bench/hostile_avatars && $(PY) -m softdeca_train hostile-avatars --out build/bench/hostile_avatars > /dev/null
+	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json --bundle build/bench/runtime_test_data/bundle \
+	  --import-corpus build/bench/hostile_avatars
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
 	@$(PY) -m softdeca_train bench-physics --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
@@ -141,13 +149,14 @@ lint: setup ## ruff check and format check of the Python code
 clean: ## remove build/ and out/ (OUT)
 	rm -rf build $(OUT)
 
-# ---- Fuzzing the streaming and recording parsers -------------------------------------------------
-# libFuzzer targets of the streaming parsers (tests/fuzz), built by clang in build/fuzz.
+# ---- Fuzzing the parsers of outside input -----------------------------------------------------
+# libFuzzer targets of the streaming, recording, bundle, fit and avatar-file parsers (tests/fuzz),
+# built by clang in build/fuzz.
 # test-fuzz: a few seconds each on the committed corpus; fuzz-long: the long runs of
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
 FUZZ         := build/fuzz
 FUZZ_TARGETS := fit_file softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
-                bundle_tar bundle_folder manifest onnx_model onnx_graph
+                bundle_tar bundle_folder manifest onnx_model onnx_graph obj shape_names avatar_folder fbx gltf
 FUZZ_SECONDS ?= 620
 
 .PHONY: fuzz-build test-fuzz fuzz-long

@@ -1,8 +1,5 @@
 #include "bench_bundle_memory.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -12,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "bench_child_memory.h"
 #include "bundle/bundle_files.h"
 #include "bundle/sha256.h"
 #include "core/error.h"
@@ -123,27 +121,6 @@ void splice(const fs::path& bundle, const fs::path& copy, const std::string& fra
   write_file(network, spliced);
 }
 
-// A line of /proc/self/status in bytes ("VmRSS", "VmHWM").
-std::uint64_t status_bytes(const char* key) {
-  std::FILE* f = std::fopen("/proc/self/status", "r");
-  if (!f) return 0;
-  char line[256];
-  std::uint64_t kib = 0;
-  const std::size_t n = std::strlen(key);
-  while (std::fgets(line, sizeof line, f))
-    if (std::strncmp(line, key, n) == 0 && line[n] == ':') kib = std::strtoull(line + n + 1, nullptr, 10);
-  std::fclose(f);
-  return kib * 1024;
-}
-
-// Resets VmHWM to the current RSS (Linux 4.0 and later); false where that is refused.
-bool reset_peak() {
-  std::FILE* f = std::fopen("/proc/self/clear_refs", "w");
-  if (!f) return false;
-  const bool ok = std::fputs("5", f) >= 0;
-  return std::fclose(f) == 0 && ok;
-}
-
 struct Load {
   std::uint64_t peak_increase = 0;
   bool loaded = false;
@@ -154,49 +131,30 @@ struct Load {
 // `warm_with`, the child first loads that bundle and drops it, so that ONNX Runtime's own
 // start (its code, environment and thread pools, once a process) is not counted.
 Load load_in_child(const fs::path& bundle, std::uint64_t budget, const fs::path& warm_with = {}) {
-  int ends[2];
-  if (::pipe(ends) != 0) throw std::runtime_error("bench-reliability: cannot make a pipe");
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) throw std::runtime_error("bench-reliability: cannot fork");
-  if (pid == 0) {
-    ::close(ends[0]);
-    ModelOptions o;
-    o.memory_budget_bytes = budget;
-    std::string report = "1 ";
+  ModelOptions o;
+  o.memory_budget_bytes = budget;
+  const auto warm = [&]() -> std::string {
+    if (warm_with.empty()) return "";
     try {
-      if (!warm_with.empty()) {
-        Model::load(BundleFiles::from_path(warm_with.string()), o);
-        if (!reset_peak()) report = "0 cannot reset the peak RSS (/proc/self/clear_refs)";
-      }
+      Model::load(BundleFiles::from_path(warm_with.string()), o);
+      return "";
     } catch (const std::exception& e) {
-      report = std::string("0 warming up: ") + e.what();
+      return std::string("warming up: ") + e.what();
     }
-    const std::uint64_t before = status_bytes("VmRSS");
-    if (report == "1 ") try {
-        Model::load(BundleFiles::from_path(bundle.string()), o);
-      } catch (const std::exception& e) {
-        report = std::string("0 ") + e.what();
-      }
-    const std::uint64_t peak = status_bytes("VmHWM");
-    report = std::to_string(peak > before ? peak - before : 0) + " " + report;
-    const ssize_t written = ::write(ends[1], report.data(), report.size());
-    ::_exit(written == static_cast<ssize_t>(report.size()) ? 0 : 1);
-  }
-  ::close(ends[1]);
-  std::string report;
-  char buf[4096];
-  for (ssize_t n; (n = ::read(ends[0], buf, sizeof buf)) > 0;) report.append(buf, static_cast<std::size_t>(n));
-  ::close(ends[0]);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || report.empty())
-    throw std::runtime_error("bench-reliability: loading " + bundle.string() + " killed its process");
+  };
+  const auto load = [&]() -> std::string {
+    try {
+      Model::load(BundleFiles::from_path(bundle.string()), o);
+      return "";
+    } catch (const std::exception& e) {
+      return e.what();  // refused
+    }
+  };
+  const ChildPeak c = peak_in_child("loading " + bundle.string(), warm, load);
   Load out;
-  char* rest = nullptr;
-  out.peak_increase = std::strtoull(report.c_str(), &rest, 10);
-  out.loaded = rest[0] == ' ' && rest[1] == '1';
-  if (!out.loaded && std::strlen(rest) > 3) out.error = rest + 3;
+  out.peak_increase = c.increase;
+  out.loaded = c.prepared && c.report.empty();
+  if (!out.loaded) out.error = c.report;
   return out;
 }
 
@@ -235,7 +193,7 @@ BundleMemory bundle_memory_run(const std::string& bundle, const std::string& scr
     for (const Size& size : sizes) {
       splice(bundle, copy, fragment(family, size.bytes));
       const Load l = load_in_child(copy, budget, bundle);
-      if (l.error.rfind("warming up", 0) == 0 || l.error.rfind("cannot reset", 0) == 0)
+      if (l.error.rfind("warming up", 0) == 0)
         throw std::runtime_error("bench-reliability: " + l.error);
       if (size.loads && !l.loaded)
         throw std::runtime_error(std::string("bench-reliability: the ") + family + " bundle " + size.name +

@@ -21,6 +21,7 @@
 
 #include "bench_bundle_memory.h"
 #include "bench_fifo.h"
+#include "bench_import_memory.h"
 #include "bench_figures.h"
 #include "bench_recording_memory.h"
 #include "command.h"
@@ -185,14 +186,16 @@ int run_bench_reliability(const Args& args) {
             "consumer's poll while the recording's disk cannot keep up (p99 poll time), and how long every\n"
             "path that opens a recording or CSV take takes to refuse a FIFO, and the memory an opened\n"
             "recording holds per frame; with --bundle, the peak memory of loading copies of that bundle\n"
-            "grown by one constant-foldable fragment each, just under, just over and far over a budget.");
+            "grown by one constant-foldable fragment each, just under, just over and far over a budget; with\n"
+            "--import-corpus, the peak memory of reading each hostile avatar against the avatar's size.");
   declare_output_options(o, "reliability", "where the runs write their files");
   o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
       .option("--resync-mib", "N", "MiB of crafted damage", "16")
       .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
       .option("--bundle", "DIR", "a small bundle folder to grow (the runtime test data's bundle)", "")
-      .option("--bundle-budget-mib", "N", "the memory budget of the bundle runs", "256");
+      .option("--bundle-budget-mib", "N", "the memory budget of the bundle runs", "256")
+      .option("--import-corpus", "DIR", "hostile avatars to read (python -m softdeca_train hostile-avatars)", "");
   if (!o.parse(args)) return 0;
   const std::string scratch = create_output_folders(o);
   const long ports = o.integer("--ports"), mib = o.integer("--resync-mib");
@@ -219,6 +222,11 @@ int run_bench_reliability(const Args& args) {
   if (!o.text("--bundle").empty()) {
     std::fprintf(stderr, "bench-reliability: bundle memory\n");
     bundles = bundle_memory_run(o.text("--bundle"), scratch, std::uint64_t(budget_mib) << 20);
+  }
+  ImportMemory imports;
+  if (!o.text("--import-corpus").empty()) {
+    std::fprintf(stderr, "bench-reliability: import memory\n");
+    imports = import_memory_run(o.text("--import-corpus"));
   }
 
   char load_text[80];
@@ -275,6 +283,15 @@ int run_bench_reliability(const Args& args) {
             figure(double(bundles.runtime_start_bytes) / double(1 << 20), "MiB", "null", "lower",
                    how + "the peak RSS increase of the first Model::load of " + o.text("--bundle") +
                        " in a fresh process: ONNX Runtime's start, once a process, outside the memory budget"));
+  }
+  if (imports.avatars > 0) {
+    char import_text[600];
+    std::snprintf(import_text, sizeof import_text,
+                  "the %d avatars of %s that softdeca fit reads (%d read, %d refused), each read in a child "
+                  "process; the worst peak RSS increase while reading (VmHWM, reset before, over VmRSS before) "
+                  "over the input's bytes + 125 MB, so that 4 is the bound 4 x the input + 500 MB: %s",
+                  imports.avatars, o.text("--import-corpus").c_str(), imports.read, imports.refused, imports.worst.c_str());
+    out.raw("reliability.import_peak_rss_over_input", figure(imports.worst_ratio, "ratio", "4", "lower", how + import_text));
   }
   write_text_file(o.text("--out"), out.str(true) + "\n");
   std::printf("%s\n", out.str(true).c_str());

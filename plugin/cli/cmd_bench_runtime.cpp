@@ -491,7 +491,7 @@ int run_bench_runtime(const Args& args) {
   const Take take = read_take(o.text("--take"), static_cast<std::size_t>(o.integer("--frames")));
   const std::size_t frames = take.weights.size();
   const FaceRig rig = read_rig(o.text("--avatar"));
-  const FaceRig user = read_rig(o.text("--avatar") + "/user_face", true);
+  const FaceRig user = read_rig(o.text("--avatar"), "user_face", true);
   Model model(o.text("--bundle"));
   const uint32_t vh = model.info.head_vertex_count;
   Bench bench{take, rig, user, model, frames, static_cast<std::size_t>(o.integer("--warmup")), o.integer("--prepares"),
