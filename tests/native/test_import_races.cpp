@@ -105,7 +105,6 @@ std::string quad_obj(float dy) {
 }  // namespace
 
 TEST(ImportRaces, AnAvatarFileSwappedWithAFifoIsReadOrRefusedNeverWaitedOn) {
-  if (!scene_files_supported()) GTEST_SKIP() << "built without assimp";
   const TempDir dir("import-race-file");
   softdeca::test::TestScene scene;
   scene.meshes.push_back({"Quad", {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, {0, 1, 2, 0, 2, 3}, {{"jawOpen", std::vector<float>(12, 0.01f), {}}}});
