@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from softdeca_train.avatars.config import (
@@ -17,6 +18,8 @@ from softdeca_train.avatars.config import (
     AvatarConfig,
 )
 from softdeca_train.commands import Command, add_ict_argument
+
+LOW_POLY_VERTICES = 3500  # skin vertices of --low-poly: about 3.7k with the rest
 
 
 def _avatar_args(p: argparse.ArgumentParser) -> None:
@@ -68,6 +71,38 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         help="the skin, the eyeballs and the teeth as separate objects (o lines)",
     )
     p.add_argument(
+        "--eyes-teeth-tongue",
+        action="store_true",
+        help="the eyeballs, the teeth and the tongue with the skin (decimated with it by "
+        "--remesh; one object with --one-object)",
+    )
+    p.add_argument(
+        "--hair-cards",
+        type=int,
+        default=0,
+        metavar="K",
+        help="K hair cards a layer (two layers, a few mm off the scalp) over the scalp and the "
+        "forehead, moved by no shape (0)",
+    )
+    p.add_argument(
+        "--eyebrows", action="store_true", help="eyebrow fins fused to the skin along the brows"
+    )
+    p.add_argument(
+        "--shoulders",
+        action="store_true",
+        help="a bust: the neck continued into shoulders and a chest (no shape moves it)",
+    )
+    p.add_argument(
+        "--one-object", action="store_true", help="every part in one object, as one mesh"
+    )
+    p.add_argument(
+        "--low-poly",
+        action="store_true",
+        help="a game-ready head as artists export one: --remesh 3500 --remesh-style adaptive "
+        "(unless given) --eyes-teeth-tongue --hair-cards 12 --eyebrows --shoulders "
+        "--one-object --unit cm --up z --names prefix --shuffle",
+    )
+    p.add_argument(
         "--keep-shapes", type=int, default=None, metavar="K", help="only K shapes, at random"
     )
     p.add_argument(
@@ -78,7 +113,8 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         choices=NAME_STYLES,
         default="arkit",
         help="the shapes' names: eyeBlinkLeft, blendShape1.eyeBlinkLeft, AK_09_EyeBlinkLeft, "
-        "eyeBlink_L, eye_blink_l or EyeBlinkLeft (arkit)",
+        "eyeBlink_L, eye_blink_l, EyeBlinkLeft, CC_Base_Body.Eye_Blink_L or "
+        "facs_bs_EyeBlinkLeft (arkit)",
     )
     p.add_argument(
         "--arkit-face",
@@ -101,7 +137,7 @@ def config_from_args(args: argparse.Namespace) -> AvatarConfig:
     identity = args.identity or DEFAULT_IDENTITY
     if args.seed is not None:
         identity = f"seed {args.seed}"
-    return AvatarConfig(
+    config = AvatarConfig(
         identity=identity,
         remesh=args.remesh,
         remesh_style=args.remesh_style,
@@ -111,11 +147,37 @@ def config_from_args(args: argparse.Namespace) -> AvatarConfig:
         mirror=args.mirror,
         body=args.body,
         separate_eyes_teeth=args.separate_eyes_teeth,
+        eyes_teeth_tongue=args.eyes_teeth_tongue,
+        hair_cards=args.hair_cards,
+        eyebrows=args.eyebrows,
+        shoulders=args.shoulders,
+        one_object=args.one_object,
         keep_shapes=args.keep_shapes,
         drop=tuple(n.strip() for n in args.drop.split(",") if n.strip()),
         names=args.names,
         arkit_face=args.arkit_face,
         variant_seed=args.variant_seed,
+    )
+    return low_poly(config) if args.low_poly else config
+
+
+def low_poly(config: AvatarConfig) -> AvatarConfig:
+    """`config` as a game-ready head as artists export one (--low-poly): decimated, eyes, teeth
+    and tongue, hair cards and eyebrow fins in one mesh with a bust, centimetres, Z-up, AK_NN_
+    names, shuffled; a remesh already asked for is kept."""
+    return replace(
+        config,
+        remesh=config.remesh or LOW_POLY_VERTICES,
+        remesh_style="adaptive" if not config.remesh else config.remesh_style,
+        eyes_teeth_tongue=True,
+        hair_cards=config.hair_cards or 12,
+        eyebrows=True,
+        shoulders=not config.body,
+        one_object=True,
+        unit="cm",
+        up="z",
+        names="prefix",
+        shuffle=True,
     )
 
 

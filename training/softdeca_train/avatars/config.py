@@ -15,9 +15,10 @@ from softdeca_train.face_names import ARKIT_BLENDSHAPES
 UNITS: dict[str, float] = {"mm": 0.001, "cm": 0.01, "inch": 0.0254, "dm": 0.1, "m": 1.0}
 UP_AXES = ("y", "z")
 # The naming habits of rigs (names.py): eyeBlinkLeft, blendShape1.eyeBlinkLeft,
-# AK_09_EyeBlinkLeft, eyeBlink_L, eye_blink_l, EyeBlinkLeft.
+# AK_09_EyeBlinkLeft, eyeBlink_L, eye_blink_l, EyeBlinkLeft, CC_Base_Body.Eye_Blink_L,
+# facs_bs_EyeBlinkLeft.
 REMESH_STYLES = ("isotropic", "adaptive")  # remesh.py
-NAME_STYLES = ("arkit", "namespace", "prefix", "suffix_LR", "snake", "pascal")
+NAME_STYLES = ("arkit", "namespace", "prefix", "suffix_LR", "snake", "pascal", "cc", "daz")
 HELD_OUT_IDENTITIES = ("seed 404", "seed 505", "seed 606")
 DEFAULT_IDENTITY = HELD_OUT_IDENTITIES[0]
 DEFAULT_BODY_VERTICES = 20_000
@@ -43,6 +44,17 @@ class AvatarConfig:
     body_vertices: int = DEFAULT_BODY_VERTICES  # the body's own vertices, about
     # the skin, the eyeballs and the teeth as separate objects (ICT's other inner parts left out)
     separate_eyes_teeth: bool = False
+    # the eyeballs, the teeth and the tongue in the skin's object (decimated with it: remesh)
+    eyes_teeth_tongue: bool = False
+    hair_cards: int = 0  # this many hair cards a layer over the scalp and forehead (extras.py)
+    # the cards move with the skin under them (shapes transferred to every mesh of a head)
+    hair_follows: bool = False
+    eyebrows: bool = False  # eyebrow fins fused to the skin along the brows (extras.py)
+    shoulders: bool = False  # a bust (neck, shoulders, chest) joined under the neck
+    one_object: bool = False  # every part in one object (the mesh's o line), as one mesh
+    # the side shapes split from their symmetric sum by a linear ramp this many metres wide
+    # across the face (build.resplit); None: as the source has them
+    split_width: float | None = None
     keep_shapes: int | None = None  # only this many of the shapes, chosen at random
     drop: tuple[str, ...] = ()  # canonical ARKit names of shapes left out
     names: str = "arkit"  # a NAME_STYLES entry
@@ -68,11 +80,19 @@ class AvatarConfig:
         unknown = [n for n in self.drop if n not in ARKIT_BLENDSHAPES]
         if unknown:
             problems.append(f"drop: not ARKit blendshape names: {', '.join(unknown)}")
-        if self.arkit_face and (self.body or self.separate_eyes_teeth):
+        if self.arkit_face and (
+            self.body or self.separate_eyes_teeth or self.eyes_teeth_tongue or self.shoulders
+        ):
             problems.append(
-                "arkit_face takes neither body nor separate_eyes_teeth (ARKit's reference face "
-                "has no neck, eyes or teeth)"
+                "arkit_face takes no body, shoulders, eyes, teeth or tongue (ARKit's reference "
+                "face has no neck, eyes or teeth)"
             )
+        if self.body and self.shoulders:
+            problems.append("body and shoulders exclude each other (a body has shoulders)")
+        if self.separate_eyes_teeth and self.eyes_teeth_tongue:
+            problems.append("separate_eyes_teeth and eyes_teeth_tongue exclude each other")
+        if not 0 <= self.hair_cards <= 200:
+            problems.append("hair_cards must be between 0 and 200")
         if problems:
             raise ValueError("avatar: " + "; ".join(problems))
 
