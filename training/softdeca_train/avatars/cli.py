@@ -5,21 +5,20 @@ from __future__ import annotations
 
 import argparse
 import time
-from dataclasses import replace
 from pathlib import Path
 
 from softdeca_train.avatars.config import (
     DEFAULT_BODY_VERTICES,
     DEFAULT_IDENTITY,
     HELD_OUT_IDENTITIES,
+    LOW_POLY_VERTICES,
     NAME_STYLES,
     REMESH_STYLES,
     UNITS,
     AvatarConfig,
+    low_poly,
 )
 from softdeca_train.commands import Command, add_ict_argument
-
-LOW_POLY_VERTICES = 3500  # skin vertices of --low-poly: about 3.7k with the rest
 
 
 def _avatar_args(p: argparse.ArgumentParser) -> None:
@@ -85,7 +84,21 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         "forehead, moved by no shape (0)",
     )
     p.add_argument(
+        "--hair-follows",
+        action="store_true",
+        help="the hair cards move with the skin under them (shapes transferred to every mesh)",
+    )
+    p.add_argument(
         "--eyebrows", action="store_true", help="eyebrow fins fused to the skin along the brows"
+    )
+    p.add_argument(
+        "--split-width",
+        type=float,
+        default=None,
+        metavar="M",
+        help="the side shapes split from their symmetric sum by a linear ramp M metres wide "
+        "across the face, as rigging tools split them (each side's shape moves the other side "
+        "a little); default: the source's own",
     )
     p.add_argument(
         "--shoulders",
@@ -98,7 +111,8 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--low-poly",
         action="store_true",
-        help="a game-ready head as artists export one: --remesh 3500 --remesh-style adaptive "
+        help=f"a game-ready head as artists export one: --remesh {LOW_POLY_VERTICES} "
+        "--remesh-style adaptive "
         "(unless given) --eyes-teeth-tongue --hair-cards 12 --eyebrows --shoulders "
         "--one-object --unit cm --up z --names prefix --shuffle",
     )
@@ -149,7 +163,9 @@ def config_from_args(args: argparse.Namespace) -> AvatarConfig:
         separate_eyes_teeth=args.separate_eyes_teeth,
         eyes_teeth_tongue=args.eyes_teeth_tongue,
         hair_cards=args.hair_cards,
+        hair_follows=args.hair_follows,
         eyebrows=args.eyebrows,
+        split_width=args.split_width,
         shoulders=args.shoulders,
         one_object=args.one_object,
         keep_shapes=args.keep_shapes,
@@ -159,26 +175,6 @@ def config_from_args(args: argparse.Namespace) -> AvatarConfig:
         variant_seed=args.variant_seed,
     )
     return low_poly(config) if args.low_poly else config
-
-
-def low_poly(config: AvatarConfig) -> AvatarConfig:
-    """`config` as a game-ready head as artists export one (--low-poly): decimated, eyes, teeth
-    and tongue, hair cards and eyebrow fins in one mesh with a bust, centimetres, Z-up, AK_NN_
-    names, shuffled; a remesh already asked for is kept."""
-    return replace(
-        config,
-        remesh=config.remesh or LOW_POLY_VERTICES,
-        remesh_style="adaptive" if not config.remesh else config.remesh_style,
-        eyes_teeth_tongue=True,
-        hair_cards=config.hair_cards or 12,
-        eyebrows=True,
-        shoulders=not config.body,
-        one_object=True,
-        unit="cm",
-        up="z",
-        names="prefix",
-        shuffle=True,
-    )
 
 
 def _avatar_run(args: argparse.Namespace) -> int:

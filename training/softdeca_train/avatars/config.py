@@ -7,7 +7,7 @@ seeds from a SeedSequence of (dataset seed, 1, identity id), 32-bit hashes (data
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
 
@@ -22,6 +22,7 @@ NAME_STYLES = ("arkit", "namespace", "prefix", "suffix_LR", "snake", "pascal", "
 HELD_OUT_IDENTITIES = ("seed 404", "seed 505", "seed 606")
 DEFAULT_IDENTITY = HELD_OUT_IDENTITIES[0]
 DEFAULT_BODY_VERTICES = 20_000
+LOW_POLY_VERTICES = 1500  # skin vertices of low_poly: about 3,900 with the rest
 
 
 @dataclass(frozen=True)
@@ -93,6 +94,8 @@ class AvatarConfig:
             problems.append("separate_eyes_teeth and eyes_teeth_tongue exclude each other")
         if not 0 <= self.hair_cards <= 200:
             problems.append("hair_cards must be between 0 and 200")
+        if self.split_width is not None and not 0.01 <= self.split_width <= 1.0:
+            problems.append("split_width must be between 0.01 and 1 metre")
         if problems:
             raise ValueError("avatar: " + "; ".join(problems))
 
@@ -102,3 +105,24 @@ class AvatarConfig:
 
     def to_dict(self) -> dict:
         return {**asdict(self), "drop": list(self.drop)}
+
+
+def low_poly(config: AvatarConfig) -> AvatarConfig:
+    """`config` as a game-ready head as artists export one (--low-poly): decimated, eyes, teeth
+    and tongue, hair cards and eyebrow fins in one mesh with a bust, centimetres, Z-up, AK_NN_
+    names, shuffled; a remesh already asked for is kept (ARKit's face: no eyes, teeth, tongue
+    or bust)."""
+    return replace(
+        config,
+        remesh=config.remesh or LOW_POLY_VERTICES,
+        remesh_style="adaptive" if not config.remesh else config.remesh_style,
+        eyes_teeth_tongue=not config.arkit_face,  # ARKit's face has none
+        hair_cards=config.hair_cards or 12,
+        eyebrows=True,
+        shoulders=not (config.body or config.arkit_face),
+        one_object=True,
+        unit="cm",
+        up="z",
+        names="prefix",
+        shuffle=True,
+    )
