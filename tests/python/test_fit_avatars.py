@@ -186,7 +186,7 @@ LOW_POLY = {
         AvatarConfig(split_width=0.16)
     ),
     "low-poly seed 505, hair carrying the shapes, CC names": replace(
-        low_poly(AvatarConfig(identity="seed 505", remesh=3000, hair_follows=True)),
+        low_poly(AvatarConfig(identity="seed 505", remesh=2000, hair_follows=True)),
         names="cc",
     ),
     "ARKit's face decimated, split by a ramp, Daz names": replace(
