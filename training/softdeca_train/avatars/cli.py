@@ -20,6 +20,28 @@ from softdeca_train.avatars.config import (
 )
 from softdeca_train.commands import Command, add_ict_argument
 
+# What real heads carry and how they are exported: on/off options of `avatar`.
+LOOK_FLAGS = (
+    (
+        "--eyes-teeth-tongue",
+        "the eyeballs, the teeth and the tongue with the skin (decimated with it by --remesh; "
+        "one object with --one-object)",
+    ),
+    (
+        "--hair-follows",
+        "the hair cards move with the skin under them (shapes transferred to every mesh)",
+    ),
+    ("--eyebrows", "eyebrow fins fused to the skin along the brows"),
+    ("--shoulders", "a bust: the neck continued into shoulders and a chest (no shape moves it)"),
+    ("--one-object", "every part in one object, as one mesh"),
+    (
+        "--low-poly",
+        f"a game-ready head as artists export one: --remesh {LOW_POLY_VERTICES} --remesh-style "
+        "adaptive (unless given) --eyes-teeth-tongue --hair-cards 12 --eyebrows --shoulders "
+        "--one-object --unit cm --up z --names prefix --shuffle",
+    ),
+)
+
 
 def _avatar_args(p: argparse.ArgumentParser) -> None:
     add_ict_argument(p)
@@ -69,12 +91,8 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="the skin, the eyeballs and the teeth as separate objects (o lines)",
     )
-    p.add_argument(
-        "--eyes-teeth-tongue",
-        action="store_true",
-        help="the eyeballs, the teeth and the tongue with the skin (decimated with it by "
-        "--remesh; one object with --one-object)",
-    )
+    for flag, text in LOOK_FLAGS:
+        p.add_argument(flag, action="store_true", help=text)
     p.add_argument(
         "--hair-cards",
         type=int,
@@ -84,14 +102,6 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         "forehead, moved by no shape (0)",
     )
     p.add_argument(
-        "--hair-follows",
-        action="store_true",
-        help="the hair cards move with the skin under them (shapes transferred to every mesh)",
-    )
-    p.add_argument(
-        "--eyebrows", action="store_true", help="eyebrow fins fused to the skin along the brows"
-    )
-    p.add_argument(
         "--split-width",
         type=float,
         default=None,
@@ -99,22 +109,6 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         help="the side shapes split from their symmetric sum by a linear ramp M metres wide "
         "across the face, as rigging tools split them (each side's shape moves the other side "
         "a little); default: the source's own",
-    )
-    p.add_argument(
-        "--shoulders",
-        action="store_true",
-        help="a bust: the neck continued into shoulders and a chest (no shape moves it)",
-    )
-    p.add_argument(
-        "--one-object", action="store_true", help="every part in one object, as one mesh"
-    )
-    p.add_argument(
-        "--low-poly",
-        action="store_true",
-        help=f"a game-ready head as artists export one: --remesh {LOW_POLY_VERTICES} "
-        "--remesh-style adaptive "
-        "(unless given) --eyes-teeth-tongue --hair-cards 12 --eyebrows --shoulders "
-        "--one-object --unit cm --up z --names prefix --shuffle",
     )
     p.add_argument(
         "--keep-shapes", type=int, default=None, metavar="K", help="only K shapes, at random"
