@@ -7,14 +7,12 @@ held-out identity and take, is `python -m softdeca_train avatar-fit-check`."""
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 from bounds import above, below
 from scipy.spatial import cKDTree
 from softdeca_train.avatars.build import make_avatar
-from softdeca_train.avatars.config import AvatarConfig, low_poly
+from softdeca_train.avatars.config import LOW_POLY_VARIANTS, AvatarConfig
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
 from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.paths import default_takes_path
@@ -175,34 +173,13 @@ def test_avatars_as_they_come_fit_and_animate(
     assert len(report["shapes_matched"]) == int(a.present.sum())
 
 
-# Low-poly game heads as artists export them (about 2,000 to 5,000 vertices): decimated skin with
-# eyes, teeth and tongue, hair cards and eyebrow fins in one mesh with a bust, centimetres,
-# Z-up, AK_NN_ names (config.low_poly); rigs whose side shapes are split by a ramp across the
-# face (each side's shape moves the other side too), whose hair cards carry the shapes, under
-# Character Creator's and Daz's names.
-LOW_POLY = {
-    "low-poly game head": low_poly(AvatarConfig()),
-    "low-poly, sides split by a ramp across the face": low_poly(
-        AvatarConfig(split_width=0.16)
-    ),
-    "low-poly seed 505, hair carrying the shapes, CC names": replace(
-        low_poly(AvatarConfig(identity="seed 505", remesh=2000, hair_follows=True)),
-        names="cc",
-    ),
-    "ARKit's face decimated, split by a ramp, Daz names": replace(
-        low_poly(AvatarConfig(arkit_face=True, remesh=800, split_width=0.3)),
-        names="daz",
-    ),
-}
-
-
-@pytest.mark.parametrize("name", list(LOW_POLY))
+@pytest.mark.parametrize("name", list(LOW_POLY_VARIANTS))
 def test_low_poly_heads_are_covered_by_the_registered_template(
     model, template, arkit, name: str
 ) -> None:
     """The avatar's face (the skin its skin-only shapes move) lies on the registered template:
     a template squeezed onto part of the face (a unit misread) leaves most of it far away."""
-    a = make_avatar(LOW_POLY[name], template, arkit)
+    a = make_avatar(LOW_POLY_VARIANTS[name], template, arkit)
     fit = NativeFit.create(model, avatar_arrays(a))
     c = face_coverage(model, fit, a)
     above(c.within, 0.7, "acceptance: 70 % of the face within 3 mm of the template")

@@ -126,3 +126,22 @@ def low_poly(config: AvatarConfig) -> AvatarConfig:
         names="prefix",
         shuffle=True,
     )
+
+
+# Low-poly game heads as artists export them (about 1,200 to 5,500 vertices): decimated skin with
+# eyes, teeth and tongue, hair cards and eyebrow fins in one mesh with a bust, centimetres,
+# Z-up, AK_NN_ names (config.low_poly); rigs whose side shapes are split by a ramp across the
+# face (each side's shape moves the other side too), whose hair cards carry the shapes, under
+# Character Creator's and Daz's names: each a test (tests/python/test_fit_avatars.py).
+LOW_POLY_VARIANTS: dict[str, AvatarConfig] = {
+    "low-poly game head": low_poly(AvatarConfig()),
+    "low-poly, sides split by a ramp across the face": low_poly(AvatarConfig(split_width=0.16)),
+    "low-poly seed 505, hair carrying the shapes, CC names": replace(
+        low_poly(AvatarConfig(identity="seed 505", remesh=2000, hair_follows=True)),
+        names="cc",
+    ),
+    "ARKit's face decimated, split by a ramp, Daz names": replace(
+        low_poly(AvatarConfig(arkit_face=True, remesh=800, split_width=0.3)),
+        names="daz",
+    ),
+}

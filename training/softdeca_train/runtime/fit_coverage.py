@@ -3,10 +3,15 @@ avatar's moving face vertices (its skin the skin-only shapes move; eyes, teeth, 
 and anything no such shape moves left out) to the registered template skin
 (`softdeca_avatar_fit_get_registered` on the bundle's skin triangles), the closest point on its
 triangles. A template squeezed onto part of the face leaves most of the face far from it; one
-lying on the avatar's surface leaves every face vertex within a millimetre or so."""
+lying on the avatar's surface leaves every face vertex within a millimetre or so.
+
+`python -m softdeca_train.runtime.fit_coverage` fits each low-poly variant (avatars/config.py,
+LOW_POLY_VARIANTS) with the committed bundle and prints its coverage ($SOFTDECA_LIBRARY: another
+build of the library)."""
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import igl
@@ -77,3 +82,32 @@ def face_coverage(model: NativeModel, fit: NativeFit, avatar: AvatarMesh) -> Cov
         float((mm <= WITHIN_MM).mean()),
         (float(extent[0]), float(extent[1]), float(extent[2])),
     )
+
+
+def main() -> int:
+    from softdeca_train.avatars.build import make_avatar
+    from softdeca_train.avatars.config import LOW_POLY_VARIANTS
+    from softdeca_train.landmarks.arkit_reference import ArkitFace
+    from softdeca_train.runtime.fit_check import DEFAULT_BUNDLE, avatar_arrays
+    from softdeca_train.template import Template
+
+    model, template, face = NativeModel(DEFAULT_BUNDLE), Template.load(), ArkitFace.load()
+    for name, config in LOW_POLY_VARIANTS.items():
+        avatar = make_avatar(config, template, face)
+        start = time.perf_counter()
+        fit = NativeFit.create(model, avatar_arrays(avatar))
+        seconds = time.perf_counter() - start
+        c, r = face_coverage(model, fit, avatar), fit.report()
+        x, y, z = c.extent_mm
+        print(
+            f"{name}: {len(avatar.neutral)} vertices, unit {r['metres_per_unit']} (measured "
+            f"{r['metres_per_unit_measured']:.4g}), median {c.median_mm:.2f} mm, within "
+            f"{WITHIN_MM:g} mm {c.within:.3f} of {c.vertices}, the registered skin {x:.0f} x "
+            f"{y:.0f} x {z:.0f} mm, {r['embedded_vertices']} embedded, fit {seconds:.1f} s",
+            flush=True,
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
