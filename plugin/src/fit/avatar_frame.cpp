@@ -16,19 +16,19 @@ namespace {
 constexpr double kMotionShare = 0.002;
 
 // Left/Right pairs whose shapes move one side's part of the face (not "mouthLeft"/"jawLeft",
-// which move the whole mouth or jaw sideways), with the distance between the Left and the Right
-// shape's centres of motion on the ICT template, in metres (tests/python/test_avatar_frame.py
-// measures them again on the template).
+// which move the whole mouth or jaw sideways), with the distance between the pair's sides on
+// the ICT template, in metres (side_distance; tests/python/test_avatar_frame.py measures them
+// again on the template).
 struct SidePair {
   const char* stem;
   double template_distance;
 };
 constexpr SidePair kSidePairs[] = {
-    {"browDown", 0.0852},    {"browOuterUp", 0.0989},  {"cheekSquint", 0.0967},   {"eyeBlink", 0.0600},
-    {"eyeLookDown", 0.0699}, {"eyeLookIn", 0.0671},    {"eyeLookOut", 0.0671},    {"eyeLookUp", 0.0685},
-    {"eyeSquint", 0.0918},   {"eyeWide", 0.0683},      {"mouthDimple", 0.0530},   {"mouthFrown", 0.0561},
-    {"mouthLowerDown", 0.0323}, {"mouthPress", 0.0427}, {"mouthSmile", 0.0701},  {"mouthStretch", 0.0649},
-    {"mouthUpperUp", 0.0523}, {"noseSneer", 0.0596},
+    {"browDown", 0.0916},    {"browOuterUp", 0.1029},  {"cheekSquint", 0.1020},   {"eyeBlink", 0.0691},
+    {"eyeLookDown", 0.0703}, {"eyeLookIn", 0.0679},    {"eyeLookOut", 0.0679},    {"eyeLookUp", 0.0691},
+    {"eyeSquint", 0.0924},   {"eyeWide", 0.0687},      {"mouthDimple", 0.0608},   {"mouthFrown", 0.0638},
+    {"mouthLowerDown", 0.0480}, {"mouthPress", 0.0566}, {"mouthSmile", 0.0786},  {"mouthStretch", 0.0765},
+    {"mouthUpperUp", 0.0636}, {"noseSneer", 0.0696},
 };
 
 // Units a measured scale snaps to when within 25 %: mm, cm, inch, dm, m.
@@ -79,6 +79,32 @@ Motion shape_motion(const AvatarShapes& s, const float* d, const std::vector<dou
   m.direction /= total;
   m.moves = true;
   return m;
+}
+
+// The distance between a Left/Right pair's sides: each side the surface where its own shape
+// moves more than the other (each over its largest), weighted by how much more. Rigs split a
+// symmetric shape into its sides with a ramp across the face, often a wide one, so each side's
+// shape moves the other side too: the shapes' own centres of motion then lie closer together
+// than the sides do (a ramp across the whole face halves their distance, and a centimetre head
+// reads as inches); what one side moves more than the other stays on that side.
+double side_distance(const AvatarShapes& s, const float* dl, const float* dr, const std::vector<double>& area) {
+  const std::size_t n = s.vertex_count;
+  const auto motion = [](const float* d, std::size_t v) { return Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm(); };
+  double pl = 0, pr = 0;
+  for (std::size_t v = 0; v < n; ++v) pl = std::max(pl, motion(dl, v)), pr = std::max(pr, motion(dr, v));
+  if (!(pl > 0 && pr > 0)) return 0;
+  Eigen::Vector3d cl = Eigen::Vector3d::Zero(), cr = Eigen::Vector3d::Zero();
+  double wl = 0, wr = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const double ml = motion(dl, v), mr = motion(dr, v);
+    if (ml <= kMotionShare * pl && mr <= kMotionShare * pr) continue;
+    const double more = ml / pl - mr / pr;
+    const Eigen::Vector3d x(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
+    if (more > 0) cl += more * area[v] * x, wl += more * area[v];
+    if (more < 0) cr -= more * area[v] * x, wr -= more * area[v];
+  }
+  if (!(wl > 0 && wr > 0)) return 0;
+  return (cl / wl - cr / wr).norm();
 }
 
 double median(std::vector<double> x) {
@@ -158,12 +184,15 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   int eye_pairs = 0;
   double eye_distance = 0;
   for (const SidePair& p : kSidePairs) {
-    const Motion& l = motion[static_cast<std::size_t>(index_of(std::string(p.stem) + "Left"))];
-    const Motion& r = motion[static_cast<std::size_t>(index_of(std::string(p.stem) + "Right"))];
+    const auto li = static_cast<std::size_t>(index_of(std::string(p.stem) + "Left"));
+    const auto ri = static_cast<std::size_t>(index_of(std::string(p.stem) + "Right"));
+    const Motion& l = motion[li];
+    const Motion& r = motion[ri];
     if (!l.moves || !r.moves) continue;
     const Eigen::Vector3d d = l.centre - r.centre;
     left += d;
-    if (d.norm() > 0) scales.push_back(p.template_distance / d.norm());
+    const double sides = side_distance(s, s.deltas[li], s.deltas[ri], area);
+    if (sides > 0) scales.push_back(p.template_distance / sides);
     if (starts_with(p.stem, "eye")) {
       eyes += 0.5 * (l.centre + r.centre);
       eye_distance += d.norm();

@@ -36,7 +36,9 @@ struct AvatarFrame {
   Eigen::Vector3d left, up, forward;
   Eigen::Vector3d eyes = Eigen::Vector3d::Zero();  // midway between the eyes (zero without eye shapes)
   double eye_distance = 0;  // between the eyes' centres of motion, avatar units (0 without eye shapes)
-  // The unit: 0.06 m over eye_distance, snapped to mm, cm, inch, dm or m when within 25 %.
+  // The unit: the template's distance between each Left/Right pair's sides (where one side's
+  // shape moves more than the other's) over the avatar's, the median over the pairs, snapped to
+  // mm, cm, inch, dm or m when within 25 %.
   double metres_per_unit = 1;
   double metres_per_unit_measured = 1;
   std::string up_axis;        // the avatar axis closest to up: "+Y", "+Z", "-X", ...
