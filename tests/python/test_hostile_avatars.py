@@ -203,7 +203,12 @@ def check_no_secret(root: Path, attack: Attack, run: Run, out: Path) -> None:
 
 
 def check_refusal(attack: Attack, run: Run) -> None:
-    lines = [line for line in run.stderr.splitlines() if ": error: " in line]
+    # An error ("softdeca fit: error: ...", exit 1) or a refused option ("softdeca fit: ...", 2).
+    lines = [
+        line
+        for line in run.stderr.splitlines()
+        if ": error: " in line or (run.returncode == 2 and line.startswith("softdeca "))
+    ]
     assert run.returncode > 0 and lines, (
         f"{attack.name}: not refused ({run.returncode}):\n{run.stderr}"
     )
