@@ -1,0 +1,132 @@
+// Python bindings of the contact rules (plugin/src/prepare/contact_sets.h): the one
+// implementation of the lip and lid sets, which data generation (training/softdeca_train/sim)
+// and the runtime's prepare share. The rules' arguments carry the names of
+// softdeca_train.contact_rules.ContactRules' fields, so `**vars(rules)` passes them.
+#include <nanobind/eigen/dense.h>
+#include <nanobind/nanobind.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <string>
+#include <vector>
+
+#include "prepare/contact_sets.h"
+
+namespace nb = nanobind;
+using namespace softdeca;
+
+namespace {
+using Indices = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 1>;
+using Flags = Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1>;
+using Line = Eigen::Matrix<double, 4, 3, Eigen::RowMajor>;
+
+std::vector<std::int32_t> to_vector(const Indices& v) { return {v.data(), v.data() + v.size()}; }
+Indices to_indices(const std::vector<std::int32_t>& v) {
+  return Eigen::Map<const Indices>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+void check_below(const Indices& v, Eigen::Index n, const char* what) {
+  if (v.size() > 0 && (v.minCoeff() < 0 || v.maxCoeff() >= n))
+    throw nb::value_error((std::string(what) + " name a vertex outside the skin").c_str());
+}
+
+void check_landmarks(const sim::Positions& skin, const Indices& landmarks68) {
+  if (landmarks68.size() != 68) throw nb::value_error("landmarks68 must hold the 68 landmarks' skin vertices");
+  check_below(landmarks68, skin.rows(), "landmarks68");
+}
+
+std::vector<std::int32_t> triangle_list(const sim::Positions& skin, const sim::TriIndices& tris) {
+  if (tris.size() > 0 && (tris.minCoeff() < 0 || tris.maxCoeff() >= skin.rows()))
+    throw nb::value_error("skin_triangles name a vertex outside the skin");
+  return {tris.data(), tris.data() + tris.size()};
+}
+
+runtime::ContactRules rules_of(const sim::Positions& skin, const Indices& landmarks68, const Indices& lid_candidates,
+                               double lip_radius, double lip_corner_radius, double lid_reach, double lid_corner_radius,
+                               double eye_zone_share) {
+  check_landmarks(skin, landmarks68);
+  check_below(lid_candidates, skin.rows(), "lid_candidates");
+  return {to_vector(landmarks68), to_vector(lid_candidates), lip_radius, lip_corner_radius,
+          lid_reach,              lid_corner_radius,          eye_zone_share};
+}
+
+// The rules' keyword arguments, after the function's own; defaults from contact_rules.json.
+template <class F, class... Extra>
+void def_with_rules(nb::module_& m, const char* name, F&& f, const char* doc, Extra&&... own) {
+  const runtime::ContactRules d;
+  m.def(name, std::forward<F>(f), std::forward<Extra>(own)..., nb::kw_only(), nb::arg("landmarks68"),
+        nb::arg("lid_candidates") = Indices(), nb::arg("lip_radius") = d.lip_radius,
+        nb::arg("lip_corner_radius") = d.lip_corner_radius, nb::arg("lid_reach") = d.lid_reach,
+        nb::arg("lid_corner_radius") = d.lid_corner_radius, nb::arg("eye_zone_share") = d.eye_zone_share, doc);
+}
+}  // namespace
+
+void bind_prepare(nb::module_& m) {
+  m.def(
+      "lip_contact_zone",
+      [](const sim::Positions& skin, const Indices& landmarks68, double radius) {
+        check_landmarks(skin, landmarks68);
+        const std::vector<char> zone = runtime::lip_contact_zone(skin, to_vector(landmarks68), radius);
+        Flags out(static_cast<Eigen::Index>(zone.size()));
+        for (std::size_t i = 0; i < zone.size(); ++i) out[static_cast<Eigen::Index>(i)] = zone[i];
+        return out;
+      },
+      nb::arg("skin"), nb::arg("landmarks68"), nb::arg("radius") = runtime::ContactRules{}.lip_radius,
+      "Per skin point, 1 where it lies within `radius` of the inner lip contour, else 0.");
+  def_with_rules(
+      m, "lip_sets",
+      [](const sim::Positions& skin, const sim::TriIndices& skin_triangles, const Indices& landmarks68,
+         const Indices& lid_candidates, double lr, double lcr, double ldr, double ldcr, double ezs) {
+        const runtime::LipSets s = runtime::lip_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs),
+                                                     skin, triangle_list(skin, skin_triangles));
+        return nb::make_tuple(to_indices(s.zone), to_indices(s.upper), to_indices(s.lower), s.upper_triangles,
+                              s.lower_triangles);
+      },
+      "The lip sets: (zone, upper, lower, upper_triangles, lower_triangles).", nb::arg("skin"),
+      nb::arg("skin_triangles"));
+  m.def(
+      "eye_fissures",
+      [](const sim::Positions& skin, const Indices& landmarks68) {
+        check_landmarks(skin, landmarks68);
+        std::vector<Line> out;
+        for (const runtime::FissureLine& line : runtime::eye_fissures(skin, to_vector(landmarks68))) {
+          Line l;
+          for (int k = 0; k < 4; ++k) l.row(k) = line[static_cast<std::size_t>(k)].transpose();
+          out.push_back(l);
+        }
+        return out;
+      },
+      nb::arg("skin"), nb::arg("landmarks68"),
+      "Each eye's fissure (right, then left): (4, 3) corner, lid midpoints, corner.");
+  m.def(
+      "lid_sides",
+      [](const sim::Positions& skin, const Indices& landmarks68, double eye_zone_share) {
+        check_landmarks(skin, landmarks68);
+        const std::vector<signed char> side = runtime::lid_sides(skin, to_vector(landmarks68), eye_zone_share);
+        Flags out(static_cast<Eigen::Index>(side.size()));
+        for (std::size_t i = 0; i < side.size(); ++i) out[static_cast<Eigen::Index>(i)] = side[i];
+        return out;
+      },
+      nb::arg("skin"), nb::arg("landmarks68"), nb::arg("eye_zone_share") = runtime::ContactRules{}.eye_zone_share,
+      "Per skin point: +1 on an upper lid's side of its eye's fissure, -1 on a lower lid's, 0 away from the eyes.");
+  def_with_rules(
+      m, "lid_sets",
+      [](const sim::Positions& skin, const Indices& landmarks68, const Indices& lid_candidates, double lr, double lcr,
+         double ldr, double ldcr, double ezs) {
+        const runtime::LidSets s =
+            runtime::lid_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs), skin);
+        return nb::make_tuple(to_indices(s.upper), to_indices(s.lower));
+      },
+      "The lid sets: (upper, lower), skin point indices of both eyes.", nb::arg("skin"));
+  def_with_rules(
+      m, "contact_sets",
+      [](const sim::Positions& skin, const sim::TriIndices& skin_triangles, const sim::TriIndices& upper_teeth,
+         const sim::TriIndices& lower_teeth, const Indices& landmarks68, const Indices& lid_candidates, double lr,
+         double lcr, double ldr, double ldcr, double ezs) {
+        return runtime::contact_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs), skin,
+                                     triangle_list(skin, skin_triangles), upper_teeth, lower_teeth);
+      },
+      "A head's five collision sets (CollisionSet): the lips against each other and the teeth, the eyelids. "
+      "upper_teeth / lower_teeth: the teeth's triangles over simulated vertices.",
+      nb::arg("skin"), nb::arg("skin_triangles"), nb::arg("upper_teeth"), nb::arg("lower_teeth"));
+}
