@@ -9,15 +9,12 @@ namespace softdeca::runtime {
 namespace {
 using Vec = Eigen::Vector3d;
 
-// Multi-PIE landmark ids the rules use: the inner lip contour, its corners and middles.
-constexpr int kInnerLipFirst = 60, kInnerLipEnd = 68;
-constexpr int kInnerRightCorner = 60, kInnerLeftCorner = 64, kInnerUpperMiddle = 62, kInnerLowerMiddle = 66;
-// Per eye (right, left): one corner, the upper lid's two, the other corner, the lower lid's
-// two (below the upper lid's, in the same order).
-struct EyeLandmarks {
-  int corner_a, upper[2], corner_b, lower[2];
-};
-constexpr EyeLandmarks kEyes[2] = {{36, {37, 38}, 39, {41, 40}}, {42, {43, 44}, 45, {47, 46}}};
+// The Multi-PIE landmark ids the rules use (plugin/data/contact_rules.json).
+constexpr int kInnerLip[] = {SOFTDECA_CONTACT_LANDMARKS_INNER_LIP};
+constexpr int kInnerMouthCorners[2] = {SOFTDECA_CONTACT_LANDMARKS_INNER_MOUTH_CORNERS};  // right, left
+constexpr int kInnerLipMiddles[2] = {SOFTDECA_CONTACT_LANDMARKS_INNER_LIP_MIDDLES};      // upper, lower
+// Per eye (right, left): one corner, the upper lid's two, the other corner, the lower lid's two.
+constexpr int kEyes[2][6] = {{SOFTDECA_CONTACT_LANDMARKS_RIGHT_EYE}, {SOFTDECA_CONTACT_LANDMARKS_LEFT_EYE}};
 
 Vec at(const sim::Positions& skin, std::int32_t i) { return skin.row(i).transpose(); }
 
@@ -54,7 +51,7 @@ std::vector<char> lip_contact_zone(const sim::Positions& skin, const std::vector
   for (Eigen::Index i = 0; i < skin.rows(); ++i) {
     const Vec p = at(skin, static_cast<std::int32_t>(i));
     double d = std::numeric_limits<double>::infinity();
-    for (int k = kInnerLipFirst; k < kInnerLipEnd; ++k) d = std::min(d, (p - at(skin, lm[static_cast<std::size_t>(k)])).norm());
+    for (const int k : kInnerLip) d = std::min(d, (p - at(skin, lm[static_cast<std::size_t>(k)])).norm());
     zone[static_cast<std::size_t>(i)] = d < radius;
   }
   return zone;
@@ -65,8 +62,8 @@ std::vector<char> lip_contact_zone(const sim::Positions& skin, const std::vector
 LipSets lip_sets(const ContactRules& r, const sim::Positions& skin, const std::vector<std::int32_t>& skin_triangles) {
   const auto l = [&](int k) { return at(skin, r.landmarks68[static_cast<std::size_t>(k)]); };
   const std::size_t n = static_cast<std::size_t>(skin.rows());
-  const Vec left = l(kInnerLeftCorner), right = l(kInnerRightCorner);
-  const double middle_raise = 0.5 * (l(kInnerUpperMiddle).y() + l(kInnerLowerMiddle).y()) - 0.5 * (left.y() + right.y());
+  const Vec left = l(kInnerMouthCorners[1]), right = l(kInnerMouthCorners[0]);
+  const double middle_raise = 0.5 * (l(kInnerLipMiddles[0]).y() + l(kInnerLipMiddles[1]).y()) - 0.5 * (left.y() + right.y());
   const std::vector<char> in_zone = lip_contact_zone(skin, r.landmarks68, r.lip_radius);
   LipSets s;
   std::vector<char> in_upper(n, 0), in_lower(n, 0);
@@ -89,9 +86,8 @@ std::array<FissureLine, 2> eye_fissures(const sim::Positions& skin, const std::v
   const auto l = [&](int k) { return at(skin, lm[static_cast<std::size_t>(k)]); };
   std::array<FissureLine, 2> lines;
   for (std::size_t e = 0; e < 2; ++e) {
-    const EyeLandmarks& k = kEyes[e];
-    lines[e] = {l(k.corner_a), 0.5 * (l(k.upper[0]) + l(k.lower[0])), 0.5 * (l(k.upper[1]) + l(k.lower[1])),
-                l(k.corner_b)};
+    const int* k = kEyes[e];
+    lines[e] = {l(k[0]), 0.5 * (l(k[1]) + l(k[4])), 0.5 * (l(k[2]) + l(k[5])), l(k[3])};
   }
   return lines;
 }
