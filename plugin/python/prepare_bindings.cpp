@@ -1,7 +1,9 @@
-// Python bindings of the contact rules (plugin/src/prepare/contact_sets.h): the one
-// implementation of the lip and lid sets, which data generation (training/softdeca_train/sim)
-// and the runtime's prepare share. The rules' arguments carry the names of
-// softdeca_train.contact_rules.ContactRules' fields, so `**vars(rules)` passes them.
+// Python bindings of prepare's rules, each implemented once in the library and shared with the
+// training package: the contact rules (plugin/src/prepare/contact_sets.h), the lip and lid sets
+// data generation (training/softdeca_train/sim) and the runtime's prepare find, whose arguments
+// carry the names of softdeca_train.contact_rules.ContactRules' fields so that `**vars(rules)`
+// passes them; and the parameter localisation rules (prepare/parameters.h) that
+// softdeca_train.models.parameters.ParameterState applies.
 #include <nanobind/eigen/dense.h>
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/string.h>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "prepare/contact_sets.h"
+#include "prepare/parameters.h"
 
 namespace nb = nanobind;
 using namespace softdeca;
@@ -19,6 +22,7 @@ namespace {
 using Indices = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 1>;
 using Flags = Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1>;
 using Line = Eigen::Matrix<double, 4, 3, Eigen::RowMajor>;
+using Values = Eigen::VectorXd;
 
 std::vector<std::int32_t> to_vector(const Indices& v) { return {v.data(), v.data() + v.size()}; }
 Indices to_indices(const std::vector<std::int32_t>& v) {
@@ -59,9 +63,40 @@ void def_with_rules(nb::module_& m, const char* name, F&& f, const char* doc, Ex
         nb::arg("lip_corner_radius") = d.lip_corner_radius, nb::arg("lid_reach") = d.lid_reach,
         nb::arg("lid_corner_radius") = d.lid_corner_radius, nb::arg("eye_zone_share") = d.eye_zone_share, doc);
 }
+
+void bind_localisation(nb::module_& m) {
+  m.def(
+      "localise_to_faces",
+      [](const Values& vertex_values, const sim::TriIndices& triangles) {
+        if (triangles.size() > 0 && (triangles.minCoeff() < 0 || triangles.maxCoeff() >= vertex_values.size()))
+          throw nb::value_error("triangles name a vertex the vertex map has no value for");
+        const std::vector<std::int32_t> t(triangles.data(), triangles.data() + triangles.size());
+        Values out(triangles.rows());
+        runtime::faces_from_vertex_map(t, vertex_values.data(), out.data());
+        return out;
+      },
+      nb::arg("vertex_values"), nb::arg("triangles"), "A vertex map on the faces: the mean of each triangle's corners.");
+  m.def(
+      "localise_to_vertices",
+      [](const Values& face_values, const sim::TriIndices& triangles, const Values& face_area, int n_vertices) {
+        if (face_values.size() != triangles.rows() || face_area.size() != triangles.rows())
+          throw nb::value_error("face_values and face_area need one value per triangle");
+        if (triangles.size() > 0 && (triangles.minCoeff() < 0 || triangles.maxCoeff() >= n_vertices))
+          throw nb::value_error("triangles name a vertex at or past n_vertices");
+        const std::vector<std::int32_t> t(triangles.data(), triangles.data() + triangles.size());
+        const std::vector<double> area(face_area.data(), face_area.data() + face_area.size());
+        Values out(n_vertices);
+        runtime::vertices_from_face_map(t, area, runtime::skin_vertex_areas(t, area, static_cast<std::size_t>(n_vertices)),
+                                        face_values.data(), out.data());
+        return out;
+      },
+      nb::arg("face_values"), nb::arg("triangles"), nb::arg("face_area"), nb::arg("n_vertices"),
+      "A face map on the vertices: the area-weighted mean of each vertex's incident faces.");
+}
 }  // namespace
 
 void bind_prepare(nb::module_& m) {
+  bind_localisation(m);
   m.def(
       "lip_contact_zone",
       [](const sim::Positions& skin, const Indices& landmarks68, double radius) {
