@@ -2,9 +2,12 @@
 // training package: the contact rules (plugin/src/prepare/contact_sets.h), the lip and lid sets
 // data generation (training/softdeca_train/sim) and the runtime's prepare find, whose arguments
 // carry the names of softdeca_train.contact_rules.ContactRules' fields so that `**vars(rules)`
-// passes them; and the parameter localisation rules (prepare/parameters.h) that
-// softdeca_train.models.parameters.ParameterState applies.
+// passes them; the parameter localisation rules (prepare/parameters.h) that
+// softdeca_train.models.parameters.ParameterState applies; and the fill's carry to a neutral
+// skin (prepare/rest_physics.h) with its stiffness, which the training package's carried fills
+// (lhm/carried.py, models/rest_head.py) use.
 #include <nanobind/eigen/dense.h>
+#include <nanobind/eigen/sparse.h>
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
@@ -14,6 +17,7 @@
 
 #include "prepare/contact_sets.h"
 #include "prepare/parameters.h"
+#include "prepare/rest_physics.h"
 
 namespace nb = nanobind;
 using namespace softdeca;
@@ -93,10 +97,55 @@ void bind_localisation(nb::module_& m) {
       nb::arg("face_values"), nb::arg("triangles"), nb::arg("face_area"), nb::arg("n_vertices"),
       "A face map on the vertices: the area-weighted mean of each vertex's incident faces.");
 }
+
+void check_tets(const sim::TetIndices& tets, Eigen::Index n, const char* what) {
+  if (tets.size() > 0 && (tets.minCoeff() < 0 || tets.maxCoeff() >= n))
+    throw nb::value_error((std::string(what) + " name a vertex outside the fill").c_str());
+}
+
+void bind_carry(nb::module_& m) {
+  m.def(
+      "fill_stiffness",
+      [](const sim::Positions& vertices, const sim::TetIndices& tets) {
+        check_tets(tets, vertices.rows(), "tets");
+        std::vector<Eigen::Triplet<double>> k;
+        runtime::add_fill_stiffness(vertices, tets, 1.0, k);
+        Eigen::SparseMatrix<double> out(vertices.rows(), vertices.rows());
+        out.setFromTriplets(k.begin(), k.end());
+        return out;
+      },
+      nb::arg("vertices"), nb::arg("tets"),
+      "(n, n) sum over tets of vol * grad(phi_a) . grad(phi_b): the Dirichlet energy of a piecewise-linear field "
+      "is x^T K x per component (scipy.sparse CSC).");
+  m.def(
+      "carry_fill",
+      [](const sim::Positions& vertices, const sim::TetIndices& soft_tets, const sim::TetIndices& muscle_tets,
+         const Eigen::Matrix<std::int32_t, Eigen::Dynamic, 4, Eigen::RowMajor>& skin_vertex,
+         const Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor>& skin_weight, const Values& carry_weight,
+         double carry_smoothness, const sim::Positions& neutral_skin) {
+        check_tets(soft_tets, vertices.rows(), "soft_tets");
+        check_tets(muscle_tets, vertices.rows(), "muscle_tets");
+        check_tets(skin_vertex, vertices.rows(), "skin_vertex");
+        if (skin_weight.rows() != skin_vertex.rows() || carry_weight.size() != skin_vertex.rows())
+          throw nb::value_error("skin_vertex, skin_weight and carry_weight need one row per skin point");
+        runtime::RestHead head;
+        head.vertices = vertices;
+        head.soft_tets = soft_tets;
+        head.muscle_tets = muscle_tets;
+        head.skin = {skin_vertex, skin_weight};
+        head.carry_weight.assign(carry_weight.data(), carry_weight.data() + carry_weight.size());
+        head.carry_smoothness = carry_smoothness;
+        return runtime::carry_fill(head, neutral_skin);
+      },
+      nb::arg("vertices"), nb::arg("soft_tets"), nb::arg("muscle_tets"), nb::arg("skin_vertex"), nb::arg("skin_weight"),
+      nb::arg("carry_weight"), nb::arg("carry_smoothness"), nb::arg("neutral_skin"),
+      "The fill's vertices carried to a neutral skin: V0 + K^-1 B^T W (S - B V0) (docs/bundle.md, Rest physics).");
+}
 }  // namespace
 
 void bind_prepare(nb::module_& m) {
   bind_localisation(m);
+  bind_carry(m);
   m.def(
       "lip_contact_zone",
       [](const sim::Positions& skin, const Indices& landmarks68, double radius) {

@@ -2,7 +2,8 @@
 simulation mesh and the rules that fit it to any avatar in the template's topology.
 
 Carried to an avatar's neutral like data generation carries the fill to an identity
-(lhm/carried.py), but from the avatar's own skin S:
+(lhm/carried.py), but from the avatar's own skin S, by the library's carry
+(plugin/src/prepare/rest_physics.h):
 
     V = V0 + K^-1 B^T W (S - B V0),   K = B^T W B + lambda * stiffness(V0)
 
@@ -14,12 +15,10 @@ file format is docs/bundle.md's "Rest physics"."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from softdeca_train.contact_rules import CONTACT_RULES, ContactRules
 from softdeca_train.lhm import LhmConfig
@@ -67,34 +66,24 @@ class RestHead:
     inert: tuple[str, ...] = ()
     tolerance: float = 1e-5  # ten times the data's 1e-4, whose noise is a fifth of a small
     max_iterations: int = 2000  # control's response (docs/training.md)
-    _factor: Any = field(default=None, repr=False, compare=False)
 
     @property
     def skin_count(self) -> int:
         return len(self.skin_vertex)
 
-    def embedding_matrix(self, weighted: bool) -> sp.csr_matrix:
-        """(N_SKIN, n) S from the fill's vertices (rows times carry_weight when `weighted`)."""
-        n_s, n = self.skin_count, len(self.vertices)
-        w = self.skin_weight * (self.carry_weight[:, None] if weighted else 1.0)
-        rows = np.repeat(np.arange(n_s), 4)
-        return sp.csr_matrix((w.ravel(), (rows, self.skin_vertex.ravel())), shape=(n_s, n))
-
     def carried_vertices(self, neutral_skin: np.ndarray) -> np.ndarray:
-        """The fill's vertices carried to an avatar's neutral skin (N_SKIN, 3)."""
+        """The fill's vertices carried to an avatar's neutral skin (N_SKIN, 3), by the library's
+        carry (prepare/rest_physics.h, carry_fill)."""
         # the carried fill needs the compiled softdeca_native; reading a bundle does not
-        from softdeca_train.lhm.carried import stiffness_matrix
+        import softdeca_native as native
 
         s = np.asarray(neutral_skin, np.float64)
         if s.shape != (self.skin_count, 3):
             raise ValueError(f"neutral skin must be ({self.skin_count}, 3), got {s.shape}")
-        b = self.embedding_matrix(weighted=True)
-        if self._factor is None:
-            tets = np.vstack([self.soft_tets, self.muscle_tets])
-            k = b.T @ b + self.carry_smoothness * stiffness_matrix(self.vertices, tets)
-            self._factor = splu(k.tocsc())
-        rhs = b.T @ (s - self.embedding_matrix(weighted=False) @ self.vertices)
-        return self.vertices + self._factor.solve(np.asarray(rhs))
+        return native.carry_fill(
+            self.vertices, self.soft_tets, self.muscle_tets, self.skin_vertex, self.skin_weight,
+            self.carry_weight, self.carry_smoothness, s,
+        )  # fmt: skip
 
     def simulation_mesh(
         self, neutral_head: np.ndarray, skin_triangles: np.ndarray
