@@ -28,6 +28,14 @@ using Flags = Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1>;
 using Line = Eigen::Matrix<double, 4, 3, Eigen::RowMajor>;
 using Values = Eigen::VectorXd;
 
+// Per-point flags (0/1 or -1/0/+1) as an int8 array.
+template <class T>
+Flags to_flags(const std::vector<T>& v) {
+  Flags out(static_cast<Eigen::Index>(v.size()));
+  for (std::size_t i = 0; i < v.size(); ++i) out[static_cast<Eigen::Index>(i)] = static_cast<std::int8_t>(v[i]);
+  return out;
+}
+
 std::vector<std::int32_t> to_vector(const Indices& v) { return {v.data(), v.data() + v.size()}; }
 Indices to_indices(const std::vector<std::int32_t>& v) {
   return Eigen::Map<const Indices>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -150,10 +158,7 @@ void bind_prepare(nb::module_& m) {
       "lip_contact_zone",
       [](const sim::Positions& skin, const Indices& landmarks68, double radius) {
         check_landmarks(skin, landmarks68);
-        const std::vector<char> zone = runtime::lip_contact_zone(skin, to_vector(landmarks68), radius);
-        Flags out(static_cast<Eigen::Index>(zone.size()));
-        for (std::size_t i = 0; i < zone.size(); ++i) out[static_cast<Eigen::Index>(i)] = zone[i];
-        return out;
+        return to_flags(runtime::lip_contact_zone(skin, to_vector(landmarks68), radius));
       },
       nb::arg("skin"), nb::arg("landmarks68"), nb::arg("radius") = runtime::ContactRules{}.lip_radius,
       "Per skin point, 1 where it lies within `radius` of the inner lip contour, else 0.");
@@ -186,10 +191,7 @@ void bind_prepare(nb::module_& m) {
       "lid_sides",
       [](const sim::Positions& skin, const Indices& landmarks68, double eye_zone_share) {
         check_landmarks(skin, landmarks68);
-        const std::vector<signed char> side = runtime::lid_sides(skin, to_vector(landmarks68), eye_zone_share);
-        Flags out(static_cast<Eigen::Index>(side.size()));
-        for (std::size_t i = 0; i < side.size(); ++i) out[static_cast<Eigen::Index>(i)] = side[i];
-        return out;
+        return to_flags(runtime::lid_sides(skin, to_vector(landmarks68), eye_zone_share));
       },
       nb::arg("skin"), nb::arg("landmarks68"), nb::arg("eye_zone_share") = runtime::ContactRules{}.eye_zone_share,
       "Per skin point: +1 on an upper lid's side of its eye's fissure, -1 on a lower lid's, 0 away from the eyes.");
