@@ -30,10 +30,35 @@ void require_finite(const std::vector<float>& values, const std::string& what) {
     if (!std::isfinite(values[i])) throw std::runtime_error(what + "vertex " + std::to_string(i / 3) + " is not finite");
 }
 
+// Coordinates an avatar may have in any unit (10,000 km in metres, 10 km in millimetres): a
+// vertex beyond is no part of a mesh but a value that would overflow what is computed from it.
+constexpr double kMaxCoordinate = 1e7;
+// A shape moves a vertex at most this many times the mesh's own size (its bounding box's
+// diagonal): a jaw opens by a fraction of the head, a 3e38 delta is no shape.
+constexpr double kMaxDeltaOverSize = 2.0;
+
+void require_within(const std::vector<float>& values, const std::string& what) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (std::abs(values[i]) > kMaxCoordinate)
+      throw std::runtime_error(what + "vertex " + std::to_string(i / 3) + " lies at " + std::to_string(values[i]) +
+                               ", beyond the 1e7 units any avatar spans");
+}
+
+double size_of(const std::vector<float>& vertices) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (std::size_t i = 0; i + 2 < vertices.size(); i += 3) {
+    const Eigen::Vector3d p = Eigen::Vector3f(vertices.data() + i).cast<double>();
+    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  return vertices.empty() ? 0.0 : (hi - lo).norm();
+}
+
 // The checks of one included mesh before anything is copied.
 void check_mesh(const std::string& path, const SourceMesh& mesh, const ShapeChoice& choice) {
   const std::string at = where(path, mesh);
   require_finite(mesh.vertices, at);
+  require_within(mesh.vertices, at);
+  const double largest_delta = kMaxDeltaOverSize * size_of(mesh.vertices);
   const std::size_t n = mesh.vertex_count();
   for (const std::int32_t t : mesh.triangles)
     if (t < 0 || static_cast<std::size_t>(t) >= n)
@@ -45,6 +70,11 @@ void check_mesh(const std::string& path, const SourceMesh& mesh, const ShapeChoi
       throw std::runtime_error(at + "shape '" + shape.name + "' has " + std::to_string(shape.deltas.size() / 3) +
                                " vertices, the mesh " + std::to_string(n));
     require_finite(shape.deltas, at + "shape '" + shape.name + "': ");
+    for (std::size_t i = 0; i + 2 < shape.deltas.size(); i += 3)
+      if (Eigen::Vector3f(shape.deltas.data() + i).cast<double>().norm() > largest_delta)
+        throw std::runtime_error(at + "shape '" + shape.name + "' moves vertex " + std::to_string(i / 3) + " by " +
+                                 std::to_string(Eigen::Vector3f(shape.deltas.data() + i).norm()) + ", more than twice the mesh's own size (" +
+                                 std::to_string(size_of(mesh.vertices)) + ")");
   }
   for (const double v : mesh.transform)
     if (!std::isfinite(v)) throw std::runtime_error(at + "its node's transform is not finite");

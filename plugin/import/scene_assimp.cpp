@@ -13,6 +13,7 @@
 
 #include "avatar_source.h"
 #include "avatar_weld.h"
+#include "fbx_bounds.h"
 #include "file_format.h"
 #include "input_files.h"
 
@@ -99,6 +100,7 @@ SourceScene read_fbx_file(const std::string& path, const ImportLimits& limits) {
   // The file is read once, checked on its open descriptor; assimp parses those bytes.
   const std::string bytes = read_named_file(path, limits.max_file_bytes, "an avatar file");
   if (agreed_format(path, bytes) != FileFormat::fbx) throw std::runtime_error(path + ": not an FBX file");
+  scan_fbx(bytes, path, limits);  // nesting, expansion and values bounded before assimp parses
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);  // one node per FBX model
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
