@@ -143,10 +143,9 @@ std::vector<double> vertex_areas(const AvatarShapes& s) {
   return area;
 }
 
-// Every shape's motion; marks the vertices that move in `face`.
-std::array<Motion, kShapes> shape_motions(const AvatarShapes& s, std::vector<uint8_t>& face) {
+// Every shape's motion (`area`: vertex_areas); marks the vertices that move in `face`.
+std::array<Motion, kShapes> shape_motions(const AvatarShapes& s, const std::vector<double>& area, std::vector<uint8_t>& face) {
   std::array<Motion, kShapes> motion{};
-  const std::vector<double> area = vertex_areas(s);
   for (std::size_t i = 0; i < kShapes; ++i)
     if (s.deltas[i] != nullptr) motion[i] = shape_motion(s, s.deltas[i], area, face);
   return motion;
@@ -156,7 +155,7 @@ std::array<Motion, kShapes> shape_motions(const AvatarShapes& s, std::vector<uin
 
 ShapeCentres shape_centres(const AvatarShapes& s) {
   std::vector<uint8_t> face(s.vertex_count, 0);
-  const std::array<Motion, kShapes> motion = shape_motions(s, face);
+  const std::array<Motion, kShapes> motion = shape_motions(s, vertex_areas(s), face);
   ShapeCentres c;
   for (std::size_t i = 0; i < kShapes; ++i) {
     c.moves[i] = motion[i].moves;
@@ -191,7 +190,8 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
       check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
   AvatarFrame f;
   f.face.assign(s.vertex_count, 0);
-  const std::array<Motion, kShapes> motion = shape_motions(s, f.face);
+  const std::vector<double> area = vertex_areas(s);
+  const std::array<Motion, kShapes> motion = shape_motions(s, area, f.face);
   for (std::size_t i = 0; i < kShapes; ++i) {
     f.shapes_used += motion[i].moves;
     f.moves[i] = motion[i].moves;
