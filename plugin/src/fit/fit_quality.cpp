@@ -30,15 +30,15 @@ std::vector<Failure> failures(const FitQuality& q, double residual_mm) {
                                            100 * q.face_coverage, 100 * b.min_face_coverage, b.covered_mm)});
   if (!(q.median_mm <= b.max_median_mm))
     out.push_back({"avatar_to_template_mm_median",
-                   format("the avatar's face vertices lie a median %.1f mm from the registered template (at most %.1f mm)",
+                   format("the avatar's face vertices lie a median %.2f mm from the registered template (at most %.1f mm)",
                           q.median_mm, b.max_median_mm)});
   if (!(q.p90_mm <= b.max_p90_mm))
     out.push_back({"avatar_to_template_mm_p90",
-                   format("a tenth of the avatar's face vertices lie %.1f mm or more from the registered template (at most "
+                   format("a tenth of the avatar's face vertices lie %.2f mm or more from the registered template (at most "
                           "%.1f mm)",
                           q.p90_mm, b.max_p90_mm)});
   if (!(residual_mm <= b.max_residual_mm))
-    out.push_back({"face_residual_mm_mean", format("the registered template's face lies a mean %.1f mm from the avatar's "
+    out.push_back({"face_residual_mm_mean", format("the registered template's face lies a mean %.2f mm from the avatar's "
                                                    "surface (at most %.1f mm)",
                                                    residual_mm, b.max_residual_mm)});
   if (q.template_scale > 0 && !(q.template_scale >= b.min_template_scale && q.template_scale <= b.max_template_scale))
