@@ -122,9 +122,10 @@ bool is_fit_folder(const std::string& dir) {
 
 std::string fit_file(const std::string& dir) { return (fs::path(dir) / "avatar.fit").string(); }
 
-std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std::string& library_report) {
+std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std::string& library_report, bool poor) {
   JsonObject o;
-  o.raw("source", source_json(avatar, dir))
+  o.raw("poor_fit", poor ? "true" : "false")
+      .raw("source", source_json(avatar, dir))
       .number("vertices", static_cast<double>(avatar.vertex_count()))
       .number("triangles", static_cast<double>(avatar.triangles.size() / 3))
       .raw("parts", parts_json(avatar))

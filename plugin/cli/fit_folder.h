@@ -1,6 +1,7 @@
 // A fit folder, what `softdeca fit MESH --out DIR` writes and `softdeca replay --avatar DIR` reads:
 //   DIR/avatar.fit   the fit (softdeca_avatar_fit_save; tied to its bundle)
-//   DIR/fit.json     the library's report under "fit", with what the file gave: "source" (the
+//   DIR/fit.json     the library's report under "fit" ("poor_fit": kept though it fails the
+//                    report's quality bounds), with what the file gave: "source" (the
 //                    mesh's path, absolute and from DIR, the names file, the SHA-256 of the mesh
 //                    as read), the parts included and left out, each ARKit shape's rig names and
 //                    the names not used
@@ -23,8 +24,9 @@ std::vector<std::string> fit_folder_files();
 bool is_fit_folder(const std::string& dir);
 std::string fit_file(const std::string& dir);  // DIR/avatar.fit
 
-// fit.json's text for `avatar` fitted into `dir`, around the library's report (JSON).
-std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std::string& library_report);
+// fit.json's text for `avatar` fitted into `dir`, around the library's report (JSON); `poor`: a
+// fit that fails the library's quality bounds, kept on request ("poor_fit": true).
+std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std::string& library_report, bool poor = false);
 
 // The mesh a fit folder was made for, read again as the fit read it (its names file too);
 // throws std::runtime_error when it cannot be found or is not the mesh that was fitted.

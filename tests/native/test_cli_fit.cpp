@@ -2,9 +2,10 @@
 // synthetic bundle: the test head written as a user's glTF and FBX (centimetres, turned and
 // moved by its node, beside a body part without ARKit shapes) is fitted and replayed, and its
 // point caches, in the head's own coordinates, match the replay of the head in the template's
-// topology; a fit folder refuses a changed mesh. The fit folder is written whole: two fits at
-// once into one folder leave one of them, a link in it is not written through, a failed write
-// leaves the previous folder.
+// topology; a fit folder refuses a changed mesh; a poor fit is refused with its reason unless
+// kept on request, marked poor. The fit folder is written whole: two fits at once into one folder
+// leave one of them, a link in it is not written through, a failed write leaves the previous
+// folder.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -132,6 +133,8 @@ TEST_F(CliFit, AFittedGltfReplaysAsItsHeadInTheTemplatesTopology) {
   EXPECT_EQ(report.at("left_out", "").array("")[0].at("name", "").string(""), "Body");
   EXPECT_EQ(report.at("shapes", "").at("jawOpen", "").at("Head", "").string(""), "blendShape1.jawOpen");
   EXPECT_TRUE(report.at("fit", "").has("face_residual_mm_max"));
+  EXPECT_TRUE(report.at("fit", "").at("quality", "").at("passed", "").boolean(""));
+  EXPECT_FALSE(report.at("poor_fit", "").boolean(""));
 
   ASSERT_EQ(softdeca("replay '" + take_ + "' --bundle '" + bundle_ + "' --avatar '" + dir_.file("fit") + "' --frames 12 --out '" +
                          dir_.file("fitted") + "'",
@@ -156,6 +159,39 @@ TEST_F(CliFit, AFittedGltfReplaysAsItsHeadInTheTemplatesTopology) {
                      "changed.log"),
             0);
   EXPECT_NE(log("changed.log").find("is not the mesh fitted in"), std::string::npos) << log("changed.log");
+}
+
+TEST_F(CliFit, APoorFitIsRefusedWithItsReasonUnlessKept) {
+  // A shell around the head, 1.5 times its size and moved by the same shapes: the template fits
+  // the head and covers a patch of the face the shapes move.
+  TestScene scene = user_scene(head_);
+  TestMesh shell = scene.meshes[0];
+  shell.name = "Shell";
+  for (float& x : shell.vertices) x *= 1.5f;
+  for (softdeca::test::TestShape& s : shell.shapes)
+    for (float& x : s.deltas) x *= 1.5f;
+  scene.meshes.push_back(shell);
+  const std::string glb = dir_.write("shell.glb", softdeca::test::glb_bytes(scene));
+  const std::string fit = "fit '" + glb + "' --bundle '" + bundle_ + "' --metres-per-unit 0.01 --out '";
+  EXPECT_NE(softdeca(fit + dir_.file("poor") + "'", "poor.log"), 0);
+  const std::string refused = log("poor.log");
+  EXPECT_NE(refused.find("the fit is poor (face_coverage)"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("at least 70 %"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("Likely cause"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("--keep-poor-fit"), std::string::npos) << refused;
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("poor/avatar.fit")));
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("poor/fit.json")));
+
+  ASSERT_EQ(softdeca(fit + dir_.file("kept") + "' --keep-poor-fit", "kept.log"), 0) << log("kept.log");
+  EXPECT_NE(log("kept.log").find("keeping a poor fit (face_coverage)"), std::string::npos) << log("kept.log");
+  EXPECT_TRUE(std::filesystem::exists(dir_.file("kept/avatar.fit")));
+  const std::vector<char> json = rt::read_bytes(dir_.file("kept/fit.json"));
+  const softdeca::runtime::Json report = softdeca::runtime::Json::parse(std::string(json.begin(), json.end()));
+  EXPECT_TRUE(report.at("poor_fit", "").boolean(""));
+  const softdeca::runtime::Json& quality = report.at("fit", "").at("quality", "");
+  EXPECT_FALSE(quality.at("passed", "").boolean(""));
+  EXPECT_EQ(quality.at("failed_measure", "").string(""), "face_coverage");
+  EXPECT_LT(report.at("fit", "").at("face_coverage", "").number(""), 0.7);
 }
 
 TEST_F(CliFit, AnFbxIsFittedOnTheSpotAndWrittenInItsWeldedOrder) {

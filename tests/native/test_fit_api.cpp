@@ -1,8 +1,9 @@
 // Fitting a user's avatar through the C ABI on the runtime tests' synthetic bundle: the head
 // shuffled, in centimetres and inside a body is fitted, saved, loaded and animated; what the
-// embedding does not hold moves exactly as the rig; hostile meshes and fit files get errors: a
-// saved fit with any bit flipped, or with values no fit holds under a matching checksum, is
-// refused, and saves from many threads to one path always leave a fit that loads.
+// embedding does not hold moves exactly as the rig; a fit that leaves most of the face uncovered
+// is judged poor in its report; hostile meshes and fit files get errors: a saved fit with any bit
+// flipped, or with values no fit holds under a matching checksum, is refused, and saves from many
+// threads to one path always leave a fit that loads.
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -19,6 +20,7 @@
 #include "api/runtime_handles.h"
 #include "fit/fit_file.h"
 
+#include "bundle/json.h"
 #include "runtime_fixture.h"
 
 namespace {
@@ -179,6 +181,72 @@ TEST_F(FitApi, FitsSavesLoadsAndAnimatesTheUsersOwnMesh) {
     }
   EXPECT_GT(moved, 0.0) << "the physics' correction reaches the avatar";
   std::filesystem::remove(path);
+}
+
+double number(const softdeca::runtime::Json& report, const std::string& name) { return report.at(name, "report").number(name); }
+
+// The user's avatar with a shell around its head: a copy 1.5 times its size, moved by the same
+// shapes (scaled alike). The template fits the head inside and lies on the avatar everywhere,
+// but the face the shapes move is the shell's too: the template covers a patch of it, as a
+// template squeezed into part of a face does.
+UserAvatar with_shell(const UserAvatar& user, std::size_t head_vertices) {
+  constexpr float kScale = 1.5f;
+  const std::size_t m = user.vertices(), total = m + head_vertices;
+  UserAvatar out = user;
+  out.neutral.resize(3 * total);
+  for (std::size_t i = 0; i < 3 * head_vertices; ++i) out.neutral[3 * m + i] = kScale * user.neutral[i];
+  out.deltas.assign(52 * total * 3, 0.0f);
+  for (std::size_t k = 0; k < 52; ++k)
+    for (std::size_t i = 0; i < 3 * m; ++i) {
+      out.deltas[k * total * 3 + i] = user.deltas[k * m * 3 + i];
+      if (i < 3 * head_vertices) out.deltas[(k * total + m) * 3 + i] = kScale * user.deltas[k * m * 3 + i];
+    }
+  for (std::size_t f = 0; f + 2 < user.triangles.size(); f += 3)
+    if (static_cast<std::size_t>(std::max({user.triangles[f], user.triangles[f + 1], user.triangles[f + 2]})) < head_vertices)
+      for (int c = 0; c < 3; ++c) out.triangles.push_back(static_cast<int32_t>(m) + user.triangles[f + static_cast<std::size_t>(c)]);
+  out.head_of.resize(total, ~0u);
+  out.describe();
+  return out;
+}
+
+TEST_F(FitApi, TheReportJudgesTheFitFromBothSides) {
+  UserAvatar user(head_);
+  FitPtr good;
+  ASSERT_EQ(fit(user.mesh, good), SOFTDECA_OK) << softdeca_last_error();
+  const auto g = softdeca::runtime::Json::parse(report(good));
+  const softdeca::runtime::Json& verdict = g.at("quality", "report");
+  EXPECT_TRUE(verdict.at("passed", "quality").boolean("passed")) << report(good);
+  EXPECT_EQ(verdict.at("failed_measure", "quality").string("failed_measure"), "");
+  EXPECT_EQ(verdict.at("reason", "quality").string("reason"), "");
+  EXPECT_GT(number(g, "face_coverage"), 0.95) << report(good);
+  EXPECT_LT(number(g, "avatar_to_template_mm_median"), 0.5) << report(good);
+  EXPECT_LE(number(g, "avatar_to_template_mm_median"), number(g, "avatar_to_template_mm_p90"));
+  EXPECT_LE(number(g, "avatar_to_template_mm_p90"), number(g, "avatar_to_template_mm_max"));
+  EXPECT_NEAR(number(g, "template_scale"), 1.0, 0.05) << report(good);
+  EXPECT_GT(number(g, "face_coverage_vertices"), 0.0);
+
+  // Every point of the template lies on the avatar (the one-way residual is as good as the
+  // head's own), yet half the face is uncovered: the fit is still made, for the host to
+  // inspect, and its report calls it poor, naming the measure, the bound and the likely cause.
+  const UserAvatar shell = with_shell(user, head_.vertices());
+  FitPtr poor;
+  ASSERT_EQ(fit(shell.mesh, poor), SOFTDECA_OK) << softdeca_last_error();
+  const auto p = softdeca::runtime::Json::parse(report(poor));
+  EXPECT_LT(number(p, "face_residual_mm_mean"), 0.5) << report(poor);
+  const softdeca::runtime::Json& refused = p.at("quality", "report");
+  EXPECT_FALSE(refused.at("passed", "quality").boolean("passed")) << report(poor);
+  EXPECT_EQ(refused.at("failed_measure", "quality").string("failed_measure"), "face_coverage") << report(poor);
+  const std::string reason = refused.at("reason", "quality").string("reason");
+  EXPECT_NE(reason.find("covers"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("at least 70 %"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("squeezed"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("0.01 m"), std::string::npos) << "names the unit the fit took: " << reason;
+  const softdeca::runtime::Json& bounds = refused.at("bounds", "quality");
+  EXPECT_EQ(bounds.at("face_coverage_min", "bounds").number("face_coverage_min"), 0.7);
+  EXPECT_EQ(bounds.at("covered_mm", "bounds").number("covered_mm"), 3.0);
+  EXPECT_LT(number(p, "face_coverage"), 0.7);
+  EXPECT_GT(number(p, "avatar_to_template_mm_median"), 10.0);
+  EXPECT_LT(number(p, "template_scale"), bounds.at("template_scale_min", "bounds").number("template_scale_min"));
 }
 
 TEST_F(FitApi, AFittedAvatarTakesMapsPerAvatarElement) {

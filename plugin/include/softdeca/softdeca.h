@@ -364,7 +364,8 @@ SOFTDECA_API softdeca_status softdeca_fit_options_init(softdeca_fit_options* opt
 
 /* Fits an avatar to the model's template (seconds for a 20k-vertex body). Errors name the
  * problem: no ARKit shape moves a vertex, no face found, NaN vertices, degenerate triangles,
- * shapes of the wrong size. options may be NULL (the defaults). */
+ * shapes of the wrong size. options may be NULL (the defaults). A fit that fails the quality
+ * bounds is still made, for the host to inspect: its report's "quality" says so and why. */
 SOFTDECA_API softdeca_status softdeca_avatar_fit_create(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
                                                         const softdeca_fit_options* options,
                                                         softdeca_avatar_fit** out_fit);
@@ -384,7 +385,9 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_load(const softdeca_model* mode
                                                       softdeca_avatar_fit** out_fit);
 
 /* The fit's report as JSON (metres_per_unit, up_axis, shapes_matched, shapes_carried,
- * face_vertices, face_residual_mm_mean / _max, seconds, ...): NUL-terminated into buffer when
+ * face_vertices, face_residual_mm_mean / _max, face_coverage, avatar_to_template_mm_median /
+ * _p90, template_scale, quality: {passed, failed_measure, reason, bounds}, seconds, ...;
+ * docs/avatars.md): NUL-terminated into buffer when
  * capacity suffices; *out_length (may be NULL) receives the length without the NUL either way
  * (SOFTDECA_ERROR_BUFFER_TOO_SMALL when it does not fit). */
 SOFTDECA_API softdeca_status softdeca_avatar_fit_report(const softdeca_avatar_fit* fit, char* buffer,

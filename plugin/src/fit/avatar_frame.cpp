@@ -38,6 +38,7 @@ constexpr double kSnap = 1.25;
 struct Motion {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // motion-weighted centre of what moves
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // summed deltas over summed lengths
+  double spread = 0;  // RMS distance of what moves from the centre, weighted alike
   bool moves = false;
 };
 
@@ -54,9 +55,9 @@ void check_finite(const float* p, std::size_t n, const std::string& what) {
     require(std::isfinite(p[i]), what + " has a non-finite value at vertex " + std::to_string(i / 3));
 }
 
-// The motion-weighted centre of one shape's moving vertices, each vertex weighted by its share
-// of the surface (so a mesh dense at the eyes and lips and one evenly meshed agree); marks them
-// in `face`.
+// The motion-weighted centre and spread of one shape's moving vertices, each vertex weighted by
+// its share of the surface (so a mesh dense at the eyes and lips and one evenly meshed agree);
+// marks them in `face`.
 Motion shape_motion(const AvatarShapes& s, const float* d, const std::vector<double>& area, std::vector<uint8_t>& face) {
   const std::size_t n = s.vertex_count;
   double peak = 0;
@@ -64,18 +65,21 @@ Motion shape_motion(const AvatarShapes& s, const float* d, const std::vector<dou
     peak = std::max(peak, Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm());
   Motion m;
   if (!(peak > 0)) return m;
-  double total = 0;
+  double total = 0, second = 0;
   for (std::size_t v = 0; v < n; ++v) {
     const double motion = Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm();
     if (motion <= kMotionShare * peak) continue;
     face[v] = 1;
     const double w = motion * area[v];
+    const Eigen::Vector3d x(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
     total += w;
-    m.centre += w * Eigen::Vector3d(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
+    m.centre += w * x;
+    second += w * x.squaredNorm();
     m.direction += Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]);
   }
   if (!(total > 0)) return m;  // only vertices on no triangle with area move
   m.centre /= total;
+  m.spread = std::sqrt(std::max(0.0, second / total - m.centre.squaredNorm()));
   m.direction /= total;
   m.moves = true;
   return m;
@@ -139,7 +143,27 @@ std::vector<double> vertex_areas(const AvatarShapes& s) {
   return area;
 }
 
+// Every shape's motion (`area`: vertex_areas); marks the vertices that move in `face`.
+std::array<Motion, kShapes> shape_motions(const AvatarShapes& s, const std::vector<double>& area, std::vector<uint8_t>& face) {
+  std::array<Motion, kShapes> motion{};
+  for (std::size_t i = 0; i < kShapes; ++i)
+    if (s.deltas[i] != nullptr) motion[i] = shape_motion(s, s.deltas[i], area, face);
+  return motion;
+}
+
 }  // namespace
+
+ShapeCentres shape_centres(const AvatarShapes& s) {
+  std::vector<uint8_t> face(s.vertex_count, 0);
+  const std::array<Motion, kShapes> motion = shape_motions(s, vertex_areas(s), face);
+  ShapeCentres c;
+  for (std::size_t i = 0; i < kShapes; ++i) {
+    c.moves[i] = motion[i].moves;
+    c.centres[i] = motion[i].centre;
+    c.spreads[i] = motion[i].spread;
+  }
+  return c;
+}
 
 std::string axis_name(const Eigen::Vector3d& up) {
   Eigen::Index k = 0;
@@ -161,17 +185,18 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   for (std::size_t i = 0; i < 3 * s.triangle_count; ++i)
     require(s.triangles[i] >= 0 && static_cast<std::size_t>(s.triangles[i]) < s.vertex_count,
             "triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh");
+  for (std::size_t i = 0; i < kShapes; ++i)
+    if (s.deltas[i] != nullptr)
+      check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
   AvatarFrame f;
   f.face.assign(s.vertex_count, 0);
-  std::array<Motion, kShapes> motion{};
   const std::vector<double> area = vertex_areas(s);
+  const std::array<Motion, kShapes> motion = shape_motions(s, area, f.face);
   for (std::size_t i = 0; i < kShapes; ++i) {
-    if (s.deltas[i] == nullptr) continue;
-    check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
-    motion[i] = shape_motion(s, s.deltas[i], area, f.face);
     f.shapes_used += motion[i].moves;
     f.moves[i] = motion[i].moves;
     f.centres[i] = motion[i].centre;
+    f.spreads[i] = motion[i].spread;
   }
   f.face_vertices = static_cast<std::size_t>(std::count(f.face.begin(), f.face.end(), uint8_t{1}));
   require(f.shapes_used > 0, "none of the avatar's ARKit blendshapes moves a vertex: no face to fit");

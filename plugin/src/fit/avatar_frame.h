@@ -46,12 +46,24 @@ struct AvatarFrame {
   // mouthFunnel, cheekPuff), else the face's normals, point along -(left x up).
   bool mirrored = false;
   std::vector<uint8_t> face;  // per vertex: 1 where some ARKit shape moves it
-  // Per shape: whether it moves a vertex, and its motion-weighted centre (avatar coordinates).
+  // Per shape: whether it moves a vertex, its motion-weighted centre (avatar coordinates) and
+  // spread (the RMS distance of what it moves from that centre, weighted alike; avatar units).
   std::array<bool, kShapes> moves{};
   std::array<Eigen::Vector3d, kShapes> centres{};
+  std::array<double, kShapes> spreads{};
   std::size_t face_vertices = 0;
   std::size_t shapes_used = 0;
 };
+
+// Each shape's motion-weighted centre and spread as avatar_frame reads them (`moves` false where
+// the shape moves nothing), without the frame: for a mesh known to be a face, such as the
+// registered template, whose shapes tell its face's size (fit/fit_quality.h).
+struct ShapeCentres {
+  std::array<bool, kShapes> moves{};
+  std::array<Eigen::Vector3d, kShapes> centres{};
+  std::array<double, kShapes> spreads{};
+};
+ShapeCentres shape_centres(const AvatarShapes& shapes);
 
 // A measured metres-per-unit snapped to mm, cm, inch, dm or m when within 25 %.
 double snap_unit(double measured);
