@@ -66,6 +66,12 @@ test-python: build ## pytest (the numerical bounds' margins -> build/bounds/nati
 
 test: lint test-native test-fuzz test-python test-kernels test-swift test-unity ## every test: lint, ctest (release, ASan+UBSan), short fuzzing, pytest, other CPUs' kernels, Swift, Unity
 
+# tests/python/test_hostile_avatars.py runs every hostile avatar through `softdeca fit` in
+# test-python; the full form also replays each one and adds the FBX zlib bomb (docs/security.md).
+.PHONY: test-hostile-full
+test-hostile-full: build ## the hostile-avatar suite in full: every attack through fit and replay, and the zlib bomb
+	@SOFTDECA_HOSTILE=full $(PY) -m pytest -q tests/python/test_hostile_avatars.py
+
 # ---- Kernel families: the numerics another x86-64 CPU computes -----------------------------
 # tests/cpu/run-as.sh caps every numerical library (this one, numpy, OpenBLAS, torch) at one
 # kernel family (docs/platforms.md, "Kernel families"). test-kernels runs the native kernel and
@@ -129,7 +135,9 @@ bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/
 	@mkdir -p build/bench
 	@$(BUILD)/plugin/cli/softdeca bench-streaming --out build/bench/streaming.json
 	@$(PY) -m softdeca_train runtime-test-data --out build/bench/runtime_test_data > /dev/null
+	@rm -rf build/bench/hostile_avatars && $(PY) -m softdeca_train hostile-avatars --out build/bench/hostile_avatars > /dev/null
 	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json --bundle build/bench/runtime_test_data/bundle \
+	  --import-corpus build/bench/hostile_avatars \
 	  --avatar build/bench/runtime_test_data/avatar --avatar-unit 1
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
 	@$(PY) -m softdeca_train bench-physics --ict "$(SOFTDECA_ICT)" --out build/bench
@@ -142,13 +150,14 @@ lint: setup ## ruff check and format check of the Python code
 clean: ## remove build/ and out/ (OUT)
 	rm -rf build $(OUT)
 
-# ---- Fuzzing the streaming and recording parsers -------------------------------------------------
-# libFuzzer targets of the streaming parsers (tests/fuzz), built by clang in build/fuzz.
+# ---- Fuzzing the parsers of outside input -----------------------------------------------------
+# libFuzzer targets of the streaming, recording, bundle, fit and avatar-file parsers (tests/fuzz),
+# built by clang in build/fuzz.
 # test-fuzz: a few seconds each on the committed corpus; fuzz-long: the long runs of
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
 FUZZ         := build/fuzz
 FUZZ_TARGETS := fit_file softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
-                bundle_tar bundle_folder manifest onnx_model onnx_graph
+                bundle_tar bundle_folder manifest onnx_model onnx_graph obj shape_names avatar_folder fbx gltf
 FUZZ_SECONDS ?= 620
 
 .PHONY: fuzz-build test-fuzz fuzz-long
@@ -258,10 +267,10 @@ bench-stress: build ## the stress suite's figures -> build/bench/physics_stress.
 # into UNITY_BINARIES on their machines, `make unity-package` packs too.
 WINDOWS        := build/windows
 WINDOWS_ORT    := $(CURDIR)/.deps/onnxruntime-win
-WINDOWS_TESTS  := test_c_abi test_stream test_bundle_folder abi_header_check_c abi_header_check_cpp replay_check
+WINDOWS_TESTS  := test_c_abi test_atomic_write test_stream test_bundle_folder abi_header_check_c abi_header_check_cpp replay_check
 # The Windows tests that run under wine: the C ABI, the streaming and recording stack (UDP over
 # loopback included), bundle folders (links, sizes, file kinds), the header checks against softdeca.dll, its export table.
-WINDOWS_CTEST  := ^(BundleFolder|OnnxConstantSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines)\.|^abi_header_check_|^dll_exports_only_c_abi$$
+WINDOWS_CTEST  := ^(AtomicWrite|BundleFolder|OnnxStaticSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines)\.|^abi_header_check_|^dll_exports_only_c_abi$$
 # The replay check: frames of a real take through models/softdeca-default on the identity of
 # seed 1, by the Linux CLI and by the Windows DLL under wine, compared vertex by vertex.
 CHECK          := build/platform-check
@@ -309,7 +318,7 @@ ARM64          := build/arm64
 ARM64_ORT      := $(CURDIR)/.deps/onnxruntime-arm64
 ARM64_TESTS    := test_c_abi test_stream test_bundle_folder test_runtime test_runtime_math test_cpu_features test_neon_kernels \
                   abi_header_check_c abi_header_check_cpp replay_check
-ARM64_CTEST    := ^(BundleFolder|OnnxConstantSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines|Runtime|Threads|Worker|HyperTensor|SparseLdlt|DeformationTransfer|CpuFeatures|NeonKernels|Half|Blendshapes|BundleFiles|Dynamics|Json|Normals|Rigid)\.|^abi_header_check_|^shared_library_exports
+ARM64_CTEST    := ^(BundleFolder|OnnxStaticSizes|CAbi|StreamCAbi|WireFormat|Golden|ArkitNames|IFacialMocap|LiveLinkFace|Rotation|JitterBuffer|NeutralAssembler|SequenceTracker|Interpolation|Player|Recording|Receiver|FrameRule|CsvNumbers|CsvLines|Runtime|Threads|Worker|HyperTensor|SparseLdlt|DeformationTransfer|CpuFeatures|NeonKernels|Half|Blendshapes|BundleFiles|Dynamics|Json|Normals|Rigid)\.|^abi_header_check_|^shared_library_exports
 ARM64_FRAMES   ?= 8
 .PHONY: arm64 test-arm64 test-arm64-quick arm64-check-inputs count-arm64
 

@@ -1,8 +1,10 @@
 // bench-reliability's bundle memory run: what loading a bundle costs in resident memory when
-// its network asks for a large constant-foldable tensor, against the memory budget
-// (docs/security.md, "Memory budget"). Copies of a small bundle get one extra producer each
-// (a Range, a Tile, a ConstantOfShape, an Expand, a Resize, a Shape-derived ConstantOfShape),
-// sized just under the budget, just over it and far over it; each copy is loaded in a child
+// its network asks for large constant-foldable tensors, against the memory budget
+// (docs/security.md, "Memory budget"). Copies of a small bundle get one extra fragment each
+// (a ConstantOfShape, an Expand, a ConstantOfShape of a shape made by a Mul, a Gather or a
+// Shape and Concat, a self-Concat, a MatMul outer product), sized just under the budget, just
+// over it and far over it (ONNX Runtime's constant folding is off for bundle networks, so a
+// copy that loads computes none of it); each copy is loaded in a child
 // process so that one load's peak does not hide another's. The child has loaded the bundle
 // unchanged first: ONNX Runtime's start, the same for every bundle and once a process, is
 // measured on its own.

@@ -1,8 +1,5 @@
 #include "bench_fit_cost.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <ctime>
 #include <cstdio>
@@ -11,7 +8,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#include "bench_process_memory.h"
+#include "bench_child_memory.h"
 #include "imported_avatar.h"
 
 namespace softdeca::cli {
@@ -92,57 +89,38 @@ AvatarArrays with_slivers(AvatarArrays a, std::size_t count, unsigned seed) {
 }
 
 FitRun fit_in_child(const std::string& bundle, const AvatarArrays& a, double metres_per_unit) {
-  int ends[2];
-  if (::pipe(ends) != 0) throw std::runtime_error("bench-reliability: cannot make a pipe");
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) throw std::runtime_error("bench-reliability: cannot fork");
-  if (pid == 0) {
-    ::close(ends[0]);
-    std::string report;
-    softdeca_model* model = nullptr;
-    if (softdeca_model_load(bundle.c_str(), nullptr, &model) != SOFTDECA_OK) {
-      report = "0 0 0 0 cannot load " + bundle + ": " + softdeca_last_error();
-    } else {
-      softdeca_fit_options options{};
-      options.struct_size = sizeof options;
-      softdeca_fit_options_init(&options);
-      options.metres_per_unit = metres_per_unit;
-      const softdeca_avatar_mesh mesh = a.mesh();
-      reset_peak();
-      const std::uint64_t before = status_bytes("VmRSS");
-      softdeca_avatar_fit* fit = nullptr;
-      const auto t0 = std::chrono::steady_clock::now();
-      const double cpu0 = cpu_seconds();
-      const softdeca_status status = softdeca_avatar_fit_create(model, &mesh, &options, &fit);
-      const double cpu = cpu_seconds() - cpu0;
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const std::uint64_t peak = status_bytes("VmHWM");
-      char head[96];
-      std::snprintf(head, sizeof head, "%d %.6f %.6f %llu ", status == SOFTDECA_OK ? 1 : 0, seconds, cpu,
-                    static_cast<unsigned long long>(peak > before ? peak - before : 0));
-      report = head + std::string(status == SOFTDECA_OK ? "" : softdeca_last_error());
-      softdeca_avatar_fit_destroy(fit);
-      softdeca_model_destroy(model);
-    }
-    const ssize_t written = ::write(ends[1], report.data(), report.size());
-    ::_exit(written == static_cast<ssize_t>(report.size()) ? 0 : 1);
-  }
-  ::close(ends[1]);
-  std::string report;
-  char buf[4096];
-  for (ssize_t n; (n = ::read(ends[0], buf, sizeof buf)) > 0;) report.append(buf, static_cast<std::size_t>(n));
-  ::close(ends[0]);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || report.empty())
-    throw std::runtime_error("bench-reliability: the fit of " + std::to_string(a.vertices()) + " vertices killed its process");
+  softdeca_model* model = nullptr;  // the child's
+  const auto load = [&]() -> std::string {
+    if (softdeca_model_load(bundle.c_str(), nullptr, &model) == SOFTDECA_OK) return "";
+    return "cannot load " + bundle + ": " + softdeca_last_error();
+  };
+  // "<1 fitted, 0 refused> <seconds> <cpu seconds> <the refusal>"
+  const auto fit = [&]() -> std::string {
+    softdeca_fit_options options{};
+    options.struct_size = sizeof options;
+    softdeca_fit_options_init(&options);
+    options.metres_per_unit = metres_per_unit;
+    const softdeca_avatar_mesh mesh = a.mesh();
+    softdeca_avatar_fit* made = nullptr;
+    const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = cpu_seconds();
+    const softdeca_status status = softdeca_avatar_fit_create(model, &mesh, &options, &made);
+    const double cpu = cpu_seconds() - cpu0;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    char head[96];
+    std::snprintf(head, sizeof head, "%d %.6f %.6f ", status == SOFTDECA_OK ? 1 : 0, seconds, cpu);
+    const std::string report = head + std::string(status == SOFTDECA_OK ? "" : softdeca_last_error());
+    softdeca_avatar_fit_destroy(made);
+    return report;
+  };
+  const ChildPeak c = peak_in_child("fitting " + std::to_string(a.vertices()) + " vertices", load, fit);
+  if (!c.prepared) throw std::runtime_error("bench-reliability: " + c.report);
   FitRun out;
   char* rest = nullptr;
-  out.fitted = std::strtol(report.c_str(), &rest, 10) == 1;
+  out.fitted = std::strtol(c.report.c_str(), &rest, 10) == 1;
   out.seconds = std::strtod(rest, &rest);
   out.cpu_seconds = std::strtod(rest, &rest);
-  out.peak_increase = std::strtoull(rest, &rest, 10);
+  out.peak_increase = c.increase;
   if (*rest == ' ') out.error = rest + 1;
   return out;
 }

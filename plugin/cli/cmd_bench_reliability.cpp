@@ -22,6 +22,7 @@
 
 #include "bench_bundle_memory.h"
 #include "bench_fifo.h"
+#include "bench_import_memory.h"
 #include "bench_figures.h"
 #include "bench_fit_cost.h"
 #include "bench_recording_memory.h"
@@ -188,9 +189,10 @@ int run_bench_reliability(const Args& args) {
             "consumer's poll while the recording's disk cannot keep up (p99 poll time), and how long every\n"
             "path that opens a recording or CSV take takes to refuse a FIFO, and the memory an opened\n"
             "recording holds per frame; with --bundle, the peak memory of loading copies of that bundle\n"
-            "grown by one constant-foldable producer each, just under, just over and far over a budget;\n"
-            "with --bundle and --avatar, the fit of that avatar subdivided to --fit-vertices vertices (time\n"
-            "and peak memory) and of the avatar with 20,000 sliver triangles added.");
+            "grown by one constant-foldable fragment each, just under, just over and far over a budget; with\n"
+            "--import-corpus, the peak memory of reading each hostile avatar against the avatar's size; with\n"
+            "--bundle and --avatar, the fit of that avatar subdivided to --fit-vertices vertices (time and\n"
+            "peak memory) and of the avatar with 20,000 sliver triangles added.");
   declare_output_options(o, "reliability", "where the runs write their files");
   o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
@@ -198,6 +200,7 @@ int run_bench_reliability(const Args& args) {
       .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
       .option("--bundle", "DIR", "a small bundle folder to grow (the runtime test data's bundle)", "")
       .option("--bundle-budget-mib", "N", "the memory budget of the bundle runs", "256")
+      .option("--import-corpus", "DIR", "hostile avatars to read (python -m softdeca_train hostile-avatars)", "")
       .option("--avatar", "MESH", "an avatar the bundle fits (the runtime test data's avatar folder)", "")
       .option("--avatar-unit", "X", "the avatar's metres per unit (0: read off its shapes)", "0")
       .option("--fit-vertices", "N", "the vertices of the large avatar's fit (at least)", "500000");
@@ -231,6 +234,11 @@ int run_bench_reliability(const Args& args) {
   if (!o.text("--bundle").empty()) {
     std::fprintf(stderr, "bench-reliability: bundle memory\n");
     bundles = bundle_memory_run(o.text("--bundle"), scratch, std::uint64_t(budget_mib) << 20);
+  }
+  ImportMemory imports;
+  if (!o.text("--import-corpus").empty()) {
+    std::fprintf(stderr, "bench-reliability: import memory\n");
+    imports = import_memory_run(o.text("--import-corpus"));
   }
   FitCost fits;
   if (!o.text("--bundle").empty() && !o.text("--avatar").empty()) {
@@ -277,10 +285,11 @@ int run_bench_reliability(const Args& args) {
   out.raw("reliability.recording_bytes_per_frame_in_memory",
           figure(memory.heap_bytes_per_frame, "bytes/frame", "64", "lower", how + memory_text));
   if (bundles.bundles > 0) {
-    char bundle_text[700];
+    char bundle_text[1024];
     std::snprintf(bundle_text, sizeof bundle_text,
-                  "%d copies of %s, each grown by one Range, Tile, ConstantOfShape, Expand, Resize or Shape-derived "
-                  "ConstantOfShape of constant inputs sized just under, just over and 64 times over a %ld MiB budget, "
+                  "%d copies of %s, each grown by one fragment of constant inputs (a ConstantOfShape, an Expand, a "
+                  "ConstantOfShape of a shape made by a Mul, a Gather or a Shape and Concat, a self-Concat, a MatMul "
+                  "outer product) sized just under, just over and 64 times over a %ld MiB budget, "
                   "loaded in a child process each (%d loaded, %d refused) after the unchanged bundle warmed ONNX "
                   "Runtime up; the worst peak RSS increase while loading (VmHWM, reset before, over VmRSS before) "
                   "over the budget: %s",
@@ -292,6 +301,15 @@ int run_bench_reliability(const Args& args) {
             figure(double(bundles.runtime_start_bytes) / double(1 << 20), "MiB", "null", "lower",
                    how + "the peak RSS increase of the first Model::load of " + o.text("--bundle") +
                        " in a fresh process: ONNX Runtime's start, once a process, outside the memory budget"));
+  }
+  if (imports.avatars > 0) {
+    char import_text[600];
+    std::snprintf(import_text, sizeof import_text,
+                  "the %d avatars of %s that softdeca fit reads (%d read, %d refused), each read in a child "
+                  "process; the worst peak RSS increase while reading (VmHWM, reset before, over VmRSS before) "
+                  "over the input's bytes + 125 MB, so that 4 is the bound 4 x the input + 500 MB: %s",
+                  imports.avatars, o.text("--import-corpus").c_str(), imports.read, imports.refused, imports.worst.c_str());
+    out.raw("reliability.import_peak_rss_over_input", figure(imports.worst_ratio, "ratio", "4", "lower", how + import_text));
   }
   if (fits.vertices > 0) {
     char fit_text[900];

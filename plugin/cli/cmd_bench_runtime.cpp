@@ -8,10 +8,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include "imported_avatar.h"
 #include "bench_figures.h"
@@ -400,6 +402,75 @@ void measure_own_avatar(Bench& bench, const std::string& path) {
   std::fprintf(stderr, "own avatar: fit %.2f s, load %.1f ms, frame %.3f ms (template %.3f ms)\n", median(fit_s), median(load_ms),
                median(own_ms), median(plain_ms));
 }
+
+// Frames of `a` and of `b` alternating on the same take (1 thread): per-frame medians of each,
+// measured under the same conditions (cache, clock, other processes) so their ratio holds.
+std::pair<double, double> alternating_ms(const Bench& bench, const std::function<void(std::size_t)>& a,
+                                         const std::function<void(std::size_t)>& b) {
+  std::vector<double> a_ms, b_ms;
+  for (std::size_t i = 0; i < bench.warmup + bench.frames; ++i) {
+    const std::size_t f = i % bench.frames;
+    const Times x = median_ms(1, 0, [&](std::size_t) { a(f); });
+    const Times y = median_ms(1, 0, [&](std::size_t) { b(f); });
+    if (i >= bench.warmup) a_ms.push_back(x.wall), b_ms.push_back(y.wall);
+  }
+  return {median(a_ms), median(b_ms)};
+}
+
+// The path users run: the shipped (trained) bundle, on the template and on a fitted avatar,
+// each against its own linear blend with frames alternating, and SparseSoftDECA (1 thread).
+void measure_shipped(Bench& bench, const std::string& bundle_path, const std::string& own_path) {
+  Model shipped(bundle_path);
+  const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
+  Avatar head(shipped, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  check(softdeca_avatar_prepare(head.handle), "prepare");
+  if (!bench.user.empty())
+    check(softdeca_avatar_calibrate_landmarks(head.handle, bench.user.neutral.vertices.data(), bench.user.neutral.vertex_count()),
+          "calibration");
+  softdeca_output* out = &bench.output;
+  const auto [softdeca, linear] = alternating_ms(
+      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(head.handle, w(f), 52, out), "softdeca"); },
+      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); });
+  const Frames& input = bench.input;
+  const auto [sparse, linear_again] = alternating_ms(
+      bench,
+      [&](std::size_t f) { check(softdeca_avatar_evaluate_landmarks(head.handle, input.points[f].data(), input.point_count, out), "sparse"); },
+      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); });
+  const std::string how = "; the shipped bundle " + bundle_path + ", the template head, dynamics off, with normals, frames "
+                          "alternating with the linear blend of the same avatar, wall-clock; 1 thread; " + bench.how;
+  bench.figures.raw("runtime.shipped_softdeca_ms", figure(softdeca, "ms", "evaluate_weights" + how));
+  bench.figures.raw("runtime.shipped_linear_ms", figure(linear, "ms", "evaluate_linear" + how));
+  bench.figures.raw("runtime.shipped_softdeca_over_linear",
+                    figure(softdeca / linear, "x", "shipped_softdeca_ms / shipped_linear_ms" + how, 1.5));
+  bench.figures.raw("runtime.sparse_shipped_ms", figure(sparse, "ms", "evaluate_landmarks" + how));
+  bench.figures.raw("runtime.sparse_shipped_over_linear",
+                    figure(sparse / linear_again, "x", "sparse_shipped_ms over the linear blend's frames between them" + how));
+  std::fprintf(stderr, "shipped bundle, template: softdeca %.3f ms, linear %.3f ms (x%.2f); sparse %.3f ms\n", softdeca, linear,
+               softdeca / linear, sparse);
+  if (own_path.empty()) return;
+  const AvatarFile file = read_avatar_file(own_path);
+  const softdeca_avatar_mesh mesh = file.abi_mesh();
+  softdeca_fit_options options{};
+  options.struct_size = sizeof options;
+  check(softdeca_fit_options_init(&options), "fit options");
+  const Fit fit(shipped, mesh, options);
+  Avatar own(shipped, fit, mesh, 1, SOFTDECA_PRECISION_HALF);
+  check(softdeca_avatar_prepare(own.handle), "prepare");
+  const auto n = static_cast<uint32_t>(file.vertex_count());
+  std::vector<float> vertices(3 * n), normals(3 * n);
+  softdeca_output own_out{sizeof(softdeca_output), vertices.data(), n, normals.data(), n};
+  const auto [own_softdeca, own_linear] = alternating_ms(
+      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(own.handle, w(f), 52, &own_out), "softdeca"); },
+      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(own.handle, w(f), 52, &own_out), "linear"); });
+  const std::string own_how = "; the shipped bundle " + bundle_path + " fitted to " + own_path + " (" + std::to_string(n) +
+                              " vertices), dynamics off, with normals, frames alternating with the avatar's own linear blend, "
+                              "wall-clock; 1 thread; " + bench.how;
+  bench.figures.raw("runtime.shipped_softdeca_fitted_ms", figure(own_softdeca, "ms", "evaluate_weights" + own_how));
+  bench.figures.raw("runtime.shipped_softdeca_over_linear_fitted",
+                    figure(own_softdeca / own_linear, "x", "shipped_softdeca_fitted_ms over the avatar's evaluate_linear" + own_how, 1.6));
+  std::fprintf(stderr, "shipped bundle, fitted avatar: softdeca %.3f ms, linear %.3f ms (x%.2f)\n", own_softdeca, own_linear,
+               own_softdeca / own_linear);
+}
 }  // namespace
 
 int run_bench_runtime(const Args& args) {
@@ -412,6 +483,7 @@ int run_bench_runtime(const Args& args) {
       .option("--prepares", "N", "prepares measured", "5")
       .option("--out", "FILE", "benchmark JSON", "build/bench/runtime.json")
       .option("--own-avatar", "MESH", "a user's avatar (glTF, FBX or avatar folder) to fit and run against the template path")
+      .option("--shipped-bundle", "DIR", "a trained bundle to time as users run it (the template, and --own-avatar fitted)")
       .option("--how", "TEXT", "the command line to record in the figures", "softdeca bench-runtime");
   if (!o.parse(args)) return 0;
   require_model_inputs(o);
@@ -419,7 +491,7 @@ int run_bench_runtime(const Args& args) {
   const Take take = read_take(o.text("--take"), static_cast<std::size_t>(o.integer("--frames")));
   const std::size_t frames = take.weights.size();
   const FaceRig rig = read_rig(o.text("--avatar"));
-  const FaceRig user = read_rig(o.text("--avatar") + "/user_face", true);
+  const FaceRig user = read_rig(o.text("--avatar"), "user_face", true);
   Model model(o.text("--bundle"));
   const uint32_t vh = model.info.head_vertex_count;
   Bench bench{take, rig, user, model, frames, static_cast<std::size_t>(o.integer("--warmup")), o.integer("--prepares"),
@@ -441,6 +513,7 @@ int run_bench_runtime(const Args& args) {
   measure_storage_error(bench);
   measure_rest_physics(bench);
   if (o.given("--own-avatar")) measure_own_avatar(bench, o.text("--own-avatar"));
+  if (o.given("--shipped-bundle")) measure_shipped(bench, o.text("--shipped-bundle"), o.given("--own-avatar") ? o.text("--own-avatar") : "");
 
   const std::string path = o.text("--out");
   const std::size_t slash = path.rfind('/');

@@ -1,20 +1,22 @@
 // softdeca fit: fits a user's own ARKit-rigged avatar (glTF, FBX or an avatar folder, any
 // topology) to a bundle's template once, through the C ABI (softdeca_avatar_fit_create), and
 // writes the fit folder `softdeca replay --avatar DIR` and Unity read (fit_folder.h): the fit,
-// its report with what the file gave, and a picture of the template on the avatar.
+// its report with what the file gave, and a picture of the template on the avatar. A fit the
+// library judges poor (its report's "quality") is refused unless --keep-poor-fit is given.
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
 
 #include "imported_avatar.h"
+#include "avatar_view.h"
+#include "bundle/json.h"
 #include "command.h"
-#include "fit/avatar_frame.h"
 #include "fit_folder.h"
 #include "fit_options_arg.h"
 #include "fit_picture.h"
-#include "json.h"
 #include "options.h"
 #include "runtime_session.h"
+#include "staged_folder.h"
 
 namespace softdeca::cli {
 
@@ -32,30 +34,48 @@ void describe(const AvatarFile& a) {
 
 // The picture's axes: the subject's frame as the library reads it off the avatar's shapes.
 PictureAxes picture_axes(const AvatarFile& a) {
-  fit::AvatarShapes shapes;
-  shapes.neutral = a.neutral.data();
-  shapes.vertex_count = a.vertex_count();
-  for (std::size_t k = 0; k < 52; ++k)
-    shapes.deltas[k] = a.shape_sources[k].empty() ? nullptr : a.blendshapes.data() + 3 * k * a.vertex_count();
-  shapes.triangles = a.triangles.data();
-  shapes.triangle_count = a.triangles.size() / 3;
-  const fit::AvatarFrame frame = fit::avatar_frame(shapes);
+  const AvatarView view = avatar_view(a, 1.0);
   PictureAxes axes{};
   for (int k = 0; k < 3; ++k) {
-    axes.left[k] = frame.left[k];
-    axes.up[k] = frame.up[k];
-    axes.forward[k] = frame.forward[k];
+    axes.left[k] = view.left[k];
+    axes.up[k] = view.up[k];
+    axes.forward[k] = view.forward[k];
   }
   return axes;
 }
 
-void draw(const std::string& path, const Model& model, const Fit& fit, const AvatarFile& a) {
+// fit.png's bytes: the registered template on the avatar.
+std::string draw(const Model& model, const Fit& fit, const AvatarFile& a) {
   const std::vector<float> registered = fit.registered(model);
   std::vector<std::int32_t> skin(3 * std::size_t{model.info.skin_triangle_count});
   check(softdeca_model_get_skin_triangles(model.handle, skin.data(), model.info.skin_triangle_count), "skin triangles");
   const PictureMesh avatar{a.neutral.data(), a.vertex_count(), a.triangles.data(), a.triangles.size() / 3};
   const PictureMesh templ{registered.data(), model.info.skin_vertex_count, skin.data(), model.info.skin_triangle_count};
-  write_fit_picture(path, avatar, templ, picture_axes(a));
+  return fit_picture_png(avatar, templ, picture_axes(a));
+}
+
+// The library's verdict on the fit, its measures printed on stderr.
+struct Verdict {
+  bool passed = true;
+  std::string measure, reason;
+};
+
+Verdict read_verdict(const std::string& report) {
+  const runtime::Json r = runtime::Json::parse(report);
+  const runtime::Json& q = r.at("quality", "the fit's report");
+  const auto number = [&](const char* name) { return r.at(name, "the fit's report").number(name); };
+  char scale[32] = "not measured";
+  if (!r.at("template_scale", "the fit's report").is_null()) std::snprintf(scale, sizeof scale, "%.2f", number("template_scale"));
+  std::fprintf(stderr,
+               "the template covers %.0f %% of the face (within %g mm); the face lies %.2f mm (median) and %.2f mm (90th "
+               "percentile) from it; template face size / avatar's: %s\n",
+               100 * number("face_coverage"), q.at("bounds", "quality").at("covered_mm", "bounds").number("covered_mm"),
+               number("avatar_to_template_mm_median"), number("avatar_to_template_mm_p90"), scale);
+  Verdict v;
+  v.passed = q.at("passed", "quality").boolean("quality.passed");
+  v.measure = q.at("failed_measure", "quality").string("quality.failed_measure");
+  v.reason = q.at("reason", "quality").string("quality.reason");
+  return v;
 }
 }  // namespace
 
@@ -70,7 +90,9 @@ int run_fit(const Args& args) {
                    "rig names, the names not used) and DIR/fit.png (front and side views: the template in colour on the\n"
                    "avatar). Then: softdeca replay TAKE --bundle B --avatar DIR.");
   o.positional("MESH", "the avatar: .gltf, .glb, .vrm, .fbx, or an avatar folder");
-  o.option("--bundle", "DIR", "model bundle folder or .tar (with the template head)").option("--out", "DIR", "the fit folder to write");
+  o.option("--bundle", "DIR", "model bundle folder or .tar (with the template head)")
+      .option("--out", "DIR", "the fit folder to write (new, or an earlier fit folder: replaced whole)");
+  o.flag("--keep-poor-fit", "write a fit that fails the library's quality bounds (docs/avatars.md) anyway, marked poor in fit.json");
   declare_fit_options(o);
   if (!o.parse(args)) return 0;
   if (!o.given("--bundle")) throw UsageError("--bundle is required");
@@ -87,12 +109,22 @@ int run_fit(const Args& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const Fit fit(model, avatar.abi_mesh(), options);
   std::fprintf(stderr, "fitted in %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  const std::string report = fit.report();
+  const Verdict verdict = read_verdict(report);
+  if (!verdict.passed) {
+    if (!o.on("--keep-poor-fit"))
+      throw std::runtime_error("the fit is poor (" + verdict.measure + "): " + verdict.reason +
+                               " Nothing was written; --keep-poor-fit writes it anyway, marked poor in fit.json.");
+    std::fprintf(stderr, "keeping a poor fit (%s): %s\n", verdict.measure.c_str(), verdict.reason.c_str());
+  }
 
-  make_directories(out);
-  fit.save(fit_file(out));
-  write_text_file(out + "/fit.json", fit_json(avatar, out, fit.report()));
+  // Written whole beside DIR and renamed into place: DIR is the previous fit folder or this one.
+  StagedFolder folder(out, fit_folder_files());
+  fit.save(fit_file(folder.path()));
+  folder.write("fit.json", fit_json(avatar, out, report, !verdict.passed));
   std::fprintf(stderr, "drawing %s/fit.png\n", out.c_str());
-  draw(out + "/fit.png", model, fit, avatar);
+  folder.write("fit.png", draw(model, fit, avatar));
+  folder.commit();
   std::printf("wrote %s/avatar.fit, %s/fit.json and %s/fit.png\n", out.c_str(), out.c_str(), out.c_str());
   return 0;
 }

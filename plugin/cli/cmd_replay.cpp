@@ -14,11 +14,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "avatar_view.h"
 #include "command.h"
 #include "fit_options_arg.h"
 #include "json.h"
 #include "mesh_io.h"
 #include "options.h"
+#include "read_limits_arg.h"
 #include "replay_avatar.h"
 #include "runtime_session.h"
 #include "take.h"
@@ -152,9 +154,9 @@ unsigned precision_of(const std::string& p) {
 }
 
 // The take's frames from --start, at most --frames of them.
-Take read_replay_take(const std::string& path, long start, long max_frames) {
+Take read_replay_take(const std::string& path, long start, long max_frames, const recording::ReadLimits& limits) {
   if (start < 0 || max_frames < 0) throw UsageError("--start and --frames must not be negative");
-  Take take = read_take(path, max_frames ? static_cast<std::size_t>(start + max_frames) : 0);
+  Take take = read_take(path, max_frames ? static_cast<std::size_t>(start + max_frames) : 0, limits);
   if (static_cast<std::size_t>(start) >= take.weights.size())
     throw UsageError("--start " + std::to_string(start) + " is past the take's " + std::to_string(take.weights.size()) + " frames");
   take.weights.erase(take.weights.begin(), take.weights.begin() + start);
@@ -264,6 +266,8 @@ std::string avatar_json(const ReplayAvatar& a) {
     std::string parts = "[";
     for (const AvatarPart& p : a.mesh->parts) parts += (parts.size() > 1 ? "," : "") + json_string(p.name);
     o.text("mesh", a.mesh->path).raw("parts", parts + "]");
+    // How a preview shows it: each part's coordinates to metres in the subject's frame.
+    o.raw("view", view_json(*a.mesh, avatar_view(*a.mesh, fit_metres_per_unit(a.fit->report()))));
   }
   if (a.landmarks) o.number("landmarks_max_distance_from_surface", a.landmarks->max_distance());
   return o.str();
@@ -295,6 +299,7 @@ int run_replay(const Args& args) {
       .option("--obj-every", "N", "also write every Nth frame as OBJ (0: none)", "0")
       .flag("--dynamics", "enable the second-order dynamics");
   declare_fit_options(o);  // for an avatar fitted now
+  declare_read_limits(o);
   if (!o.parse(args)) return 0;
   require_model_inputs(o);
   const std::string out = o.text("--out");
@@ -302,7 +307,7 @@ int run_replay(const Args& args) {
   const unsigned threads = static_cast<unsigned>(o.integer("--threads"));
   const unsigned precision = precision_of(o.text("--precision"));
   const long start = o.integer("--start");
-  const Take take = read_replay_take(o.arg(0), start, o.integer("--frames"));
+  const Take take = read_replay_take(o.arg(0), start, o.integer("--frames"), read_limits(o));
   const std::vector<std::string> models = models_to_run(o.text("--models"), o.given("--localised"));
   const std::string avatar_path = o.text("--avatar");
 

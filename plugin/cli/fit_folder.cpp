@@ -113,6 +113,8 @@ std::string locate_mesh(const std::string& dir, const std::string& recorded, con
 }
 }  // namespace
 
+std::vector<std::string> fit_folder_files() { return {"avatar.fit", "fit.json", "fit.png"}; }
+
 bool is_fit_folder(const std::string& dir) {
   std::error_code error;
   return fs::is_directory(dir, error) && fs::is_regular_file(fit_file(dir), error);
@@ -120,9 +122,10 @@ bool is_fit_folder(const std::string& dir) {
 
 std::string fit_file(const std::string& dir) { return (fs::path(dir) / "avatar.fit").string(); }
 
-std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std::string& library_report) {
+std::string fit_json(const AvatarFile& avatar, const std::string& dir, const std::string& library_report, bool poor) {
   JsonObject o;
-  o.raw("source", source_json(avatar, dir))
+  o.raw("poor_fit", poor ? "true" : "false")
+      .raw("source", source_json(avatar, dir))
       .number("vertices", static_cast<double>(avatar.vertex_count()))
       .number("triangles", static_cast<double>(avatar.triangles.size() / 3))
       .raw("parts", parts_json(avatar))

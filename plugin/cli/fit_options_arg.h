@@ -2,6 +2,7 @@
 // the spot): the rig-name mapping file and the fit's own options.
 #pragma once
 
+#include "fit/limits.h"
 #include "imported_avatar.h"
 #include "options.h"
 #include "runtime_session.h"
@@ -11,7 +12,7 @@ namespace softdeca::cli {
 inline void declare_fit_options(Options& o) {
   o.option("--names", "FILE", "lines 'rigName<TAB>arkitName' or 'rigName=arkitName' ('none' leaves a shape out); "
                               "the names listed override the rule")
-      .option("--metres-per-unit", "X", "the mesh's unit in metres (0: read off the shapes)", "0")
+      .option("--metres-per-unit", "X", "the mesh's unit in metres, 1e-6 to 1000 (0: read off the shapes)", "0")
       .option("--iterations", "N", "registration iterations (0: the library's default)", "0");
 }
 
@@ -22,7 +23,11 @@ inline ShapeNames shape_names(const Options& o) {
 inline softdeca_fit_options fit_options(const Options& o) {
   const double metres_per_unit = o.number("--metres-per-unit");
   const long iterations = o.integer("--iterations");
-  if (metres_per_unit < 0 || iterations < 0) throw UsageError("--metres-per-unit and --iterations must not be negative");
+  if (iterations < 0) throw UsageError("--iterations must not be negative");
+  // The range a saved fit's unit is read back in: a fit made with any other unit would not load.
+  if (metres_per_unit != 0 && !(metres_per_unit >= fit::kMinMetresPerUnit && metres_per_unit <= fit::kMaxMetresPerUnit))
+    throw UsageError("--metres-per-unit must be 0 (read off the shapes) or " + fit::metres_per_unit_range() +
+                     " (metres), not " + o.text("--metres-per-unit"));
   softdeca_fit_options options{};
   options.struct_size = sizeof options;
   check(softdeca_fit_options_init(&options), "fit options");

@@ -150,9 +150,9 @@ Picture draw_fit(const PictureMesh& avatar, const PictureMesh& registered, const
   return picture;
 }
 
-void write_fit_picture(const std::string& path, const PictureMesh& avatar, const PictureMesh& registered, const PictureAxes& axes) {
+std::string fit_picture_png(const PictureMesh& avatar, const PictureMesh& registered, const PictureAxes& axes) {
   const Picture p = draw_fit(avatar, registered, axes);
-  write_png(path, p.rgb.data(), p.width, p.height);
+  return encode_png(p.rgb.data(), p.width, p.height);
 }
 
 }  // namespace softdeca::cli

@@ -31,7 +31,7 @@ struct Picture {
 // Throws std::invalid_argument when an axis is zero or not finite, or the template is empty.
 Picture draw_fit(const PictureMesh& avatar, const PictureMesh& registered, const PictureAxes& axes,
                  std::size_t view_pixels = 480);
-void write_fit_picture(const std::string& path, const PictureMesh& avatar, const PictureMesh& registered,
-                       const PictureAxes& axes);
+// fit.png's bytes: draw_fit's picture as a PNG file.
+std::string fit_picture_png(const PictureMesh& avatar, const PictureMesh& registered, const PictureAxes& axes);
 
 }  // namespace softdeca::cli

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
+#include <stdexcept>
 #include <string>
 
 #include "command.h"
@@ -34,6 +36,18 @@ int main(int argc, char** argv) {
     } catch (const softdeca::cli::UsageError& e) {
       std::fprintf(stderr, "softdeca %s: %s\n", c.name, e.what());
       return 2;
+    } catch (const std::bad_alloc&) {
+      // Every reader bounds what it allocates; what is left is a machine with less memory than
+      // an input within those bounds needs.
+      std::fprintf(stderr, "softdeca %s: error: not enough memory for this input (docs/security.md lists the sizes each "
+                           "input may have)\n", c.name);
+      return 1;
+    } catch (const std::logic_error&) {
+      // A standard library check (an index, a length) caught what no check of ours named: the
+      // input is malformed in a way this version does not describe.
+      std::fprintf(stderr, "softdeca %s: error: the input is malformed in a way this version cannot describe (an "
+                           "internal check failed: please report it with the file)\n", c.name);
+      return 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "softdeca %s: error: %s\n", c.name, e.what());
       return 1;

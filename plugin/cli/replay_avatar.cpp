@@ -11,7 +11,7 @@ namespace softdeca::cli {
 namespace {
 bool template_topology(const Model& model, const std::string& path) {
   if (is_fit_folder(path) || !file_exists(path + "/neutral.obj")) return false;
-  return read_obj(path + "/neutral.obj").vertex_count() == model.info.head_vertex_count;
+  return read_avatar_obj(path, "neutral.obj").vertex_count() == model.info.head_vertex_count;
 }
 
 void open_template(const Model& model, const std::string& path, unsigned threads, unsigned precision, ReplayAvatar& a) {
@@ -61,8 +61,8 @@ ReplayAvatar open_replay_avatar(const Model& model, const std::string& path, con
   ReplayAvatar a;
   if (template_topology(model, path)) open_template(model, path, threads, precision, a);
   else open_fitted(model, path, names, options, threads, precision, a);
-  a.user = read_rig(path + "/user_face", true);
-  if (a.user.empty() && a.kind == "fit folder") a.user = read_rig(a.mesh->path + "/user_face", true);  // beside the fitted mesh
+  a.user = read_rig(path, "user_face", true);
+  if (a.user.empty() && a.kind == "fit folder") a.user = read_rig(a.mesh->path, "user_face", true);  // beside the fitted mesh
   if (!a.user.empty()) {
     a.calibration = a.user.neutral.vertices;
   } else if (a.landmarks) {

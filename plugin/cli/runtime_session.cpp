@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "input_files.h"
 #include "stream/arkit_names.h"
 
 namespace softdeca::cli {
@@ -110,17 +111,24 @@ void make_directories(const std::string& path) {
   }
 }
 
-FaceRig read_rig(const std::string& dir, bool optional) {
+ObjMesh read_avatar_obj(const std::string& dir, const std::string& relative) {
+  const avatar_import::InputFolder folder(dir);
+  return avatar_import::parse_obj(folder.read(relative, avatar_import::ImportLimits{}.max_file_bytes, "an OBJ file"),
+                                  dir + "/" + relative);
+}
+
+FaceRig read_rig(const std::string& dir, const std::string& sub, bool optional) {
   FaceRig rig;
-  if (optional && !file_exists(dir + "/neutral.obj")) return rig;
-  rig.neutral = read_obj(dir + "/neutral.obj");
+  const std::string at = sub.empty() ? "" : sub + "/";
+  if (optional && !file_exists(dir + "/" + at + "neutral.obj")) return rig;
+  rig.neutral = read_avatar_obj(dir, at + "neutral.obj");
   const std::size_t n = rig.neutral.vertices.size();
   rig.deltas.assign(52 * n, 0.0f);
   for (std::size_t s = 0; s < 52; ++s) {
-    const std::string path = dir + "/blendshapes/" + stream::blendshape_name(s) + ".obj";
-    if (!file_exists(path)) continue;
-    const ObjMesh shape = read_obj(path);
-    if (shape.vertices.size() != n) throw std::runtime_error(path + ": vertex count differs from the neutral");
+    const std::string relative = at + "blendshapes/" + stream::blendshape_name(s) + ".obj";
+    if (!file_exists(dir + "/" + relative)) continue;
+    const ObjMesh shape = read_avatar_obj(dir, relative);
+    if (shape.vertices.size() != n) throw std::runtime_error(dir + "/" + relative + ": vertex count differs from the neutral");
     for (std::size_t i = 0; i < n; ++i) rig.deltas[s * n + i] = shape.vertices[i] - rig.neutral.vertices[i];
     ++rig.present;
   }

@@ -60,9 +60,14 @@ struct FaceRig {  // a neutral mesh and 52 blendshape deltas
   void blend(const float* weights, float* out) const;
 };
 
-// Reads <dir>/neutral.obj and <dir>/blendshapes/*.obj; with `optional`, a missing folder gives
-// an empty rig instead of an error.
-FaceRig read_rig(const std::string& dir, bool optional = false);
+// Reads <dir>/<sub>/neutral.obj and <dir>/<sub>/blendshapes/*.obj (`sub` "" or a folder such as
+// "user_face"); with `optional`, a missing neutral.obj gives an empty rig instead of an error.
+// Read through the avatar's folder (read_avatar_obj).
+FaceRig read_rig(const std::string& dir, const std::string& sub = "", bool optional = false);
+
+// <dir>/<relative> read through the folder (input_files.h): no link below `dir` is followed and
+// no FIFO opened; refusals name the file and why.
+ObjMesh read_avatar_obj(const std::string& dir, const std::string& relative);
 
 bool file_exists(const std::string& path);
 

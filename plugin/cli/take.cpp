@@ -10,13 +10,13 @@
 
 namespace softdeca::cli {
 
-Take read_take(const std::string& path, std::size_t max_frames) {
+Take read_take(const std::string& path, std::size_t max_frames, const recording::ReadLimits& limits) {
   Take take;
   take.path = path;
   std::vector<stream::Frame> frames;
   const bool csv = path.size() >= 4 && path.compare(path.size() - 4, 4, ".csv") == 0;
   if (csv) {
-    recording::CsvTake t = recording::read_livelinkface_csv(path, recording::kLiveLinkFaceTimecodeRate);
+    recording::CsvTake t = recording::read_livelinkface_csv(path, recording::kLiveLinkFaceTimecodeRate, limits);
     take.rows = t.rows;
     take.face_lost = t.face_lost_rows;
     take.invalid = t.malformed_rows;
@@ -26,7 +26,7 @@ Take read_take(const std::string& path, std::size_t max_frames) {
   // A recording's frames are decoded one at a time from its index (recording_index.h).
   std::unique_ptr<recording::RecordingIndex> index;
   if (!csv) {
-    index = std::make_unique<recording::RecordingIndex>(recording::RecordingIndex::open(path));
+    index = std::make_unique<recording::RecordingIndex>(recording::RecordingIndex::open(path, limits));
     const recording::Recovery& r = index->meta().recovery;
     take.rows = index->frame_count() + r.invalid_frames;
     take.invalid = r.invalid_frames;

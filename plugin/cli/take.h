@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "recording/read_limits.h"
+
 namespace softdeca::cli {
 
 struct Take {
@@ -19,8 +21,9 @@ struct Take {
   double median_frame_s = 0;  // median time between kept frames
 };
 
-// `.csv`: Live Link Face; anything else: a recording. At most `max_frames` frames (0: all).
-// Throws std::runtime_error or softdeca::Error naming the problem.
-Take read_take(const std::string& path, std::size_t max_frames = 0);
+// `.csv`: Live Link Face; anything else: a recording. At most `max_frames` frames (0: all); a
+// file over `limits` is refused before it is read. Throws std::runtime_error or softdeca::Error
+// naming the problem.
+Take read_take(const std::string& path, std::size_t max_frames = 0, const recording::ReadLimits& limits = {});
 
 }  // namespace softdeca::cli

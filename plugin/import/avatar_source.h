@@ -21,7 +21,7 @@ struct SourceShape {
 };
 
 struct SourceMesh {
-  std::string name;  // the node's name, else the mesh's
+  std::string name;  // the node's name, else the mesh's (glTF: else the nearest named ancestor's)
   std::vector<float> vertices;          // local coordinates, the file's vertex order
   std::vector<std::int32_t> triangles;  // points and lines dropped
   std::vector<SourceShape> shapes;
@@ -37,16 +37,19 @@ struct SourceScene {
   std::vector<SourceMesh> meshes;
 };
 
-// glTF 2.0 (.gltf, .glb, .vrm) and FBX through assimp, triangulated only (each mesh keeps its
-// vertex order; FBX's per-corner vertices are welded back, avatar_weld.h). Throws
-// std::runtime_error naming the file, and the mesh where one is at fault.
+// glTF 2.0 (.gltf, .glb, .vrm: gltf_reader.h) or FBX (read_fbx_file), by the file's extension.
+// Throws std::runtime_error naming the file, and the mesh or the place in the file at fault.
 SourceScene read_scene_file(const std::string& path, const ImportLimits& limits);
+
+// FBX through assimp, triangulated only (each mesh keeps its vertex order; the per-corner
+// vertices assimp makes are welded back, avatar_weld.h).
+SourceScene read_fbx_file(const std::string& path, const ImportLimits& limits);
 
 // An avatar folder (avatar_file.h): neutral.obj and the shapes of blendshapes/ that `names`
 // chooses (choose_shapes), one mesh; the other shape files are listed by name, unread.
 SourceScene read_avatar_folder(const std::string& dir, const ShapeNames& names, const ImportLimits& limits);
 
-// False when this build has no assimp: read_scene_file then throws, saying so.
-bool scene_files_supported();
+// False when this build has no assimp: FBX files are then refused, saying so.
+bool fbx_files_supported();
 
 }  // namespace softdeca::avatar_import

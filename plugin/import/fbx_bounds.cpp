@@ -1,6 +1,8 @@
 #include "fbx_bounds.h"
 
+#if SOFTDECA_HAVE_ZLIB
 #include <zlib.h>
+#endif
 
 #include <cstdio>
 #include <algorithm>
@@ -29,43 +31,53 @@ std::string size_text(std::uint64_t bytes) {
   return text;
 }
 
-// The error messages: "<path>: <what>".
+// The error messages: "<path>: <what>"; a structure that is not FBX's, "<path>: not a readable
+// FBX file: <what>".
 struct Refuse {
   const std::string& path;
   [[noreturn]] void operator()(const std::string& what) const { throw std::runtime_error(path + ": " + what); }
+  [[noreturn]] void broken(const std::string& what) const { operator()("not a readable FBX file: " + what); }
 };
 
-// What all the file's values and arrays cost the reader, against the one bound.
+// "the 1 GiB an avatar may decode", or the file's own budget when it is the smaller.
+std::string budget_text(std::uint64_t budget, std::uint64_t file_bytes, const ImportLimits& limits, const char* what) {
+  if (budget >= limits.max_decoded_bytes) return "the " + size_text(budget) + " an avatar may decode";
+  return "the " + size_text(budget) + " a file of " + size_text(file_bytes) + " may " + what;
+}
+
+// What all the file's tokens and arrays cost the reader, against its budgets.
 struct Budget {
   const ImportLimits& limits;
   const Refuse& refuse;
+  std::uint64_t file_bytes = 0;
+  std::uint64_t decoded_budget = fbx_decoded_budget(file_bytes, limits), token_budget = fbx_token_budget(file_bytes, limits);
   std::uint64_t values = 0, decoded = 0;
 
   void add_values(std::uint64_t n, const char* kind) {
     values += n;
-    if (values > limits.max_decoded_bytes / kFbxBytesPerValue)
-      refuse(std::string(kind) + " FBX of more than " + std::to_string(values) +
-             " values: reading them would take more than the " + size_text(limits.max_decoded_bytes) +
-             " an avatar may decode (about " + std::to_string(kFbxBytesPerValue) + " bytes each)");
+    if (values > token_budget / kFbxBytesPerToken)
+      refuse(std::string(kind) + " FBX of more than " + std::to_string(values) + " values: the reader would hold more than " +
+             budget_text(token_budget, file_bytes, limits, "hold") + " (about " + std::to_string(kFbxBytesPerToken) +
+             " bytes a value)");
   }
   // `where` (a callable) names the array, only when it is refused.
   template <class Where>
   void add_array(std::uint64_t bytes, const Where& where) {
-    if (bytes > limits.max_decoded_bytes)
-      refuse(where() + ": an array that would expand to " + size_text(bytes) + ", more than the " +
-             size_text(limits.max_decoded_bytes) + " an avatar may decode");
+    if (bytes > decoded_budget)
+      refuse(where() + ": an array that would expand to " + size_text(bytes) + ", more than " +
+             budget_text(decoded_budget, file_bytes, limits, "expand to"));
     decoded += bytes;
-    if (decoded > limits.max_decoded_bytes)
-      refuse("its arrays would expand to more than the " + size_text(limits.max_decoded_bytes) +
-             " an avatar may decode (" + size_text(decoded) + " by " + where() + ")");
+    if (decoded > decoded_budget)
+      refuse("its arrays would expand to more than " + budget_text(decoded_budget, file_bytes, limits, "expand to") + " (" +
+             size_text(decoded) + " by " + where() + ")");
   }
 };
 
 // ---- the objects and their connections ------------------------------------------------------
 
-// What assimp makes of the objects once it has parsed them, bounded before it does: scene
-// nodes of the Model objects by recursion from the root (id 0), once per path (a chain of
-// 10,000 overflows its stack, a ladder of 30 pairs makes a billion nodes); and per blend shape
+// What assimp makes of the objects once it has parsed them, bounded before it does: it follows
+// connections by recursion (a chain of 10,000 bones overflows its stack), makes a scene node of
+// a Model once per path from the root (a ladder of 30 pairs makes a billion); and per blend shape
 // of a mesh, a copy of the mesh's per-corner vertices and normals (a thousand tiny shapes on a
 // mesh of ten million corners make a quarter of a terabyte).
 struct SceneGraph {
@@ -91,49 +103,53 @@ std::string object_name(const std::string& stored) {
   return colons == std::string::npos ? stored : stored.substr(colons + 2);
 }
 
-void check_models(const SceneGraph& g, const Refuse& refuse, const ImportLimits& limits) {
-  std::unordered_map<std::int64_t, std::size_t> index;  // model id -> 1 + its place; 0 the root
-  index.reserve(g.models.size() + 1);
+// The chains of object-object connections: at most max_node_depth long, without a cycle; the
+// Model objects' scene nodes (one per path from the root) at most max_nodes. Returns the
+// longest chain.
+std::size_t check_connections(const SceneGraph& g, const Refuse& refuse, const ImportLimits& limits) {
+  std::unordered_map<std::int64_t, std::size_t> index;  // object id -> its place; the root (0) first
+  index.reserve(2 * g.links.size() + 1);
   index.emplace(0, 0);
-  for (const std::int64_t id : g.models) index.emplace(id, index.size());
+  for (const auto& [child, parent] : g.links) index.emplace(parent, index.size()), index.emplace(child, index.size());
   const std::size_t n = index.size();
+  std::vector<uint8_t> model(n, 0);
+  for (const std::int64_t id : g.models)
+    if (const auto m = index.find(id); m != index.end() && m->second != 0) model[m->second] = 1;
   std::vector<std::vector<std::size_t>> children(n);
+  std::vector<std::size_t> waiting(n, 0);
   for (const auto& [child, parent] : g.links) {
-    const auto c = index.find(child), p = index.find(parent);
-    if (c != index.end() && p != index.end() && c->second != 0) children[p->second].push_back(c->second);
+    const std::size_t c = index[child];
+    children[index[parent]].push_back(c);
+    ++waiting[c];
   }
-  // The models the root reaches, each with how many links lead to it from reached models.
-  std::vector<std::size_t> waiting(n, 0), order{0};
-  std::vector<uint8_t> reached(n, 0);
-  reached[0] = 1;
-  for (std::size_t i = 0; i < order.size(); ++i)
-    for (const std::size_t c : children[order[i]]) {
-      ++waiting[c];
-      if (!reached[c]) reached[c] = 1, order.push_back(c);
-    }
-  // In topological order: the longest chain to each and the paths to it (the nodes made of it).
+  // In topological order: the longest chain to each object, and for models the paths to it
+  // from the root through models (the scene nodes made of it).
   std::vector<std::uint64_t> depth(n, 0), paths(n, 0);
   paths[0] = 1;
-  std::vector<std::size_t> ready{0};
-  std::size_t done = 0;
+  std::vector<std::size_t> ready;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!waiting[i]) ready.push_back(i);
+  std::size_t done = 0, deepest = 0;
   std::uint64_t nodes = 0;
   while (!ready.empty()) {
     const std::size_t m = ready.back();
     ready.pop_back();
     ++done;
     nodes += paths[m];
+    deepest = std::max<std::size_t>(deepest, depth[m]);
     if (nodes > limits.max_nodes)
       refuse("its models make more than " + std::to_string(limits.max_nodes) +
              " scene nodes (a model connected to many parents makes a node for each path to it)");
     if (depth[m] > static_cast<std::uint64_t>(limits.max_node_depth))
-      refuse("its models are nested more than " + std::to_string(limits.max_node_depth) + " deep");
+      refuse("objects connected more than " + std::to_string(limits.max_node_depth) + " deep");
     for (const std::size_t c : children[m]) {
       depth[c] = std::max(depth[c], depth[m] + 1);
-      paths[c] = std::min<std::uint64_t>(paths[c] + paths[m], std::uint64_t{1} << 62);
+      if (model[c]) paths[c] = std::min<std::uint64_t>(paths[c] + paths[m], std::uint64_t{1} << 62);
       if (--waiting[c] == 0) ready.push_back(c);
     }
   }
-  if (done != order.size()) refuse("its models' connections form a loop");
+  if (done != n) refuse("objects connected in a cycle");
+  return deepest;
 }
 
 // Per mesh, the shapes assimp copies it for: each link of a shape to a channel of a blend
@@ -175,9 +191,10 @@ void check_blend_shapes(const SceneGraph& g, const Refuse& refuse, const ImportL
   }
 }
 
-void check_scene_graph(const SceneGraph& g, const Refuse& refuse, const ImportLimits& limits) {
-  check_models(g, refuse, limits);
+std::size_t check_scene_graph(const SceneGraph& g, const Refuse& refuse, const ImportLimits& limits) {
+  const std::size_t depth = check_connections(g, refuse, limits);
   check_blend_shapes(g, refuse, limits);
+  return depth;
 }
 
 // ---- binary FBX ---------------------------------------------------------------------------
@@ -203,6 +220,7 @@ struct Bytes {
   }
 };
 
+#if SOFTDECA_HAVE_ZLIB
 // Decompresses the zlib stream in[0, n) to exactly `size` bytes, handing them to `take` in
 // pieces; false when the stream is damaged, ends early or holds more.
 bool inflate_exactly(const unsigned char* in, std::uint64_t n, std::uint64_t size,
@@ -226,6 +244,13 @@ bool inflate_exactly(const unsigned char* in, std::uint64_t n, std::uint64_t siz
   inflateEnd(&z);
   return status == Z_STREAM_END && total == size;
 }
+#else
+// Without zlib a stream is taken at the size it declares: a build without zlib has no assimp to
+// hand it to either.
+bool inflate_exactly(const unsigned char*, std::uint64_t, std::uint64_t, const std::function<void(const unsigned char*, std::size_t)>&) {
+  return true;
+}
+#endif
 
 // The int32 values of an array's bytes, however they arrive in pieces.
 struct Int32Reader {
@@ -260,17 +285,20 @@ struct Open {
 class BinaryWalk {
  public:
   BinaryWalk(const Bytes& b, const Refuse& refuse, const ImportLimits& limits)
-      : b_(b), refuse_(refuse), limits_(limits), budget_{limits, refuse} {}
+      : b_(b), refuse_(refuse), limits_(limits), budget_{limits, refuse, b.size} {}
 
-  FbxSummary run() {
-    if (b_.size < kBinaryHeader) refuse_("a binary FBX header cut short");
+  FbxScan run() {
+    if (b_.size < kBinaryHeader) refuse_.broken("a binary FBX header cut short");
     const std::uint64_t version = b_.u32(23);
+    FbxScan s;
+    s.binary = true;
+    s.version = static_cast<std::uint32_t>(version);
     wide_ = version >= 7500;
     const std::uint64_t header = wide_ ? 25 : 13;  // of a node record, and the empty record
     std::uint64_t pos = kBinaryHeader;
     for (;;) {
       if (!open_.empty() && pos == open_.back().children_end) {
-        if (pos + header > b_.size || !zeros(pos, header)) refuse_(where() + ": its children do not end with an empty record");
+        if (pos + header > b_.size || !zeros(pos, header)) refuse_.broken(where() + ": its children do not end with an empty record");
         pos += header;
         close();
         continue;
@@ -278,8 +306,8 @@ class BinaryWalk {
       const std::uint64_t limit = open_.empty() ? b_.size : open_.back().children_end;
       if (open_.empty() && pos == b_.size) break;  // the top level ends with the file
       if (pos + header > limit) {
-        if (open_.empty()) refuse_("it ends inside a node record (truncated?)");
-        refuse_(where() + ": a child node runs past the end of its parent");
+        if (open_.empty()) refuse_.broken("it ends inside a node record (truncated?)");
+        refuse_.broken(where() + ": a child node runs past the end of its parent");
       }
       const std::uint64_t end = wide_ ? b_.u64(pos) : b_.u32(pos);
       const std::uint64_t count = wide_ ? b_.u64(pos + 8) : b_.u32(pos + 4);
@@ -287,16 +315,16 @@ class BinaryWalk {
       const std::uint64_t name_length = b_.data[pos + header - 1];
       if (end == 0) {
         if (open_.empty()) break;  // the top level's end; a footer follows
-        refuse_(at(pos) + ": a node without an end");
+        refuse_.broken(at(pos) + ": a node without an end");
       }
-      if (end <= pos || end > limit) refuse_(at(pos) + ": its end lies outside " + (open_.empty() ? "the file" : "its parent"));
+      if (end <= pos || end > limit) refuse_.broken(at(pos) + ": its end lies outside " + (open_.empty() ? "the file" : "its parent"));
       const std::uint64_t name_at = pos + header, first = name_at + name_length;
-      if (first > end) refuse_(at(pos) + ": its name runs past its end");
+      if (first > end) refuse_.broken(at(pos) + ": its name runs past its end");
       Open node;
       node.name.assign(reinterpret_cast<const char*>(b_.data + name_at), name_length);
-      if (length > end - first) refuse_(where(node.name) + ": its properties run past its end");
+      if (length > end - first) refuse_.broken(where(node.name) + ": its properties run past its end");
       const std::uint64_t last = first + length;
-      if (count > length / 2) refuse_(where(node.name) + ": " + std::to_string(count) + " properties in " + std::to_string(length) + " bytes");
+      if (count > length / 2) refuse_.broken(where(node.name) + ": " + std::to_string(count) + " properties in " + std::to_string(length) + " bytes");
       budget_.add_values(1 + 2 * count, "a binary");  // its name, each property and a separator
       const Firsts firsts = properties(node, first, last, count);
       const std::string& kind = firsts.last_string;
@@ -316,17 +344,17 @@ class BinaryWalk {
         finish(node);
         continue;
       }
-      if (end - pos < header) refuse_(where(node.name) + ": its children do not fit before its end");
+      if (end - pos < header) refuse_.broken(where(node.name) + ": its children do not fit before its end");
       if (static_cast<int>(open_.size()) >= limits_.max_fbx_depth)
         refuse_("nested more than " + std::to_string(limits_.max_fbx_depth) + " deep (at byte " + std::to_string(pos) + ")");
       node.children_end = end - header;
       node.end = end;
       open_.push_back(std::move(node));
+      deepest_ = std::max(deepest_, static_cast<int>(open_.size()));
       budget_.add_values(2, "a binary");  // the braces of its children
     }
-    check_scene_graph(graph_, refuse_, limits_);
-    FbxSummary s;
-    s.binary = true;
+    s.connection_depth = check_scene_graph(graph_, refuse_, limits_);
+    s.depth = deepest_;
     s.meshes = meshes_;
     s.values = budget_.values;
     s.decoded_bytes = budget_.decoded;
@@ -366,10 +394,10 @@ class BinaryWalk {
     Firsts firsts;
     std::string& last_string = firsts.last_string;
     for (std::uint64_t i = 0; i < count; ++i) {
-      if (at >= last) refuse_(where(node.name) + ": its properties run past their length");
+      if (at >= last) refuse_.broken(where(node.name) + ": its properties run past their length");
       const char type = static_cast<char>(b_.data[at++]);
       const auto need = [&](std::uint64_t n) {
-        if (n > last - at) refuse_(where(node.name) + ": a property of type '" + std::string(1, type) + "' runs past its node");
+        if (n > last - at) refuse_.broken(where(node.name) + ": a property of type '" + std::string(1, type) + "' runs past its node");
       };
       switch (type) {
         case 'C': need(1), at += 1; break;
@@ -391,19 +419,19 @@ class BinaryWalk {
           break;
         }
         case 'f': case 'd': case 'l': case 'i': case 'b': case 'c': at = array(node, type, at, last); break;
-        default: refuse_(where(node.name) + ": a property of unknown type (byte " + std::to_string(at - 1) + ")");
+        default: refuse_.broken(where(node.name) + ": a property of unknown type (byte " + std::to_string(at - 1) + ")");
       }
     }
-    if (at != last) refuse_(where(node.name) + ": its properties do not fill their declared length");
+    if (at != last) refuse_.broken(where(node.name) + ": its properties do not fill their declared length");
     return firsts;
   }
 
   std::uint64_t array(Open& node, char type, std::uint64_t at, std::uint64_t last) {
     const auto here = [&] { return where(node.name); };
-    if (12 > last - at) refuse_(here() + ": an array's header runs past its node");
+    if (12 > last - at) refuse_.broken(here() + ": an array's header runs past its node");
     const std::uint64_t length = b_.u32(at), encoding = b_.u32(at + 4), stored = b_.u32(at + 8);
     at += 12;
-    if (stored > last - at) refuse_(here() + ": an array's data runs past its node");
+    if (stored > last - at) refuse_.broken(here() + ": an array's data runs past its node");
     const std::uint64_t element = type == 'd' || type == 'l' ? 8 : type == 'f' || type == 'i' ? 4 : 1;
     const std::uint64_t bytes = length * element;  // at most 2^35: no overflow
     budget_.add_array(bytes, here);
@@ -426,13 +454,13 @@ class BinaryWalk {
     }
     if (encoding == 0) {
       if (stored != bytes)
-        refuse_(here() + ": an array of " + std::to_string(length) + " elements that holds " + std::to_string(stored) + " bytes");
+        refuse_.broken(here() + ": an array of " + std::to_string(length) + " elements that holds " + std::to_string(stored) + " bytes");
       if (take) take(b_.data + at, static_cast<std::size_t>(stored));
     } else if (encoding == 1) {
       if (!inflate_exactly(b_.data + at, stored, bytes, take))
-        refuse_(here() + ": an array whose compressed data is damaged or not the " + size_text(bytes) + " it declares");
+        refuse_.broken(here() + ": an array whose compressed data is damaged or not the " + size_text(bytes) + " it declares");
     } else {
-      refuse_(here() + ": an array of unknown encoding " + std::to_string(encoding));
+      refuse_.broken(here() + ": an array of unknown encoding " + std::to_string(encoding));
     }
     return at + stored;
   }
@@ -441,13 +469,13 @@ class BinaryWalk {
   void finish(const Open& node) {
     if (node.geometry == Open::Geometry::mesh) {
       if (node.coordinates % 3)
-        refuse_(where(node.name) + ": a mesh's Vertices hold " + std::to_string(node.coordinates) + " numbers, not a multiple of 3");
+        refuse_.broken(where(node.name) + ": a mesh's Vertices hold " + std::to_string(node.coordinates) + " numbers, not a multiple of 3");
       if (node.top_index >= static_cast<std::int64_t>(node.coordinates / 3))
-        refuse_(where(node.name) + ": a polygon names vertex " + std::to_string(node.top_index) + " of a mesh of " +
+        refuse_.broken(where(node.name) + ": a polygon names vertex " + std::to_string(node.top_index) + " of a mesh of " +
                 std::to_string(node.coordinates / 3));
     }
     if (node.geometry == Open::Geometry::shape && node.has_indexes && node.has_coordinates && node.indexes * 3 != node.coordinates)
-      refuse_(where(node.name) + ": a blend shape of " + std::to_string(node.indexes) + " indexes and " +
+      refuse_.broken(where(node.name) + ": a blend shape of " + std::to_string(node.indexes) + " indexes and " +
               std::to_string(node.coordinates) + " numbers (3 per index)");
   }
 
@@ -464,6 +492,7 @@ class BinaryWalk {
   bool wide_ = false;
   std::vector<Open> open_;
   std::size_t meshes_ = 0;
+  int deepest_ = 0;
   SceneGraph graph_;
 };
 
@@ -473,9 +502,9 @@ class BinaryWalk {
 class AsciiWalk {
  public:
   AsciiWalk(const std::string& text, const Refuse& refuse, const ImportLimits& limits)
-      : text_(text), refuse_(refuse), limits_(limits), budget_{limits, refuse} {}
+      : text_(text), refuse_(refuse), limits_(limits), budget_{limits, refuse, text.size()} {}
 
-  FbxSummary run() {
+  FbxScan run() {
     std::size_t token = std::string::npos;  // where the token being read began
     for (std::size_t i = 0; i < text_.size(); ++i) {
       const char c = text_[i];
@@ -494,13 +523,14 @@ class AsciiWalk {
         while (i + 1 < text_.size() && text_[i + 1] != '\n' && text_[i + 1] != '\r') ++i;
       } else if (c == '"') {  // a string, one value
         const std::size_t close = text_.find('"', i + 1);
-        if (close == std::string::npos) refuse_("line " + std::to_string(line_) + ": a string that never ends");
+        if (close == std::string::npos) refuse_.broken("line " + std::to_string(line_) + ": a string that never ends");
         for (std::size_t k = i + 1; k < close; ++k) line_ += text_[k] == '\n';
         ended(i + 1, close, true, false);
         i = close;
       } else if (c == ',' || c == '{' || c == '}') {
         ++values_;
         if (c == '{') {
+          deepest_ = std::max(deepest_, depth_ + 1);
           if (++depth_ > limits_.max_fbx_depth)
             refuse_("nested more than " + std::to_string(limits_.max_fbx_depth) + " deep (line " + std::to_string(line_) + ")");
           if (depth_ == 1) block_ = key_;
@@ -511,8 +541,10 @@ class AsciiWalk {
     }
     if (token != std::string::npos) ended(token, text_.size(), false, false);
     count_values();
-    check_scene_graph(graph_, refuse_, limits_);
-    FbxSummary s;
+    FbxScan s;
+    s.connection_depth = check_scene_graph(graph_, refuse_, limits_);
+    s.depth = deepest_;
+    s.meshes = graph_.meshes.size();
     s.values = budget_.values;
     s.decoded_bytes = budget_.decoded;
     return s;
@@ -536,7 +568,7 @@ class AsciiWalk {
     if (!string && text_[begin] == '*') {
       const std::uint64_t declared = std::strtoull(text_.c_str() + begin + 1, nullptr, 10);
       if (declared > (text_.size() - begin) / 2)
-        refuse_("line " + std::to_string(line_) + ": an array that declares " + std::to_string(declared) +
+        refuse_.broken("line " + std::to_string(line_) + ": an array that declares " + std::to_string(declared) +
                 " values, more than the rest of the file can hold");
       budget_.add_array(8 * declared, [&] { return "line " + std::to_string(line_); });
       // A mesh's polygon corners: "PolygonVertexIndex: *N {" inside its Geometry.
@@ -567,7 +599,7 @@ class AsciiWalk {
   const Refuse& refuse_;
   const ImportLimits& limits_;
   Budget budget_;
-  int depth_ = 0;
+  int depth_ = 0, deepest_ = 0;
   std::uint64_t line_ = 1, values_ = 0;
   std::string key_, block_, inner_key_;  // the last key at the top two levels, and below; the block open
   int field_ = 0;                         // values since that key
@@ -577,7 +609,15 @@ class AsciiWalk {
 };
 }  // namespace
 
-FbxSummary check_fbx_bounds(const std::string& bytes, const std::string& path, const ImportLimits& limits) {
+std::uint64_t fbx_decoded_budget(std::uint64_t file_bytes, const ImportLimits& limits) {
+  return std::min(limits.max_decoded_bytes, 2 * file_bytes + (std::uint64_t{200} << 20));
+}
+
+std::uint64_t fbx_token_budget(std::uint64_t file_bytes, const ImportLimits& limits) {
+  return std::min(limits.max_decoded_bytes, 3 * file_bytes + (std::uint64_t{400} << 20));
+}
+
+FbxScan scan_fbx(const std::string& bytes, const std::string& path, const ImportLimits& limits) {
   const Refuse refuse{path};
   if (bytes.compare(0, std::strlen(kBinaryMagic), kBinaryMagic) == 0) {
     const Bytes b{reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()};

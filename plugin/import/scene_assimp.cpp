@@ -1,7 +1,8 @@
-// glTF 2.0 and FBX avatars through assimp. Only triangulation runs (no joining of identical
-// vertices, which would reorder them): each mesh keeps the vertex order its file gives, so a
-// point cache written in that order loads onto the mesh. assimp reads FBX one vertex per polygon
-// corner; those corners are welded back into the file's vertices (avatar_weld.h).
+// FBX avatars through assimp (glTF has a reader of its own, gltf_reader.h). Only triangulation
+// runs (no joining of identical vertices, which would reorder them): each mesh keeps the vertex
+// order its file gives, so a point cache written in that order loads onto the mesh. assimp reads
+// FBX one vertex per polygon corner; those corners are welded back into the file's vertices
+// (avatar_weld.h).
 #include <assimp/Exceptional.h>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
@@ -15,7 +16,6 @@
 #include "avatar_weld.h"
 #include "fbx_bounds.h"
 #include "file_format.h"
-#include "gltf_targets.h"
 #include "input_files.h"
 
 namespace softdeca::avatar_import {
@@ -81,12 +81,7 @@ struct Reader {
 
 // FBX says how many centimetres a unit is (UnitScaleFactor); assimp keeps the raw units and
 // passes the factor on as metadata.
-void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
-  if (!fbx) {
-    out.declared_unit = "metre (glTF 2.0)";
-    out.declared_metres_per_unit = 1;
-    return;
-  }
+void declared_unit(const aiScene& scene, SourceScene& out) {
   double centimetres = 0;
   float as_float = 0;
   if (!scene.mMetaData) return;
@@ -98,8 +93,7 @@ void declared_unit(const aiScene& scene, bool fbx, SourceScene& out) {
   out.declared_unit = text;
   out.declared_metres_per_unit = centimetres / 100.0;
 }
-
-constexpr const char* kTooLarge = "too large to read: the reader ran out of memory";
+constexpr const char* kTooLarge = "too large to read: not enough memory";
 constexpr const char* kDamaged = "its structure is damaged (the reader failed inside it)";
 
 // Why assimp failed, in the user's terms: its own messages ("FBX-Parser ...") pass; a C++
@@ -119,54 +113,48 @@ std::string reader_failure(const std::exception_ptr& failure, const std::string&
 
 // assimp's parse of `bytes`; throws std::runtime_error naming the file and why, never a C++
 // library's own text.
-const aiScene* parse(Assimp::Importer& importer, const std::string& bytes, const char* hint, const std::string& path, bool fbx) {
-  const std::string what = std::string(": not a readable ") + (fbx ? "FBX" : "glTF 2.0") + " file (";
+const aiScene* parse(Assimp::Importer& importer, const std::string& bytes, const std::string& path) {
+  const std::string what = path + ": not a readable FBX file (";
   const aiScene* scene = nullptr;
   try {
-    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_ValidateDataStructure | aiProcess_Triangulate, hint);
+    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_ValidateDataStructure | aiProcess_Triangulate, "fbx");
   } catch (...) {
-    throw std::runtime_error(path + what + reader_failure(std::current_exception(), kDamaged) + ")");
+    throw std::runtime_error(what + reader_failure(std::current_exception(), kDamaged) + ")");
   }
-  if (!scene || !scene->mRootNode)
-    throw std::runtime_error(path + what + reader_failure(importer.GetException(), importer.GetErrorString()) + ")");
+  if (!scene || !scene->mRootNode) throw std::runtime_error(what + reader_failure(importer.GetException(), importer.GetErrorString()) + ")");
   return scene;
 }
 
-SourceScene read_scene(const std::string& path, const ImportLimits& limits) {
-  // The file is read once, checked on its open descriptor; assimp parses those bytes.
+SourceScene read_fbx(const std::string& path, const ImportLimits& limits) {
+  // The file is read once, checked on its open descriptor; assimp parses those bytes once they
+  // pass the scan (fbx_bounds.h): assimp trusts what a file declares.
   const std::string bytes = read_named_file(path, limits.max_file_bytes, "an avatar file");
-  const FileFormat format = agreed_format(path, bytes);
-  const bool fbx = format == FileFormat::fbx;
-  FbxSummary fbx_summary;
-  if (fbx) fbx_summary = check_fbx_bounds(bytes, path, limits);  // assimp trusts what the file declares
-  if (!fbx) check_gltf_targets(bytes, path);
+  if (agreed_format(path, bytes) != FileFormat::fbx) throw std::runtime_error(path + ": not an FBX file");
+  const FbxScan scan = scan_fbx(bytes, path, limits);
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);  // one node per FBX model
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
-  const char* hint = format == FileFormat::gltf_binary ? "glb" : fbx ? "fbx" : "gltf";
-  const aiScene* scene = parse(importer, bytes, hint, path, fbx);
+  const aiScene* scene = parse(importer, bytes, path);
   Reader reader{path, limits, *scene, {}};
-  reader.out.format = fbx ? "FBX" : "glTF 2.0";
-  reader.out.vertex_order = fbx ? "the FBX file's vertices in the order its polygons first use them"
-                                : "as in the file's vertex buffers";
-  declared_unit(*scene, fbx, reader.out);
+  reader.out.format = "FBX";
+  reader.out.vertex_order = "the FBX file's vertices in the order its polygons first use them";
+  declared_unit(*scene, reader.out);
   reader.walk(*scene->mRootNode, aiMatrix4x4(), 0);
   // assimp leaves out a mesh whose data does not add up, saying nothing.
-  if (fbx && reader.out.meshes.empty() && fbx_summary.meshes > 0)
-    throw std::runtime_error(path + ": none of its " + std::to_string(fbx_summary.meshes) +
+  if (reader.out.meshes.empty() && scan.meshes > 0)
+    throw std::runtime_error(path + ": none of its " + std::to_string(scan.meshes) +
                              " meshes could be read (their data is damaged or empty)");
-  if (fbx)
-    for (SourceMesh& mesh : reader.out.meshes) weld_corners(mesh);
+  for (SourceMesh& mesh : reader.out.meshes) weld_corners(mesh);
   return std::move(reader.out);
 }
 }  // namespace
 
-bool scene_files_supported() { return true; }
+bool fbx_files_supported() { return true; }
 
-SourceScene read_scene_file(const std::string& path, const ImportLimits& limits) {
+SourceScene read_fbx_file(const std::string& path, const ImportLimits& limits) {
   try {
-    return read_scene(path, limits);
+    return read_fbx(path, limits);
   } catch (const std::bad_alloc&) {
     throw std::runtime_error(path + ": " + kTooLarge);
   }

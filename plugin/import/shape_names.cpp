@@ -26,7 +26,11 @@ std::string trim(const std::string& s) {
 
 ShapeNames ShapeNames::from_file(const std::string& path) {
   // Read once, as a regular file within its bound: a FIFO or /dev/zero is refused, not waited on.
-  std::istringstream in(read_named_file(path, kMaxNamesFileBytes, "a names file"));
+  return parse(read_named_file(path, kMaxNamesFileBytes, "a names file"), path);
+}
+
+ShapeNames ShapeNames::parse(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
   ShapeNames names;
   names.file_ = path;
   std::string line;

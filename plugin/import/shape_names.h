@@ -18,6 +18,8 @@ class ShapeNames {
   // exactly and override the rule; the rest follow the rule. Throws std::runtime_error naming
   // the file and line.
   static ShapeNames from_file(const std::string& path);
+  // The same from the text of such a file; `path` names it in errors (and is file()).
+  static ShapeNames parse(const std::string& text, const std::string& path);
 
   int index(const std::string& rig_name) const;  // 0..51, or -1
   const std::string& file() const { return file_; }

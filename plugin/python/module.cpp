@@ -17,6 +17,7 @@ using namespace softdeca::geometry;
 
 void bind_sim(nb::module_& m);  // sim_bindings.cpp: the physics simulator
 void bind_fit(nb::module_& m);  // fit_bindings.cpp: fitting a user's avatar
+void bind_prepare(nb::module_& m);  // prepare_bindings.cpp: the contact rules
 
 NB_MODULE(softdeca_native, m) {
   m.doc() = "SoftDECA native geometry (C++), used by the training pipeline";
@@ -48,4 +49,5 @@ NB_MODULE(softdeca_native, m) {
         "Pairs (triangle of A, triangle of B) that intersect.");
   bind_sim(m);
   bind_fit(m);
+  bind_prepare(m);
 }

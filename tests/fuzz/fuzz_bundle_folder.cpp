@@ -5,9 +5,7 @@
 //
 // Input: entries of [kind % 5][name length][name][content length][content]; kind 0 file,
 // 1 link to content, 2 FIFO, 3 folder, 4 link to the secret file.
-#include <fcntl.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -19,6 +17,7 @@
 #include "api/error_boundary.h"
 #include "bundle/bundle_files.h"
 #include "fuzz_check.h"
+#include "fuzz_files.h"
 
 namespace fs = std::filesystem;
 using namespace softdeca::runtime;
@@ -26,21 +25,11 @@ using namespace softdeca::runtime;
 namespace {
 const std::string kSecret = "secret: never in a bundle";
 
-fs::path workspace() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("softdeca-fuzz-folder-" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+using softdeca::fuzz::write_file;
 
-// The harness itself must not block: no following links, no waiting for a FIFO's reader.
-void write_file(const fs::path& path, const std::string& content) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0600);
-  if (fd < 0) return;
-  if (::write(fd, content.data(), content.size()) < 0) { /* a short file is fine */ }
-  ::close(fd);
+fs::path workspace() {
+  static const fs::path dir = softdeca::fuzz::workspace("folder");
+  return dir;
 }
 
 // Names stay inside the bundle folder: [a-z0-9._/], no leading slash, no "..".

@@ -24,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       for (const auto& [key, n] : manifest.networks) {
         if (!files.has(n.file)) continue;
         const Bytes& onnx = files.get(n.file);
-        scan_onnx_model(onnx.data(), onnx.size());
+        scan_onnx_model(onnx.data(), onnx.size(), n.inputs);
       }
     } catch (const softdeca::Error&) {
     }

@@ -1,10 +1,12 @@
-// The ONNX scan's size estimate on graphs rather than bytes: the fuzzer's bytes are a small
-// program that builds a graph of the constant-foldable producers the memory budget counts
-// (Range, Tile, ConstantOfShape, Expand, Resize), fed by constants of chosen sizes and
-// values, Shape chains, Concat, Cast and subgraphs. Each graph is scanned after every step:
-// a step only adds tensors of new names, so the estimate never shrinks, and a
-// ConstantOfShape of a known vector is counted at least at its size, saturating at
-// UINT64_MAX rather than wrapping (docs/security.md, "Memory budget").
+// The ONNX scan's static shapes on graphs rather than bytes: the fuzzer's bytes are a small
+// program that builds a graph from a graph input and initializers and Constant nodes of chosen
+// sizes and values, through the listed operators that carry shapes and sizes (Shape, Gather,
+// Slice, Concat, Unsqueeze, Reshape, Mul, Add, Sub, Cast, Identity, ConstantOfShape, Expand,
+// MatMul), and sometimes an operator off the list or a subgraph. Each graph is scanned after
+// every step (a step only adds tensors of new names): a graph with an operator off the list or
+// a subgraph is refused, and a refused graph stays refused; an accepted graph's total never
+// shrinks, counts every ConstantOfShape of a known vector at least at its size, and saturates
+// at 2^64 - 1 rather than wrapping (docs/security.md, "Memory budget").
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -17,7 +19,7 @@
 #include "onnx_test_support.h"
 
 using namespace softdeca::runtime;
-using softdeca::test::field;
+using namespace softdeca::test;
 
 namespace {
 
@@ -43,39 +45,6 @@ class Bytes {
   std::size_t size_, pos_ = 0;
 };
 
-std::string int64s(const std::vector<std::int64_t>& values) {
-  std::string raw;
-  for (std::int64_t v : values)
-    for (int i = 0; i < 8; ++i) raw += static_cast<char>(static_cast<std::uint64_t>(v) >> (8 * i));
-  return raw;
-}
-std::string floats_of(const std::vector<std::int64_t>& values) {
-  std::string raw;
-  for (std::int64_t v : values) {
-    const float f = static_cast<float>(v);
-    raw.append(reinterpret_cast<const char*>(&f), 4);
-  }
-  return raw;
-}
-// TensorProto: dims, data type (1 float, 7 int64), name, raw data.
-std::string tensor(const std::string& name, std::uint64_t dtype, const std::vector<std::uint64_t>& dims,
-                   const std::string& raw) {
-  std::string t;
-  for (std::uint64_t d : dims) t += field(1, d);
-  t += field(2, dtype) + field(8, name);
-  if (!raw.empty()) t += field(9, raw);
-  return t;
-}
-std::string int_attribute(const std::string& name, std::int64_t v) {
-  return field(5, field(1, name) + field(3, static_cast<std::uint64_t>(v)));
-}
-std::string node(const std::string& op, const std::vector<std::string>& inputs, const std::string& output,
-                 const std::string& attributes = "") {
-  std::string n;
-  for (const std::string& i : inputs) n += field(1, i);
-  return field(1, n + field(2, output) + field(4, op) + attributes);
-}
-
 // Builds the graph step by step; every step defines only names no earlier step used.
 class GraphProgram {
  public:
@@ -85,51 +54,76 @@ class GraphProgram {
   bool step() {
     if (in_.empty() || fields_.size() >= kMaxSteps) return false;
     const std::string out = "t" + std::to_string(fields_.size());
-    switch (in_.next() % 13) {
-      case 0: {  // an int64 vector initializer: a shape, repeats, sizes or a Range bound
+    const std::uint8_t op = in_.next();
+    switch (op % 16) {
+      case 0: {  // an int64 vector initializer: a shape, axes, indices
         const std::vector<std::int64_t> v = values();
-        fields_.push_back(field(5, tensor(out, 7, {v.size()}, int64s(v))));
+        fields_.push_back(initializer(int64_vector(out, v)));
         vectors_.push_back({out, v});
         break;
       }
-      case 1: {  // a float scalar initializer (Range bounds in float)
-        const std::vector<std::int64_t> v{in_.value()};
-        fields_.push_back(field(5, tensor(out, 1, {}, floats_of(v))));
-        break;
-      }
-      case 2: {  // a float tensor of declared dims and no data: a static shape
+      case 1: {  // a float tensor of declared dims and no data
         std::vector<std::uint64_t> dims;
         for (std::size_t i = 0, n = in_.next() % 5; i < n; ++i) dims.push_back(in_.next() % 64);
-        fields_.push_back(field(5, tensor(out, 1, dims, "")));
+        fields_.push_back(initializer(tensor(out, kFloat, dims)));
         break;
       }
-      case 3: {  // a Constant node holding an int64 vector
+      case 2: {  // a Constant node holding an int64 vector
         const std::vector<std::int64_t> v = values();
-        fields_.push_back(node("Constant", {}, out,
-                               field(5, field(1, std::string("value")) + field(5, tensor("", 7, {v.size()}, int64s(v))))));
+        fields_.push_back(vector_constant(out, v));
         vectors_.push_back({out, v});
         break;
       }
-      case 4: {  // Shape, sliced or not
+      case 3: {  // Shape, sliced or not
+        const std::string x = any();
         std::string attributes;
-        if (in_.next() & 1) attributes = int_attribute("start", in_.value() % 8) + int_attribute("end", in_.value() % 8);
-        fields_.push_back(node("Shape", {any()}, out, attributes));
+        if (in_.next() & 1) {
+          attributes = int_attribute("start", in_.value() % 8);
+          attributes += int_attribute("end", in_.value() % 8);
+        }
+        fields_.push_back(node("Shape", {x}, out, attributes));
         break;
       }
-      case 5: fields_.push_back(node("Concat", {any(), any()}, out, int_attribute("axis", 0))); break;
-      case 6: fields_.push_back(node(in_.next() & 1 ? "Cast" : "Identity", {any()}, out, int_attribute("to", 7))); break;
-      case 7: fields_.push_back(node("Range", {any(), any(), any()}, out)); break;
-      case 8: fields_.push_back(node("Tile", {any(), any()}, out)); break;
-      case 9: constant_of_shape(out); break;
-      case 10: fields_.push_back(node("Expand", {any(), any()}, out)); break;
-      case 11: fields_.push_back(node("Resize", {any(), "", in_.next() & 1 ? any() : "", any()}, out)); break;
-      case 12: {  // a subgraph: an If whose branch fills a constant shape
-        const std::vector<std::int64_t> v = values();
-        const std::string branch = node("Constant", {}, out + "s",
-                                        field(5, field(1, std::string("value")) + field(5, tensor("", 7, {v.size()}, int64s(v))))) +
-                                   node("ConstantOfShape", {out + "s"}, out + "f");
-        fields_.push_back(node("If", {any()}, out, field(5, field(1, std::string("then_branch")) + field(6, branch))));
-        expected_ = std::max(expected_, filled_bytes(v));
+      case 4: {
+        const std::vector<std::string> inputs = operands(2);
+        fields_.push_back(node("Concat", inputs, out, int_attribute("axis", in_.value() % 3)));
+        break;
+      }
+      case 5: {
+        const std::string x = any();
+        const std::uint8_t kind = in_.next();
+        fields_.push_back(kind & 1 ? node("Cast", {x}, out, int_attribute("to", kind & 2 ? 7 : 1)) : node("Identity", {x}, out));
+        break;
+      }
+      case 6: {
+        const char* ops[] = {"Mul", "Add", "Sub"};
+        const char* which = ops[in_.next() % 3];
+        fields_.push_back(node(which, operands(2), out));
+        break;
+      }
+      case 7: constant_of_shape(out); break;
+      case 8: fields_.push_back(node("Expand", operands(2), out)); break;
+      case 9: fields_.push_back(node("Reshape", operands(2), out)); break;
+      case 10: {
+        const std::vector<std::string> inputs = operands(2);
+        fields_.push_back(node("Gather", inputs, out, int_attribute("axis", in_.value() % 3)));
+        break;
+      }
+      case 11: fields_.push_back(node("Slice", operands(3), out)); break;
+      case 12: fields_.push_back(node("MatMul", operands(2), out)); break;
+      case 13: fields_.push_back(node("Unsqueeze", operands(2), out)); break;
+      case 14: {  // an operator off the list
+        const char* ops[] = {"Range", "Tile", "Squeeze", "Resize"};
+        const char* which = ops[in_.next() % 4];
+        fields_.push_back(node(which, operands(2), out));
+        unlisted_ = true;
+        break;
+      }
+      case 15: {  // a listed operator holding a subgraph
+        const std::string x = any();
+        const std::string body = vector_constant(out + "s", values());
+        fields_.push_back(node("Identity", {x}, out, field(5, field(1, std::string("body")) + field(6, body))));
+        unlisted_ = true;
         break;
       }
     }
@@ -137,12 +131,14 @@ class GraphProgram {
     return true;
   }
 
-  std::string model() const {
-    std::string graph = field(2, std::string("g"));
+  std::string bytes() const {
+    std::string graph = graph_input("input");
     for (const std::string& f : fields_) graph += f;
-    return field(1, 8) + field(7, graph);
+    return model(graph);
   }
-  // The least a correct scan counts: the largest ConstantOfShape of a known vector.
+  // Whether the graph holds an operator off the list or a subgraph: it must be refused.
+  bool unlisted() const { return unlisted_; }
+  // The least an accepting scan counts: the largest ConstantOfShape of a known vector.
   std::uint64_t expected() const { return expected_; }
 
  private:
@@ -156,17 +152,20 @@ class GraphProgram {
     for (std::size_t i = 0, n = in_.next() % 6; i < n; ++i) v.push_back(in_.value());
     return v;
   }
-  // A name an earlier step defined, or one nothing defines (a run-time input).
+  // A name an earlier step defined, or the graph input.
   std::string any() {
     const std::uint8_t b = in_.next();
     return names_.empty() || b == 0xFF ? std::string("input") : names_[b % names_.size()];
   }
-  // The scan's rule for a dimension: below 1 counts as 1 (nonsense or "infer").
-  // An empty vector (a scalar's shape, 4 bytes) is left out: too small to matter.
+  std::vector<std::string> operands(std::size_t n) {
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < n; ++i) names.push_back(any());  // in order: the program's bytes decide
+    return names;
+  }
+  // Floats of those dims (a negative one makes the graph refused, so it never counts).
   static std::uint64_t filled_bytes(const std::vector<std::int64_t>& dims) {
-    if (dims.empty()) return 0;
-    std::uint64_t n = 4;  // float elements, ConstantOfShape's default
-    for (std::int64_t d : dims) n = mul_sat(n, d < 1 ? 1 : static_cast<std::uint64_t>(d));
+    std::uint64_t n = 4;
+    for (const std::int64_t d : dims) n = mul_sat(n, d < 0 ? 0 : static_cast<std::uint64_t>(d));
     return n;
   }
   void constant_of_shape(const std::string& out) {
@@ -176,7 +175,8 @@ class GraphProgram {
       fields_.push_back(node("ConstantOfShape", {v.name}, out));
       expected_ = std::max(expected_, filled_bytes(v.values));
     } else {
-      fields_.push_back(node("ConstantOfShape", {any()}, out));
+      const std::string x = any();
+      fields_.push_back(node("ConstantOfShape", {x}, out));
     }
   }
 
@@ -184,31 +184,29 @@ class GraphProgram {
   std::vector<std::string> fields_, names_;
   std::vector<Vector> vectors_;
   std::uint64_t expected_ = 0;
+  bool unlisted_ = false;
 };
-
-OnnxModelScan scan(const std::string& model) {
-  return scan_onnx_model(reinterpret_cast<const std::uint8_t*>(model.data()), model.size());
-}
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   Bytes in(data, size);
   GraphProgram program(in);
+  bool refused = false;
   std::uint64_t previous = 0;
   while (program.step()) {
-    OnnxModelScan s;
+    const std::string m = program.bytes();
     try {
-      s = scan(program.model());
+      const OnnxModelScan s = scan_onnx_model(reinterpret_cast<const std::uint8_t*>(m.data()), m.size(), {{"input", {-1, 3}}});
+      FUZZ_CHECK(!refused);              // a refused graph stays refused
+      FUZZ_CHECK(!program.unlisted());   // an operator off the list is never accepted
+      FUZZ_CHECK(s.bytes >= previous);   // one more node never lowers the total
+      FUZZ_CHECK(s.bytes >= program.expected());  // saturated, never wrapped
+      FUZZ_CHECK(s.largest_bytes <= s.bytes);
+      previous = s.bytes;
     } catch (const softdeca::Error&) {
-      FUZZ_CHECK(!"a well-formed graph was refused");
+      refused = true;
     }
-    const std::uint64_t total = s.total_bytes();
-    FUZZ_CHECK(total >= previous);  // one more producer never lowers the estimate
-    FUZZ_CHECK(total >= s.initializer_bytes && total >= s.declared_bytes && total >= s.shaped_bytes);
-    FUZZ_CHECK(s.shaped_bytes >= program.expected());  // saturated, never wrapped
-    FUZZ_CHECK(s.largest_bytes <= total);
-    previous = total;
   }
   return 0;
 }

@@ -30,6 +30,15 @@ inline std::size_t arkit_index(const char* name) {
   return static_cast<std::size_t>(index);
 }
 
+// Deltas that differ per vertex and per shape, so a reordering or a mix-up shows: scale x
+// (1 + vertex + 10 x coordinate), zero before vertex `only_from`.
+inline std::vector<float> deltas(std::size_t vertices, float scale, std::size_t only_from = 0) {
+  std::vector<float> d(3 * vertices, 0.0f);
+  for (std::size_t i = only_from; i < vertices; ++i)
+    for (std::size_t c = 0; c < 3; ++c) d[3 * i + c] = scale * static_cast<float>(1 + i + 10 * c);
+  return d;
+}
+
 struct TestShape {
   std::string name;
   std::vector<float> deltas;     // vertex_count x 3

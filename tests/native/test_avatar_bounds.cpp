@@ -21,8 +21,8 @@ namespace files = softdeca::test::files_detail;
 
 namespace {
 
-#define REQUIRE_SCENE_FILES() \
-  if (!scene_files_supported()) GTEST_SKIP() << "built without assimp"
+#define REQUIRE_FBX() \
+  if (!fbx_files_supported()) GTEST_SKIP() << "built without assimp"
 
 // A head of 12 vertices (an icosahedron, 1 unit across) with two ARKit shapes.
 TestMesh head() {
@@ -72,7 +72,7 @@ void expect_error(const std::string& error, const std::string& path, const std::
 }  // namespace
 
 TEST(AvatarBounds, TheTestHeadReadsRawAndCompressed) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-ok");
   for (const bool zlib : {false, true}) {
     const AvatarFile a = read_avatar_file(dir.write(zlib ? "zlib.fbx" : "raw.fbx", softdeca::test::fbx_bytes(scene(zlib))));
@@ -82,7 +82,7 @@ TEST(AvatarBounds, TheTestHeadReadsRawAndCompressed) {
 }
 
 TEST(AvatarBounds, FbxNestedDeepIsRefusedWithoutRecursion) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-nested");
   const std::string binary = dir.write("deep.fbx", softdeca::test::fbx_nested_bytes(100000));
   expect_error(error_of(binary), binary, "nested more than 64 deep");
@@ -100,7 +100,7 @@ TEST(AvatarBounds, FbxNestedDeepIsRefusedWithoutRecursion) {
 }
 
 TEST(AvatarBounds, ModelHierarchiesDeepOrExplodingAreRefused) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-models");
   const double zero[3] = {0, 0, 0}, one[3] = {1, 1, 1};
   // `count` bones under the root; `link` connects bone i (id 5000 + i) to its parents.
@@ -120,7 +120,7 @@ TEST(AvatarBounds, ModelHierarchiesDeepOrExplodingAreRefused) {
   };
   // A chain of 10,000 bones: assimp's recursion over it overflows its stack.
   const std::string chain = skeleton("chain.fbx", 10000, [&](files::FbxNode& c, int i) { c.children.push_back(oo(5000 + i, i ? 4999 + i : 0)); });
-  expect_error(error_of(chain), chain, "its models are nested more than 256 deep");
+  expect_error(error_of(chain), chain, "objects connected more than 256 deep");
   // A ladder of 40 rungs, each bone a child of both bones of the rung above: 2^40 paths.
   const std::string ladder = skeleton("ladder.fbx", 80, [&](files::FbxNode& c, int i) {
     if (i < 2) {
@@ -135,7 +135,7 @@ TEST(AvatarBounds, ModelHierarchiesDeepOrExplodingAreRefused) {
     c.children.push_back(oo(5000 + i, 5000 + (i + 1) % 3));
     if (i == 0) c.children.push_back(oo(5000, 0));
   });
-  expect_error(error_of(loop), loop, "its models' connections form a loop");
+  expect_error(error_of(loop), loop, "objects connected in a cycle");
   // A skeleton of 300 bones, 20 deep, reads.
   const std::string bones = skeleton("bones.fbx", 300, [&](files::FbxNode& c, int i) { c.children.push_back(oo(5000 + i, i < 15 ? 0 : 4985 + i)); });
   EXPECT_EQ(error_of(bones), "");
@@ -145,11 +145,11 @@ TEST(AvatarBounds, ModelHierarchiesDeepOrExplodingAreRefused) {
   text += "}\nConnections:  {\n";
   for (int i = 0; i < 1000; ++i) text += "\tC: \"OO\"," + std::to_string(5000 + i) + "," + std::to_string(i ? 4999 + i : 0) + "\n";
   const std::string ascii = dir.write("chain_ascii.fbx", text + "}\n");
-  expect_error(error_of(ascii), ascii, "its models are nested more than 256 deep");
+  expect_error(error_of(ascii), ascii, "objects connected more than 256 deep");
 }
 
 TEST(AvatarBounds, BlendShapesTheReaderWouldCopyPerCornerAreBounded) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-shapes");
   // 100 shapes on a mesh of a million polygon corners (4 MB of indexes, 4 KB compressed):
   // assimp would copy the corners' positions and normals for each, 2.3 GiB.
@@ -166,9 +166,10 @@ TEST(AvatarBounds, BlendShapesTheReaderWouldCopyPerCornerAreBounded) {
 }
 
 TEST(AvatarBounds, AZlibBombIsRefusedByItsDeclaredSize) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-bomb");
-  // 1.5 GiB of zeros in a 10 MB zlib stream, declared as the head's vertices.
+  // 1.5 GiB of zeros in a 10 MB zlib stream, declared as the head's vertices: more than a file of
+  // its size may expand to (twice its size and 200 MiB), more than any avatar may decode.
   const std::uint64_t bytes = 3ull << 29;
   const std::string bomb = files::zlib_zeros(bytes);
   ASSERT_LT(bomb.size(), 11u << 20);
@@ -177,7 +178,11 @@ TEST(AvatarBounds, AZlibBombIsRefusedByItsDeclaredSize) {
         files::fbx_array_declared('d', static_cast<std::uint32_t>(bytes / 8), 1, bomb);
   }));
   expect_error(error_of(path), path,
-               "node 'Objects/Geometry/Vertices': an array that would expand to 1.5 GiB, more than the 1 GiB an avatar may decode");
+               "node 'Objects/Geometry/Vertices': an array that would expand to 1.5 GiB, more than the 219 MiB a file of 9.68 MiB "
+               "may expand to");
+  ImportLimits tight;
+  tight.max_decoded_bytes = 100 << 20;
+  expect_error(error_of(path, tight), path, "an array that would expand to 1.5 GiB, more than the 100 MiB an avatar may decode");
 
   // Arrays each within the bound, together beyond it: the budget is the file's.
   ImportLimits small;
@@ -204,7 +209,7 @@ TEST(AvatarBounds, AZlibBombIsRefusedByItsDeclaredSize) {
 }
 
 TEST(AvatarBounds, ArraysThatDoNotAddUpAreNamed) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-arrays");
   const auto edited = [&](const std::string& name, const std::function<void(files::FbxNode&)>& edit) {
     return dir.write(name, softdeca::test::fbx_bytes(scene(), edit));
@@ -250,7 +255,7 @@ TEST(AvatarBounds, ArraysThatDoNotAddUpAreNamed) {
 }
 
 TEST(AvatarBounds, AsciiFbxValuesAndDeclaredCountsAreBounded) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-ascii");
   const std::string header = "; FBX 7.4.0 project file\nFBXHeaderExtension:  {\n\tFBXHeaderVersion: 1003\n}\n";
   const std::string huge = dir.write("huge_count.fbx", header + "Objects: {\n\tGeometry: 1, \"Geometry::\", \"Mesh\" {\n"
@@ -265,7 +270,7 @@ TEST(AvatarBounds, AsciiFbxValuesAndDeclaredCountsAreBounded) {
 }
 
 TEST(AvatarBounds, DamagedBytesNeverCrashNorSpeakCpp) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX();
   const TempDir dir("bounds-flips");
   std::mt19937 random(11);
   for (const bool zlib : {false, true}) {
@@ -289,7 +294,6 @@ TEST(AvatarBounds, DamagedBytesNeverCrashNorSpeakCpp) {
 }
 
 TEST(AvatarBounds, StrayVerticesAndHugeShapeDeltasAreRefusedByName) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("bounds-values");
   TestScene far = scene();
   far.meshes[0].vertices[3 * 7] = 1e30f;
@@ -302,5 +306,5 @@ TEST(AvatarBounds, StrayVerticesAndHugeShapeDeltasAreRefusedByName) {
   // Within the bound (a jaw opening as far as the head is tall) reads.
   TestScene open = scene();
   open.meshes[0].shapes[0].deltas[3 * 4 + 1] = -1.5f;
-  EXPECT_EQ(error_of(dir.write("open.fbx", softdeca::test::fbx_bytes(open))), "");
+  EXPECT_EQ(error_of(dir.write("open.glb", softdeca::test::glb_bytes(open))), "");
 }

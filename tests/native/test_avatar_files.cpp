@@ -14,6 +14,7 @@
 #include "avatar_file.h"
 #include "avatar_test_files.h"
 #include "avatar_weld.h"
+#include "fbx_bounds.h"
 #include "mesh_io.h"
 #include "part_space.h"
 #include "softdeca/softdeca.h"
@@ -23,19 +24,12 @@ using namespace softdeca::avatar_import;
 using softdeca::test::expected_transform;
 using softdeca::test::TempDir;
 constexpr auto shape = softdeca::test::arkit_index;
+using softdeca::test::deltas;
 using softdeca::test::TestMesh;
 using softdeca::test::TestScene;
 using softdeca::test::TestShape;
 
 namespace {
-// Deltas that differ per vertex and per shape, so a reordering or a mix-up shows.
-std::vector<float> deltas(std::size_t vertices, float scale, std::size_t only_from = 0) {
-  std::vector<float> d(3 * vertices, 0.0f);
-  for (std::size_t i = only_from; i < vertices; ++i)
-    for (std::size_t c = 0; c < 3; ++c) d[3 * i + c] = scale * static_cast<float>(1 + i + 10 * c);
-  return d;
-}
-
 // An octahedron whose vertex order differs from the order its triangles first use them.
 TestMesh head() {
   TestMesh m;
@@ -131,12 +125,11 @@ std::vector<std::size_t> identity_order(std::size_t n) {
   return order;
 }
 
-#define REQUIRE_SCENE_FILES() \
-  if (!scene_files_supported()) GTEST_SKIP() << "built without assimp"
+#define REQUIRE_FBX_FILES() \
+  if (!fbx_files_supported()) GTEST_SKIP() << "built without assimp"
 }  // namespace
 
 TEST(AvatarFiles, GlbKeepsVertexOrderPlacesPartsAndFindsArkitShapes) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-glb");
   const TestScene scene = avatar_scene();
   const AvatarFile a = read_avatar_file(dir.write("avatar.glb", softdeca::test::glb_bytes(scene)));
@@ -176,7 +169,6 @@ TEST(AvatarFiles, GlbKeepsVertexOrderPlacesPartsAndFindsArkitShapes) {
 }
 
 TEST(AvatarFiles, FramesGoBackToEachPartsOwnCoordinates) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-local");
   const TestScene scene = avatar_scene();
   const AvatarFile a = read_avatar_file(dir.write("avatar.glb", softdeca::test::glb_bytes(scene)));
@@ -203,7 +195,6 @@ TEST(AvatarFiles, FramesGoBackToEachPartsOwnCoordinates) {
 }
 
 TEST(AvatarFiles, VrmIsReadAsBinaryGltf) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-vrm");
   const AvatarFile a = read_avatar_file(dir.write("avatar.vrm", softdeca::test::glb_bytes(avatar_scene())));
   EXPECT_EQ(a.format, "glTF 2.0");
@@ -211,7 +202,7 @@ TEST(AvatarFiles, VrmIsReadAsBinaryGltf) {
 }
 
 TEST(AvatarFiles, FbxWeldsCornersBackAndTakesTheFullShapeOfAnInBetween) {
-  REQUIRE_SCENE_FILES();
+  REQUIRE_FBX_FILES();
   const TempDir dir("avatar-fbx");
   TestScene scene = avatar_scene();
   scene.fbx_unit_cm = 1;
@@ -244,7 +235,6 @@ TEST(AvatarFiles, FbxWeldsCornersBackAndTakesTheFullShapeOfAnInBetween) {
 }
 
 TEST(AvatarFiles, AMirroringTransformTurnsTheTrianglesOverAndBack) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-mirror");
   TestScene scene;
   scene.meshes = {head()};
@@ -268,7 +258,6 @@ TEST(AvatarFiles, WeldingKeepsCornersApartThatAShapeMovesApart) {
 }
 
 TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-hostile");
   const std::string glb = softdeca::test::glb_bytes(avatar_scene());
 
@@ -311,11 +300,77 @@ TEST(AvatarFiles, HostileFilesGetErrorsNamingTheFileAndMesh) {
 }
 
 TEST(AvatarFiles, AShapeOfAnotherVertexCountIsRefused) {
-  REQUIRE_SCENE_FILES();
   const TempDir dir("avatar-shape-size");
   TestScene scene = avatar_scene();
   scene.meshes[1].shapes[0].deltas.resize(9);  // 3 of the teeth's 4 vertices
   const std::string path = dir.write("short_shape.glb", softdeca::test::glb_bytes(scene));
   const std::string error = error_of(path);
   EXPECT_NE(error.find(path + ": mesh 'Teeth': shape 'jawOpen' has 3 vertices, the mesh 4"), std::string::npos) << error;
+}
+
+// FBX is scanned before assimp parses it (plugin/import/fbx_bounds.h).
+namespace {
+std::string binary_fbx(const std::vector<softdeca::test::files_detail::FbxNode>& top) {
+  std::string out("Kaydara FBX Binary  \0\x1a\0", 23);
+  softdeca::test::files_detail::append(out, std::uint32_t{7400});
+  for (const auto& node : top) softdeca::test::files_detail::fbx_put(out, node);
+  return out + std::string(13, '\0');
+}
+
+std::string scan_error(const std::string& bytes, const ImportLimits& limits = {}) {
+  try {
+    scan_fbx(bytes, "a.fbx", limits);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(FbxBounds, TheTestAvatarPassesAndItsConnectionsAreRead) {
+  const FbxScan scan = scan_fbx(softdeca::test::fbx_bytes(avatar_scene()), "a.fbx", {});
+  EXPECT_TRUE(scan.binary);
+  EXPECT_EQ(scan.version, 7400u);
+  EXPECT_GE(scan.depth, 3);
+  EXPECT_GE(scan.connection_depth, 2u);  // a mesh's geometry under its model under the root
+}
+
+TEST(FbxBounds, DeepNestingLongChainsAndExpandingArraysAreRefusedBeforeAssimp) {
+  using softdeca::test::files_detail::FbxNode;
+  FbxNode deep{"Objects", {}, {}};
+  FbxNode* at = &deep;
+  for (int i = 0; i < 80; ++i) {
+    at->children.push_back({"Model", {}, {}});
+    at = &at->children.back();
+  }
+  EXPECT_NE(scan_error(binary_fbx({deep})).find("nested more than 64 deep"), std::string::npos);
+
+  FbxNode chain{"Connections", {}, {}};
+  for (std::int64_t i = 1; i <= 300; ++i)
+    chain.children.push_back({"C", {softdeca::test::files_detail::fbx_string("OO"), softdeca::test::files_detail::fbx_long(i),
+                                    softdeca::test::files_detail::fbx_long(i + 1)}, {}});
+  EXPECT_NE(scan_error(binary_fbx({chain})).find("connected more than 256 deep"), std::string::npos);
+  chain.children.push_back({"C", {softdeca::test::files_detail::fbx_string("OO"), softdeca::test::files_detail::fbx_long(301),
+                                  softdeca::test::files_detail::fbx_long(1)}, {}});
+  EXPECT_NE(scan_error(binary_fbx({chain})).find("in a cycle"), std::string::npos);
+
+  // A zlib array that says it holds 300 million doubles (2.4 GB) in a file of a few bytes.
+  std::string bomb;
+  softdeca::test::files_detail::append(bomb, std::uint32_t{300000000});
+  softdeca::test::files_detail::append(bomb, std::uint32_t{1});
+  softdeca::test::files_detail::append(bomb, std::uint32_t{4});
+  bomb += "abcd";
+  const FbxNode vertices{"Vertices", {{'d', bomb}}, {}};
+  EXPECT_NE(scan_error(binary_fbx({vertices})).find("would expand to 2.24 GiB, more than"), std::string::npos);
+
+  std::string truncated = softdeca::test::fbx_bytes(avatar_scene());
+  truncated.resize(truncated.size() / 2);
+  EXPECT_NE(scan_error(truncated).find("not a readable FBX file"), std::string::npos);
+
+  std::string ascii = "; FBX 7.4.0 project file\nFBXHeaderExtension:  {\n}\n";
+  for (int i = 0; i < 100; ++i) ascii += "A: {\n";
+  EXPECT_NE(scan_error(ascii).find("nested more than 64 deep"), std::string::npos);
+  std::string ascii_chain = "FBXHeaderExtension:  {\n}\nConnections:  {\n";
+  for (int i = 1; i <= 300; ++i) ascii_chain += "\tC: \"OO\"," + std::to_string(i) + "," + std::to_string(i + 1) + "\n";
+  EXPECT_NE(scan_error(ascii_chain + "}\n").find("connected more than 256 deep"), std::string::npos);
 }

@@ -29,7 +29,7 @@ using namespace softdeca::runtime;
 
 namespace {
 
-using softdeca::test::field;
+using namespace softdeca::test;
 
 // TensorProto: a float tensor of 4 elements whose data lives at `location`.
 std::string external_tensor(const std::string& name, const std::string& location) {
@@ -38,13 +38,8 @@ std::string external_tensor(const std::string& name, const std::string& location
 }
 
 // GraphProto fragment: ConstantOfShape of a constant int64 shape [elements] (float output).
-std::string constant_of_shape(std::uint64_t elements) {
-  std::string raw(8, '\0');
-  for (int i = 0; i < 8; ++i) raw[i] = static_cast<char>(elements >> (8 * i));
-  const std::string shape = field(1, 1) + field(2, 7) + field(8, std::string("big_shape")) + field(9, raw);
-  const std::string node =
-      field(1, std::string("big_shape")) + field(2, std::string("big")) + field(4, std::string("ConstantOfShape"));
-  return field(1, node) + field(5, shape);
+std::string constant_of_shape(std::int64_t elements) {
+  return initializer(int64_vector("big_shape", {elements})) + node("ConstantOfShape", {"big_shape"}, "big");
 }
 
 // Appending a second `graph` field to a ModelProto merges it into the first (protobuf rules):
@@ -107,21 +102,23 @@ TEST(Sha256, KnownDigests) {
   EXPECT_EQ(sha(std::string(1000, 'a')), "41edece42d63e8d9bf515a9ba6932e1c20cbc9f5a5d134645adb5db1b9737ea3");
 }
 
-TEST(OnnxModelScan, FindsExternalDataAndConstantShapes) {
-  const std::string model = field(1, 8) + field(7, field(2, std::string("g")) + field(5, external_tensor("w", "x.bin")) +
-                                                       constant_of_shape(std::uint64_t{1} << 30));
-  const auto scan = scan_onnx_model(reinterpret_cast<const std::uint8_t*>(model.data()), model.size());
-  ASSERT_EQ(scan.external_tensors.size(), 1u);
-  EXPECT_EQ(scan.external_tensors[0], "w");
-  EXPECT_EQ(scan.shaped_bytes, std::uint64_t{4} << 30);
-  EXPECT_EQ(scan.largest_tensor, "big");
+TEST(OnnxModelScan, FindsExternalDataAndCountsConstantShapes) {
+  const auto scan = [](const std::string& m) {
+    return scan_onnx_model(reinterpret_cast<const std::uint8_t*>(m.data()), m.size(), {});
+  };
+  const std::string big = model(constant_of_shape(std::int64_t{1} << 30));
+  const OnnxModelScan counted = scan(big);
+  EXPECT_EQ(counted.bytes, (std::uint64_t{4} << 30) + 8);
+  EXPECT_EQ(counted.largest_tensor, "big");
+  const OnnxModelScan external = scan(model(field(5, external_tensor("w", "x.bin")) + constant_of_shape(1)));
+  ASSERT_EQ(external.external_tensors.size(), 1u);
+  EXPECT_EQ(external.external_tensors[0], "w");
   // Bytes that are not a protobuf message are refused, never read past their end.
-  const std::string cut = model.substr(0, model.size() - 3);
-  EXPECT_THROW(scan_onnx_model(reinterpret_cast<const std::uint8_t*>(cut.data()), cut.size()), Error);
+  const std::string cut = big.substr(0, big.size() - 3);
+  EXPECT_THROW(scan(cut), Error);
   std::string deep;
   for (int i = 0; i < 40; ++i) deep = field(1, field(5, field(6, deep)));  // nodes in subgraphs in nodes...
-  deep = field(7, deep);
-  EXPECT_THROW(scan_onnx_model(reinterpret_cast<const std::uint8_t*>(deep.data()), deep.size()), Error);
+  EXPECT_THROW(scan(field(8, field(2, 17)) + field(7, deep)), Error);
 }
 
 TEST_F(HostileBundle, ExternalDataIsRefusedWithoutReadingAndWithoutHostPaths) {
@@ -234,7 +231,7 @@ TEST_F(HostileBundle, TamperedFilesFailTheirSha256) {
 
 TEST_F(HostileBundle, FourGibibyteModelIsRefusedBeforeAllocation) {
   const std::string model = read_text(bundle_ / "identity_encoder.onnx");
-  replace("identity_encoder.onnx", with_graph(model, constant_of_shape(std::uint64_t{1} << 30)));
+  replace("identity_encoder.onnx", with_graph(model, constant_of_shape(std::int64_t{1} << 30)));
   EXPECT_LT(read_text(bundle_ / "identity_encoder.onnx").size(), model.size() + 100);
   rusage before{}, after{};
   ::getrusage(RUSAGE_SELF, &before);
@@ -242,6 +239,33 @@ TEST_F(HostileBundle, FourGibibyteModelIsRefusedBeforeAllocation) {
   ::getrusage(RUSAGE_SELF, &after);
   EXPECT_NE(error.find("over the memory budget of 2048 MiB"), std::string::npos) << error;
   EXPECT_NE(error.find("identity_encoder.onnx tensor 'big', 4096 MiB"), std::string::npos) << error;
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256L * 1024) << "peak resident memory grew (KiB)";
+}
+
+// Graphs that fold to gigabytes however their shapes are computed (onnx_test_support.h), each
+// added to a network of the test bundle: refused under a 200 MiB budget that the bundle itself
+// fits, by operator or by size, before any session exists.
+TEST_F(HostileBundle, RedTeamGraphsAreRefusedUnderTheBudget) {
+  ModelOptions budget;
+  budget.memory_budget_bytes = std::uint64_t{200} << 20;
+  EXPECT_EQ(load_error(budget), "");
+  const std::string model = read_text(bundle_ / "identity_encoder.onnx");
+  rusage before{}, after{};
+  ::getrusage(RUSAGE_SELF, &before);
+  for (const RedTeamGraph& g : red_team_graphs()) {
+    SCOPED_TRACE(g.what);
+    replace("identity_encoder.onnx", with_graph(model, g.fields));
+    const std::string error = load_error(budget);
+    if (g.refused_operator) {
+      EXPECT_NE(error.find(std::string("identity_encoder.onnx: ONNX model: operator '") + g.refused_operator + "'"),
+                std::string::npos)
+          << error;
+    } else {
+      EXPECT_NE(error.find("over the memory budget of 200 MiB"), std::string::npos) << error;
+      EXPECT_NE(error.find("largest: identity_encoder.onnx tensor 'red_big'"), std::string::npos) << error;
+    }
+  }
+  ::getrusage(RUSAGE_SELF, &after);
   EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256L * 1024) << "peak resident memory grew (KiB)";
 }
 

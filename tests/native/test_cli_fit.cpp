@@ -2,7 +2,10 @@
 // synthetic bundle: the test head written as a user's glTF and FBX (centimetres, turned and
 // moved by its node, beside a body part without ARKit shapes) is fitted and replayed, and its
 // point caches, in the head's own coordinates, match the replay of the head in the template's
-// topology; a fit folder refuses a changed mesh.
+// topology; a fit folder refuses a changed mesh; a poor fit is refused with its reason unless
+// kept on request, marked poor. The fit folder is written whole: two fits at once into one folder
+// leave one of them, a link in it is not written through, a failed write leaves the previous
+// folder.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +13,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -72,7 +76,6 @@ class CliFit : public ::testing::Test {
  protected:
   void SetUp() override {
     if (rt::data_dir().empty()) GTEST_SKIP() << "SOFTDECA_TEST_DATA is not set (ctest's runtime_test_data fixture)";
-    if (!softdeca::avatar_import::scene_files_supported()) GTEST_SKIP() << "built without assimp";
     head_ = rt::Head::load();
     bundle_ = rt::data_dir() + "/bundle";
     take_ = rt::data_dir() + "/take.csv";
@@ -130,6 +133,8 @@ TEST_F(CliFit, AFittedGltfReplaysAsItsHeadInTheTemplatesTopology) {
   EXPECT_EQ(report.at("left_out", "").array("")[0].at("name", "").string(""), "Body");
   EXPECT_EQ(report.at("shapes", "").at("jawOpen", "").at("Head", "").string(""), "blendShape1.jawOpen");
   EXPECT_TRUE(report.at("fit", "").has("face_residual_mm_max"));
+  EXPECT_TRUE(report.at("fit", "").at("quality", "").at("passed", "").boolean(""));
+  EXPECT_FALSE(report.at("poor_fit", "").boolean(""));
 
   ASSERT_EQ(softdeca("replay '" + take_ + "' --bundle '" + bundle_ + "' --avatar '" + dir_.file("fit") + "' --frames 12 --out '" +
                          dir_.file("fitted") + "'",
@@ -156,7 +161,41 @@ TEST_F(CliFit, AFittedGltfReplaysAsItsHeadInTheTemplatesTopology) {
   EXPECT_NE(log("changed.log").find("is not the mesh fitted in"), std::string::npos) << log("changed.log");
 }
 
+TEST_F(CliFit, APoorFitIsRefusedWithItsReasonUnlessKept) {
+  // A shell around the head, 1.5 times its size and moved by the same shapes: the template fits
+  // the head and covers a patch of the face the shapes move.
+  TestScene scene = user_scene(head_);
+  TestMesh shell = scene.meshes[0];
+  shell.name = "Shell";
+  for (float& x : shell.vertices) x *= 1.5f;
+  for (softdeca::test::TestShape& s : shell.shapes)
+    for (float& x : s.deltas) x *= 1.5f;
+  scene.meshes.push_back(shell);
+  const std::string glb = dir_.write("shell.glb", softdeca::test::glb_bytes(scene));
+  const std::string fit = "fit '" + glb + "' --bundle '" + bundle_ + "' --metres-per-unit 0.01 --out '";
+  EXPECT_NE(softdeca(fit + dir_.file("poor") + "'", "poor.log"), 0);
+  const std::string refused = log("poor.log");
+  EXPECT_NE(refused.find("the fit is poor (face_coverage)"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("at least 70 %"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("Likely cause"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("--keep-poor-fit"), std::string::npos) << refused;
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("poor/avatar.fit")));
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("poor/fit.json")));
+
+  ASSERT_EQ(softdeca(fit + dir_.file("kept") + "' --keep-poor-fit", "kept.log"), 0) << log("kept.log");
+  EXPECT_NE(log("kept.log").find("keeping a poor fit (face_coverage)"), std::string::npos) << log("kept.log");
+  EXPECT_TRUE(std::filesystem::exists(dir_.file("kept/avatar.fit")));
+  const std::vector<char> json = rt::read_bytes(dir_.file("kept/fit.json"));
+  const softdeca::runtime::Json report = softdeca::runtime::Json::parse(std::string(json.begin(), json.end()));
+  EXPECT_TRUE(report.at("poor_fit", "").boolean(""));
+  const softdeca::runtime::Json& quality = report.at("fit", "").at("quality", "");
+  EXPECT_FALSE(quality.at("passed", "").boolean(""));
+  EXPECT_EQ(quality.at("failed_measure", "").string(""), "face_coverage");
+  EXPECT_LT(report.at("fit", "").at("face_coverage", "").number(""), 0.7);
+}
+
 TEST_F(CliFit, AnFbxIsFittedOnTheSpotAndWrittenInItsWeldedOrder) {
+  if (!softdeca::avatar_import::fbx_files_supported()) GTEST_SKIP() << "built without assimp";
   const std::string fbx = dir_.write("user.fbx", softdeca::test::fbx_bytes(user_scene(head_)));
   ASSERT_EQ(softdeca("replay '" + take_ + "' --bundle '" + bundle_ + "' --avatar '" + fbx + "' --metres-per-unit 0.01 --frames 12 " +
                          "--models linear --out '" + dir_.file("fbx") + "'",
@@ -178,4 +217,124 @@ TEST_F(CliFit, AnFbxIsFittedOnTheSpotAndWrittenInItsWeldedOrder) {
       for (std::size_t c = 0; c < 3; ++c)
         if (order[v] != SIZE_MAX) worst = std::max(worst, std::abs(fitted[f][3 * order[v] + c] - want[f][3 * v + c]));
   EXPECT_LT(worst, 1e-3f);
+}
+
+namespace {
+namespace fs = std::filesystem;
+
+std::string text_of(const std::string& path) {
+  const std::vector<char> bytes = rt::read_bytes(path);
+  return std::string(bytes.begin(), bytes.end());
+}
+
+// The fit folder's files as they are now.
+std::vector<std::string> folder_files(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const char* name : {"avatar.fit", "fit.json", "fit.png"}) out.push_back(text_of(dir + "/" + name));
+  return out;
+}
+
+// What `softdeca fit` writes, written by several at once, links in the folder, failed writes:
+// the test avatar folder (the runtime tests' head), no assimp needed.
+class CliFitFolder : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (rt::data_dir().empty()) GTEST_SKIP() << "SOFTDECA_TEST_DATA is not set (ctest's runtime_test_data fixture)";
+    bundle_ = rt::data_dir() + "/bundle";
+    // The head as two avatars: as made, and with one vertex moved a tenth of a millimetre.
+    fs::copy(rt::data_dir() + "/avatar", dir_.file("a"), fs::copy_options::recursive);
+    fs::copy(rt::data_dir() + "/avatar", dir_.file("b"), fs::copy_options::recursive);
+    softdeca::cli::ObjMesh moved = softdeca::cli::read_obj(dir_.file("b/neutral.obj"));
+    moved.vertices[0] += 1e-4f;
+    softdeca::cli::write_obj(dir_.file("b/neutral.obj"), moved.vertices.data(), moved.vertex_count(), nullptr,
+                             moved.triangles.data(), moved.triangles.size() / 3, "a vertex moved");
+  }
+  // The command line `softdeca fit MESH --out OUT` (the synthetic shapes give no unit: metres).
+  std::string fit_command(const std::string& mesh, const std::string& out, const std::string& log) const {
+    return "'" SOFTDECA_CLI "' fit '" + dir_.file(mesh) + "' --bundle '" + bundle_ + "' --out '" + dir_.file(out) +
+           "' --metres-per-unit 1 > '" + dir_.file(log) + "' 2>&1";
+  }
+  int fit(const std::string& mesh, const std::string& out, const std::string& log) const {
+    return std::system(fit_command(mesh, out, log).c_str());
+  }
+  // The fit folder is one fit's: the mesh fit.json names (checked against its SHA-256) is the
+  // one avatar.fit was made for (the library checks its own hash of it).
+  void expect_one_fit(const std::string& out) const {
+    const softdeca::cli::AvatarFile mesh = softdeca::cli::read_fitted_mesh(dir_.file(out));
+    rt::ModelPtr model;
+    ASSERT_EQ(softdeca_model_load(bundle_.c_str(), nullptr, &model.p), SOFTDECA_OK) << softdeca_last_error();
+    softdeca_avatar_fit* loaded = nullptr;
+    ASSERT_EQ(softdeca_avatar_fit_load(model.p, softdeca::cli::fit_file(dir_.file(out)).c_str(), &loaded), SOFTDECA_OK)
+        << softdeca_last_error();
+    const softdeca_avatar_mesh abi = mesh.abi_mesh();
+    rt::AvatarPtr avatar;
+    EXPECT_EQ(softdeca_avatar_create_fitted(model.p, loaded, &abi, 1, 0, &avatar.p), SOFTDECA_OK) << softdeca_last_error();
+    softdeca_avatar_fit_destroy(loaded);
+  }
+  // Nothing but what the test made beside the fit folders: no temporary folder is left.
+  void expect_no_temporary_folder() const {
+    for (const auto& e : fs::directory_iterator(dir_.dir))
+      EXPECT_NE(e.path().filename().string().front(), '.') << e.path() << " is left";
+  }
+
+  TempDir dir_{"cli-fit-folder"};
+  std::string bundle_;
+};
+}  // namespace
+
+TEST_F(CliFitFolder, TwoFitsAtOnceIntoOneFolderLeaveOneWholeFit) {
+  for (int round = 0; round < 2; ++round) {
+    const std::string both = fit_command("a", "out", "a.log") + " & a=$!; " + fit_command("b", "out", "b.log") +
+                             " & b=$!; wait $a; ra=$?; wait $b; rb=$?; exit $((ra | rb))";
+    ASSERT_EQ(std::system(both.c_str()), 0) << text_of(dir_.file("a.log")) << text_of(dir_.file("b.log"));
+    expect_one_fit("out");
+  }
+  expect_no_temporary_folder();
+}
+
+TEST_F(CliFitFolder, ALinkInAFitFolderIsReplacedNotWrittenThrough) {
+  ASSERT_EQ(fit("a", "out", "first.log"), 0) << text_of(dir_.file("first.log"));
+  const std::string outside = dir_.write("outside.txt", "not the fit's");
+  for (const char* name : {"fit.png", "fit.json"}) {
+    fs::remove(dir_.file(std::string("out/") + name));
+    fs::create_symlink(outside, dir_.file(std::string("out/") + name));
+  }
+  ASSERT_EQ(fit("b", "out", "second.log"), 0) << text_of(dir_.file("second.log"));
+  EXPECT_EQ(text_of(outside), "not the fit's");
+  for (const char* name : {"avatar.fit", "fit.png", "fit.json"})
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir_.file(std::string("out/") + name)))) << name;
+  expect_one_fit("out");
+  expect_no_temporary_folder();
+}
+
+TEST_F(CliFitFolder, AFailedWriteLeavesThePreviousFolderAndNoTemporaryFolder) {
+  ASSERT_EQ(fit("a", "out", "first.log"), 0) << text_of(dir_.file("first.log"));
+  const std::vector<std::string> before = folder_files(dir_.file("out"));
+  ASSERT_LT(before[0].size(), 500000u) << "avatar.fit fits under the limit below";
+  ASSERT_GT(before[2].size(), 1300000u) << "fit.png does not";
+  // A file size limit of 600 kB (sh counts 512-byte blocks) cuts fit.png short, as a full disk would.
+  const std::string limited = "trap '' XFSZ; ulimit -f 1200; " + fit_command("b", "out", "limited.log");
+  EXPECT_NE(std::system(limited.c_str()), 0);
+  EXPECT_NE(text_of(dir_.file("limited.log")).find("could not save"), std::string::npos) << text_of(dir_.file("limited.log"));
+  EXPECT_EQ(folder_files(dir_.file("out")), before);
+  expect_no_temporary_folder();
+
+  // A folder holding other files is not replaced.
+  dir_.write("other/notes.txt", "mine");
+  EXPECT_NE(fit("a", "other", "other.log"), 0);
+  EXPECT_NE(text_of(dir_.file("other.log")).find("holds notes.txt, which is not a fit folder's"), std::string::npos)
+      << text_of(dir_.file("other.log"));
+  EXPECT_EQ(text_of(dir_.file("other/notes.txt")), "mine");
+  EXPECT_EQ(fs::directory_iterator(dir_.file("other"))->path().filename(), "notes.txt");
+  expect_no_temporary_folder();
+}
+
+TEST_F(CliFitFolder, AUnitTheFitCouldNotLoadIsRefusedBeforeFitting) {
+  const std::string command = "'" SOFTDECA_CLI "' fit '" + dir_.file("a") + "' --bundle '" + bundle_ + "' --out '" +
+                              dir_.file("out") + "' --metres-per-unit 1e-300 > '" + dir_.file("unit.log") + "' 2>&1";
+  EXPECT_NE(std::system(command.c_str()), 0);
+  EXPECT_NE(text_of(dir_.file("unit.log")).find("--metres-per-unit must be 0 (read off the shapes) or 1e-06 to 1000"),
+            std::string::npos)
+      << text_of(dir_.file("unit.log"));
+  EXPECT_FALSE(fs::exists(dir_.file("out")));
 }

@@ -385,6 +385,28 @@ TEST(Json, ParsesTheSubsetManifestsUse) {
   EXPECT_THROW(Json::parse(deep), softdeca::Error);
 }
 
+TEST(Json, BoundsItsNestingAndItsValues) {
+  // Every value counts: the array, its members, an object's member values.
+  softdeca::runtime::JsonLimits limits;
+  limits.max_values = 4;
+  EXPECT_NO_THROW(Json::parse("[1, 2, 3]", limits));
+  EXPECT_THROW(Json::parse("[1, 2, 3, 4]", limits), softdeca::Error);
+  EXPECT_THROW(Json::parse(R"({"a": [1, 2], "b": 3})", limits), softdeca::Error);
+  limits = {};
+  limits.max_depth = 3;  // the document is at depth 0, the 1 in [[[1]]] at 3
+  EXPECT_NO_THROW(Json::parse("[[[1]]]", limits));
+  try {
+    Json::parse("[[[[1]]]]", limits);
+    ADD_FAILURE() << "a value 4 deep was read";
+  } catch (const softdeca::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nesting deeper than 3"), std::string::npos) << e.what();
+  }
+  const Json j = Json::parse(R"({"k": 1, "k": 2})");
+  ASSERT_EQ(j.members("").size(), 2u);  // in file order, repeats kept
+  EXPECT_EQ(j.members("")[1].second.number(""), 2);
+  EXPECT_STREQ(j.kind(), "an object");
+}
+
 // A ustar member header (name, size, checksum) followed by its data padded to 512 bytes.
 std::vector<uint8_t> tar_member(const std::string& name, const std::string& data) {
   std::vector<uint8_t> h(512, 0);

@@ -3,7 +3,7 @@
 native.py) mirror them by hand. These tests parse the header and hold every mirror to it: the
 same fields in the same order with the same types (and names, up to the languages' spelling),
 the same ABI version, and C#'s P/Invoke declarations (NativeMethods.cs) the header's
-signatures."""
+signatures, and Python's function table (native.SIGNATURES) the same."""
 
 from __future__ import annotations
 
@@ -473,3 +473,39 @@ def test_a_mismatch_is_found(mirror: list[Field], problem: str) -> None:
     assert differences(header, header) == []
     found = differences(header, mirror)
     assert found and problem in found[0], found
+
+
+# ---- Python's function table ----------------------------------------------------------------
+def python_functions() -> dict[str, tuple[str, list[str]]]:
+    """native.SIGNATURES in the kinds above: c_void_p stands for any pointer, as C#'s IntPtr."""
+
+    def kind(ctype: type | None) -> str:
+        if ctype is None:
+            return "void"
+        if ctype is C.c_void_p:
+            return "any"
+        if ctype is C.c_char_p:
+            return "ptr:u8"
+        return PY_KINDS[ctype]
+
+    return {
+        name: (kind(restype), [kind(a) for a in argtypes])
+        for name, (restype, argtypes) in native.SIGNATURES.items()
+    }
+
+
+def test_pythons_function_table_matches_the_headers_prototypes() -> None:
+    declared = python_functions()
+    assert "softdeca_avatar_set_parameter" in declared
+    assert signature_problems(header_functions(), declared) == {}
+
+
+def test_python_calls_no_function_outside_its_table() -> None:
+    called = {
+        m[1]
+        for path in (ROOT / "training" / "softdeca_train").rglob("*.py")
+        for m in re.finditer(r"\.(softdeca_\w+)\(", path.read_text(encoding="utf-8"))
+    }
+    header = header_functions()
+    assert called & set(header), "no C ABI call found: the pattern is stale"
+    assert sorted((called & set(header)) - set(native.SIGNATURES)) == []

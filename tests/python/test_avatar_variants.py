@@ -15,6 +15,7 @@ import pytest
 import scipy.sparse as sp
 import softdeca_native as native
 from bounds import below
+from scipy.spatial import cKDTree
 from softdeca_train.avatars import (
     HELD_OUT_IDENTITIES,
     NAME_STYLES,
@@ -27,6 +28,8 @@ from softdeca_train.avatars import (
     write_avatar,
 )
 from softdeca_train.avatars.cli import COMMANDS, config_from_args
+from softdeca_train.avatars.config import low_poly
+from softdeca_train.avatars.mesh import PARTS
 from softdeca_train.avatars.remesh import remesh
 from softdeca_train.cli import STAGES
 from softdeca_train.data.plan import derived_seed
@@ -294,6 +297,8 @@ def test_name_styles_look_as_rigs_spell_them() -> None:
         "suffix_LR": "eyeBlink_L",
         "snake": "eye_blink_l",
         "pascal": "EyeBlinkLeft",
+        "cc": "CC_Base_Body.Eye_Blink_L",
+        "daz": "facs_bs_EyeBlinkLeft",
     }
     assert rig_name("jawLeft", "suffix_LR") == "jawLeft"  # a direction, not a side
     assert rig_name("mouthSmileRight", "snake") == "mouth_smile_r"
@@ -317,6 +322,52 @@ def test_separate_eyes_and_teeth_are_objects_of_their_own(remeshed) -> None:
         owner[corners] = k
         assert remeshed.truth.part_mask(parts.get(name, "eyes"))[corners].all(), name
     assert (owner >= 0).all()
+
+
+def test_a_low_poly_game_head(template) -> None:
+    """Decimated skin, eyes, teeth and tongue, hair cards, eyebrow fins and a bust in one
+    object: the cards hover off the skin as sheets of their own that no shape moves, the fins
+    stand on skin vertices and move with them, and the frame still reads centimetres and Z-up."""
+    a = make_avatar(low_poly(AvatarConfig()), template)
+    t = a.truth
+    assert a.groups == (("head", len(a.triangles)),) and 3_000 < len(a.neutral) < 5_000
+    assert {"skin", "eyes", "teeth", "inner", "body", "hair"} <= {
+        PARTS[p] for p in t.part
+    }
+    adjacency = sp.csc_matrix(igl.adjacency_matrix(a.triangles.astype(np.int64)))
+    _, labels, _ = igl.connected_components(adjacency)
+    skin = t.part_mask("skin")
+    head = labels[skin][0]
+    fins = t.part_mask("hair") & (labels == head)
+    cards = t.part_mask("hair") & (labels != head)
+    assert fins.sum() > 20 and cards.sum() > 100
+    assert not a.deltas[:, cards].any() and a.deltas[:, fins].any()
+    assert not np.isin(labels[cards], labels[skin]).any()  # sheets of their own
+    gap = cKDTree(a.neutral[skin]).query(a.neutral[cards])[0]  # cm
+    assert 0.1 < np.median(gap) < 1.5
+    assert (labels[t.part_mask("body")] == head).all()  # the bust continues the neck
+    f = check_frame(a)
+    assert f["up_axis"] == "+Z" and f["metres_per_unit"] == 0.01
+
+
+def test_a_ramp_split_moves_both_sides_and_keeps_the_sum(template) -> None:
+    plain = make_avatar(AvatarConfig(), template)
+    ramp = make_avatar(AvatarConfig(split_width=0.16), template)
+    left, right = (
+        ARKIT_BLENDSHAPES.index(n) for n in ("eyeBlinkLeft", "eyeBlinkRight")
+    )
+    np.testing.assert_allclose(
+        ramp.deltas[left] + ramp.deltas[right], plain.deltas[left] + plain.deltas[right]
+    )
+    on_right = plain.neutral[:, 0] < -0.03  # the subject's right, metres
+    assert (
+        np.abs(ramp.deltas[left][on_right]).max()
+        > 0.1 * np.abs(plain.deltas[right]).max()
+    )
+    # the unit is read off the pairs' sides; the ramp moves the eye and brow shapes' centres of
+    # motion a little, and with them the up axis read (forward 5.1° off measured)
+    f = check_frame(ramp, forward_deg=8.0)
+    assert f["metres_per_unit"] == 1.0
 
 
 def test_a_whole_body_leaves_the_face_a_small_part(bodied) -> None:

@@ -28,10 +28,13 @@ from softdeca_train.controls.real_takes import (
     MILD_MM,
     FrameDistances,
     RecordedTake,
+    readme_lines,
     recorded_takes,
     summarise,
     trained_on,
     trained_take_names,
+    validate_real_takes,
+    worse_when_calm,
 )
 from softdeca_train.controls.report import (
     kept_real_takes,
@@ -214,6 +217,24 @@ def test_real_takes_are_reported_per_take_with_unseen_and_mild_frames_apart() ->
     assert real["seen"]["mild"]["frames"] == 1 and real["seen"]["strong"]["frames"] == 2
     assert real["unseen"]["worst_take_ratio"] == pytest.approx(0.85 / 0.88)
     assert MILD_MM == real["mild_mm"]
+
+
+def test_calm_frames_are_reported_and_a_take_worse_there_is_named() -> None:
+    real = _real_takes()
+    seen, unseen = real["takes"]
+    assert seen["calm"]["frames"] == 1  # linear 0.05 mm <= CALM_MM
+    assert seen["calm"]["ratio"] == pytest.approx(0.01 / 0.05)
+    assert unseen["calm"] is None  # no frame of it within CALM_MM
+    assert worse_when_calm(real) == []
+    seen["calm"]["ratio"] = 1.4
+    assert worse_when_calm(real) == ["source-a/seen"]
+    assert any("further from the physics" in line for line in readme_lines(real))
+    older = _real_takes()  # a report made before the calm figure is read as it is
+    older.pop("calm_mm")
+    for t in older["takes"]:
+        t.pop("calm")
+    validate_real_takes(older)
+    assert "calm ratio" in "".join(readme_lines(older))
 
 
 def test_the_takes_a_bundle_trained_on_come_from_its_training_record() -> None:

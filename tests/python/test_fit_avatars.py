@@ -12,7 +12,7 @@ import pytest
 from bounds import above, below
 from scipy.spatial import cKDTree
 from softdeca_train.avatars.build import make_avatar
-from softdeca_train.avatars.config import AvatarConfig
+from softdeca_train.avatars.config import LOW_POLY_VARIANTS, AvatarConfig
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
 from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.paths import default_takes_path
@@ -23,6 +23,7 @@ from softdeca_train.runtime.fit_check import (
     check_identity,
     template_head,
 )
+from softdeca_train.runtime.fit_coverage import face_coverage
 from softdeca_train.runtime.native import (
     AvatarArrays,
     NativeAvatar,
@@ -37,6 +38,14 @@ LIMIT_RATIO = (
 )
 LIMIT_FROM_LINEAR_MM = 20.0  # no vertex further than this from the avatar's own blend
 FACE_FADE_M = 0.03  # the fit's fall-off beyond the face (plugin/src/fit/avatar_fit.cpp, kFaceFade)
+
+
+def assert_fit_passes(report: dict) -> None:
+    """The library's verdict on the fit (plugin/src/fit/fit_quality.h): every test avatar passes
+    its quality bounds."""
+    quality = report["quality"]
+    assert quality["passed"], quality["reason"]
+    assert quality["failed_measure"] == "" and quality["reason"] == ""
 
 
 @pytest.fixture(scope="module")
@@ -71,6 +80,7 @@ def test_a_held_out_identity_in_another_topology_gets_the_template_paths_physics
         "the acceptance bound of the fit's residual",
     )
     assert r.fit["metres_per_unit"] == 0.01 and r.fit["up_axis"] == "+Z"
+    assert_fit_passes(r.fit)
     (t,) = r.takes
     below(
         t.softdeca_ratio_max,
@@ -99,6 +109,7 @@ def replay(model, mesh, weights) -> tuple[dict, float, np.ndarray, np.ndarray]:
     """Fit, save and load, animate: the report, the largest distance from the avatar's own
     blend (avatar units) and the last frame's output and blend."""
     fit = NativeFit.create(model, mesh)
+    assert_fit_passes(fit.report())
     avatar = NativeAvatar.fitted(model, fit, mesh)
     avatar.prepare()
     worst = 0.0
@@ -172,6 +183,29 @@ def test_avatars_as_they_come_fit_and_animate(
     assert len(report["shapes_matched"]) == int(a.present.sum())
 
 
+@pytest.mark.parametrize("name", list(LOW_POLY_VARIANTS))
+def test_low_poly_heads_are_covered_by_the_registered_template(
+    model, template, arkit, name: str
+) -> None:
+    """The avatar's face (the skin its skin-only shapes move) lies on the registered template:
+    a template squeezed onto part of the face (a unit misread) leaves most of it far away."""
+    a = make_avatar(LOW_POLY_VARIANTS[name], template, arkit)
+    fit = NativeFit.create(model, avatar_arrays(a))
+    c = face_coverage(model, fit, a)
+    above(c.within, 0.7, "acceptance: 70 % of the face within 3 mm of the template")
+    below(c.median_mm, 1.0, "acceptance: the face a median 1 mm from the template")
+    report = fit.report()
+    assert report["metres_per_unit"] == a.truth.metres_per_unit
+    assert_fit_passes(report)
+    # the library's own coverage (its face: what the skin-only shapes move, eyebrow fins and
+    # hair cards that follow them too) agrees with this one on the truth's skin (0.001 apart)
+    below(
+        abs(report["face_coverage"] - c.within),
+        0.02,
+        "the library's and the truth's face differ by a few fins",
+    )
+
+
 def test_the_fitted_head_is_the_template_paths_on_its_own_topology(
     model, template
 ) -> None:
@@ -198,6 +232,32 @@ def test_the_fitted_head_is_the_template_paths_on_its_own_topology(
     below(ratio, LIMIT_RATIO, "acceptance: within 20 %")
 
 
+def test_a_template_on_a_patch_of_the_face_is_judged_poor_from_the_avatars_side(
+    model, template
+) -> None:
+    """A head in centimetres fitted as if its unit were 4 cm: the template, at a head's size,
+    settles on a patch of a face four times as large. Its own distance to the avatar is as small
+    as a good fit's, yet it covers almost none of the face: the report calls the fit poor and
+    names the unit it took."""
+    a = make_avatar(AvatarConfig(unit="cm"), template)
+    report = NativeFit.create(model, avatar_arrays(a), metres_per_unit=0.04).report()
+    below(
+        report["face_residual_mm_mean"],
+        1.0,
+        "one way, the fit looks fine (0.04 mm measured)",
+    )
+    quality = report["quality"]
+    assert not quality["passed"]
+    assert quality["failed_measure"] == "face_coverage", quality["reason"]
+    assert "0.04 m" in quality["reason"] and "squeezed" in quality["reason"]
+    below(report["face_coverage"], 0.7, "the bound (0.01 measured)")
+    below(
+        report["template_scale"],
+        quality["bounds"]["template_scale_min"],
+        "the template's face smaller than the avatar's (0.15 measured)",
+    )
+
+
 def test_an_avatar_without_shapes_fits_on_landmarks_and_animates(model, arkit) -> None:
     """ARKit's face with no shapes at all, in centimetres and Z-up, and the bundle's landmarks on
     it: it fits, and the template's shapes carried back through the fit move it."""
@@ -208,6 +268,7 @@ def test_an_avatar_without_shapes_fits_on_landmarks_and_animates(model, arkit) -
     report = fit.report()
     assert report["metres_per_unit"] == 0.01 and report["up_axis"] == "+Z"
     assert report["landmarks"] == len(landmarks) and report["shapes_matched"] == []
+    assert_fit_passes(report)
     below(report["face_residual_mm_mean"], 1.0, "acceptance: a face mask within 1 mm")
     avatar = NativeAvatar.fitted(model, fit, mesh)
     avatar.prepare()

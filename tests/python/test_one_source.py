@@ -4,6 +4,7 @@ These tests fail where a second copy appears in the source trees."""
 
 from __future__ import annotations
 
+import ast
 import json
 import math
 import re
@@ -171,3 +172,189 @@ def test_every_reader_names_the_landmark_file() -> None:
     ]
     assert "training/softdeca_train/landmarks/definition.py" in readers
     assert "ios_capture/Sources/SoftDecaCapture/LandmarkProfile.swift" in readers
+
+
+# ---- Algorithms written once ----------------------------------------------------------------
+# Each algorithm the library and the training package share has one implementation, in the
+# library; the training package calls it through softdeca_native. A Python function of one of
+# these names must hand the work to softdeca_native; the names are the homes' own and those of
+# the Python functions that call them.
+PACKAGE = ROOT / "training" / "softdeca_train"
+ONE_HOME: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
+    # job: (home, its functions, the names a Python implementation would take)
+    "the lip and lid contact sets": (
+        "plugin/src/prepare/contact_sets.cpp",
+        (
+            "lip_contact_zone",
+            "lip_sets",
+            "eye_fissures",
+            "lid_sides",
+            "lid_sets",
+            "contact_sets",
+        ),
+        (
+            "lip_contact_zone",
+            "lip_sets",
+            "lip_sets_of",
+            "eye_fissures",
+            "fissure_line",
+            "lid_sides",
+            "lid_side_of_points",
+            "lid_sets",
+            "lid_sets_of",
+            "contact_sets",
+            "collision_sets",
+        ),
+    ),
+    "the parameter localisation rules": (
+        "plugin/src/prepare/parameters.cpp",
+        ("skin_vertex_areas", "faces_from_vertex_map", "vertices_from_face_map"),
+        (
+            "localise_to_faces",
+            "localise_to_vertices",
+            "faces_from_vertex_map",
+            "vertices_from_face_map",
+            "skin_vertex_areas",
+            "vertex_areas",
+            "_column",  # ParameterState's per-element values
+        ),
+    ),
+    # The data's identity fields (lhm/carried.py, carry_basis) still assemble the same
+    # stiffness with numpy: add_fill_stiffness's differs from it by round-off (1e-16), which
+    # would change every carried fill of the data.
+    "the fill's carry to a neutral skin": (
+        "plugin/src/prepare/rest_physics.cpp",
+        ("carry_fill", "add_fill_stiffness"),
+        ("carry_fill", "carried_vertices", "fill_stiffness"),
+    ),
+}
+# Modules using the contact rules' landmarks for another job, with that job.
+OTHER_LANDMARK_JOBS = {
+    "lhm/tissue_depth.py": "soft-tissue depth anchors below the lower lids",
+}
+
+
+def package_modules() -> dict[str, ast.Module]:
+    return {
+        str(p.relative_to(PACKAGE)): ast.parse(p.read_text(encoding="utf-8"))
+        for p in sorted(PACKAGE.rglob("*.py"))
+    }
+
+
+def calls_native(function: ast.AST) -> bool:
+    """Whether the function calls softdeca_native (imported as itself or as `native`)."""
+    return any(
+        isinstance(n, ast.Call)
+        and isinstance(n.func, ast.Attribute)
+        and isinstance(n.func.value, ast.Name)
+        and n.func.value.id in ("native", "softdeca_native")
+        for n in ast.walk(function)
+    )
+
+
+def own_implementations(modules: dict[str, ast.Module]) -> list[str]:
+    """Python functions of a listed name that do the work themselves."""
+    names = {n: job for job, (_, _, py) in ONE_HOME.items() for n in py}
+    return [
+        f"{path}:{f.lineno}: {f.name} ({names[f.name]}) does not call softdeca_native"
+        for path, tree in modules.items()
+        for f in ast.walk(tree)
+        if isinstance(f, ast.FunctionDef | ast.AsyncFunctionDef)
+        and f.name in names
+        and not calls_native(f)
+    ]
+
+
+def contact_landmarks() -> dict[str, frozenset[int]]:
+    data = json.loads(CONTACT_RULES.read_text(encoding="utf-8"))
+    return {name: frozenset(e["value"]) for name, e in data["landmarks"].items()}
+
+
+def _int_literals(node: ast.AST) -> list[int] | None:
+    """The ids a literal collection or a slice of int literals names, else None."""
+    if isinstance(node, ast.Tuple | ast.List | ast.Set) and len(node.elts) >= 2:
+        values = [e.value for e in node.elts if isinstance(e, ast.Constant)]
+        if len(values) == len(node.elts) and all(type(v) is int for v in values):
+            return values
+    if (
+        isinstance(node, ast.Slice)
+        and isinstance(node.lower, ast.Constant)
+        and isinstance(node.upper, ast.Constant)
+        and type(node.lower.value) is int
+        and type(node.upper.value) is int
+        and node.step is None
+        and node.upper.value - node.lower.value >= 2
+    ):
+        return list(range(node.lower.value, node.upper.value))
+    return None
+
+
+def landmark_copies(
+    modules: dict[str, ast.Module], landmarks: dict[str, frozenset[int]]
+) -> list[str]:
+    """Literal collections of two or more landmark ids from one of the rules' landmark lists
+    (the inner lip contour, its corners, an eye's fissure), outside the reader."""
+    out = []
+    for path, tree in modules.items():
+        if path == "contact_rules.py" or path in OTHER_LANDMARK_JOBS:
+            continue
+        for node in ast.walk(tree):
+            ids = _int_literals(node)
+            if ids is None:
+                continue
+            out += [
+                f"{path}:{node.lineno}: {ids} are contact_rules.json's landmarks.{name}"
+                for name, members in landmarks.items()
+                if set(ids) <= members
+            ][:1]
+    return out
+
+
+def test_each_shared_algorithm_has_one_home() -> None:
+    for job, (home, functions, _) in ONE_HOME.items():
+        text = (ROOT / home).read_text(encoding="utf-8")
+        for f in functions:
+            assert re.search(rf"\b{f}\(", text), f"{job}: {home} defines no {f}"
+        bindings = (ROOT / "plugin/python/prepare_bindings.cpp").read_text(
+            encoding="utf-8"
+        )
+        assert all(f"runtime::{f}(" in bindings for f in functions), job
+    modules = package_modules()
+    # the check finds a copy: a function of a listed name that computes on its own
+    copy = ast.parse(
+        "def lip_sets_of(skin, tris, rules):\n"
+        "    return np.flatnonzero(np.linalg.norm(skin - skin[60], axis=1) < 0.012)\n"
+        "def fissure_line(skin, lm68, eye):\n"
+        "    return native.eye_fissures(skin, lm68)[0]\n"
+    )
+    assert own_implementations({"copy.py": copy}) == [
+        "copy.py:1: lip_sets_of (the lip and lid contact sets) does not call softdeca_native"
+    ]
+    wrappers = [
+        f.name
+        for tree in modules.values()
+        for f in ast.walk(tree)
+        if isinstance(f, ast.FunctionDef) and calls_native(f)
+    ]
+    assert {"lip_sets_of", "lid_sets_of", "fissure_line", "lid_side_of_points"} <= set(
+        wrappers
+    )
+    assert own_implementations(modules) == []
+
+
+def test_the_contact_landmarks_are_written_once() -> None:
+    landmarks = contact_landmarks()
+    assert landmarks["inner_lip"] == frozenset(range(60, 68))
+    from softdeca_train.contact_rules import CONTACT_LANDMARKS
+
+    assert {k: frozenset(v) for k, v in vars(CONTACT_LANDMARKS).items()} == landmarks
+    # the check finds a copy of a list, a pair of them, or a range
+    copies = ast.parse(
+        "EYES = {'right': (36, (37, 38), 39, (41, 40))}\n"
+        "corner = lm[[60, 64]]\n"
+        "mouth = lm68[60:68]\n"
+        "face = (27, 8)\n"
+    )
+    found = landmark_copies({"copy.py": copies}, landmarks)
+    assert sorted(f.split(":")[1] for f in found) == ["1", "1", "2", "3"], found
+    assert landmark_copies(package_modules(), landmarks) == []

@@ -80,7 +80,8 @@ def test_rest_inert_parameters_are_those_that_move_nothing_unloaded(head, rest):
 
 
 def test_the_contact_rules_find_the_datas_sets(template):
-    from softdeca_train.sim.collision_spec import collision_sets
+    """Prepare's five sets are the data's lip and lid sets (both from the native rules,
+    prepare/contact_sets.h), each against its surface."""
     from softdeca_train.sim.lids import lid_candidates, lid_sets_of
     from softdeca_train.sim.lips import lip_sets_of
     from softdeca_train.template.model import N_SKIN
@@ -92,14 +93,17 @@ def test_the_contact_rules_find_the_datas_sets(template):
             None if seed is None else template.sample_identity(seed)
         )[:N_SKIN]
         ours = contact_sets(rules, skin, template.skin_triangles, none, none)
-        data = collision_sets(
-            lip_sets_of(skin, template.skin_triangles, rules),
-            lid_sets_of(skin, rules),
-            none,
-            none,
-        )
-        assert [c.name for c in ours] == [c.name for c in data]
-        for a, b in zip(ours, data, strict=True):
-            assert np.array_equal(a.points, b.points), a.name
-            assert np.array_equal(a.surface, b.surface), a.name
+        lips = lip_sets_of(skin, template.skin_triangles, rules)
+        lids = lid_sets_of(skin, rules)
+        expected = [
+            ("upper_lip_over_lower_lip", lips.upper, lips.lower_triangles),
+            ("lower_lip_over_upper_lip", lips.lower, lips.upper_triangles),
+            ("lips_over_upper_teeth", lips.zone, none),
+            ("lips_over_lower_teeth", lips.zone, none),
+            ("eyelids", np.concatenate([lids.upper, lids.lower]), none),
+        ]
+        assert [c.name for c in ours] == [name for name, _, _ in expected]
+        for c, (name, points, surface) in zip(ours, expected, strict=True):
+            assert np.array_equal(c.points, points), name
+            assert np.array_equal(c.surface, surface), name
         assert len(ours[0].points) > 100 and len(ours[4].points) > 100

@@ -1,5 +1,6 @@
-"""The numbers of the lip and lid contact rules, read from their one definition
-plugin/data/contact_rules.json (the same file the C++ library embeds at build time)."""
+"""The numbers and landmarks of the lip and lid contact rules, read from their one definition
+plugin/data/contact_rules.json (the same file the C++ library embeds at build time for the
+rules' one implementation, plugin/src/prepare/contact_sets.cpp)."""
 
 from __future__ import annotations
 
@@ -36,6 +37,28 @@ def _load() -> ContactDistances:
 
 
 CONTACT_RULES = _load()
+
+
+@dataclass(frozen=True)
+class ContactLandmarks:
+    """Ids of the 68 Multi-PIE landmarks the rules use (the file's "landmarks")."""
+
+    inner_lip: tuple[int, ...]  # right corner, upper lip's three, left corner, lower lip's three
+    inner_mouth_corners: tuple[int, ...]  # right, left
+    inner_lip_middles: tuple[int, ...]  # upper, lower
+    right_eye: tuple[int, ...]  # corner, upper lid's two, corner, lower lid's two
+    left_eye: tuple[int, ...]
+
+
+def _load_landmarks() -> ContactLandmarks:
+    entries = json.loads(DEFINITION.read_text())["landmarks"]
+    names = [f.name for f in fields(ContactLandmarks)]
+    if sorted(entries) != sorted(names):
+        raise ValueError(f"{DEFINITION}: landmarks must be exactly {', '.join(names)}")
+    return ContactLandmarks(**{n: tuple(int(i) for i in entries[n]["value"]) for n in names})
+
+
+CONTACT_LANDMARKS = _load_landmarks()
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,8 @@ namespace SoftDeca.Editor
 {
     /// <summary>
     /// The inspector of SoftDecaAvatar: the Fit button (fits the user's own mesh to the bundle's
-    /// template in the editor and stores the fit as an asset) with the fit's report, a slider per
+    /// template in the editor and stores the fit as an asset, unless the library judges it poor:
+    /// then it shows why and keeps the previous fit) with the fit's report, a slider per
     /// bundle parameter (its range and unit from the bundle), region controls (spheres on the
     /// face, moved in the Scene view), and the component's own fields.
     /// </summary>
@@ -23,6 +24,7 @@ namespace SoftDeca.Editor
         private string loadError;
         private TextAsset reportOf;  // the fit asset whose report is shown
         private FitReport report;
+        private FitReport refused;  // the report of a fit just made and refused as poor
         private string fitMessage;
 
         public override void OnInspectorGUI()
@@ -79,6 +81,7 @@ namespace SoftDeca.Editor
                 };
             EditorGUI.EndDisabledGroup();
             if (fitMessage != null) EditorGUILayout.HelpBox(fitMessage, MessageType.Error);
+            if (refused != null) Measures(refused);
             ShowReport(avatar);
         }
 
@@ -91,6 +94,7 @@ namespace SoftDeca.Editor
             Mesh source = avatar.SourceMesh;
             string asset = FitAssetPath(source);
             fitMessage = null;
+            refused = null;
             try
             {
                 EditorUtility.DisplayProgressBar(title, "Reading " + source.name + " and its ARKit shapes", 0.05f);
@@ -105,11 +109,20 @@ namespace SoftDeca.Editor
                         EditorUtility.DisplayProgressBar(title, "Fitting the template to the face of " + mesh.VertexCount + " vertices (" +
                                                                 t.ToString("F0") + " s)", 0.1f + 0.8f * (float)(1 - Math.Exp(-t / 10)));
                     }
-                    EditorUtility.DisplayProgressBar(title, "Saving " + asset, 0.95f);
                     using (AvatarFit done = fitting.Result)
                     {
+                        FitReport made = done.Report();
+                        FitQuality quality = made.Quality;
+                        if (quality != null && !quality.Passed)
+                        {
+                            refused = made;
+                            fitMessage = "The fit was refused as poor (" + quality.FailedMeasure + "): " + quality.Reason +
+                                         (avatar.fit != null ? " The previous fit is kept." : "");
+                            return;
+                        }
+                        EditorUtility.DisplayProgressBar(title, "Saving " + asset, 0.95f);
                         done.Save(Path.GetFullPath(asset));
-                        report = done.Report();
+                        report = made;
                     }
                 }
                 AssetDatabase.ImportAsset(asset);
@@ -160,13 +173,33 @@ namespace SoftDeca.Editor
                 }
             }
             if (report == null) return;
+            FitQuality quality = report.Quality;
+            if (quality != null && !quality.Passed)
+                EditorGUILayout.HelpBox("This fit is poor (" + quality.FailedMeasure + "): " + quality.Reason, MessageType.Warning);
             EditorGUILayout.LabelField("Metres per unit", Format(report.MetresPerUnit, "G4"));
             EditorGUILayout.LabelField("Up axis", report.UpAxis ?? "?");
             EditorGUILayout.LabelField("ARKit shapes", Count(report.ShapesMatched) + " matched, " + Count(report.ShapesCarried) +
                                                        " carried from the template, " + Count(report.ShapesMissing) + " missing");
             if (report.Mirrored) EditorGUILayout.HelpBox("The mesh was exported mirrored (left-handed).", MessageType.Warning);
-            EditorGUILayout.LabelField("Face residual", Format(report.FaceResidualMmMean, "F2") + " mm mean, " +
-                                                        Format(report.FaceResidualMmMax, "F2") + " mm largest");
+            Measures(report);
+        }
+
+        // The quality measures, each with its bound as the library reports it.
+        private static void Measures(FitReport r)
+        {
+            FitQuality q = r.Quality;
+            Func<string, double> bound = name => q == null ? double.NaN : q.Bound(name);
+            EditorGUILayout.LabelField("Face covered", Format(100 * r.FaceCoverage, "F0") + " % within " + Format(bound("covered_mm"), "G3") +
+                                                           " mm (at least " + Format(100 * bound("face_coverage_min"), "F0") + " %)");
+            EditorGUILayout.LabelField("Face to template", Format(r.AvatarToTemplateMmMedian, "F2") + " mm median (at most " +
+                                                               Format(bound("avatar_to_template_mm_median_max"), "G3") + "), " +
+                                                               Format(r.AvatarToTemplateMmP90, "F2") + " mm 90th percentile (at most " +
+                                                               Format(bound("avatar_to_template_mm_p90_max"), "G3") + ")");
+            EditorGUILayout.LabelField("Template face size", Format(r.TemplateScale, "F2") + " x the avatar's (" +
+                                                                 Format(bound("template_scale_min"), "F2") + " to " +
+                                                                 Format(bound("template_scale_max"), "F2") + ")");
+            EditorGUILayout.LabelField("Face residual", Format(r.FaceResidualMmMean, "F2") + " mm mean, " +
+                                                        Format(r.FaceResidualMmMax, "F2") + " mm largest");
         }
 
         private static string Count(string[] names) { return names == null ? "?" : names.Length.ToString(); }

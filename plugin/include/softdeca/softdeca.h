@@ -353,7 +353,8 @@ typedef struct softdeca_avatar_mesh {
 
 typedef struct softdeca_fit_options {
   uint32_t struct_size;     /* sizeof(softdeca_fit_options) */
-  double metres_per_unit;   /* 0: read off the shapes (snapped to mm, cm, inch, dm, m) */
+  double metres_per_unit;   /* 0: read off the shapes (snapped to mm, cm, inch, dm, m); else
+                               1e-6 (a micrometre) to 1000 */
   uint32_t iterations;      /* registration iterations; 0: the default */
   uint32_t reserved;
 } softdeca_fit_options;
@@ -363,22 +364,30 @@ SOFTDECA_API softdeca_status softdeca_fit_options_init(softdeca_fit_options* opt
 
 /* Fits an avatar to the model's template (seconds for a 20k-vertex body). Errors name the
  * problem: no ARKit shape moves a vertex, no face found, NaN vertices, degenerate triangles,
- * shapes of the wrong size. options may be NULL (the defaults). */
+ * shapes of the wrong size. options may be NULL (the defaults). A fit that fails the quality
+ * bounds is still made, for the host to inspect: its report's "quality" says so and why. */
 SOFTDECA_API softdeca_status softdeca_avatar_fit_create(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
                                                         const softdeca_fit_options* options,
                                                         softdeca_avatar_fit** out_fit);
 /* NULL is a no-op. */
 SOFTDECA_API void softdeca_avatar_fit_destroy(softdeca_avatar_fit* fit);
 
-/* Saves a fit (written to a temporary file and renamed into place: never half-written). */
+/* Saves a fit: written whole to a new file of a unique name beside `path`, flushed and renamed
+ * over it, so a reader sees the previous file or the new one, never a part, whichever threads
+ * or processes save to the same path at once. On failure (SOFTDECA_ERROR_IO) the previous file
+ * is left as it was and no temporary file remains. */
 SOFTDECA_API softdeca_status softdeca_avatar_fit_save(const softdeca_avatar_fit* fit, const char* path);
 
-/* Loads a saved fit for this model; refuses a fit of another bundle (SOFTDECA_ERROR_FORMAT). */
+/* Loads a saved fit for this model; refuses (SOFTDECA_ERROR_FORMAT) a fit of another bundle, a
+ * file whose checksum does not match ("... is damaged (its checksum does not match); fit the
+ * avatar again"), one of an earlier fit file version, and values no fit holds. */
 SOFTDECA_API softdeca_status softdeca_avatar_fit_load(const softdeca_model* model, const char* path,
                                                       softdeca_avatar_fit** out_fit);
 
 /* The fit's report as JSON (metres_per_unit, up_axis, shapes_matched, shapes_carried,
- * face_vertices, face_residual_mm_mean / _max, seconds, ...): NUL-terminated into buffer when
+ * face_vertices, face_residual_mm_mean / _max, face_coverage, avatar_to_template_mm_median /
+ * _p90, template_scale, quality: {passed, failed_measure, reason, bounds}, seconds, ...;
+ * docs/avatars.md): NUL-terminated into buffer when
  * capacity suffices; *out_length (may be NULL) receives the length without the NUL either way
  * (SOFTDECA_ERROR_BUFFER_TOO_SMALL when it does not fit). */
 SOFTDECA_API softdeca_status softdeca_avatar_fit_report(const softdeca_avatar_fit* fit, char* buffer,

@@ -1,15 +1,14 @@
 // The fit part of the C ABI: fitting a user's avatar, saving and loading the fit, and the
 // avatar made on it (fit/avatar_fit.h, runtime/fitted_avatar.h).
 #include <Eigen/LU>
-#include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "api/error_boundary.h"
 #include "api/handles.h"
 #include "api/runtime_handles.h"
+#include "core/atomic_write.h"
 #include "core/regular_file.h"
 #include "fit/fit_file.h"
 #include "fit/limits.h"
@@ -20,6 +19,16 @@ using namespace softdeca;
 
 // A saved fit holds about 30 bytes per avatar vertex and 30 per template skin vertex.
 constexpr std::uint64_t kMaxFitFileBytes = std::uint64_t{1} << 30;
+
+fit::FitSizes fit_sizes(const runtime::Model& m) {
+  const runtime::Manifest& mf = m.manifest();
+  fit::FitSizes s;
+  s.head_vertices = static_cast<std::size_t>(mf.head_vertices);
+  s.skin_vertices = static_cast<std::size_t>(mf.skin_vertices);
+  s.skin_triangles = static_cast<std::size_t>(mf.skin_triangles);
+  s.identity_modes = static_cast<std::size_t>(mf.template_identity_modes);
+  return s;
+}
 
 const softdeca_avatar_fit& fit_of(const softdeca_avatar_fit* f) {
   require_not_null(f, "fit");
@@ -81,8 +90,9 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_create(const softdeca_model* mo
     fit::FitOptions o;
     if (options) {
       require_struct(options, "options");
-      require(options->metres_per_unit >= 0 && options->metres_per_unit <= 1000,
-              "options->metres_per_unit must be 0 (detect) or a unit of at most 1000 m");
+      const double unit = options->metres_per_unit;
+      require(unit == 0 || (unit >= fit::kMinMetresPerUnit && unit <= fit::kMaxMetresPerUnit),
+              "options->metres_per_unit must be 0 (detect) or a unit of " + fit::metres_per_unit_range() + " m");
       require(options->iterations <= 1000, "options->iterations must be at most 1000");
       o.metres_per_unit = options->metres_per_unit;
       o.iterations = static_cast<int>(options->iterations);
@@ -91,6 +101,9 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_create(const softdeca_model* mo
     create_handle(out_fit, "out_fit", [&](softdeca_avatar_fit& h) {
       h.fit = fit::fit_avatar(t, a, o);
       h.bundle_sha256 = m.manifest_sha256();
+      // What is saved must load: a fit outside the ranges the loader accepts is not made.
+      const std::string problem = fit::fit_out_of_range(h.fit, fit_sizes(m));
+      require(problem.empty(), "the avatar gives a fit outside the ranges a fit lies in (" + problem + ")");
     });
   });
 }
@@ -101,23 +114,8 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_save(const softdeca_avatar_fit*
   return guarded(__func__, [&] {
     const softdeca_avatar_fit& f = fit_of(fit);
     require_not_null(path, "path");
-    const std::vector<std::uint8_t> bytes =
-        fit::encode_fit(f.fit, f.bundle_sha256, f.fit.source.weight.size());
-    const std::string part = std::string(path) + ".part";
-    {
-      FilePtr file = open_regular_file(part, FileAccess::create);
-      if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size() || std::fflush(file.get()) != 0) {
-        file.reset();
-        std::remove(part.c_str());
-        throw Error(SOFTDECA_ERROR_IO, "could not write " + part);
-      }
-    }
-    std::error_code ec;
-    std::filesystem::rename(std::filesystem::u8path(part), std::filesystem::u8path(path), ec);
-    if (ec) {
-      std::remove(part.c_str());
-      throw Error(SOFTDECA_ERROR_IO, "could not move " + part + " to " + path + ": " + ec.message());
-    }
+    const std::vector<std::uint8_t> bytes = fit::encode_fit(f.fit, f.bundle_sha256, f.fit.source.weight.size());
+    write_file_atomically(path, bytes.data(), bytes.size());
   });
 }
 
@@ -132,11 +130,8 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_load(const softdeca_model* mode
     if (size > kMaxFitFileBytes) throw Error(SOFTDECA_ERROR_FORMAT, std::string(path) + " is larger than any fit");
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
     if (!read_at(file.get(), 0, bytes.data(), bytes.size())) throw Error(SOFTDECA_ERROR_IO, std::string("could not read ") + path);
-    const runtime::Manifest& mf = m.manifest();
     create_handle(out_fit, "out_fit", [&](softdeca_avatar_fit& h) {
-      h.fit = fit::decode_fit(bytes.data(), bytes.size(), path, m.manifest_sha256(),
-                              static_cast<std::size_t>(mf.head_vertices), static_cast<std::size_t>(mf.skin_vertices),
-                              static_cast<std::size_t>(mf.skin_triangles));
+      h.fit = fit::decode_fit(bytes.data(), bytes.size(), path, m.manifest_sha256(), fit_sizes(m));
       h.bundle_sha256 = m.manifest_sha256();
     });
   });

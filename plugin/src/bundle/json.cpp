@@ -25,7 +25,7 @@ const char* type_name(Json::Type t) {
 
 class JsonParser {
  public:
-  explicit JsonParser(const std::string& text) : s_(text) {}
+  JsonParser(const std::string& text, const JsonLimits& limits) : s_(text), limits_(limits) {}
 
   Json document() {
     Json v = value(0);
@@ -35,9 +35,10 @@ class JsonParser {
   }
 
  private:
-  static constexpr int kMaxDepth = 64;
   const std::string& s_;
+  const JsonLimits limits_;
   std::size_t pos_ = 0;
+  std::size_t values_ = 0;
 
   [[noreturn]] void error(const std::string& what) const {
     fail("JSON: " + what + " at byte " + std::to_string(pos_));
@@ -78,7 +79,8 @@ class JsonParser {
   }
 
   Json value(int depth) {
-    if (depth > kMaxDepth) error("nesting too deep");
+    if (depth > limits_.max_depth) error("nesting deeper than " + std::to_string(limits_.max_depth));
+    if (++values_ > limits_.max_values) error("more than the " + std::to_string(limits_.max_values) + " values a document may have");
     skip_space();
     if (pos_ >= s_.size()) error("unexpected end");
     Json v;
@@ -195,7 +197,9 @@ class JsonParser {
   }
 };
 
-Json Json::parse(const std::string& text) { return JsonParser(text).document(); }
+const char* Json::kind() const { return type_name(type_); }
+
+Json Json::parse(const std::string& text, const JsonLimits& limits) { return JsonParser(text, limits).document(); }
 
 namespace {
 void expect(const Json& j, Json::Type t, const std::string& what) {
@@ -234,6 +238,11 @@ bool Json::has(const std::string& key) const {
   for (const auto& [k, v] : object_)
     if (k == key) return true;
   return false;
+}
+
+const std::vector<std::pair<std::string, Json>>& Json::members(const std::string& what) const {
+  expect(*this, Type::Object, what);
+  return object_;
 }
 
 const Json& Json::at(const std::string& key, const std::string& what) const {

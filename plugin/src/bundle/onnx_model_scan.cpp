@@ -1,22 +1,17 @@
 #include "bundle/onnx_model_scan.h"
 
-#include <algorithm>
 #include <cstring>
-#include <limits>
 #include <map>
 
-#include "bundle/onnx_constant_sizes.h"
+#include "bundle/onnx_graph.h"
+#include "bundle/onnx_operators.h"
+#include "bundle/onnx_static_sizes.h"
 #include "core/error.h"
 
 namespace softdeca::runtime {
 namespace {
 
-constexpr int kMaxDepth = 32;
-constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
-constexpr std::size_t kMaxShapeValues = 16;  // shape tensors longer than this are not shapes
-
-std::uint64_t add_sat(std::uint64_t a, std::uint64_t b) { return a > kMax - b ? kMax : a + b; }
-std::uint64_t mul_sat(std::uint64_t a, std::uint64_t b) { return a != 0 && b > kMax / a ? kMax : a * b; }
+using namespace onnx;
 
 [[noreturn]] void bad(const std::string& why) { throw Error(SOFTDECA_ERROR_FORMAT, "ONNX model: " + why); }
 
@@ -32,6 +27,7 @@ struct Field {
 class Message {
  public:
   Message(const std::uint8_t* data, std::size_t size) : p_(data), end_(data + size) {}
+  explicit Message(const Field& f) : Message(f.data, f.size) {}
 
   bool next(Field& f) {
     if (p_ == end_) return false;
@@ -87,13 +83,11 @@ void repeated_varints(const Field& f, Sink&& sink) {
     return;
   }
   if (f.wire != 2) bad("a repeated integer field has the wrong wire type");
-  // Packed: a message of consecutive varints; reuse the reader with key-less parsing.
   const std::uint8_t* p = f.data;
   const std::uint8_t* end = f.data + f.size;
   while (p != end) {
     std::uint64_t v = 0;
-    int shift = 0;
-    for (;; shift += 7) {
+    for (int shift = 0;; shift += 7) {
       if (p == end || shift >= 70) bad("bad packed varint");
       const std::uint8_t b = *p++;
       v |= std::uint64_t{b & 0x7Fu} << shift;
@@ -108,345 +102,289 @@ std::string text(const Field& f) {
   return std::string(reinterpret_cast<const char*>(f.data), f.size);
 }
 
-std::uint64_t element_size(std::uint64_t dtype) {
-  switch (dtype) {
-    case 2: case 3: case 9: case 17: case 18: case 19: case 20: case 21: case 22: return 1;  // 8-bit, bool, fp8, int4
-    case 4: case 5: case 10: case 16: return 2;                                          // 16-bit
-    case 1: case 6: case 12: return 4;                                                   // float, int32, uint32
-    case 7: case 11: case 13: case 14: return 8;                                         // 64-bit, complex64
-    case 15: return 16;                                                                  // complex128
-    default: return 32;                                                                  // strings, unknown
-  }
+// A message field that protobuf would merge when given twice: refused instead (a tensor or a
+// type split over two fields would read differently here and in ONNX Runtime).
+void once(bool& seen, const char* what) {
+  if (seen) bad(std::string(what) + " is given twice");
+  seen = true;
 }
 
-struct Tensor {
-  std::string name;
-  std::uint64_t dtype = 1;
-  std::uint64_t elements = 1;
-  std::vector<std::uint64_t> dims;
-  bool external = false;
-  std::vector<double> values;  // short numeric tensors (float, double, int32, int64): possible shapes
-};
-
-// Little-endian numbers of `width` bytes as the tensor's type says (raw_data, packed fields).
-void little_endian_values(const std::uint8_t* p, std::size_t size, std::uint64_t dtype, std::vector<double>& out) {
-  const std::size_t width = dtype == 7 || dtype == 11 ? 8 : 4;
-  if (size % width != 0 || size / width > kMaxShapeValues) return;
-  out.clear();
-  for (std::size_t i = 0; i < size; i += width) {
+// Little-endian integers of `width` bytes, sign-extended for signed types.
+std::vector<std::int64_t> little_endian(const Field& raw, std::int64_t dtype) {
+  const std::size_t width = static_cast<std::size_t>(element_size(dtype));
+  std::vector<std::int64_t> out;
+  if (raw.size % width != 0 || raw.size / width > kMaxValues) return out;
+  const bool is_signed = dtype == kInt8 || dtype == kInt16 || dtype == kInt32 || dtype == kInt64;
+  for (std::size_t i = 0; i < raw.size; i += width) {
     std::uint64_t v = 0;
-    for (std::size_t k = 0; k < width; ++k) v |= std::uint64_t{p[i + k]} << (8 * k);
-    if (dtype == 1) {
-      float f;
-      const auto u = static_cast<std::uint32_t>(v);
-      std::memcpy(&f, &u, 4);
-      out.push_back(f);
-    } else if (dtype == 11) {
-      double d;
-      std::memcpy(&d, &v, 8);
-      out.push_back(d);
-    } else if (dtype == 6) {
-      out.push_back(static_cast<double>(static_cast<std::int32_t>(static_cast<std::uint32_t>(v))));
-    } else {
-      out.push_back(static_cast<double>(static_cast<std::int64_t>(v)));
-    }
+    for (std::size_t k = 0; k < width; ++k) v |= std::uint64_t{raw.data[i + k]} << (8 * k);
+    if (is_signed && width < 8 && (v >> (8 * width - 1)) & 1) v |= ~std::uint64_t{0} << (8 * width);
+    if (!is_signed && width == 8 && v >> 63) return {};  // a uint64 past int64: not carried
+    out.push_back(static_cast<std::int64_t>(v));
   }
+  return out;
 }
 
-class Scanner {
+class Reader {
  public:
-  OnnxModelScan result;
+  Graph graph;
+  std::vector<std::string> external;  // tensors with external data (initializers or attributes)
 
   void model(const std::uint8_t* data, std::size_t size) {
     Message m(data, size);
     Field f;
+    bool opset = false;
     while (m.next(f)) {
       if (f.wire != 2) continue;
-      if (f.number == 7) graph(f, 1);
-      else if (f.number == 20) training_info(f, 1);
-      else if (f.number == 25) function(f, 1);
+      switch (f.number) {
+        case 7: read_graph(f); break;  // given twice, protobuf merges the graphs: so does this
+        case 8: opset = opset_import(f) || opset; break;
+        case 20: bad("the model holds training information; a bundle's networks hold inference graphs only");
+        case 25: bad("the model defines functions; a bundle's networks use the listed operators only (docs/bundle.md)");
+        default: break;
+      }
     }
-    // Outputs whose size follows from constants (computed at run time otherwise: ONNX
-    // Runtime's own checks).
-    folding_.evaluate([&](const std::string& name, std::uint64_t bytes) {
-      result.shaped_bytes = add_sat(result.shaped_bytes, bytes);
-      note(name, bytes);
-    });
+    if (!opset) bad("the model imports no version of the ONNX operator set (a bundle's networks use opset " +
+                    std::to_string(kOpsetVersion) + ")");
   }
 
  private:
-  ConstantSizes folding_;
+  static bool default_domain(const std::string& d) { return d.empty() || d == "ai.onnx"; }
 
-  static void depth_check(int depth) {
-    if (depth > kMaxDepth) bad("messages nested deeper than " + std::to_string(kMaxDepth));
-  }
-  void note(const std::string& name, std::uint64_t bytes) {
-    ++result.tensors;
-    if (bytes > result.largest_bytes || result.largest_tensor.empty()) {
-      result.largest_bytes = bytes;
-      result.largest_tensor = name;
+  // OperatorSetIdProto: domain (1), version (2). True for the default domain.
+  static bool opset_import(const Field& f) {
+    std::string domain;
+    std::int64_t version = 0;
+    Message m(f);
+    Field x;
+    while (m.next(x)) {
+      if (x.number == 1) domain = text(x);
+      else if (x.number == 2 && x.wire == 0) version = static_cast<std::int64_t>(x.varint);
     }
+    if (!default_domain(domain))
+      bad("the model imports the operator set '" + printable(domain) + "'; a bundle's networks use ONNX's own only");
+    if (version != kOpsetVersion)
+      bad("the model imports ONNX opset " + std::to_string(version) + "; a bundle's networks use opset " +
+          std::to_string(kOpsetVersion));
+    return true;
   }
 
-  void training_info(const Field& f, int depth) {
-    depth_check(depth);
-    Message m(f.data, f.size);
-    Field g;
-    while (m.next(g))
-      if (g.wire == 2 && (g.number == 1 || g.number == 2)) graph(g, depth + 1);
-  }
-
-  void function(const Field& f, int depth) {
-    depth_check(depth);
-    Message m(f.data, f.size);
-    Field n;
-    while (m.next(n))
-      if (n.wire == 2 && n.number == 7) node(n, depth + 1);
-  }
-
-  void graph(const Field& f, int depth) {
-    depth_check(depth);
-    Message m(f.data, f.size);
+  void read_graph(const Field& f) {
+    Message m(f);
     Field g;
     while (m.next(g)) {
       if (g.wire != 2) continue;
       switch (g.number) {
-        case 1: node(g, depth + 1); break;
-        case 5: initializer(tensor(g, depth + 1)); break;
-        case 15: sparse_tensor(g, depth + 1); break;
-        case 11: case 12: case 13: value_info(g, depth + 1); break;
-        default: break;
+        case 1: node(g); break;
+        case 5: {
+          Initializer i;
+          i.tensor = tensor(g, i.name);
+          graph.initializers.push_back(std::move(i));
+          break;
+        }
+        case 11: input(g); break;
+        case 15: bad("the graph has a sparse initializer; a bundle's networks store dense tensors only");
+        default: break;  // outputs, value_info, annotations: the shapes are inferred instead
       }
     }
   }
 
-  void initializer(const Tensor& t) {
-    if (t.external) result.external_tensors.push_back(t.name.empty() ? std::string("(unnamed)") : t.name);
-    const std::uint64_t bytes = mul_sat(t.elements, element_size(t.dtype));
-    result.initializer_bytes = add_sat(result.initializer_bytes, bytes);
-    note(t.name, bytes);
-    if (t.name.empty()) return;
-    if (!t.values.empty()) folding_.values(t.name, t.values);
-    folding_.shape(t.name, t.dims, element_size(t.dtype));
-  }
-
-  void sparse_tensor(const Field& f, int depth) {
-    depth_check(depth);
-    Message m(f.data, f.size);
-    Field s;
-    while (m.next(s))
-      if (s.wire == 2 && (s.number == 1 || s.number == 2)) initializer(tensor(s, depth + 1));
-  }
-
-  Tensor tensor(const Field& f, int depth) {
-    depth_check(depth);
+  // TensorProto: its type and dims, and the values of a short integer tensor; its name.
+  Tensor tensor(const Field& f, std::string& name) {
     Tensor t;
-    bool has_dims = false;
-    std::vector<double> numbers;
+    bool outside = false;
+    t.dtype = 0;
+    std::vector<std::int64_t> listed;
+    bool too_many = false;
     Field raw;
-    Message m(f.data, f.size);
+    Message m(f);
     Field x;
     while (m.next(x)) {
       switch (x.number) {
         case 1:
-          has_dims = true;
           repeated_varints(x, [&](std::uint64_t d) {
-            if (static_cast<std::int64_t>(d) < 0) bad("tensor with a negative dimension");
-            t.elements = mul_sat(t.elements, d);
-            if (t.dims.size() < kMaxShapeValues) t.dims.push_back(d);
+            if (static_cast<std::int64_t>(d) < 0) bad("a tensor with a negative dimension");
+            if (t.dims.size() == kMaxRank) bad("a tensor of more than " + std::to_string(kMaxRank) + " dimensions");
+            t.dims.push_back(d);
           });
           break;
-        case 2: if (x.wire == 0) t.dtype = x.varint; break;
-        case 5: case 7:  // int32_data, int64_data: varints
+        case 2: if (x.wire == 0) t.dtype = static_cast<std::int64_t>(x.varint); break;
+        case 3: bad("a tensor in segments");
+        case 5: case 7: case 11:  // int32_data, int64_data, uint64_data
           repeated_varints(x, [&](std::uint64_t v) {
-            if (numbers.size() <= kMaxShapeValues)
-              numbers.push_back(x.number == 5 ? double(static_cast<std::int32_t>(v)) : double(static_cast<std::int64_t>(v)));
+            if (listed.size() == kMaxValues) too_many = true;
+            else listed.push_back(x.number == 5 ? static_cast<std::int32_t>(v) : static_cast<std::int64_t>(v));
           });
           break;
-        case 4: case 10:  // float_data, double_data: packed fixed-width
-          if (x.wire == 2) little_endian_values(x.data, x.size, x.number == 4 ? 1 : 11, numbers);
-          break;
-        case 8: t.name = text(x); break;
-        case 9:
-          if (x.wire == 2) raw = x;  // decoded once the type is known
-          break;
-        case 13: t.external = true; break;                      // external_data entries
-        case 14: if (x.varint == 1) t.external = true; break;   // data_location = EXTERNAL
+        case 8: name = text(x); break;
+        case 9: if (x.wire == 2) raw = x; break;
+        case 13: outside = true; break;                      // external_data entries
+        case 14: if (x.varint == 1) outside = true; break;   // data_location = EXTERNAL
         default: break;
       }
     }
-    if (!has_dims) t.elements = 1;  // a scalar
-    if (raw.data) little_endian_values(raw.data, raw.size, t.dtype, numbers);
-    const bool numeric = t.dtype == 1 || t.dtype == 6 || t.dtype == 7 || t.dtype == 11;
-    if (numeric && numbers.size() <= kMaxShapeValues && numbers.size() == t.elements) t.values = std::move(numbers);
+    if (outside) external.push_back(name.empty() ? std::string("(unnamed)") : name);
+    const std::string id = name.empty() ? "" : " '" + printable(name) + "'";
+    if (element_size(t.dtype) == 0)
+      bad("tensor" + id + " has element type " + std::to_string(t.dtype) + ", which no network uses");
+    if (is_integer(t.dtype) && t.elements() <= kMaxValues) {
+      std::vector<std::int64_t> values = raw.data ? little_endian(raw, t.dtype) : too_many ? std::vector<std::int64_t>{} : listed;
+      if (values.size() == t.elements()) {
+        if (t.dtype == kUint64) {
+          for (const std::int64_t v : values)
+            if (v < 0) values.clear();  // past int64: not carried
+        }
+        t.values = std::move(values);
+        t.known = t.values.size() == t.elements();
+        for (const std::int64_t v : t.values) t.known = t.known && holds(t.dtype, v);
+        if (!t.known) t.values.clear();
+      }
+    }
     return t;
   }
 
-  void value_info(const Field& f, int depth) {
-    depth_check(depth);
-    std::string name;
-    std::uint64_t bytes = 0;
-    StaticShape shape;
-    Message m(f.data, f.size);
+  // ValueInfoProto of a graph input: its name and, for a tensor type, the element type (its
+  // dimensions are the contract's, as the runtime feeds them).
+  void input(const Field& f) {
+    GraphInput in;
+    bool typed = false;
+    Message m(f);
     Field v;
     while (m.next(v)) {
-      if (v.number == 1) name = text(v);
-      else if (v.number == 2 && v.wire == 2) bytes = type_bytes(v, depth + 1, shape);
-    }
-    result.declared_bytes = add_sat(result.declared_bytes, bytes);
-    note(name, bytes);
-    if (shape.is_static && !name.empty()) folding_.shape(name, shape.dims, shape.element_bytes);
-  }
-
-  struct StaticShape {
-    bool is_static = false;  // a tensor type whose every dimension is a number
-    std::vector<std::uint64_t> dims;
-    std::uint64_t element_bytes = 4;
-  };
-
-  // TypeProto: tensor_type (1) and sparse_tensor_type (8) have elem_type (1) and shape (2).
-  std::uint64_t type_bytes(const Field& f, int depth, StaticShape& static_shape) {
-    depth_check(depth);
-    Message m(f.data, f.size);
-    Field t;
-    std::uint64_t bytes = 0;
-    while (m.next(t)) {
-      if (t.wire != 2 || (t.number != 1 && t.number != 8)) continue;
-      std::uint64_t dtype = 1, elements = 1;
-      bool has_shape = false, all_numbers = true;
-      std::vector<std::uint64_t> dims;
-      Message tensor_type(t.data, t.size);
-      Field x;
-      while (tensor_type.next(x)) {
-        if (x.number == 1 && x.wire == 0) dtype = x.varint;
-        if (x.number != 2 || x.wire != 2) continue;
-        has_shape = true;
-        Message shape(x.data, x.size);
-        Field dim;
-        while (shape.next(dim)) {
-          if (dim.number != 1 || dim.wire != 2) continue;
-          std::uint64_t value = 1;  // dim_param (a named free dimension): counted as 1
-          bool number = false;
-          Message d(dim.data, dim.size);
-          Field dv;
-          while (d.next(dv))
-            if (dv.number == 1 && dv.wire == 0 && static_cast<std::int64_t>(dv.varint) >= 0) {
-              value = std::max<std::uint64_t>(dv.varint, 1);
-              number = true;
-            }
-          all_numbers = all_numbers && number;
-          elements = mul_sat(elements, value);
-          if (dims.size() < kMaxShapeValues) dims.push_back(value);
-          else all_numbers = false;
+      if (v.number == 1) in.name = text(v);
+      if (v.number != 2 || v.wire != 2) continue;
+      once(typed, "an input's type");
+      Message type(v);
+      Field t;
+      bool tensor_type = false;
+      while (type.next(t)) {
+        if (t.wire != 2) continue;
+        if (t.number != 1) {  // sequence, map, sparse, optional...
+          in.dtype = 0;
+          continue;
         }
+        once(tensor_type, "an input's tensor type");
+        Message tt(t);
+        Field e;
+        while (tt.next(e))
+          if (e.number == 1 && e.wire == 0) in.dtype = static_cast<std::int64_t>(e.varint);
       }
-      bytes = add_sat(bytes, mul_sat(elements, element_size(dtype)));
-      if (t.number == 1 && has_shape && all_numbers) static_shape = {true, std::move(dims), element_size(dtype)};
     }
-    return bytes;
+    graph.inputs.push_back(std::move(in));
   }
 
-  // Nodes go to the constant folding (onnx_constant_sizes.h), evaluated in order at the end.
-  void node(const Field& f, int depth) {
-    depth_check(depth);
-    FoldNode n;
-    Message m(f.data, f.size);
+  void node(const Field& f) {
+    Node n;
+    std::string overload;
+    std::vector<Field> attributes;  // read once the operator is known to be listed
+    Message m(f);
     Field x;
     while (m.next(x)) {
       switch (x.number) {
         case 1: n.inputs.push_back(text(x)); break;
         case 2: n.outputs.push_back(text(x)); break;
+        case 3: n.name = text(x); break;
         case 4: n.op = text(x); break;
-        case 5:
-          if (x.wire == 2) attribute(x, depth + 1, n);
-          break;
+        case 5: if (x.wire == 2) attributes.push_back(x); break;
+        case 7: n.domain = text(x); break;
+        case 8: overload = text(x); break;
         default: break;
       }
     }
-    folding_.node(std::move(n));
+    if (!default_domain(n.domain))
+      bad("operator '" + printable(n.op) + "' of domain '" + printable(n.domain) + "' (" + n.label() +
+          ") is not one a bundle's networks may use (docs/bundle.md, \"Operators\")");
+    if (!is_allowed_operator(n.op))
+      bad("operator '" + printable(n.op) + "' (" + n.label() +
+          ") is not one a bundle's networks may use (docs/bundle.md, \"Operators\")");
+    if (!overload.empty()) bad(n.label() + " names a function overload");
+    for (const Field& a : attributes) attribute(a, n);
+    graph.nodes.push_back(std::move(n));
   }
 
-  // AttributeProto: name (1), ints (8), t (5), g (6), tensors (10), graphs (11),
-  // sparse_tensor (22), sparse_tensors (23). Every tensor counts as an initializer.
-  // A node's integer attributes (i: 3), and a Constant's value however it is given: value
-  // (a tensor), value_int(s), value_float(s) (f: 2, floats: 7).
-  void attribute(const Field& f, int depth, FoldNode& node) {
-    depth_check(depth);
-    std::string name;
-    std::vector<double> ints, floats;
-    bool value_tensor = false, has_int = false, has_float = false;
-    std::int64_t i = 0;
-    Tensor t;
-    Message m(f.data, f.size);
+  // AttributeProto: name (1), f (2), i (3), s (4), t (5), floats (7), ints (8), type (20). The
+  // other kinds (graphs, tensor lists, sparse tensors, type protos, references to a
+  // function's attributes) are not taken by any listed operator.
+  void attribute(const Field& f, Node& node) {
+    std::string name, tensor_name;
+    Attribute a;
+    std::uint64_t declared = 0;  // AttributeType, when given
+    int present = -1;            // the kind its fields say, the last one given
+    bool has_t = false;
+    Message m(f);
     Field x;
     while (m.next(x)) {
       switch (x.number) {
         case 1: name = text(x); break;
-        case 2:
-          if (x.wire == 5) {
-            const auto u = static_cast<std::uint32_t>(x.varint);
-            float v;
-            std::memcpy(&v, &u, 4);
-            floats.assign(1, v);
-            has_float = true;
-          }
-          break;
-        case 3:
-          if (x.wire == 0) {
-            i = static_cast<std::int64_t>(x.varint);
-            has_int = true;
-          }
+        case 2: if (x.wire == 5) present = Attribute::kFloat; break;
+        case 3: if (x.wire == 0) { a.i = static_cast<std::int64_t>(x.varint); present = Attribute::kInt; } break;
+        case 4: a.s = text(x); present = Attribute::kString; break;
+        case 5:
+          if (x.wire != 2) break;
+          once(has_t, "an attribute's tensor");
+          a.t = tensor(x, tensor_name);
+          present = Attribute::kTensor;
           break;
         case 7:
-          if (x.wire == 2) little_endian_values(x.data, x.size, 1, floats);
+          if (x.wire == 2) a.floats += x.size / 4;
+          else if (x.wire == 5) ++a.floats;
+          present = Attribute::kFloats;
           break;
         case 8:
           repeated_varints(x, [&](std::uint64_t v) {
-            if (ints.size() <= kMaxShapeValues) ints.push_back(double(static_cast<std::int64_t>(v)));
+            if (a.ints.size() == kMaxValues) bad("attribute '" + printable(name) + "' lists over " + std::to_string(kMaxValues) + " integers");
+            a.ints.push_back(static_cast<std::int64_t>(v));
           });
+          present = Attribute::kInts;
           break;
-        case 5:
-          if (x.wire == 2) {
-            t = tensor(x, depth + 1);
-            initializer(t);
-            value_tensor = true;
-          }
-          break;
-        case 10: if (x.wire == 2) initializer(tensor(x, depth + 1)); break;
-        case 6: case 11: if (x.wire == 2) graph(x, depth + 1); break;
-        case 22: case 23: if (x.wire == 2) sparse_tensor(x, depth + 1); break;
+        case 20: if (x.wire == 0) declared = x.varint; break;
+        case 6: case 11: bad(node.label() + " holds a subgraph; a bundle's networks have none");
+        case 9: case 10: case 14: case 15: case 21: case 22: case 23:
+          bad("attribute '" + printable(name) + "' of " + node.label() + " is of a kind no listed operator takes");
         default: break;
       }
     }
-    if (has_int) node.ints[name] = i;
-    const auto constant = [&](std::vector<double> v, std::vector<std::uint64_t> dims, std::uint64_t bytes) {
-      node.has_value = v.size() <= kMaxShapeValues;
-      node.value = std::move(v);
-      node.value_dims = std::move(dims);
-      node.value_element_bytes = bytes;
-    };
-    if (name == "value" && value_tensor) {
-      node.value_element_bytes = element_size(t.dtype);
-      node.value_dims = t.dims;
-      if (!t.values.empty()) constant(t.values, t.dims, element_size(t.dtype));
+    switch (declared) {  // AttributeProto.AttributeType
+      case 0: break;
+      case 1: present = Attribute::kFloat; break;
+      case 2: present = Attribute::kInt; break;
+      case 3: present = Attribute::kString; break;
+      case 4: present = Attribute::kTensor; break;
+      case 6: present = Attribute::kFloats; break;
+      case 7: present = Attribute::kInts; break;
+      default: bad("attribute '" + printable(name) + "' of " + node.label() + " is of a kind no listed operator takes");
     }
-    if (name == "value_int" && has_int) constant({double(i)}, {}, 8);
-    if (name == "value_ints" && ints.size() <= kMaxShapeValues) constant(ints, {ints.size()}, 8);
-    if (name == "value_float" && has_float) constant(floats, {}, 4);
-    if (name == "value_floats" && !floats.empty()) constant(floats, {floats.size()}, 4);
+    if (present < 0) bad("attribute '" + printable(name) + "' of " + node.label() + " has no value");
+    if (present == Attribute::kTensor && !has_t) bad("attribute '" + printable(name) + "' of " + node.label() + " has no tensor");
+    a.kind = static_cast<Attribute::Kind>(present);
+    if (!node.attributes.emplace(name, std::move(a)).second)
+      bad(node.label() + " has attribute '" + printable(name) + "' twice");
   }
 };
 
 }  // namespace
 
-std::uint64_t OnnxModelScan::total_bytes() const {
-  return add_sat(add_sat(initializer_bytes, declared_bytes), shaped_bytes);
-}
-
-OnnxModelScan scan_onnx_model(const std::uint8_t* data, std::size_t size) {
-  Scanner s;
-  s.model(data, size);
-  return std::move(s.result);
+OnnxModelScan scan_onnx_model(const std::uint8_t* data, std::size_t size, const std::vector<TensorSpec>& inputs) {
+  Reader r;
+  r.model(data, size);
+  OnnxModelScan scan;
+  scan.external_tensors = r.external;
+  if (!scan.external_tensors.empty()) return scan;
+  std::map<std::string, std::vector<std::uint64_t>> fed;
+  for (const TensorSpec& t : inputs) {
+    std::vector<std::uint64_t>& dims = fed[t.name];
+    for (const std::int64_t d : t.shape) dims.push_back(static_cast<std::uint64_t>(d < 0 ? kFedBatch : d));
+  }
+  try {
+    const StaticSizes s = static_sizes(r.graph, fed);
+    scan.bytes = s.bytes;
+    scan.largest_tensor = s.largest;
+    scan.largest_bytes = s.largest_bytes;
+    scan.tensors = s.tensors;
+  } catch (const Error& e) {
+    bad(e.what());
+  }
+  return scan;
 }
 
 }  // namespace softdeca::runtime

@@ -10,6 +10,8 @@
 
 #include "core/error.h"
 #include "fit/closest_identity.h"
+#include "fit/fit_quality.h"
+#include "fit/limits.h"
 #include "fit/mesh_hash.h"
 #include "fit/mesh_topology.h"
 #include "fit/placement.h"
@@ -36,7 +38,7 @@ constexpr const char* kSkinShapes[] = {
 // Distances of the embedding (metres): an avatar vertex within kNear of the registered skin
 // follows it fully, beyond kFar not at all; the template's face weight falls to zero over
 // kFaceFade away from the vertices its shapes move.
-constexpr double kNear = 0.003, kFar = 0.010, kFaceFade = 0.03;
+constexpr double kNear = 0.003, kFar = kEmbeddingReach, kFaceFade = 0.03;
 // A template vertex takes the avatar's shapes fully within kShapeNear of the avatar's surface,
 // its own beyond kShapeFar.
 constexpr double kShapeNear = 0.004, kShapeFar = 0.015;
@@ -133,6 +135,9 @@ namespace {
 // shape), their triangles with area and those triangles' open edges.
 struct SkinSurface {
   std::vector<uint8_t> part;  // per part of the mesh: skin
+  // per vertex: what the skin-only shapes move noticeably (the face the fit's quality is measured
+  // on); without such shapes, the frame's face on the skin parts
+  std::vector<uint8_t> face;
   std::vector<std::int32_t> triangles;
   std::vector<uint8_t> open_edges;
   std::size_t parts() const { return static_cast<std::size_t>(std::count(part.begin(), part.end(), 1)); }
@@ -142,17 +147,18 @@ SkinSurface skin_surface(const AvatarMesh& a, const AvatarFrame& frame, const Me
   const std::size_t n = a.vertex_count;
   SkinSurface s;
   s.part.assign(topo.components, 0);
+  s.face.assign(n, 0);
   for (const char* name : kSkinShapes) {
     const float* d = a.deltas[static_cast<std::size_t>(stream::blendshape_index(name))];
     if (!d) continue;
     double peak = 0;
     for (std::size_t v = 0; v < n; ++v) peak = std::max(peak, row3(d, v).norm());
     for (std::size_t v = 0; v < n; ++v)
-      if (peak > 0 && row3(d, v).norm() > 0.05 * peak) s.part[static_cast<std::size_t>(topo.component[v])] = 1;
+      if (peak > 0 && row3(d, v).norm() > 0.05 * peak) s.part[static_cast<std::size_t>(topo.component[v])] = 1, s.face[v] = 1;
   }
   if (s.parts() == 0)
     for (std::size_t v = 0; v < n; ++v)
-      if (frame.face[v]) s.part[static_cast<std::size_t>(topo.component[v])] = 1;
+      if (frame.face[v]) s.part[static_cast<std::size_t>(topo.component[v])] = 1, s.face[v] = 1;
   const auto weld = [&](std::int32_t v) { return topo.weld[static_cast<std::size_t>(v)]; };
   for (std::size_t f = 0; f < a.triangle_count; ++f) {
     const std::int32_t* c = a.triangles + 3 * f;
@@ -310,26 +316,85 @@ std::vector<float> registered_head(const Session& s, const Points& skin) {
 
 struct Residual {
   double mean_mm = 0, max_mm = 0;
-  std::size_t points = 0;
+  std::size_t points = 0, beyond_rim = 0;
+  std::vector<uint8_t> past_rim;  // per template skin vertex: on the face, past the avatar's rim
 };
 
-// The registered template's distance to the avatar's surface over the template's face, where the
-// avatar has surface (a face mask's rim is not counted).
-Residual face_residual(const Session& s, const Points& skin, double reach) {
+// The registered template's distance to the avatar's surface over the template's face, however
+// far; the template's vertices whose closest point is on the avatar's open rim (past a face
+// mask's edge, where the avatar has no surface) are counted apart.
+Residual face_residual(const Session& s, const Points& skin) {
   Residual r;
+  r.past_rim.assign(s.t.skin_vertices, 0);
   double sum = 0;
   for (std::size_t v = 0; v < s.t.skin_vertices; ++v) {
     if (!s.tframe.face[v]) continue;
-    const geometry::SurfacePoint p = s.matcher->neutral().closest(skin.row(static_cast<Eigen::Index>(v)).transpose(), reach);
-    if (p.triangle < 0 || s.matcher->on_boundary(p)) continue;
+    const geometry::SurfacePoint p = s.matcher->neutral().closest(skin.row(static_cast<Eigen::Index>(v)).transpose());
+    if (s.matcher->on_boundary(p)) {
+      ++r.beyond_rim;
+      r.past_rim[v] = 1;
+      continue;
+    }
     const double d = 1000 * std::sqrt(p.squared_distance);
     sum += d;
     r.max_mm = std::max(r.max_mm, d);
     ++r.points;
   }
-  require(r.points > 0, "the template's face found no surface of the avatar near it: is this mesh a face?");
+  require(r.points > 0, "every point of the template's face lies past the avatar's open rim: is this mesh a face?");
   r.mean_mm = sum / static_cast<double>(r.points);
   return r;
+}
+
+// What the fit's quality is measured on (fit/fit_quality.h): the avatar's face vertices, placed,
+// and what each side's face size is read off: the skin-only shapes both move, on the avatar
+// (its frame's, placed; spreads in metres) and on the registered template (its own shapes over
+// the registered skin `registered`, where the avatar has surface: past a face mask's rim the
+// template has face the avatar lacks); for a fit by landmarks, the landmarks.
+QualityInput quality_input(const Session& s, const std::vector<float>& registered, const Residual& residual) {
+  QualityInput in;
+  in.metres_per_unit = s.at.unit;
+  in.residual_mm = residual.mean_mm;
+  for (std::size_t v = 0; v < s.a.vertex_count; ++v)
+    if (s.skin.face[v]) in.avatar_face.push_back(s.y.row(static_cast<Eigen::Index>(v)).transpose());
+  const TemplateData& t = s.t;
+  const std::size_t vs = t.skin_vertices;
+  AvatarShapes shapes;
+  shapes.neutral = registered.data();  // its first skin_vertices rows: the registered skin
+  shapes.vertex_count = vs;
+  shapes.triangles = t.skin_triangles;
+  shapes.triangle_count = t.skin_triangle_count;
+  std::vector<float> covered(std::size(kSkinShapes) * vs * 3, 0.0f);  // the skin-only shapes where the avatar has surface
+  for (std::size_t i = 0; i < std::size(kSkinShapes); ++i) {
+    const auto k = static_cast<std::size_t>(stream::blendshape_index(kSkinShapes[i]));
+    if (!t.moves[k]) continue;
+    float* d = covered.data() + i * vs * 3;
+    for (std::size_t v = 0; v < 3 * vs; ++v)
+      if (!residual.past_rim[v / 3]) d[v] = t.shapes[k * vs * 3 + v];
+    shapes.deltas[k] = d;
+  }
+  const ShapeCentres on_template = shape_centres(shapes);
+  const AvatarFrame& frame = s.at.frame;
+  for (const char* name : kSkinShapes) {
+    const auto k = static_cast<std::size_t>(stream::blendshape_index(name));
+    if (!frame.moves[k] || !on_template.moves[k]) continue;
+    in.on_avatar.centres.push_back(s.at.place.to_template(frame.centres[k]));
+    in.on_avatar.spreads.push_back(s.at.unit * frame.spreads[k]);
+    in.on_template.centres.push_back(on_template.centres[k]);
+    in.on_template.spreads.push_back(on_template.spreads[k]);
+  }
+  if (in.on_avatar.centres.size() >= 3 || !s.a.landmarks || s.a.landmark_count != t.landmark_triangle.size()) return in;
+  in.on_avatar = in.on_template = {};
+  for (std::size_t l = 0; l < s.a.landmark_count; ++l) {
+    in.on_avatar.centres.push_back(s.at.place.to_template(row3(s.a.landmarks, l)));
+    const auto tri = static_cast<std::size_t>(t.landmark_triangle[l]);
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < 3; ++k)
+      p += t.landmark_bary[l][k] * row3(registered.data(), static_cast<std::size_t>(t.skin_triangles[3 * tri + k]));
+    in.on_template.centres.push_back(p);
+  }
+  in.on_avatar.spreads.assign(s.a.landmark_count, 0.0);
+  in.on_template.spreads.assign(s.a.landmark_count, 0.0);
+  return in;
 }
 
 // Where each template vertex reads the avatar's shapes: its closest point of the avatar's skin.
@@ -354,7 +419,8 @@ ShapeSource shape_source(const Session& s, const Points& skin) {
 
 // Every skin-part vertex of the avatar near the registered skin, weighted 1 on the template's
 // face and fading over kFaceFade beyond it and from kNear to kFar away from the skin.
-Embedding embed(const Session& s, const Points& skin) {
+Embedding embed(const Session& s, const geometry::SurfaceQuery& registered) {
+  const Points& skin = registered.vertices();
   const std::size_t vs = s.t.skin_vertices;
   std::vector<Eigen::Index> in_face;
   for (std::size_t v = 0; v < vs; ++v)
@@ -365,7 +431,6 @@ Embedding embed(const Session& s, const Points& skin) {
   std::vector<double> face_weight(vs);
   for (std::size_t v = 0; v < vs; ++v)
     face_weight[v] = smooth_fall((s.tskin.row(static_cast<Eigen::Index>(v)) - sites.row(near[v])).norm(), 0.0, kFaceFade);
-  const geometry::SurfaceQuery registered(skin, s.ttri);
   const Points normals = vertex_normals(skin, s.ttri);
   Embedding e;
   for (std::size_t v = 0; v < s.a.vertex_count; ++v) {
@@ -392,7 +457,21 @@ Embedding embed(const Session& s, const Points& skin) {
   return e;
 }
 
-std::string report_json(const Session& s, const AvatarFit& fit, const Residual& r, std::size_t landmarks, double seconds) {
+// The verdict and the bounds it was judged by (fit/fit_quality.h).
+std::string quality_json(const FitQuality& q) {
+  const QualityBounds& b = kQualityBounds;
+  std::ostringstream o;
+  o << "{\"passed\": " << (q.passed ? "true" : "false") << ", \"failed_measure\": " << json_string(q.failed_measure)
+    << ", \"reason\": " << json_string(q.reason) << ", \"bounds\": {\"covered_mm\": " << b.covered_mm
+    << ", \"face_coverage_min\": " << b.min_face_coverage << ", \"avatar_to_template_mm_median_max\": " << b.max_median_mm
+    << ", \"avatar_to_template_mm_p90_max\": " << b.max_p90_mm << ", \"face_residual_mm_mean_max\": " << b.max_residual_mm
+    << ", \"template_scale_min\": " << b.min_template_scale
+    << ", \"template_scale_max\": " << b.max_template_scale << "}}";
+  return o.str();
+}
+
+std::string report_json(const Session& s, const AvatarFit& fit, const Residual& r, const FitQuality& q, std::size_t landmarks,
+                        double seconds) {
   const AvatarFrame& frame = s.at.frame;
   std::size_t full = 0;
   for (const float w : fit.embedding.weight) full += w >= 1.0f;
@@ -408,7 +487,13 @@ std::string report_json(const Session& s, const AvatarFit& fit, const Residual& 
     << ", \"shapes_missing\": " << name_list(fit.origin, ShapeOrigin::None) << ", \"landmarks\": " << landmarks
     << ", \"matched_by_shapes\": " << s.matcher->described() << ", \"face_residual_mm_mean\": " << r.mean_mm
     << ", \"face_residual_mm_max\": " << r.max_mm << ", \"face_residual_points\": " << r.points
-    << ", \"seconds\": " << seconds << "}";
+    << ", \"face_residual_beyond_rim\": " << r.beyond_rim << ", \"face_coverage\": " << q.face_coverage
+    << ", \"face_coverage_vertices\": " << q.face_points << ", \"avatar_to_template_mm_median\": " << q.median_mm
+    << ", \"avatar_to_template_mm_p90\": " << q.p90_mm << ", \"avatar_to_template_mm_max\": " << q.max_mm
+    << ", \"template_scale\": ";
+  if (q.template_scale > 0) o << q.template_scale;
+  else o << "null";
+  o << ", \"quality\": " << quality_json(q) << ", \"seconds\": " << seconds << "}";
   return o.str();
 }
 
@@ -472,13 +557,16 @@ AvatarFit fit_avatar(const TemplateData& t, const AvatarMesh& a, const FitOption
   fit.identity = s.identity;
   fit.registered = registered_head(s, reg.skin);
   step("measuring the fit", 0.8);
-  const Residual residual = face_residual(s, reg.skin, settings.reach_end * 2);
+  const Residual residual = face_residual(s, reg.skin);
+  const geometry::SurfaceQuery registered(reg.skin, s.ttri);
+  const FitQuality quality = fit_quality(registered, quality_input(s, fit.registered, residual));
   fit.source = shape_source(s, reg.skin);
   for (std::size_t k = 0; k < kShapes; ++k)
     fit.origin[k] = s.at.frame.moves[k] ? ShapeOrigin::Avatar : t.moves[k] ? ShapeOrigin::Template : ShapeOrigin::None;
   step("embedding the avatar", 0.85);
-  fit.embedding = embed(s, reg.skin);
-  fit.report = report_json(s, fit, residual, guides.size(), std::chrono::duration<double>(Clock::now() - t0).count());
+  fit.embedding = embed(s, registered);
+  fit.report =
+      report_json(s, fit, residual, quality, guides.size(), std::chrono::duration<double>(Clock::now() - t0).count());
   step("done", 1.0);
   return fit;
 }

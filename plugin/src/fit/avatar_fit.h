@@ -90,7 +90,7 @@ struct AvatarFit {
   ShapeSource source;
   std::array<ShapeOrigin, kShapes> origin{};
   Embedding embedding;
-  std::string report;  // JSON object (the report's facts; fit/fit_report.h)
+  std::string report;  // JSON object: the report's facts and the quality verdict (fit/fit_quality.h)
 };
 
 // Throws softdeca::Error (invalid argument) with a message a user can act on.

@@ -16,19 +16,19 @@ namespace {
 constexpr double kMotionShare = 0.002;
 
 // Left/Right pairs whose shapes move one side's part of the face (not "mouthLeft"/"jawLeft",
-// which move the whole mouth or jaw sideways), with the distance between the Left and the Right
-// shape's centres of motion on the ICT template, in metres (tests/python/test_avatar_frame.py
-// measures them again on the template).
+// which move the whole mouth or jaw sideways), with the distance between the pair's sides on
+// the ICT template, in metres (side_distance; tests/python/test_avatar_frame.py measures them
+// again on the template).
 struct SidePair {
   const char* stem;
   double template_distance;
 };
 constexpr SidePair kSidePairs[] = {
-    {"browDown", 0.0852},    {"browOuterUp", 0.0989},  {"cheekSquint", 0.0967},   {"eyeBlink", 0.0600},
-    {"eyeLookDown", 0.0699}, {"eyeLookIn", 0.0671},    {"eyeLookOut", 0.0671},    {"eyeLookUp", 0.0685},
-    {"eyeSquint", 0.0918},   {"eyeWide", 0.0683},      {"mouthDimple", 0.0530},   {"mouthFrown", 0.0561},
-    {"mouthLowerDown", 0.0323}, {"mouthPress", 0.0427}, {"mouthSmile", 0.0701},  {"mouthStretch", 0.0649},
-    {"mouthUpperUp", 0.0523}, {"noseSneer", 0.0596},
+    {"browDown", 0.0916},    {"browOuterUp", 0.1029},  {"cheekSquint", 0.1020},   {"eyeBlink", 0.0691},
+    {"eyeLookDown", 0.0703}, {"eyeLookIn", 0.0679},    {"eyeLookOut", 0.0679},    {"eyeLookUp", 0.0691},
+    {"eyeSquint", 0.0924},   {"eyeWide", 0.0687},      {"mouthDimple", 0.0608},   {"mouthFrown", 0.0638},
+    {"mouthLowerDown", 0.0480}, {"mouthPress", 0.0566}, {"mouthSmile", 0.0786},  {"mouthStretch", 0.0765},
+    {"mouthUpperUp", 0.0636}, {"noseSneer", 0.0696},
 };
 
 // Units a measured scale snaps to when within 25 %: mm, cm, inch, dm, m.
@@ -38,6 +38,7 @@ constexpr double kSnap = 1.25;
 struct Motion {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // motion-weighted centre of what moves
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // summed deltas over summed lengths
+  double spread = 0;  // RMS distance of what moves from the centre, weighted alike
   bool moves = false;
 };
 
@@ -54,9 +55,9 @@ void check_finite(const float* p, std::size_t n, const std::string& what) {
     expect(std::isfinite(p[i]), [&] { return what + " has a non-finite value at vertex " + std::to_string(i / 3); });
 }
 
-// The motion-weighted centre of one shape's moving vertices, each vertex weighted by its share
-// of the surface (so a mesh dense at the eyes and lips and one evenly meshed agree); marks them
-// in `face`.
+// The motion-weighted centre and spread of one shape's moving vertices, each vertex weighted by
+// its share of the surface (so a mesh dense at the eyes and lips and one evenly meshed agree);
+// marks them in `face`.
 Motion shape_motion(const AvatarShapes& s, const float* d, const std::vector<double>& area, std::vector<uint8_t>& face) {
   const std::size_t n = s.vertex_count;
   double peak = 0;
@@ -64,21 +65,50 @@ Motion shape_motion(const AvatarShapes& s, const float* d, const std::vector<dou
     peak = std::max(peak, Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm());
   Motion m;
   if (!(peak > 0)) return m;
-  double total = 0;
+  double total = 0, second = 0;
   for (std::size_t v = 0; v < n; ++v) {
     const double motion = Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm();
     if (motion <= kMotionShare * peak) continue;
     face[v] = 1;
     const double w = motion * area[v];
+    const Eigen::Vector3d x(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
     total += w;
-    m.centre += w * Eigen::Vector3d(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
+    m.centre += w * x;
+    second += w * x.squaredNorm();
     m.direction += Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]);
   }
   if (!(total > 0)) return m;  // only vertices on no triangle with area move
   m.centre /= total;
+  m.spread = std::sqrt(std::max(0.0, second / total - m.centre.squaredNorm()));
   m.direction /= total;
   m.moves = true;
   return m;
+}
+
+// The distance between a Left/Right pair's sides: each side the surface where its own shape
+// moves more than the other (each over its largest), weighted by how much more. Rigs split a
+// symmetric shape into its sides with a ramp across the face, often a wide one, so each side's
+// shape moves the other side too: the shapes' own centres of motion then lie closer together
+// than the sides do (a ramp across the whole face halves their distance, and a centimetre head
+// reads as inches); what one side moves more than the other stays on that side.
+double side_distance(const AvatarShapes& s, const float* dl, const float* dr, const std::vector<double>& area) {
+  const std::size_t n = s.vertex_count;
+  const auto motion = [](const float* d, std::size_t v) { return Eigen::Vector3d(d[3 * v], d[3 * v + 1], d[3 * v + 2]).norm(); };
+  double pl = 0, pr = 0;
+  for (std::size_t v = 0; v < n; ++v) pl = std::max(pl, motion(dl, v)), pr = std::max(pr, motion(dr, v));
+  if (!(pl > 0 && pr > 0)) return 0;
+  Eigen::Vector3d cl = Eigen::Vector3d::Zero(), cr = Eigen::Vector3d::Zero();
+  double wl = 0, wr = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const double ml = motion(dl, v), mr = motion(dr, v);
+    if (ml <= kMotionShare * pl && mr <= kMotionShare * pr) continue;
+    const double more = ml / pl - mr / pr;
+    const Eigen::Vector3d x(s.neutral[3 * v], s.neutral[3 * v + 1], s.neutral[3 * v + 2]);
+    if (more > 0) cl += more * area[v] * x, wl += more * area[v];
+    if (more < 0) cr -= more * area[v] * x, wr -= more * area[v];
+  }
+  if (!(wl > 0 && wr > 0)) return 0;
+  return (cl / wl - cr / wr).norm();
 }
 
 double median(std::vector<double> x) {
@@ -113,7 +143,27 @@ std::vector<double> vertex_areas(const AvatarShapes& s) {
   return area;
 }
 
+// Every shape's motion (`area`: vertex_areas); marks the vertices that move in `face`.
+std::array<Motion, kShapes> shape_motions(const AvatarShapes& s, const std::vector<double>& area, std::vector<uint8_t>& face) {
+  std::array<Motion, kShapes> motion{};
+  for (std::size_t i = 0; i < kShapes; ++i)
+    if (s.deltas[i] != nullptr) motion[i] = shape_motion(s, s.deltas[i], area, face);
+  return motion;
+}
+
 }  // namespace
+
+ShapeCentres shape_centres(const AvatarShapes& s) {
+  std::vector<uint8_t> face(s.vertex_count, 0);
+  const std::array<Motion, kShapes> motion = shape_motions(s, vertex_areas(s), face);
+  ShapeCentres c;
+  for (std::size_t i = 0; i < kShapes; ++i) {
+    c.moves[i] = motion[i].moves;
+    c.centres[i] = motion[i].centre;
+    c.spreads[i] = motion[i].spread;
+  }
+  return c;
+}
 
 std::string axis_name(const Eigen::Vector3d& up) {
   Eigen::Index k = 0;
@@ -135,17 +185,18 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   for (std::size_t i = 0; i < 3 * s.triangle_count; ++i)
     expect(s.triangles[i] >= 0 && static_cast<std::size_t>(s.triangles[i]) < s.vertex_count,
            [&] { return "triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh"; });
+  for (std::size_t i = 0; i < kShapes; ++i)
+    if (s.deltas[i] != nullptr)
+      check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
   AvatarFrame f;
   f.face.assign(s.vertex_count, 0);
-  std::array<Motion, kShapes> motion{};
   const std::vector<double> area = vertex_areas(s);
+  const std::array<Motion, kShapes> motion = shape_motions(s, area, f.face);
   for (std::size_t i = 0; i < kShapes; ++i) {
-    if (s.deltas[i] == nullptr) continue;
-    check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));
-    motion[i] = shape_motion(s, s.deltas[i], area, f.face);
     f.shapes_used += motion[i].moves;
     f.moves[i] = motion[i].moves;
     f.centres[i] = motion[i].centre;
+    f.spreads[i] = motion[i].spread;
   }
   f.face_vertices = static_cast<std::size_t>(std::count(f.face.begin(), f.face.end(), uint8_t{1}));
   require(f.shapes_used > 0, "none of the avatar's ARKit blendshapes moves a vertex: no face to fit");
@@ -158,12 +209,15 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   int eye_pairs = 0;
   double eye_distance = 0;
   for (const SidePair& p : kSidePairs) {
-    const Motion& l = motion[static_cast<std::size_t>(index_of(std::string(p.stem) + "Left"))];
-    const Motion& r = motion[static_cast<std::size_t>(index_of(std::string(p.stem) + "Right"))];
+    const auto li = static_cast<std::size_t>(index_of(std::string(p.stem) + "Left"));
+    const auto ri = static_cast<std::size_t>(index_of(std::string(p.stem) + "Right"));
+    const Motion& l = motion[li];
+    const Motion& r = motion[ri];
     if (!l.moves || !r.moves) continue;
     const Eigen::Vector3d d = l.centre - r.centre;
     left += d;
-    if (d.norm() > 0) scales.push_back(p.template_distance / d.norm());
+    const double sides = side_distance(s, s.deltas[li], s.deltas[ri], area);
+    if (sides > 0) scales.push_back(p.template_distance / sides);
     if (starts_with(p.stem, "eye")) {
       eyes += 0.5 * (l.centre + r.centre);
       eye_distance += d.norm();

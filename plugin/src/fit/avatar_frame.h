@@ -36,7 +36,9 @@ struct AvatarFrame {
   Eigen::Vector3d left, up, forward;
   Eigen::Vector3d eyes = Eigen::Vector3d::Zero();  // midway between the eyes (zero without eye shapes)
   double eye_distance = 0;  // between the eyes' centres of motion, avatar units (0 without eye shapes)
-  // The unit: 0.06 m over eye_distance, snapped to mm, cm, inch, dm or m when within 25 %.
+  // The unit: the template's distance between each Left/Right pair's sides (where one side's
+  // shape moves more than the other's) over the avatar's, the median over the pairs, snapped to
+  // mm, cm, inch, dm or m when within 25 %.
   double metres_per_unit = 1;
   double metres_per_unit_measured = 1;
   std::string up_axis;        // the avatar axis closest to up: "+Y", "+Z", "-X", ...
@@ -44,12 +46,24 @@ struct AvatarFrame {
   // mouthFunnel, cheekPuff), else the face's normals, point along -(left x up).
   bool mirrored = false;
   std::vector<uint8_t> face;  // per vertex: 1 where some ARKit shape moves it
-  // Per shape: whether it moves a vertex, and its motion-weighted centre (avatar coordinates).
+  // Per shape: whether it moves a vertex, its motion-weighted centre (avatar coordinates) and
+  // spread (the RMS distance of what it moves from that centre, weighted alike; avatar units).
   std::array<bool, kShapes> moves{};
   std::array<Eigen::Vector3d, kShapes> centres{};
+  std::array<double, kShapes> spreads{};
   std::size_t face_vertices = 0;
   std::size_t shapes_used = 0;
 };
+
+// Each shape's motion-weighted centre and spread as avatar_frame reads them (`moves` false where
+// the shape moves nothing), without the frame: for a mesh known to be a face, such as the
+// registered template, whose shapes tell its face's size (fit/fit_quality.h).
+struct ShapeCentres {
+  std::array<bool, kShapes> moves{};
+  std::array<Eigen::Vector3d, kShapes> centres{};
+  std::array<double, kShapes> spreads{};
+};
+ShapeCentres shape_centres(const AvatarShapes& shapes);
 
 // A measured metres-per-unit snapped to mm, cm, inch, dm or m when within 25 %.
 double snap_unit(double measured);

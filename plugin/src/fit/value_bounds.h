@@ -2,7 +2,8 @@
 // files"): the import refuses a file that breaks them (naming the file, mesh, shape and
 // vertex) and the fit a mesh handed over directly (naming the vertex and shape), by one rule.
 //
-// - A coordinate within +-kMaxCoordinate units.
+// - A coordinate within +-kMaxCoordinate units (10,000 km in metres, 10 km in millimetres: any
+//   avatar in any unit; beyond, a value that would overflow what is computed from it).
 // - A vertex within kStrayReach times the mesh's extent of the box that holds its vertices but
 //   the outermost 2 % on each axis (a stray vertex at 1e30 far from a head).
 // - A shape's delta no longer than kMaxDeltaReach times the diagonal of the mesh's whole box
@@ -15,7 +16,7 @@
 
 namespace softdeca::fit {
 
-constexpr double kMaxCoordinate = 1e9;
+constexpr double kMaxCoordinate = 1e7;
 constexpr double kStrayReach = 10;
 constexpr double kMaxDeltaReach = 2;
 

@@ -1,5 +1,6 @@
 #include "prepare/parameters.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -7,16 +8,36 @@
 
 namespace softdeca::runtime {
 
+std::vector<double> skin_vertex_areas(const std::vector<std::int32_t>& triangles, const std::vector<double>& face_area,
+                                      std::size_t n_vertices) {
+  std::vector<double> area(n_vertices, 0.0);
+  for (std::size_t f = 0; f < triangles.size() / 3; ++f)
+    for (int c = 0; c < 3; ++c) area[static_cast<std::size_t>(triangles[3 * f + c])] += face_area[f];
+  return area;
+}
+
+void faces_from_vertex_map(const std::vector<std::int32_t>& t, const double* vertex_values, double* out) {
+  const auto v = [&](std::size_t k) { return vertex_values[static_cast<std::size_t>(t[k])]; };
+  for (std::size_t f = 0; f < t.size() / 3; ++f) out[f] = (v(3 * f) + v(3 * f + 1) + v(3 * f + 2)) / 3.0;
+}
+
+void vertices_from_face_map(const std::vector<std::int32_t>& t, const std::vector<double>& face_area,
+                            const std::vector<double>& vertex_area, const double* face_values, double* out) {
+  std::fill(out, out + vertex_area.size(), 0.0);
+  for (std::size_t f = 0; f < t.size() / 3; ++f)
+    for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(t[3 * f + c])] += face_area[f] * face_values[f];
+  // an unheld vertex has no area: 0 rather than 0 / 0
+  for (std::size_t i = 0; i < vertex_area.size(); ++i) out[i] /= std::max(vertex_area[i], 1e-300);
+}
+
 ParameterState::ParameterState(const Manifest& manifest, const std::vector<std::int32_t>& triangles,
                                const std::vector<double>& face_area)
     : specs_(&manifest.parameters),
       triangles_(&triangles),
       face_area_(face_area),
-      vertex_area_(static_cast<std::size_t>(manifest.skin_vertices), 0.0),
+      vertex_area_(skin_vertex_areas(triangles, face_area, static_cast<std::size_t>(manifest.skin_vertices))),
       n_faces_(triangles.size() / 3),
       n_vertices_(static_cast<std::size_t>(manifest.skin_vertices)) {
-  for (std::size_t f = 0; f < n_faces_; ++f)
-    for (int c = 0; c < 3; ++c) vertex_area_[static_cast<std::size_t>(triangles[3 * f + c])] += face_area_[f];
   reset();
 }
 
@@ -102,22 +123,17 @@ void ParameterState::column(const Value& v, bool faces, std::vector<float>& out)
   const std::size_t n = faces ? n_faces_ : n_vertices_;
   out.assign(n, static_cast<float>(v.global));
   if (v.kind == Kind::Global) return;
-  const std::vector<std::int32_t>& t = *triangles_;
-  if (faces && v.kind == Kind::Faces) {
+  if ((faces && v.kind == Kind::Faces) || (!faces && v.kind == Kind::Vertices)) {
     out = v.map;
-  } else if (!faces && v.kind == Kind::Vertices) {
-    out = v.map;
-  } else if (faces) {  // vertex map -> faces: mean of the corners
-    for (std::size_t f = 0; f < n_faces_; ++f)
-      out[f] = static_cast<float>((static_cast<double>(v.map[static_cast<std::size_t>(t[3 * f])]) +
-                                   v.map[static_cast<std::size_t>(t[3 * f + 1])] + v.map[static_cast<std::size_t>(t[3 * f + 2])]) /
-                                  3.0);
-  } else {  // face map -> vertices: area-weighted mean of the incident faces
-    std::vector<double> acc(n_vertices_, 0.0);
-    for (std::size_t f = 0; f < n_faces_; ++f)
-      for (int c = 0; c < 3; ++c) acc[static_cast<std::size_t>(t[3 * f + c])] += face_area_[f] * v.map[f];
-    for (std::size_t i = 0; i < n_vertices_; ++i) out[i] = static_cast<float>(acc[i] / vertex_area_[i]);
+    return;
   }
+  const std::vector<double> from(v.map.begin(), v.map.end());
+  std::vector<double> to(n);
+  if (faces)
+    faces_from_vertex_map(*triangles_, from.data(), to.data());
+  else
+    vertices_from_face_map(*triangles_, face_area_, vertex_area_, from.data(), to.data());
+  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(to[i]);
 }
 
 void ParameterState::face_matrix(const std::vector<int>& columns, float* out) const { matrix(columns, true, out); }

@@ -1,7 +1,8 @@
 // Material parameters of one avatar: each a global value, a map over the skin triangles or a
 // map over the skin vertices, turned into the hypernetworks' per-element inputs by the rules
 // of docs/bundle.md (face map -> vertex: area-weighted mean of the incident faces; vertex map
-// -> face: mean of the three corners). Mirrors training/softdeca_train/models/parameters.py.
+// -> face: mean of the three corners). The rules are this file's alone: the training package
+// calls them through softdeca_native (models/parameters.py).
 #pragma once
 
 #include <cstddef>
@@ -11,6 +12,17 @@
 #include "bundle/manifest.h"
 
 namespace softdeca::runtime {
+
+// The localisation rules over a skin's triangles (3 indices each). vertex_values: one per
+// vertex; face_values and face_area: one per triangle; vertex_area: skin_vertex_areas'.
+std::vector<double> skin_vertex_areas(const std::vector<std::int32_t>& triangles, const std::vector<double>& face_area,
+                                      std::size_t n_vertices);
+// Vertex map -> faces: the mean of each triangle's corners.
+void faces_from_vertex_map(const std::vector<std::int32_t>& triangles, const double* vertex_values, double* out);
+// Face map -> vertices: the area-weighted mean of the incident faces (0 at a vertex no triangle
+// holds).
+void vertices_from_face_map(const std::vector<std::int32_t>& triangles, const std::vector<double>& face_area,
+                            const std::vector<double>& vertex_area, const double* face_values, double* out);
 
 class ParameterState {
  public:

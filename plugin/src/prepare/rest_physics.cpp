@@ -15,23 +15,6 @@ namespace softdeca::runtime {
 namespace {
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-// sum over tets of vol * grad(phi_a) . grad(phi_b): the fill's Dirichlet energy (the
-// carry's smoothness term, lhm/carried.py's stiffness_matrix).
-void add_stiffness(const sim::Positions& x, const sim::TetIndices& tets, double scale, Triplets& out) {
-  for (Eigen::Index t = 0; t < tets.rows(); ++t) {
-    Eigen::Matrix3d e;
-    for (int j = 0; j < 3; ++j) e.col(j) = (x.row(tets(t, j + 1)) - x.row(tets(t, 0))).transpose();
-    const double det = e.determinant();
-    if (!(std::abs(det) > 0)) continue;  // a degenerate tet adds no energy (the bundle's fill has none)
-    Eigen::Matrix<double, 4, 3> g;
-    g.bottomRows<3>() = e.inverse();
-    g.row(0) = -g.bottomRows<3>().colwise().sum();
-    const double vol = std::abs(det) / 6.0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) out.emplace_back(tets(t, a), tets(t, b), scale * vol * g.row(a).dot(g.row(b)));
-  }
-}
-
 // The per-element field of parameter `index`'s map on the physics' domain, built from the one
 // kind of values that domain reads: per vertex (tets through their skin vertex, skin points) or
 // per face (skin triangles). Empty where the domain has no per-element values.
@@ -71,6 +54,21 @@ void embed_own_skin(const sim::Positions& fill, const sim::Positions& skin, sim:
 }
 }  // namespace
 
+void add_fill_stiffness(const sim::Positions& x, const sim::TetIndices& tets, double scale, Triplets& out) {
+  for (Eigen::Index t = 0; t < tets.rows(); ++t) {
+    Eigen::Matrix3d e;
+    for (int j = 0; j < 3; ++j) e.col(j) = (x.row(tets(t, j + 1)) - x.row(tets(t, 0))).transpose();
+    const double det = e.determinant();
+    if (!(std::abs(det) > 0)) continue;  // a degenerate tet adds no energy (the bundle's fill has none)
+    Eigen::Matrix<double, 4, 3> g;
+    g.bottomRows<3>() = e.inverse();
+    g.row(0) = -g.bottomRows<3>().colwise().sum();
+    const double vol = std::abs(det) / 6.0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) out.emplace_back(tets(t, a), tets(t, b), scale * vol * g.row(a).dot(g.row(b)));
+  }
+}
+
 sim::Positions carry_fill(const RestHead& head, const sim::Positions& neutral_skin) {
   const Eigen::Index n = head.vertices.rows(), ns = head.skin.size();
   require(neutral_skin.rows() == ns, "carry_fill: the neutral skin does not match the bundle's skin");
@@ -81,8 +79,8 @@ sim::Positions carry_fill(const RestHead& head, const sim::Positions& neutral_sk
         b.emplace_back(i, head.skin.vertex(i, c), head.skin.weight(i, c) * head.carry_weight[static_cast<std::size_t>(i)]);
   Eigen::SparseMatrix<double> bw(ns, n);
   bw.setFromTriplets(b.begin(), b.end());
-  add_stiffness(head.vertices, head.soft_tets, head.carry_smoothness, k);
-  add_stiffness(head.vertices, head.muscle_tets, head.carry_smoothness, k);
+  add_fill_stiffness(head.vertices, head.soft_tets, head.carry_smoothness, k);
+  add_fill_stiffness(head.vertices, head.muscle_tets, head.carry_smoothness, k);
   Eigen::SparseMatrix<double> system(n, n);
   system.setFromTriplets(k.begin(), k.end());
   system += Eigen::SparseMatrix<double>(bw.transpose() * bw);

@@ -7,9 +7,11 @@
 // parameters, which the frames' rest correction compares across parameter values. The lip and
 // lid sets are found on the avatar's neutral (prepare/contact_sets.h), and a parameter map
 // reaches a tet through the skin vertex nearest its centroid, as in the training data.
-// Mirrors training/softdeca_train/models/rest_physics.py.
+// Mirrors training/softdeca_train/models/rest_physics.py; the carry is this file's alone (the
+// training package calls carry_fill and add_fill_stiffness through softdeca_native).
 #pragma once
 
+#include <Eigen/SparseCore>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -24,6 +26,12 @@ namespace softdeca::runtime {
 
 // The fill's vertices carried to a neutral skin (skin_vertices x 3, metres).
 sim::Positions carry_fill(const RestHead& head, const sim::Positions& neutral_skin);
+
+// Appends scale * (sum over tets of vol * grad(phi_a) . grad(phi_b)), the Dirichlet energy of
+// a piecewise-linear field on the fill (the carry's smoothness term), as (a, b, value)
+// triplets; a degenerate tet adds nothing.
+void add_fill_stiffness(const sim::Positions& x, const sim::TetIndices& tets, double scale,
+                        std::vector<Eigen::Triplet<double>>& out);
 
 class RestPhysics {
  public:

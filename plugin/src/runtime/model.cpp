@@ -6,6 +6,7 @@
 #include <cstring>
 #include <iterator>
 
+#include "bundle/onnx_graph.h"
 #include "bundle/onnx_model_scan.h"
 #include "bundle/sha256.h"
 #include "core/error.h"
@@ -23,13 +24,6 @@ const char* const kNetworkKeys[] = {"identity_encoder", "softdeca.f_w",    "soft
 
 std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
 
-// A name from the file, made safe to print: printable ASCII, at most 64 characters.
-std::string printable(const std::string& name) {
-  std::string out;
-  for (const char c : name.substr(0, 64)) out += (c >= 32 && c < 127) ? c : '?';
-  return name.size() > 64 ? out + "..." : out;
-}
-
 // The file's bytes, once their sha256 matches the manifest's.
 const Bytes& verified(const BundleFiles& files, const std::string& name, const std::string& sha256) {
   const Bytes& bytes = files.get(name);
@@ -38,27 +32,27 @@ const Bytes& verified(const BundleFiles& files, const std::string& name, const s
   return bytes;
 }
 
-std::uint64_t add_sat(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
-
-// Refuses external data and adds what the network may allocate to the estimate.
+// Refuses external data and graphs outside the exporter's operators or without static shapes,
+// and adds what the network may allocate to the estimate.
 void scan_network(const Bytes& bytes, const NetworkSpec& spec, MemoryEstimate& estimate) {
   const OnnxModelScan scan = [&] {
     try {
-      return scan_onnx_model(bytes.data(), bytes.size());
+      return scan_onnx_model(bytes.data(), bytes.size(), spec.inputs);
     } catch (const Error& e) {
       fail(spec.file + ": " + e.what());
     }
   }();
   if (!scan.external_tensors.empty())
-    fail(spec.file + ": tensor '" + printable(scan.external_tensors.front()) +
+    fail(spec.file + ": tensor '" + onnx::printable(scan.external_tensors.front()) +
          "' keeps its data in another file (ONNX external data); a bundle's networks must hold all their data");
   std::uint64_t contract = 0;
   for (const auto* side : {&spec.inputs, &spec.outputs})
-    for (const TensorSpec& t : *side) contract = add_sat(contract, OnnxNetwork::element_count(t, 1) * sizeof(float));
-  estimate.bytes = add_sat(estimate.bytes, add_sat(scan.total_bytes(), contract));
+    for (const TensorSpec& t : *side)
+      contract = onnx::add_sat(contract, OnnxNetwork::element_count(t, kFedBatch) * sizeof(float));
+  estimate.bytes = onnx::add_sat(estimate.bytes, onnx::add_sat(scan.bytes, contract));
   if (scan.largest_bytes > estimate.largest_bytes) {
     estimate.largest_bytes = scan.largest_bytes;
-    estimate.largest = spec.file + " tensor '" + printable(scan.largest_tensor) + "'";
+    estimate.largest = spec.file + " tensor '" + onnx::printable(scan.largest_tensor) + "'";
   }
 }
 }  // namespace

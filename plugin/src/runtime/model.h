@@ -22,9 +22,9 @@ constexpr std::uint64_t kDefaultMemoryBudget = std::uint64_t{2} << 30;
 
 struct ModelOptions {
   int prepare_threads = 1;  // intra-op threads of the per-avatar networks (f_ph, f_ph_v, f_r_ph, f_dyn)
-  // Upper bound on what the bundle's networks may ask for (initializers, declared tensor
-  // shapes, constant-shaped outputs, the contract's tensors), checked before any ONNX Runtime
-  // session is created.
+  // Upper bound on what the bundle's networks may ask for (every tensor of their graphs at its
+  // static size, and the contract's tensors), checked before any ONNX Runtime session is
+  // created.
   std::uint64_t memory_budget_bytes = kDefaultMemoryBudget;
 };
 

@@ -61,6 +61,10 @@ OnnxNetwork::OnnxNetwork(Ort::Env& env, const Bytes& model, const NetworkSpec& s
     opts.SetGraphOptimizationLevel(GraphOptimizationLevel::ORT_ENABLE_ALL);
     // Spinning worker threads would steal the cores the frame loop needs.
     opts.AddConfigEntry("session.intra_op.allow_spinning", "0");
+    // No constant folding: a session then computes nothing while it is created, so loading
+    // allocates no tensor of a bundle's graph beyond its initializers; the tensors a run makes
+    // are bounded by the load-time check (bundle/onnx_model_scan.h, docs/security.md).
+    opts.AddConfigEntry("optimization.disable_specified_optimizers", "ConstantFolding");
     session_ = std::make_unique<Ort::Session>(env, model.data(), model.size(), opts);
   } catch (const Ort::Exception& e) {
     throw Error(SOFTDECA_ERROR_FORMAT, spec.file + ": ONNX Runtime cannot load it: " + e.what());

@@ -15,6 +15,8 @@ NECK_DEPTH = 0.03  # m below the neck boundary where the torso's section is a ci
 # The torso's section below the neck boundary: (depth m, half width m, half depth m), linear
 # between; shoulders, chest, waist, hips. The hips are closed with a fan.
 TORSO_PROFILE = ((0.09, 0.20, 0.12), (0.35, 0.17, 0.11), (0.55, 0.15, 0.10), (0.72, 0.17, 0.11))
+# A bust's: the shoulders and the chest, closed under the chest.
+BUST_PROFILE = ((0.09, 0.20, 0.12), (0.22, 0.18, 0.11))
 RING_SPACING = 0.01  # m between the torso's rings
 # Limbs: (start, end) as (x m, depth m below the neck boundary) and the radius in m; the
 # left one, mirrored for the right.
@@ -40,17 +42,20 @@ def neck_loop(skin: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return min(loops, key=lambda loop: float(skin[loop, 1].mean()))
 
 
-def _torso(skin: np.ndarray, loop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rings from the neck loop down to the hips, then a fan: vertices and triangles in the
-    combined index space (the loop's skin indices, the torso's from len(skin))."""
+def _torso(
+    skin: np.ndarray, loop: np.ndarray, profile_rows: tuple = TORSO_PROFILE
+) -> tuple[np.ndarray, np.ndarray]:
+    """Rings from the neck loop down the profile (TORSO_PROFILE: to the hips), then a fan:
+    vertices and triangles in the combined index space (the loop's skin indices, the torso's
+    from len(skin))."""
     ring0 = skin[loop]
     centre = ring0.mean(axis=0)
     y0 = centre[1]
     offset = ring0[:, [0, 2]] - centre[[0, 2]]
     theta = np.arctan2(offset[:, 1], offset[:, 0])
     neck_radius = float(np.linalg.norm(offset, axis=1).mean())
-    depths = np.arange(RING_SPACING, TORSO_PROFILE[-1][0] + 1e-9, RING_SPACING)
-    profile = np.array(((NECK_DEPTH, neck_radius, neck_radius), *TORSO_PROFILE))
+    depths = np.arange(RING_SPACING, profile_rows[-1][0] + 1e-9, RING_SPACING)
+    profile = np.array(((NECK_DEPTH, neck_radius, neck_radius), *profile_rows))
     half_x = np.interp(depths, profile[:, 0], profile[:, 1])
     half_z = np.interp(depths, profile[:, 0], profile[:, 2])
     rings = []
@@ -124,3 +129,11 @@ def synthetic_body(skin: np.ndarray, skin_triangles: np.ndarray, n_vertices: int
             tris.append(t + count)
             count += len(v)
     return Body(np.concatenate(parts), np.concatenate(tris).astype(np.int64))
+
+
+def synthetic_bust(skin: np.ndarray, skin_triangles: np.ndarray) -> Body:
+    """Shoulders and a chest under the skin (vertices, triangles), joined to its neck boundary,
+    as busts and head-and-shoulders avatars end."""
+    loop = neck_loop(skin, skin_triangles)
+    vertices, triangles = _torso(skin, loop, BUST_PROFILE)
+    return Body(vertices, triangles.astype(np.int64))

@@ -15,14 +15,15 @@ mirror and the vertex order change, in the order the truth states them."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from softdeca_train.avatars.body import synthetic_body
+from softdeca_train.avatars.body import synthetic_body, synthetic_bust
 from softdeca_train.avatars.config import AvatarConfig
+from softdeca_train.avatars.extras import eyebrow_fins, hair_cards
 from softdeca_train.avatars.mesh import PARTS, AvatarMesh, AvatarTruth
-from softdeca_train.avatars.names import rig_name
+from softdeca_train.avatars.names import _side, rig_name
 from softdeca_train.avatars.remesh import SurfacePoints, remesh
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
 from softdeca_train.landmarks import ArkitFace
@@ -37,6 +38,8 @@ SEPARATE = {
     "teeth_upper": "teeth",
     "teeth_lower": "teeth",
 }
+# ICT components in the skin's object with eyes_teeth_tongue: the eyeballs, the teeth, the tongue.
+IN_HEAD = (*SEPARATE, "gums_tongue")
 Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # +Y to +Z, +Z to -Y
 
 
@@ -167,7 +170,70 @@ def head_pieces(source: Source, config: AvatarConfig, progress: bool) -> list[Pi
         for c in COMPONENTS:
             if c.name in SEPARATE:
                 pieces.append(subset_piece(source, c.name, np.arange(c.start, c.stop)))
+    if config.eyes_teeth_tongue:
+        # decimated in the skin's proportion, as a low-poly head's are
+        ratio = (config.remesh or len(surface)) / len(surface)
+        for c in COMPONENTS:
+            if c.name not in IN_HEAD:
+                continue
+            inside = np.arange(c.start, c.stop)
+            if config.remesh:
+                target = max(60, round(ratio * len(inside)))
+                pieces.append(remeshed_piece(source, c.name, inside, target, "adaptive"))
+            else:
+                pieces.append(subset_piece(source, c.name, inside))
+    if config.eyebrows:
+        pieces[0] = with_eyebrow_fins(pieces[0])
+    if config.hair_cards:
+        pieces.append(hair_piece(pieces[0], config))
     return pieces
+
+
+def with_eyebrow_fins(skin: Piece) -> Piece:
+    """The skin with fins along its brows (extras.py): their feet are its own vertices, their
+    tips new vertices that move as the skin they stand on; the tips are hair."""
+    rows = (skin.part[skin.triangles] == PARTS.index("skin")).all(axis=1)
+    fins = eyebrow_fins(skin.vertices, skin.triangles[rows], skin.deltas)
+    n = len(fins.foot)
+    return Piece(
+        skin.name,
+        np.concatenate([skin.vertices, fins.tips]),
+        np.concatenate([skin.deltas, skin.deltas[:, fins.foot]], axis=1),
+        np.concatenate([skin.triangles, fins.triangles]),
+        SurfacePoints(
+            np.concatenate([skin.points.triangle, np.full(n, -1, np.int64)]),
+            np.concatenate([skin.points.bary, np.zeros((n, 3))]),
+        ),
+        np.concatenate([skin.source_vertex, np.full(n, -1, np.int64)]),
+        np.concatenate([skin.part, np.full(n, PARTS.index("hair"), np.int8)]),
+    )
+
+
+def hair_piece(skin: Piece, config: AvatarConfig) -> Piece:
+    """Hair cards over the skin's scalp and forehead (extras.py), moved by no shape, or with
+    hair_follows by the shapes of the skin they hover over."""
+    rows = (skin.part[skin.triangles] == PARTS.index("skin")).all(axis=1)
+    cards = hair_cards(
+        skin.vertices, skin.triangles[rows], skin.deltas, config.hair_cards, config.variant_seed
+    )
+    piece = _unmoved("hair", cards.vertices, cards.triangles, "hair")
+    if config.hair_follows:
+        piece = replace(piece, deltas=skin.deltas[:, cards.foot])
+    return piece
+
+
+def _unmoved(name: str, vertices: np.ndarray, triangles: np.ndarray, part: str) -> Piece:
+    """A piece on no source point that no shape moves."""
+    n = len(vertices)
+    return Piece(
+        name,
+        vertices,
+        np.zeros((52, n, 3)),
+        triangles,
+        SurfacePoints(np.full(n, -1, np.int64), np.zeros((n, 3))),
+        np.full(n, -1, np.int64),
+        np.full(n, PARTS.index(part), np.int8),
+    )
 
 
 def _say(progress: bool, text: str) -> None:
@@ -175,22 +241,18 @@ def _say(progress: bool, text: str) -> None:
         print(text, flush=True)
 
 
-def body_piece(skin: Piece, n_vertices: int, offset: int) -> Piece:
-    """The body joined to the skin's neck boundary; the skin is the avatar's first object and
-    the body starts at vertex `offset`, so its triangles' indices below 0 are the skin's."""
+def body_piece(skin: Piece, n_vertices: int | None, offset: int) -> Piece:
+    """The body (a bust when n_vertices is None) joined to the skin's neck boundary; the skin is
+    the avatar's first object and the body starts at vertex `offset`, so its triangles' indices
+    below 0 are the skin's."""
     rows = (skin.part[skin.triangles] == PARTS.index("skin")).all(axis=1)
-    body = synthetic_body(skin.vertices, skin.triangles[rows], n_vertices)
-    n, n_skin = len(body.vertices), len(skin.vertices)
+    if n_vertices is None:
+        body = synthetic_bust(skin.vertices, skin.triangles[rows])
+    else:
+        body = synthetic_body(skin.vertices, skin.triangles[rows], n_vertices)
+    n_skin = len(skin.vertices)
     triangles = np.where(body.triangles < n_skin, body.triangles - offset, body.triangles - n_skin)
-    return Piece(
-        "body",
-        body.vertices,
-        np.zeros((52, n, 3)),
-        triangles,
-        SurfacePoints(np.full(n, -1, np.int64), np.zeros((n, 3))),
-        np.full(n, -1, np.int64),
-        np.full(n, PARTS.index("body"), np.int8),
-    )
+    return _unmoved("body", body.vertices, triangles, "body")
 
 
 def assemble(pieces: list[Piece]) -> tuple[Piece, tuple[tuple[str, int], ...]]:
@@ -209,6 +271,22 @@ def assemble(pieces: list[Piece]) -> tuple[Piece, tuple[tuple[str, int], ...]]:
         np.concatenate([p.part for p in pieces]),
     )
     return whole, tuple((p.name, len(p.triangles)) for p in pieces)
+
+
+def resplit(whole: Piece, width: float) -> np.ndarray:
+    """The side shapes split again from their symmetric sum by a linear ramp `width` metres
+    wide across the face (x, the subject's left), as rigging tools split a symmetric shape
+    into Left and Right: each side's shape then moves the other side a little too."""
+    deltas = whole.deltas.copy()
+    left = np.clip(0.5 + whole.vertices[:, 0] / width, 0.0, 1.0)[:, None]
+    for k, name in enumerate(ARKIT_BLENDSHAPES):
+        stem, side = _side(name)
+        if side != "Left":
+            continue
+        r = ARKIT_BLENDSHAPES.index(stem + "Right")
+        both = whole.deltas[k] + whole.deltas[r]
+        deltas[k], deltas[r] = left * both, (1 - left) * both
+    return deltas
 
 
 def chosen_shapes(config: AvatarConfig, moving: np.ndarray) -> np.ndarray:
@@ -243,12 +321,16 @@ def make_avatar(
     else:
         source = ict_source(template or Template.load(), config.identity)
     pieces = head_pieces(source, config, progress)
-    if config.body:
+    if config.body or config.shoulders:
         offset = sum(len(p.vertices) for p in pieces)
-        pieces.append(body_piece(pieces[0], config.body_vertices, offset))
+        size = config.body_vertices if config.body else None
+        pieces.append(body_piece(pieces[0], size, offset))
     whole, groups = assemble(pieces)
+    if config.one_object:
+        groups = (("head", len(whole.triangles)),)
     present = chosen_shapes(config, source.moving)
-    deltas = np.where(present[:, None, None], whole.deltas, 0.0)
+    deltas = whole.deltas if config.split_width is None else resplit(whole, config.split_width)
+    deltas = np.where(present[:, None, None], deltas, 0.0)
     # the conventions: feet at 0 with a body, then mirror, axes and unit (AvatarTruth.linear)
     lift = np.array([0.0, -whole.vertices[:, 1].min() if config.body else 0.0, 0.0])
     rotation = Z_UP if config.up == "z" else np.eye(3)

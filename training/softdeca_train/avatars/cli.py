@@ -11,12 +11,36 @@ from softdeca_train.avatars.config import (
     DEFAULT_BODY_VERTICES,
     DEFAULT_IDENTITY,
     HELD_OUT_IDENTITIES,
+    LOW_POLY_VERTICES,
     NAME_STYLES,
     REMESH_STYLES,
     UNITS,
     AvatarConfig,
+    low_poly,
 )
 from softdeca_train.commands import Command, add_ict_argument
+
+# What real heads carry and how they are exported: on/off options of `avatar`.
+LOOK_FLAGS = (
+    (
+        "--eyes-teeth-tongue",
+        "the eyeballs, the teeth and the tongue with the skin (decimated with it by --remesh; "
+        "one object with --one-object)",
+    ),
+    (
+        "--hair-follows",
+        "the hair cards move with the skin under them (shapes transferred to every mesh)",
+    ),
+    ("--eyebrows", "eyebrow fins fused to the skin along the brows"),
+    ("--shoulders", "a bust: the neck continued into shoulders and a chest (no shape moves it)"),
+    ("--one-object", "every part in one object, as one mesh"),
+    (
+        "--low-poly",
+        f"a game-ready head as artists export one: --remesh {LOW_POLY_VERTICES} --remesh-style "
+        "adaptive (unless given) --eyes-teeth-tongue --hair-cards 12 --eyebrows --shoulders "
+        "--one-object --unit cm --up z --names prefix --shuffle",
+    ),
+)
 
 
 def _avatar_args(p: argparse.ArgumentParser) -> None:
@@ -67,6 +91,25 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="the skin, the eyeballs and the teeth as separate objects (o lines)",
     )
+    for flag, text in LOOK_FLAGS:
+        p.add_argument(flag, action="store_true", help=text)
+    p.add_argument(
+        "--hair-cards",
+        type=int,
+        default=0,
+        metavar="K",
+        help="K hair cards a layer (two layers, a few mm off the scalp) over the scalp and the "
+        "forehead, moved by no shape (0)",
+    )
+    p.add_argument(
+        "--split-width",
+        type=float,
+        default=None,
+        metavar="M",
+        help="the side shapes split from their symmetric sum by a linear ramp M metres wide "
+        "across the face, as rigging tools split them (each side's shape moves the other side "
+        "a little); default: the source's own",
+    )
     p.add_argument(
         "--keep-shapes", type=int, default=None, metavar="K", help="only K shapes, at random"
     )
@@ -78,7 +121,8 @@ def _avatar_args(p: argparse.ArgumentParser) -> None:
         choices=NAME_STYLES,
         default="arkit",
         help="the shapes' names: eyeBlinkLeft, blendShape1.eyeBlinkLeft, AK_09_EyeBlinkLeft, "
-        "eyeBlink_L, eye_blink_l or EyeBlinkLeft (arkit)",
+        "eyeBlink_L, eye_blink_l, EyeBlinkLeft, CC_Base_Body.Eye_Blink_L or "
+        "facs_bs_EyeBlinkLeft (arkit)",
     )
     p.add_argument(
         "--arkit-face",
@@ -101,7 +145,7 @@ def config_from_args(args: argparse.Namespace) -> AvatarConfig:
     identity = args.identity or DEFAULT_IDENTITY
     if args.seed is not None:
         identity = f"seed {args.seed}"
-    return AvatarConfig(
+    config = AvatarConfig(
         identity=identity,
         remesh=args.remesh,
         remesh_style=args.remesh_style,
@@ -111,12 +155,20 @@ def config_from_args(args: argparse.Namespace) -> AvatarConfig:
         mirror=args.mirror,
         body=args.body,
         separate_eyes_teeth=args.separate_eyes_teeth,
+        eyes_teeth_tongue=args.eyes_teeth_tongue,
+        hair_cards=args.hair_cards,
+        hair_follows=args.hair_follows,
+        eyebrows=args.eyebrows,
+        split_width=args.split_width,
+        shoulders=args.shoulders,
+        one_object=args.one_object,
         keep_shapes=args.keep_shapes,
         drop=tuple(n.strip() for n in args.drop.split(",") if n.strip()),
         names=args.names,
         arkit_face=args.arkit_face,
         variant_seed=args.variant_seed,
     )
+    return low_poly(config) if args.low_poly else config
 
 
 def _avatar_run(args: argparse.Namespace) -> int:

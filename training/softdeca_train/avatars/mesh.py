@@ -17,8 +17,9 @@ from pathlib import Path
 import numpy as np
 
 # Vertex parts, the values of AvatarTruth.part. "inner": ICT's gums and tongue, lacrimal fluid,
-# eye blend and occlusion meshes and eyelashes (in the whole-head layout only).
-PARTS = ("skin", "eyes", "teeth", "inner", "body")
+# eye blend and occlusion meshes and eyelashes (in the whole-head layout; the gums and tongue
+# alone with eyes_teeth_tongue); "hair": hair cards and the eyebrow fins' tips.
+PARTS = ("skin", "eyes", "teeth", "inner", "body", "hair")
 SOURCES = ("ict", "arkit")
 TRUTH_FORMAT = 1
 
@@ -29,7 +30,7 @@ class AvatarTruth:
     metres_per_unit (mirror: diag(-1, 1, 1) when set, else the identity)."""
 
     source: str  # "ict": rows of Template.triangles; "arkit": rows of ArkitFace.triangles
-    triangle: np.ndarray  # (N,) int64, the source triangle each vertex sits on; -1: body
+    triangle: np.ndarray  # (N,) int64, the source triangle each vertex sits on; -1: body, hair
     bary: np.ndarray  # (N, 3) float64, its barycentric coordinates there (0 for the body)
     corners: np.ndarray  # (N, 3) int64, that triangle's source vertices; -1: body
     source_vertex: np.ndarray  # (N,) int64, the source vertex it is, -1 where none

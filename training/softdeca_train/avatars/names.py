@@ -28,6 +28,7 @@ def rig_name(canonical: str, style: str) -> str:
     arkit      eyeBlinkLeft               namespace  blendShape1.eyeBlinkLeft
     prefix     AK_09_EyeBlinkLeft         suffix_LR  eyeBlink_L (jawLeft stays jawLeft)
     snake      eye_blink_l, jaw_left      pascal     EyeBlinkLeft
+    cc         CC_Base_Body.Eye_Blink_L   daz        facs_bs_EyeBlinkLeft
     """
     index = ARKIT_BLENDSHAPES.index(canonical)
     pascal = canonical[0].upper() + canonical[1:]
@@ -45,4 +46,9 @@ def rig_name(canonical: str, style: str) -> str:
         return "_".join(words + ([side[0].lower()] if side else []))
     if style == "pascal":
         return pascal
+    if style == "cc":  # Character Creator's mesh before the name, its words capitalised
+        words = [w.capitalize() for w in _WORD.findall(stem)]
+        return "CC_Base_Body." + "_".join(words + ([side[0]] if side else []))
+    if style == "daz":
+        return f"facs_bs_{pascal}"
     raise ValueError(f"unknown name style {style!r}")

@@ -5,7 +5,9 @@ A figure on frames the model trained on says little about a user's own takes, so
 any training frame of the bundle came from (its manifest's training record) are summarised
 apart from those it never saw, and the report leads with the unseen ones. Mild frames (the
 linear blend within MILD_MM of the physics: speech, small co-activations) are summarised apart
-from strong ones, since a pooled mean is mostly the many mild frames."""
+from strong ones, since a pooled mean is mostly the many mild frames. Calm frames (the linear
+blend within CALM_MM: a face near rest, as in most live talking) are summarised too: there the
+linear blend is nearly the physics already, and SoftDECA must not be further from it."""
 
 from __future__ import annotations
 
@@ -19,9 +21,13 @@ import numpy as np
 from softdeca_train.streaming.takes import TAKE_SUFFIXES, read_take, take_paths
 
 MILD_MM = 0.1  # a frame is mild when the linear blend is this close to the physics (mean, mm)
+CALM_MM = 0.05  # and calm when it is this close
 GROUP_KEYS = ("frames", "softdeca_mm", "linear_mm", "ratio")
-TAKE_KEYS = ("take", "trained_on", *GROUP_KEYS, "mild", "strong")
-KEYS = ("every", "identities", "mild_mm", "takes", "unseen", "seen", "rest")
+TAKE_KEYS = ("take", "trained_on", *GROUP_KEYS, "mild", "strong", "calm")
+KEYS = ("every", "identities", "mild_mm", "calm_mm", "takes", "unseen", "seen", "rest")
+# Reports made before the calm figure existed lack these; they are read all the same.
+LATER_TAKE_KEYS = ("calm",)
+LATER_KEYS = ("calm_mm",)
 REST_KEYS = ("softdeca_mm", "linear_mm")
 
 
@@ -97,11 +103,12 @@ def _with_mild_and_strong(softdeca: np.ndarray, linear: np.ndarray) -> dict | No
     whole = _group(softdeca, linear)
     if whole is None:
         return None
-    mild = linear <= MILD_MM
+    mild, calm = linear <= MILD_MM, linear <= CALM_MM
     return {
         **whole,
         "mild": _group(softdeca[mild], linear[mild]),
         "strong": _group(softdeca[~mild], linear[~mild]),
+        "calm": _group(softdeca[calm], linear[calm]),
     }
 
 
@@ -139,6 +146,7 @@ def summarise(
         "every": every,
         "identities": identities,
         "mild_mm": MILD_MM,
+        "calm_mm": CALM_MM,
         "takes": per_take,
         "unseen": _pooled(d, [i for i in range(len(takes)) if not seen[i]], per_take),
         "seen": _pooled(d, [i for i in range(len(takes)) if seen[i]], per_take),
@@ -160,18 +168,20 @@ def _check_group(where: str, g: object, optional: bool = False) -> None:
 
 def validate_real_takes(real: object) -> None:
     """ValueError naming the first problem of a `real_takes` section."""
-    if not isinstance(real, dict) or set(real) != set(KEYS):
+    if not isinstance(real, dict) or not set(KEYS) - set(LATER_KEYS) <= set(real) <= set(KEYS):
         raise ValueError(f"report: `real_takes` needs exactly {KEYS}")
     if not (isinstance(real["identities"], int) and real["identities"] > 0):
         raise ValueError("report: real_takes.identities must be a positive count")
     if not isinstance(real["takes"], list) or not real["takes"]:
         raise ValueError("report: real_takes.takes must be a non-empty list")
     for t in real["takes"]:
-        if not isinstance(t, dict) or set(t) != set(TAKE_KEYS):
+        if not isinstance(t, dict) or not set(TAKE_KEYS) - set(LATER_TAKE_KEYS) <= set(t) <= set(
+            TAKE_KEYS
+        ):
             raise ValueError(f"report: a real take needs exactly {TAKE_KEYS}")
         _check_group(t["take"], t)
-        for part in ("mild", "strong"):
-            _check_group(f"{t['take']}.{part}", t[part], optional=True)
+        for part in ("mild", "strong", "calm"):
+            _check_group(f"{t['take']}.{part}", t.get(part), optional=True)
     if real["unseen"] is None and real["seen"] is None:
         raise ValueError("report: real_takes has neither unseen nor seen takes")
     for part in ("unseen", "seen"):
@@ -183,6 +193,16 @@ def validate_real_takes(real: object) -> None:
         and all(isinstance(v, (int, float)) and math.isfinite(v) and v >= 0 for v in rest.values())
     ):
         raise ValueError(f"report: real_takes.rest needs the distances {REST_KEYS} in mm")
+
+
+def worse_when_calm(real: dict) -> list[str]:
+    """The takes on whose calm frames SoftDECA is further from the physics than the linear
+    blend (calm ratio above 1): what a user streaming calm talking would see."""
+    return [
+        t["take"]
+        for t in real["takes"]
+        if (t.get("calm") or {}).get("ratio") is not None and t["calm"]["ratio"] > 1.0
+    ]
 
 
 def _cell(g: dict | None, key: str) -> str:
@@ -197,8 +217,18 @@ def readme_lines(real: dict) -> list[str]:
         f"Real takes (every {real['every']}th frame, {real['identities']} identities no model "
         "trained on, default parameters): mean distance to the physics over the skin (mm) and "
         "SoftDECA's share of the linear blend's (ratio; below 1 is closer to the physics). "
-        f"Mild frames: the linear blend within {real['mild_mm']} mm of the physics.",
+        f"Mild frames: the linear blend within {real['mild_mm']} mm of the physics"
+        + (f"; calm frames: within {real['calm_mm']} mm." if "calm_mm" in real else "."),
         "",
+        *(
+            [
+                "**On calm frames SoftDECA is further from the physics than the linear blend "
+                f"in {len(worse)} take(s): {', '.join(worse)}.**",
+                "",
+            ]
+            if (worse := worse_when_calm(real))
+            else []
+        ),
         *(
             [
                 f"At rest (every weight 0) SoftDECA is {real['rest']['softdeca_mm']:.3f} mm from "
@@ -208,8 +238,9 @@ def readme_lines(real: dict) -> list[str]:
             if real["rest"]
             else []
         ),
-        "| take | trained on | frames | SoftDECA | linear | ratio | mild ratio | strong ratio |",
-        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "| take | trained on | frames | SoftDECA | linear | ratio | calm ratio | mild ratio "
+        "| strong ratio |",
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     rows = sorted(real["takes"], key=lambda t: (t["trained_on"], t["take"]))
     for label, g in [(t["take"], t) for t in rows] + [
@@ -221,8 +252,8 @@ def readme_lines(real: dict) -> list[str]:
         seen = {True: "yes", False: "no"}.get(g.get("trained_on"), "")
         lines.append(
             f"| {label} | {seen} | {g['frames']} | {_cell(g, 'softdeca_mm')} "
-            f"| {_cell(g, 'linear_mm')} | {_cell(g, 'ratio')} | {_cell(g['mild'], 'ratio')} "
-            f"| {_cell(g['strong'], 'ratio')} |"
+            f"| {_cell(g, 'linear_mm')} | {_cell(g, 'ratio')} | {_cell(g.get('calm'), 'ratio')} "
+            f"| {_cell(g['mild'], 'ratio')} | {_cell(g['strong'], 'ratio')} |"
         )
     return lines
 

@@ -23,10 +23,13 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-# ICT 68-landmark ids of the inner lip contour: corner, upper (61-63), corner, lower (65-67).
-INNER_RIGHT_CORNER, INNER_LEFT_CORNER = 60, 64
-INNER_UPPER = (61, 62, 63)
-INNER_LOWER = (67, 66, 65)  # below 61, 62, 63 in that order
+from softdeca_train.contact_rules import CONTACT_LANDMARKS
+
+# ICT 68-landmark ids of the inner lip contour (the contact rules'): corner, the upper lip's
+# three, corner, the lower lip's three back toward the first corner.
+INNER_RIGHT_CORNER, INNER_LEFT_CORNER = CONTACT_LANDMARKS.inner_mouth_corners
+INNER_UPPER = CONTACT_LANDMARKS.inner_lip[1:4]
+INNER_LOWER = CONTACT_LANDMARKS.inner_lip[:4:-1]  # below INNER_UPPER's, in that order
 
 
 def mouth_line(skin: np.ndarray, lm68: np.ndarray) -> np.ndarray:
@@ -39,8 +42,8 @@ def mouth_line(skin: np.ndarray, lm68: np.ndarray) -> np.ndarray:
 
 # ICT 68-landmark ids on each lip, away from the corners (48, 54, 60, 64): outer and inner
 # contour.
-UPPER_LIP_LANDMARKS = (49, 50, 51, 52, 53, 61, 62, 63)
-LOWER_LIP_LANDMARKS = (55, 56, 57, 58, 59, 65, 66, 67)
+UPPER_LIP_LANDMARKS = (49, 50, 51, 52, 53, *INNER_UPPER)
+LOWER_LIP_LANDMARKS = (55, 56, 57, 58, 59, *INNER_LOWER[::-1])
 
 
 def upper_lip_points(

@@ -1,7 +1,8 @@
-"""Material parameter specs as the model bundle carries them, and the localisation rules that
-turn a global value, a per-face map or a per-vertex map into the per-element inputs of the
-hypernetworks. The native runtime implements the same rules (plugin/src/prepare/parameters.*);
-docs/bundle.md states them."""
+"""Material parameter specs as the model bundle carries them, and each avatar's parameter
+state: a global value, a per-face map or a per-vertex map per parameter, turned into the
+per-element inputs of the hypernetworks by the localisation rules of docs/bundle.md. The rules
+are the native library's (plugin/src/prepare/parameters.h), called through softdeca_native
+where a map reaches the other kind of element."""
 
 from __future__ import annotations
 
@@ -136,7 +137,8 @@ class ParameterState:
     """Per avatar: every parameter is a global value, a map over the skin triangles, or a map
     over the skin vertices. `face_matrix` / `vertex_matrix` give the hypernetworks' inputs:
     a face map reaches vertices as the area-weighted mean of the incident faces (neutral
-    areas); a vertex map reaches faces as the mean of the three corners."""
+    areas); a vertex map reaches faces as the mean of the three corners (the library's rules,
+    softdeca_native.localise_to_vertices / localise_to_faces)."""
 
     def __init__(
         self, specs: Sequence[ParameterSpec], triangles: np.ndarray, face_areas: np.ndarray
@@ -146,9 +148,6 @@ class ParameterState:
         self.n_vertices = int(self.triangles.max()) + 1 if len(self.triangles) else 0
         self.face_areas = np.asarray(face_areas, dtype=np.float64)
         self._values = [_Value("global", s.default) for s in self.specs]
-        # Incident area per vertex, for the face -> vertex rule.
-        self._vertex_area = np.zeros(self.n_vertices)
-        np.add.at(self._vertex_area, self.triangles.ravel(), np.repeat(self.face_areas, 3))
 
     def index(self, name: str) -> int:
         for i, s in enumerate(self.specs):
@@ -195,11 +194,13 @@ class ParameterState:
         data = np.asarray(value.data)
         if value.kind == on:
             return data
-        if on == "faces":  # vertex map -> faces: mean of the corners
-            return data[self.triangles].mean(axis=1)
-        acc = np.zeros(self.n_vertices)  # face map -> vertices: area-weighted incident mean
-        np.add.at(acc, self.triangles.ravel(), np.repeat(data * self.face_areas, 3))
-        return acc / np.maximum(self._vertex_area, 1e-300)
+        # A map on the other kind of element: the library's rules. Reading a bundle and
+        # training with global values need no compiled softdeca_native.
+        import softdeca_native as native
+
+        if on == "faces":
+            return native.localise_to_faces(data, self.triangles)
+        return native.localise_to_vertices(data, self.triangles, self.face_areas, self.n_vertices)
 
     def with_defaults(self, names: Sequence[str] | None = None) -> ParameterState:
         """A copy with the named parameters (default: all) back at their global defaults."""

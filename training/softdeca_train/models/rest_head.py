@@ -2,31 +2,26 @@
 simulation mesh and the rules that fit it to any avatar in the template's topology.
 
 Carried to an avatar's neutral like data generation carries the fill to an identity
-(lhm/carried.py), but from the avatar's own skin S:
+(lhm/carried.py), but from the avatar's own skin S, by the library's carry
+(plugin/src/prepare/rest_physics.h):
 
     V = V0 + K^-1 B^T W (S - B V0),   K = B^T W B + lambda * stiffness(V0)
 
 B the skin's embedding in the fill, W 1 for skin points the template's fill holds (not the
 mouth and eye sockets), stiffness the fill's Dirichlet energy. S is then embedded in the same
 tets with its own barycentric coordinates, the teeth are the avatar's own, and the lip and lid
-sets are found on the avatar's neutral by the data's rules (sim/lips.py, sim/lids.py). The
+sets are found on the avatar's neutral by the data's rules (prepare/contact_sets.h). The
 file format is docs/bundle.md's "Rest physics"."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
-from softdeca_train.contact_rules import ContactRules
-from softdeca_train.lhm import LhmConfig, eyes
-from softdeca_train.lhm.eyes import EYE_ZONE_SHARE
-from softdeca_train.sim.collision_spec import CollisionSpec, collision_sets
-from softdeca_train.sim.lids import lid_candidates, lid_sets_of
-from softdeca_train.sim.lips import lip_sets_of
+from softdeca_train.contact_rules import CONTACT_RULES, ContactRules
+from softdeca_train.lhm import LhmConfig
 
 REST_HEAD_FILE = "rest_head.bin"
 
@@ -37,13 +32,15 @@ def contact_sets(
     skin_triangles: np.ndarray,
     upper_teeth: np.ndarray,
     lower_teeth: np.ndarray,
-) -> list[CollisionSpec]:
-    """The collision sets the rules find on a head's skin, as data generation finds them
-    (sim/head.py)."""
-    if rules.eye_zone_share != eyes.EYE_ZONE_SHARE:
+) -> list[Any]:
+    """The collision sets (native.CollisionSet) the rules find on a head's skin, as data
+    generation finds them (sim/head.py)."""
+    # the physics needs the compiled softdeca_native; reading a bundle does not
+    import softdeca_native as native
+
+    if rules.eye_zone_share != CONTACT_RULES.eye_zone_share:
         raise ValueError("the bundle's eye_zone_share differs from the physics'")
-    lips = lip_sets_of(skin, skin_triangles, rules)
-    return collision_sets(lips, lid_sets_of(skin, rules), upper_teeth, lower_teeth)
+    return native.contact_sets(skin, skin_triangles, upper_teeth, lower_teeth, **vars(rules))
 
 
 @dataclass
@@ -69,34 +66,24 @@ class RestHead:
     inert: tuple[str, ...] = ()
     tolerance: float = 1e-5  # ten times the data's 1e-4, whose noise is a fifth of a small
     max_iterations: int = 2000  # control's response (docs/training.md)
-    _factor: Any = field(default=None, repr=False, compare=False)
 
     @property
     def skin_count(self) -> int:
         return len(self.skin_vertex)
 
-    def embedding_matrix(self, weighted: bool) -> sp.csr_matrix:
-        """(N_SKIN, n) S from the fill's vertices (rows times carry_weight when `weighted`)."""
-        n_s, n = self.skin_count, len(self.vertices)
-        w = self.skin_weight * (self.carry_weight[:, None] if weighted else 1.0)
-        rows = np.repeat(np.arange(n_s), 4)
-        return sp.csr_matrix((w.ravel(), (rows, self.skin_vertex.ravel())), shape=(n_s, n))
-
     def carried_vertices(self, neutral_skin: np.ndarray) -> np.ndarray:
-        """The fill's vertices carried to an avatar's neutral skin (N_SKIN, 3)."""
+        """The fill's vertices carried to an avatar's neutral skin (N_SKIN, 3), by the library's
+        carry (prepare/rest_physics.h, carry_fill)."""
         # the carried fill needs the compiled softdeca_native; reading a bundle does not
-        from softdeca_train.lhm.carried import stiffness_matrix
+        import softdeca_native as native
 
         s = np.asarray(neutral_skin, np.float64)
         if s.shape != (self.skin_count, 3):
             raise ValueError(f"neutral skin must be ({self.skin_count}, 3), got {s.shape}")
-        b = self.embedding_matrix(weighted=True)
-        if self._factor is None:
-            tets = np.vstack([self.soft_tets, self.muscle_tets])
-            k = b.T @ b + self.carry_smoothness * stiffness_matrix(self.vertices, tets)
-            self._factor = splu(k.tocsc())
-        rhs = b.T @ (s - self.embedding_matrix(weighted=False) @ self.vertices)
-        return self.vertices + self._factor.solve(np.asarray(rhs))
+        return native.carry_fill(
+            self.vertices, self.soft_tets, self.muscle_tets, self.skin_vertex, self.skin_weight,
+            self.carry_weight, self.carry_smoothness, s,
+        )  # fmt: skip
 
     def simulation_mesh(
         self, neutral_head: np.ndarray, skin_triangles: np.ndarray
@@ -111,16 +98,10 @@ class RestHead:
         collisions = []
         if self.contacts is not None:
             n, nu = len(fill), len(self.teeth_upper)
-            specs = contact_sets(
+            collisions = contact_sets(
                 self.contacts, skin, skin_triangles, self.upper_teeth_triangles + n,
                 self.lower_teeth_triangles + n + nu,
             )  # fmt: skip
-            collisions = [
-                native.CollisionSet(
-                    c.name, c.points.tolist(), c.surface, surface_on_skin=c.surface_on_skin
-                )
-                for c in specs
-            ]
         mesh = native.SimulationMesh(
             rest=rest,
             soft_tets=self.soft_tets,
@@ -167,6 +148,7 @@ def rest_head_from_template(template: Any, config: Any = None) -> RestHead:
     # the physics needs the compiled softdeca_native; reading a bundle does not
     from softdeca_train.lhm.carried import carry_basis
     from softdeca_train.sim import build_head_simulation
+    from softdeca_train.sim.lids import lid_candidates
 
     cfg = config or LhmConfig(level=3, tet_mesh="carried")
     head_sim = build_head_simulation(template, None, cfg)
@@ -195,7 +177,6 @@ def rest_head_from_template(template: Any, config: Any = None) -> RestHead:
         contacts=ContactRules(
             np.asarray(template.landmarks68, i32),
             lid_candidates(template).astype(i32),
-            eye_zone_share=EYE_ZONE_SHARE,
         ),
     )
 

@@ -1,6 +1,7 @@
 """`make bench`'s runtime figures: a full-size untrained bundle on the template topology (with
 SoftDECA's vertex and residual stages, as the trained bundles have them), the avatar of
-identity seed 1, and `softdeca bench-runtime` on the frames of a real take ->
+identity seed 1, and `softdeca bench-runtime` on the frames of a real take, with the shipped
+bundle (models/softdeca-default) timed as users run it on the same avatars ->
 build/bench/runtime.json (docs/ARCHITECTURE.md, Conventions)."""
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from softdeca_train.paths import REPO_ROOT, default_takes_path
 from softdeca_train.template import Template
 
 DEFAULT_TAKE = default_takes_path() / "S07-001.csv"
+SHIPPED_BUNDLE = REPO_ROOT / "models" / "softdeca-default"
 CLI = REPO_ROOT / "build" / "release" / "plugin" / "cli" / "softdeca"
 
 
@@ -70,6 +72,8 @@ def bench_runtime(
         "--take", str(take), "--frames", str(frames), "--out", str(path), "--how", how,
         "--own-avatar", str(own),
     ]  # fmt: skip
+    if (SHIPPED_BUNDLE / "manifest.json").is_file():  # the path users run, timed too
+        cmd += ["--shipped-bundle", str(SHIPPED_BUNDLE)]
     print("running", " ".join(cmd), file=sys.stderr)
     subprocess.run(cmd, check=True, env=os.environ.copy())
     figures = json.loads(path.read_text())

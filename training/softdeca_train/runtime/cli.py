@@ -144,6 +144,25 @@ def _runtime_test_data_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _hostile_avatars_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", required=True, help="folder for the corpus (must not exist)")
+    p.add_argument("--fan-mib", type=int, default=30, help="size of the OBJ face fan (30)")
+    p.add_argument(
+        "--bomb-mib",
+        type=int,
+        default=1024,
+        help="what the FBX zlib bomb inflates to (1024; 0: none)",
+    )
+
+
+def _hostile_avatars_run(args: argparse.Namespace) -> int:
+    from softdeca_train.runtime.hostile_avatars import write_corpus
+
+    attacks = write_corpus(Path(args.out), args.fan_mib, args.bomb_mib)
+    print(f"wrote {len(attacks)} hostile avatars and {Path(args.out) / 'corpus.json'}")
+    return 0
+
+
 def _runtime_bench_args(p: argparse.ArgumentParser) -> None:
     add_ict_argument(p)
     p.add_argument("--out", default="build/bench", help="folder for runtime.json (build/bench)")
@@ -234,6 +253,13 @@ COMMANDS = [
         "Write the native runtime tests' inputs (synthetic bundle, avatar, take).",
         _runtime_test_data_args,
         _runtime_test_data_run,
+    ),
+    Command(
+        "hostile-avatars",
+        "Write hostile avatar files (path escapes, FIFOs, links, nesting, bombs, wild values) "
+        "and corpus.json, for softdeca bench-reliability --import-corpus.",
+        _hostile_avatars_args,
+        _hostile_avatars_run,
     ),
     Command(
         "runtime-bench",

@@ -158,6 +158,52 @@ class Stats(C.Structure):
     ]
 
 
+# Every C ABI function this binding calls, as the header declares it: (restype, argtypes), with
+# every pointer a c_void_p (handles, arrays, structs) or c_char_p (strings). Set on the library
+# at load, so ctypes converts and checks each argument instead of guessing (a double passed
+# where no argtypes are declared would go through as an int).
+# tests/python/test_abi_mirrors.py holds this table to plugin/include/softdeca/softdeca.h.
+_STATUS, _PTR, _STR, _U32, _I32 = C.c_int32, C.c_void_p, C.c_char_p, C.c_uint32, C.c_int32
+SIGNATURES: dict[str, tuple[type | None, tuple[type, ...]]] = {
+    "softdeca_abi_version": (C.c_uint32, ()),
+    "softdeca_version": (_STR, ()),
+    "softdeca_last_error": (_STR, ()),
+    "softdeca_blendshape_index": (_STATUS, (_STR, _PTR)),
+    "softdeca_model_load": (_STATUS, (_STR, _PTR, _PTR)),
+    "softdeca_model_load_memory": (_STATUS, (_PTR, _U32, _PTR, _PTR)),
+    "softdeca_model_destroy": (None, (_PTR,)),
+    "softdeca_model_get_info": (_STATUS, (_PTR, _PTR)),
+    "softdeca_model_get_parameter": (_STATUS, (_PTR, _U32, _PTR)),
+    "softdeca_model_find_parameter": (_STATUS, (_PTR, _STR, _PTR)),
+    "softdeca_model_get_landmark_vertices": (_STATUS, (_PTR, _PTR, _U32)),
+    "softdeca_model_get_skin_triangles": (_STATUS, (_PTR, _PTR, _U32)),
+    "softdeca_model_evaluate_landmarks": (_STATUS, (_PTR, _PTR, _U32, _PTR, _U32)),
+    "softdeca_avatar_create": (_STATUS, (_PTR, _PTR, _PTR)),
+    "softdeca_avatar_create_fitted": (_STATUS, (_PTR, _PTR, _PTR, _U32, _I32, _PTR)),
+    "softdeca_avatar_destroy": (None, (_PTR,)),
+    "softdeca_avatar_set_parameter": (_STATUS, (_PTR, _U32, C.c_double)),
+    "softdeca_avatar_set_parameter_faces": (_STATUS, (_PTR, _U32, _PTR, _U32)),
+    "softdeca_avatar_set_parameter_vertices": (_STATUS, (_PTR, _U32, _PTR, _U32)),
+    "softdeca_avatar_get_identity": (_STATUS, (_PTR, _PTR, _U32)),
+    "softdeca_avatar_set_identity": (_STATUS, (_PTR, _PTR, _U32)),
+    "softdeca_avatar_prepare": (_STATUS, (_PTR,)),
+    "softdeca_avatar_evaluate_weights": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
+    "softdeca_avatar_evaluate_surface": (_STATUS, (_PTR, _PTR, _U32, _PTR, _U32, _PTR)),
+    "softdeca_avatar_evaluate_linear": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
+    "softdeca_avatar_calibrate_landmarks": (_STATUS, (_PTR, _PTR, _U32)),
+    "softdeca_avatar_evaluate_landmarks": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
+    "softdeca_avatar_set_dynamics": (_STATUS, (_PTR, _I32)),
+    "softdeca_avatar_reset_dynamics": (_STATUS, (_PTR,)),
+    "softdeca_avatar_get_stats": (_STATUS, (_PTR, _PTR)),
+    "softdeca_avatar_fit_create": (_STATUS, (_PTR, _PTR, _PTR, _PTR)),
+    "softdeca_avatar_fit_destroy": (None, (_PTR,)),
+    "softdeca_avatar_fit_save": (_STATUS, (_PTR, _STR)),
+    "softdeca_avatar_fit_load": (_STATUS, (_PTR, _STR, _PTR)),
+    "softdeca_avatar_fit_report": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
+    "softdeca_avatar_fit_get_registered": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
+}
+
+
 def library_path() -> Path:
     """$SOFTDECA_LIBRARY, else the release build's libsoftdeca.so."""
     env = os.environ.get("SOFTDECA_LIBRARY")
@@ -174,12 +220,9 @@ def lib() -> C.CDLL:
         if not path.is_file():
             raise FileNotFoundError(f"{path} not found: run `make build`")
         loaded = C.CDLL(str(path))
-        loaded.softdeca_last_error.restype = C.c_char_p
-        loaded.softdeca_version.restype = C.c_char_p
-        loaded.softdeca_abi_version.restype = C.c_uint32
-        loaded.softdeca_model_destroy.restype = None
-        loaded.softdeca_avatar_destroy.restype = None
-        loaded.softdeca_avatar_fit_destroy.restype = None
+        for name, (restype, argtypes) in SIGNATURES.items():
+            function = getattr(loaded, name)
+            function.restype, function.argtypes = restype, argtypes
         found = loaded.softdeca_abi_version()
         if found != ABI_VERSION:
             raise RuntimeError(

@@ -47,14 +47,35 @@ def pick_frames(caches: dict[str, np.ndarray], neutral: np.ndarray, count: int) 
     return [int(a + np.argmax(motion[a:b])) for a, b in pairwise(bounds) if b > a]
 
 
-def face_focus(neutral: np.ndarray) -> Focus:
+def face_focus(neutral: np.ndarray, centred: bool = False) -> Focus:
     """The box of the face: the extent (width, chin to forehead) of the vertices within 5 cm
-    of the most forward point (the nose tip), 10 cm deep so that the cheeks are in frame."""
+    of the most forward point (the nose tip), 10 cm deep so that the cheeks are in frame.
+    `centred`: the origin lies between the eyes (to_view), and only what lies within 15 cm of
+    it is the head (a body's hands or toes may reach further forward than the nose)."""
+    if centred:
+        neutral = neutral[np.linalg.norm(neutral, axis=1) < 0.15]
     z = neutral[:, 2]
     front = neutral[z > z.max() - 0.05]
     lo, hi = front.min(axis=0), front.max(axis=0)
     lo[2] = z.max() - 0.10
     return Focus(tuple(float(x) for x in lo), tuple(float(x) for x in hi))
+
+
+def to_view(summary: dict, points: np.ndarray) -> np.ndarray:
+    """A user's avatar (`softdeca replay` of a fit writes each part in its own coordinates, units
+    and axes) in metres in the subject's frame (+X left, +Y up, +Z out of the face, the origin
+    between the eyes), by the replay's `avatar_mesh.view`; the template's heads are in it already.
+    `points`: (..., N, 3)."""
+    view = (summary.get("avatar_mesh") or {}).get("view")
+    if not view:
+        return points
+    out = np.empty(points.shape, dtype=np.float32)
+    for part in view["parts"]:
+        a, n = int(part["first_vertex"]), int(part["vertex_count"])
+        m = np.asarray(part["to_view"], dtype=np.float64).reshape(3, 4)
+        p = points[..., a : a + n, :].astype(np.float64)
+        out[..., a : a + n, :] = p @ m[:, :3].T + m[:, 3]
+    return out
 
 
 def _with_physics(
@@ -86,7 +107,11 @@ def render_preview(
     replay = Path(replay)
     summary = json.loads((replay / "replay.json").read_text())
     neutral, triangles = read_obj(replay / "neutral.obj")
-    caches = {name: read_pc2(Path(path)) for name, path in summary["point_caches"].items()}
+    neutral = to_view(summary, neutral)
+    caches = {
+        name: to_view(summary, read_pc2(Path(path)))
+        for name, path in summary["point_caches"].items()
+    }
     chosen = pick_frames(caches, neutral, frames)
     first = int(summary.get("first_frame", 0))
     physics_notes: list[str] = []
@@ -94,7 +119,7 @@ def render_preview(
         caches, chosen, physics_notes = _add_physics(
             replay, summary, caches, chosen, first, physics_seed, ict
         )
-    focus = face_focus(neutral)
+    focus = face_focus(neutral, centred=bool((summary.get("avatar_mesh") or {}).get("view")))
     settings = RenderSettings(size=(size, size), margin=1.15)
 
     def distance_mm(a: str, b: str, f: int) -> np.ndarray:

@@ -14,7 +14,6 @@ from softdeca_train.lhm import LayeredHeadModel, LhmConfig, fit_lhm
 from softdeca_train.lhm.carried import tissue_mesh
 from softdeca_train.lhm.fit import embed_skin_by_side, jaw_motion
 from softdeca_train.lhm.model import JAW
-from softdeca_train.sim.collision_spec import collision_sets
 from softdeca_train.sim.lids import LidSets, lid_candidates, lid_sets_of
 from softdeca_train.sim.lips import LipSets, lip_sets_of
 from softdeca_train.template import Template
@@ -170,10 +169,9 @@ def build_head_simulation(
     lips, lids = lip_sets_of(skin, template.skin_triangles, rules), lid_sets_of(skin, rules)
     upper_teeth = template.component_triangles("teeth_upper") - up.start + teeth_upper[0]
     lower_teeth = template.component_triangles("teeth_lower") - lo.start + teeth_lower[0]
-    collisions = [
-        native.CollisionSet(c.name, c.points.tolist(), c.surface, surface_on_skin=c.surface_on_skin)
-        for c in collision_sets(lips, lids, upper_teeth, lower_teeth)
-    ]
+    collisions = native.contact_sets(
+        skin, template.skin_triangles, upper_teeth, lower_teeth, **vars(rules)
+    )
     lm_points = lm_weights = None
     if landmarks is not None:
         tri, bary = landmarks

@@ -21,10 +21,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import softdeca_native as native
 
 from softdeca_train.contact_rules import ContactRules
-from softdeca_train.lhm.eyes import EYES, fissure_line, lid_side_of_points
-from softdeca_train.lhm.mouth import closest_on_polyline
 from softdeca_train.template import Template
 
 
@@ -43,14 +42,6 @@ def lid_candidates(template: Template) -> np.ndarray:
 
 
 def lid_sets_of(skin: np.ndarray, rules: ContactRules) -> LidSets:
-    """The lid sets of a head's skin `skin` (rules.lid_candidates: lid_candidates)."""
-    lm68, candidates = rules.landmarks68, rules.lid_candidates
-    side = lid_side_of_points(skin, lm68)
-    chosen = np.zeros(len(skin), bool)
-    for eye in EYES:
-        line = fissure_line(skin, lm68, eye)
-        p = skin[candidates]
-        near = np.linalg.norm(p - closest_on_polyline(p, line), axis=1) < rules.lid_reach
-        corners = np.linalg.norm(p[:, None] - line[None, [0, -1]], axis=2).min(axis=1)
-        chosen[candidates[near & (corners > rules.lid_corner_radius)]] = True
-    return LidSets(np.flatnonzero(chosen & (side > 0)), np.flatnonzero(chosen & (side < 0)))
+    """The lid sets of a head's skin `skin` (rules.lid_candidates: lid_candidates), found by
+    the native library (prepare/contact_sets.h) as at prepare."""
+    return LidSets(*native.lid_sets(skin, **vars(rules)))

@@ -13,9 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import softdeca_native as native
 
 from softdeca_train.contact_rules import ContactRules
-from softdeca_train.template.plausibility import lip_contact_zone
 
 
 @dataclass(frozen=True)
@@ -30,25 +30,7 @@ class LipSets:
 def lip_sets_of(skin: np.ndarray, skin_triangles: np.ndarray, rules: ContactRules) -> LipSets:
     """Split the lip contact zone (S points within the rules' `lip_radius` of the inner lip
     contour) into upper and lower lip by the mouth line: the segment between the inner mouth
-    corners (ICT landmarks 60 and 64), per x; points within `lip_corner_radius` of those
-    corners belong to neither."""
-    lm68 = rules.landmarks68
-    zone = np.flatnonzero(lip_contact_zone(skin, lm68, rules.lip_radius))
-    lm = skin[lm68]
-    left, right = lm[64], lm[60]
-    t = np.clip((skin[zone, 0] - right[0]) / (left[0] - right[0]), 0.0, 1.0)
-    mouth_y = right[1] + t * (left[1] - right[1])
-    # The inner lip contour's midpoint between the upper (62) and lower (66) middles.
-    mouth_y += 0.5 * (lm[62, 1] + lm[66, 1]) - 0.5 * (left[1] + right[1])
-    corner = np.linalg.norm(skin[zone, None] - lm[None, [60, 64]], axis=2).min(axis=1)
-    away = corner > rules.lip_corner_radius
-    upper = zone[away & (skin[zone, 1] >= mouth_y)]
-    lower = zone[away & (skin[zone, 1] < mouth_y)]
-    tris = np.asarray(skin_triangles)
-
-    def inside(ids: np.ndarray) -> np.ndarray:
-        mask = np.zeros(len(skin), bool)
-        mask[ids] = True
-        return tris[mask[tris].all(axis=1)]
-
-    return LipSets(zone, upper, lower, inside(upper), inside(lower))
+    corners, per x, raised to the contour's middle; points within `lip_corner_radius` of those
+    corners belong to neither. The rules run in the native library (prepare/contact_sets.h),
+    the same code that finds an avatar's sets at prepare."""
+    return LipSets(*native.lip_sets(skin, skin_triangles, **vars(rules)))

@@ -39,10 +39,12 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import softdeca_native as native
 
+from softdeca_train.contact_rules import CONTACT_LANDMARKS
 from softdeca_train.sim.head import HeadSimulation
 from softdeca_train.sim.measures import PENETRATION_TOLERANCE, SoftVolume
 
-UPPER_LIP_MIDDLE, LOWER_LIP_MIDDLE = 62, 66  # ICT 68-landmark ids of the inner lip middles
+# ICT 68-landmark ids of the inner lip middles
+UPPER_LIP_MIDDLE, LOWER_LIP_MIDDLE = CONTACT_LANDMARKS.inner_lip_middles
 
 
 @dataclass(frozen=True)

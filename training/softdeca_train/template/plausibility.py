@@ -31,18 +31,19 @@ def lip_contact_zone(
 ) -> np.ndarray:
     """S vertices within `radius` of the inner lip contour. ICT's own neutral has its lips
     pressed into each other there; the simulation's collision step resolves that contact."""
-    mouth = head[lm68[60:68]]
-    d = np.linalg.norm(head[:N_SKIN, None, :] - mouth[None], axis=2).min(axis=1)
-    return d < radius
+    # The compiled module holds the contact rules (prepare/contact_sets.h); the template loads
+    # without it (streaming and landmark tools read the template on machines that never build
+    # the plugin).
+    import softdeca_native as native
+
+    return native.lip_contact_zone(head[:N_SKIN], lm68, radius).astype(bool)
 
 
 def skin_self_intersections(
     head: np.ndarray, skin_tris: np.ndarray, lm68: np.ndarray, limit: int = 100000
 ) -> list[tuple[int, int]]:
     """Intersecting triangle pairs of S, ignoring those where both lie in the lip contact."""
-    # The compiled module is built with the plugin; the template loads without it (streaming and
-    # landmark tools read the template on machines that never build the plugin).
-    import softdeca_native as native
+    import softdeca_native as native  # compiled with the plugin: see lip_contact_zone
 
     lips = lip_contact_zone(head, lm68)
     pairs = native.self_intersections(head[:N_SKIN], skin_tris, limit)

@@ -162,6 +162,32 @@ namespace SoftDeca
     }
 
     /// <summary>
+    /// The library's verdict on a fit (its report's "quality"): whether every quality measure is
+    /// within its bound, the first that is not and why, and the bounds themselves
+    /// (docs/avatars.md, "The fit's quality"). Read from the report, never recomputed.
+    /// </summary>
+    public sealed class FitQuality
+    {
+        private readonly FitReport fields;
+        private readonly FitReport bounds;
+
+        internal FitQuality(FitReport fields)
+        {
+            this.fields = fields;
+            string b = fields.Text("bounds");
+            bounds = FitReport.Parse(b != null && b.StartsWith("{", StringComparison.Ordinal) ? b : "{}");
+        }
+
+        public bool Passed { get { return fields.Text("passed") == "true"; } }
+        /// <summary>The report's name of the first measure outside its bound ("" when passed).</summary>
+        public string FailedMeasure { get { return fields.Text("failed_measure") ?? ""; } }
+        /// <summary>What failed, by how much and the likely cause ("" when passed).</summary>
+        public string Reason { get { return fields.Text("reason") ?? ""; } }
+        /// <summary>A bound by its report name ("face_coverage_min", "covered_mm", ...), or NaN.</summary>
+        public double Bound(string name) { return bounds.Number(name); }
+    }
+
+    /// <summary>
     /// A fit's report (AvatarFit.ReportJson): the top-level fields of the library's JSON by name,
     /// with the ones the inspector shows as properties.
     /// </summary>
@@ -187,6 +213,25 @@ namespace SoftDeca
         /// <summary>The registered template's distance to the avatar's face, mean and largest, millimetres.</summary>
         public double FaceResidualMmMean { get { return Number("face_residual_mm_mean"); } }
         public double FaceResidualMmMax { get { return Number("face_residual_mm_max"); } }
+        /// <summary>
+        /// The share of the avatar's face vertices (those its skin-only shapes move) within
+        /// Quality.Bound("covered_mm") of the registered template.
+        /// </summary>
+        public double FaceCoverage { get { return Number("face_coverage"); } }
+        /// <summary>Those face vertices' distances to the registered template, median and 90th percentile, millimetres.</summary>
+        public double AvatarToTemplateMmMedian { get { return Number("avatar_to_template_mm_median"); } }
+        public double AvatarToTemplateMmP90 { get { return Number("avatar_to_template_mm_p90"); } }
+        /// <summary>The registered template's face size over the avatar's; NaN when not measured.</summary>
+        public double TemplateScale { get { return Number("template_scale"); } }
+        /// <summary>The library's verdict on the fit, or null for a fit made before the library judged fits.</summary>
+        public FitQuality Quality
+        {
+            get
+            {
+                string q = Text("quality");
+                return q != null && q.StartsWith("{", StringComparison.Ordinal) ? new FitQuality(Parse(q)) : null;
+            }
+        }
         public double Seconds { get { return Number("seconds"); } }
 
         /// <summary>The field names, in no particular order.</summary>

@@ -108,6 +108,13 @@ namespace SoftDeca.Tests
             Assert.IsTrue(report.FaceResidualMmMean >= 0 && report.FaceResidualMmMean <= report.FaceResidualMmMax,
                           report.FaceResidualMmMean + " / " + report.FaceResidualMmMax);
             Assert.Less(report.FaceResidualMmMean, 2.0, "mm between the registered template and the face");
+            FitQuality quality = report.Quality;
+            Assert.IsNotNull(quality, "the library's verdict");
+            Assert.IsTrue(quality.Passed, quality.Reason);
+            Assert.AreEqual("", quality.FailedMeasure);
+            Assert.GreaterOrEqual(report.FaceCoverage, quality.Bound("face_coverage_min"));
+            Assert.LessOrEqual(report.AvatarToTemplateMmMedian, report.AvatarToTemplateMmP90);
+            Assert.AreEqual(1.0, report.TemplateScale, 0.2, "the template's face the avatar's size");
 
             // The registered template skin, in the avatar's units and axes, lies on the face: the
             // avatar is itself in the template topology, so skin vertex t is near avatar vertex toAvatar[t].

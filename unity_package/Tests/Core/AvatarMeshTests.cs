@@ -135,6 +135,35 @@ namespace SoftDeca.Tests
             Assert.AreEqual("\u00e9\n", FitReport.Parse("{\"k\": \"\\u00e9\\n\"}").Text("k"));
             foreach (string bad in new[] { "", "[1]", "{\"a\": 1", "{\"a\" 1}", "{\"a\": [1, 2}" })
                 Assert.Throws<FormatException>(() => FitReport.Parse(bad), bad);
+            Assert.IsNull(r.Quality, "a fit made before the library judged fits");
+        }
+
+        [Test]
+        public void TheFitsVerdictReadsAsTheLibraryWroteIt()
+        {
+            const string json = "{\"face_coverage\": 0.16, \"avatar_to_template_mm_median\": 18.2, \"avatar_to_template_mm_p90\": 31.5, " +
+                                "\"template_scale\": 0.61, \"quality\": {\"passed\": false, \"failed_measure\": \"face_coverage\", " +
+                                "\"reason\": \"the registered template covers 16 % of the avatar's face\", " +
+                                "\"bounds\": {\"covered_mm\": 3, \"face_coverage_min\": 0.7}}}";
+            FitReport r = FitReport.Parse(json);
+            Assert.AreEqual(0.16, r.FaceCoverage);
+            Assert.AreEqual(18.2, r.AvatarToTemplateMmMedian);
+            Assert.AreEqual(31.5, r.AvatarToTemplateMmP90);
+            Assert.AreEqual(0.61, r.TemplateScale);
+            FitQuality q = r.Quality;
+            Assert.IsFalse(q.Passed);
+            Assert.AreEqual("face_coverage", q.FailedMeasure);
+            StringAssert.Contains("16 %", q.Reason);
+            Assert.AreEqual(0.7, q.Bound("face_coverage_min"));
+            Assert.AreEqual(3.0, q.Bound("covered_mm"));
+            Assert.IsNaN(q.Bound("template_scale_max"), "a bound the report does not hold");
+
+            FitReport passed = FitReport.Parse("{\"template_scale\": null, \"quality\": {\"passed\": true, " +
+                                               "\"failed_measure\": \"\", \"reason\": \"\"}}");
+            Assert.IsTrue(passed.Quality.Passed);
+            Assert.AreEqual("", passed.Quality.FailedMeasure);
+            Assert.IsNaN(passed.TemplateScale, "not measured");
+            Assert.IsNaN(passed.Quality.Bound("covered_mm"), "no bounds");
         }
     }
 }
