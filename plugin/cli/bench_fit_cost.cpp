@@ -9,24 +9,11 @@
 #include <unordered_map>
 
 #include "bench_child_memory.h"
-#include "imported_avatar.h"
 
 namespace softdeca::cli {
 
-std::uint64_t AvatarArrays::bytes() const {
-  return (neutral.size() + blendshapes.size()) * sizeof(float) + triangles.size() * sizeof(std::int32_t);
-}
-
-softdeca_avatar_mesh AvatarArrays::mesh() const {
-  softdeca_avatar_mesh m{};
-  m.struct_size = sizeof m;
-  m.neutral = neutral.data();
-  m.vertex_count = static_cast<uint32_t>(vertices());
-  m.triangles = triangles.data();
-  m.triangle_count = static_cast<uint32_t>(triangle_count());
-  m.blendshapes = blendshapes.data();
-  m.blendshape_count = 52;
-  return m;
+std::uint64_t mesh_bytes(const AvatarFile& a) {
+  return (a.neutral.size() + a.blendshapes.size()) * sizeof(float) + a.triangles.size() * sizeof(std::int32_t);
 }
 
 namespace {
@@ -37,8 +24,8 @@ double cpu_seconds() {
 }
 
 // One level of subdivision: a vertex at every edge's midpoint, four triangles for each.
-AvatarArrays split_once(const AvatarArrays& a) {
-  const std::size_t n = a.vertices();
+AvatarFile split_once(const AvatarFile& a) {
+  const std::size_t n = a.vertex_count();
   std::unordered_map<std::uint64_t, std::int32_t> midpoint;
   midpoint.reserve(a.triangles.size());
   std::vector<std::pair<std::int32_t, std::int32_t>> ends;
@@ -48,9 +35,9 @@ AvatarArrays split_once(const AvatarArrays& a) {
     if (added) ends.emplace_back(u, v);
     return it->second;
   };
-  AvatarArrays out;
+  AvatarFile out;
   out.triangles.reserve(4 * a.triangles.size());
-  for (std::size_t t = 0; t < a.triangle_count(); ++t) {
+  for (std::size_t t = 0; t < a.triangles.size() / 3; ++t) {
     const std::int32_t* c = a.triangles.data() + 3 * t;
     const std::int32_t ab = middle(c[0], c[1]), bc = middle(c[1], c[2]), ca = middle(c[2], c[0]);
     out.triangles.insert(out.triangles.end(), {c[0], ab, ca, ab, c[1], bc, ca, bc, c[2], ab, bc, ca});
@@ -70,16 +57,16 @@ AvatarArrays split_once(const AvatarArrays& a) {
 }
 }  // namespace
 
-AvatarArrays subdivided(AvatarArrays a, std::size_t vertices) {
-  while (a.vertices() < vertices && !a.triangles.empty()) a = split_once(a);
+AvatarFile subdivided(AvatarFile a, std::size_t vertices) {
+  while (a.vertex_count() < vertices && !a.triangles.empty()) a = split_once(a);
   return a;
 }
 
-AvatarArrays with_slivers(AvatarArrays a, std::size_t count, unsigned seed) {
+AvatarFile with_slivers(AvatarFile a, std::size_t count, unsigned seed) {
   std::mt19937 random(seed);
-  const std::size_t triangles = a.triangle_count();
+  const std::size_t triangles = a.triangles.size() / 3;
   std::uniform_int_distribution<std::size_t> any_triangle(0, triangles - 1), any_corner(0, 2);
-  std::uniform_int_distribution<std::int32_t> any_vertex(0, static_cast<std::int32_t>(a.vertices()) - 1);
+  std::uniform_int_distribution<std::int32_t> any_vertex(0, static_cast<std::int32_t>(a.vertex_count()) - 1);
   for (std::size_t i = 0; i < count; ++i) {
     const std::int32_t* t = a.triangles.data() + 3 * any_triangle(random);
     const std::size_t k = any_corner(random);
@@ -88,7 +75,7 @@ AvatarArrays with_slivers(AvatarArrays a, std::size_t count, unsigned seed) {
   return a;
 }
 
-FitRun fit_in_child(const std::string& bundle, const AvatarArrays& a, double metres_per_unit) {
+FitRun fit_in_child(const std::string& bundle, const AvatarFile& a, double metres_per_unit) {
   softdeca_model* model = nullptr;  // the child's
   const auto load = [&]() -> std::string {
     if (softdeca_model_load(bundle.c_str(), nullptr, &model) == SOFTDECA_OK) return "";
@@ -100,7 +87,7 @@ FitRun fit_in_child(const std::string& bundle, const AvatarArrays& a, double met
     options.struct_size = sizeof options;
     softdeca_fit_options_init(&options);
     options.metres_per_unit = metres_per_unit;
-    const softdeca_avatar_mesh mesh = a.mesh();
+    const softdeca_avatar_mesh mesh = a.abi_mesh();
     softdeca_avatar_fit* made = nullptr;
     const auto t0 = std::chrono::steady_clock::now();
     const double cpu0 = cpu_seconds();
@@ -113,7 +100,7 @@ FitRun fit_in_child(const std::string& bundle, const AvatarArrays& a, double met
     softdeca_avatar_fit_destroy(made);
     return report;
   };
-  const ChildPeak c = peak_in_child("fitting " + std::to_string(a.vertices()) + " vertices", load, fit);
+  const ChildPeak c = peak_in_child("fitting " + std::to_string(a.vertex_count()) + " vertices", load, fit);
   if (!c.prepared) throw std::runtime_error("bench-reliability: " + c.report);
   FitRun out;
   char* rest = nullptr;
@@ -130,15 +117,26 @@ double FitCost::memory_over_target() const {
   return (input + double(large.peak_increase)) / (4 * input + 500e6);
 }
 
+std::string FitCost::describe(const std::string& avatar, const std::string& bundle) const {
+  char text[900];
+  std::snprintf(text, sizeof text,
+                "%s (%zu vertices) subdivided to %zu vertices (%.0f MB of mesh), fitted by %s in a child process: "
+                "%.1f s, the fit's peak RSS increase %.0f MB; the mesh and that increase over 4x the mesh + 500 MB: "
+                "%.2f. The same avatar with %zu sliver triangles (an edge of it to a random vertex) added: %s in %.1f s%s%s",
+                avatar.c_str(), base_vertices, vertices, double(large_input_bytes) / 1e6, bundle.c_str(), large.seconds,
+                double(large.peak_increase) / 1e6, memory_over_target(), slivers, sliver.fitted ? "fitted" : "refused",
+                sliver.seconds, sliver.fitted ? "" : ": ", sliver.error.c_str());
+  return text;
+}
+
 FitCost fit_cost_run(const std::string& bundle, const std::string& avatar, std::size_t vertices, double metres_per_unit) {
-  const AvatarFile file = read_avatar_file(avatar);
-  AvatarArrays base{file.neutral, file.blendshapes, file.triangles};
+  const AvatarFile base = read_avatar_file(avatar);
   FitCost out;
-  out.base_vertices = base.vertices();
+  out.base_vertices = base.vertex_count();
   {
-    const AvatarArrays large = subdivided(base, vertices);
-    out.vertices = large.vertices();
-    out.large_input_bytes = large.bytes();
+    const AvatarFile large = subdivided(base, vertices);
+    out.vertices = large.vertex_count();
+    out.large_input_bytes = mesh_bytes(large);
     out.large = fit_in_child(bundle, large, metres_per_unit);
   }
   if (!out.large.fitted)

@@ -8,28 +8,20 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <vector>
 
-#include "softdeca/softdeca.h"
+#include "imported_avatar.h"
 
 namespace softdeca::cli {
 
-// An avatar mesh as the C ABI takes it, owning its arrays.
-struct AvatarArrays {
-  std::vector<float> neutral, blendshapes;  // N x 3; 52 x N x 3
-  std::vector<std::int32_t> triangles;
-  std::size_t vertices() const { return neutral.size() / 3; }
-  std::size_t triangle_count() const { return triangles.size() / 3; }
-  std::uint64_t bytes() const;  // of its arrays
-  softdeca_avatar_mesh mesh() const;
-};
+// The bytes of the arrays the fit is given (neutral, triangles, shapes).
+std::uint64_t mesh_bytes(const AvatarFile& a);
 
 // Every triangle split into four at its edges' midpoints (positions and shapes interpolated)
-// until the mesh has at least `vertices` vertices.
-AvatarArrays subdivided(AvatarArrays a, std::size_t vertices);
+// until the mesh has at least `vertices` vertices; only the arrays are kept.
+AvatarFile subdivided(AvatarFile a, std::size_t vertices);
 
 // `count` long thin triangles added, each from a random edge of the mesh to a random vertex.
-AvatarArrays with_slivers(AvatarArrays a, std::size_t count, unsigned seed);
+AvatarFile with_slivers(AvatarFile a, std::size_t count, unsigned seed);
 
 struct FitRun {
   bool fitted = false;
@@ -41,7 +33,7 @@ struct FitRun {
 
 // Loads `bundle` in a child process and fits `a` there at `metres_per_unit` (0: read off the
 // shapes). Throws std::runtime_error when the child dies.
-FitRun fit_in_child(const std::string& bundle, const AvatarArrays& a, double metres_per_unit);
+FitRun fit_in_child(const std::string& bundle, const AvatarFile& a, double metres_per_unit);
 
 struct FitCost {
   std::size_t vertices = 0, base_vertices = 0, slivers = 0;
@@ -50,6 +42,8 @@ struct FitCost {
   double seconds_per_100k() const { return large.seconds / (double(vertices) / 1e5); }
   // The large fit's peak memory (the mesh and the fit's own increase) over 4x the mesh + 500 MB.
   double memory_over_target() const;
+  // What the runs did, for the figures' "how".
+  std::string describe(const std::string& avatar, const std::string& bundle) const;
 };
 
 // The avatar at `avatar` (any file the command line reads) subdivided to `vertices` and fitted

@@ -312,15 +312,7 @@ int run_bench_reliability(const Args& args) {
     out.raw("reliability.import_peak_rss_over_input", figure(imports.worst_ratio, "ratio", "4", "lower", how + import_text));
   }
   if (fits.vertices > 0) {
-    char fit_text[900];
-    std::snprintf(fit_text, sizeof fit_text,
-                  "%s (%zu vertices) subdivided to %zu vertices (%.0f MB of mesh), fitted by %s in a child process: "
-                  "%.1f s, the fit's peak RSS increase %.0f MB; the mesh and that increase over 4x the mesh + 500 MB: "
-                  "%.2f. The same avatar with %zu sliver triangles (an edge of it to a random vertex) added: %s in %.1f s%s%s",
-                  o.text("--avatar").c_str(), fits.base_vertices, fits.vertices, double(fits.large_input_bytes) / 1e6,
-                  o.text("--bundle").c_str(), fits.large.seconds, double(fits.large.peak_increase) / 1e6,
-                  fits.memory_over_target(), fits.slivers, fits.sliver.fitted ? "fitted" : "refused", fits.sliver.seconds,
-                  fits.sliver.fitted ? "" : ": ", fits.sliver.error.c_str());
+    const std::string fit_text = fits.describe(o.text("--avatar"), o.text("--bundle"));
     out.raw("reliability.fit_s_per_100k_vertices", figure(fits.seconds_per_100k(), "s", "1.5", "lower", how + fit_text));
     out.raw("reliability.fit_memory_over_target", figure(fits.memory_over_target(), "ratio", "1.0", "lower", how + fit_text));
     out.raw("reliability.fit_slivers_s", figure(fits.sliver.seconds, "s", "60", "lower", how + fit_text));

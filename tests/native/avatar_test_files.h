@@ -18,9 +18,20 @@
 #include <string>
 #include <vector>
 
+#include "avatar_file.h"
 #include "softdeca/softdeca.h"
 
 namespace softdeca::test {
+
+// What reading the avatar at `path` is refused with, "" when it reads.
+inline std::string error_of(const std::string& path, const avatar_import::ImportLimits& limits = {}) {
+  try {
+    avatar_import::read_avatar_file(path, avatar_import::ShapeNames(), limits);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
 
 // The canonical index of an ARKit shape by its name (the C ABI's rule).
 inline std::size_t arkit_index(const char* name) {

@@ -14,6 +14,7 @@
 #include "softdeca/softdeca.h"
 
 using namespace softdeca::avatar_import;
+using softdeca::test::error_of;
 using softdeca::test::TempDir;
 using softdeca::test::TestMesh;
 using softdeca::test::TestScene;
@@ -48,14 +49,6 @@ TestScene scene(bool zlib = false) {
   return s;
 }
 
-std::string error_of(const std::string& path, const ImportLimits& limits = {}) {
-  try {
-    read_avatar_file(path, ShapeNames(), limits);
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // What no message may hold: a C++ library's own words.
 bool speaks_cpp(const std::string& message) {

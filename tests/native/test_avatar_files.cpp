@@ -22,6 +22,7 @@
 using namespace softdeca::cli;
 using namespace softdeca::avatar_import;
 using softdeca::test::expected_transform;
+using softdeca::test::error_of;
 using softdeca::test::TempDir;
 constexpr auto shape = softdeca::test::arkit_index;
 using softdeca::test::deltas;
@@ -110,14 +111,6 @@ bool has_unused(const AvatarFile& a, const std::string& mesh, const std::string&
   return false;
 }
 
-std::string error_of(const std::string& path, const ImportLimits& limits = {}) {
-  try {
-    read_avatar_file(path, ShapeNames(), limits);
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
 
 std::vector<std::size_t> identity_order(std::size_t n) {
   std::vector<std::size_t> order(n);
