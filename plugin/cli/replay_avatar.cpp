@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "fit_folder.h"
+#include "fit_verdict.h"
 
 namespace softdeca::cli {
 
@@ -34,11 +35,18 @@ void open_fitted(const Model& model, const std::string& path, const ShapeNames& 
     a.kind = "fit folder";
     a.mesh = std::make_unique<AvatarFile>(read_fitted_mesh(path));
     a.fit = std::make_unique<Fit>(model, fit_file(path));
+    const Verdict verdict = read_verdict(a.fit->report());
+    if (!verdict.passed)  // kept with softdeca fit --keep-poor-fit: the user chose it, and is told
+      std::fprintf(stderr, "warning: %s holds a poor fit (%s): %s\n", path.c_str(), verdict.measure.c_str(), verdict.reason.c_str());
   } else {
     a.kind = "fitted now";
     a.mesh = std::make_unique<AvatarFile>(read_avatar_file(path, names));
     std::fprintf(stderr, "fitting %s (%zu vertices; softdeca fit saves a fit to reuse)\n", path.c_str(), a.mesh->vertex_count());
     a.fit = std::make_unique<Fit>(model, a.mesh->abi_mesh(), options);
+    const Verdict verdict = read_verdict(a.fit->report());
+    if (!verdict.passed)
+      throw std::runtime_error("the fit of " + path + " is poor (" + verdict.measure + "): " + verdict.reason +
+                               " To replay it anyway: softdeca fit " + path + " --keep-poor-fit --out DIR, then --avatar DIR.");
   }
   a.vertex_count = a.mesh->vertex_count();
   a.avatar = std::make_unique<Avatar>(model, *a.fit, a.mesh->abi_mesh(), threads, precision);
