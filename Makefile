@@ -137,7 +137,8 @@ bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/
 	@$(PY) -m softdeca_train runtime-test-data --out build/bench/runtime_test_data > /dev/null
 	@rm -rf build/bench/hostile_avatars && $(PY) -m softdeca_train hostile-avatars --out build/bench/hostile_avatars > /dev/null
 	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json --bundle build/bench/runtime_test_data/bundle \
-	  --import-corpus build/bench/hostile_avatars
+	  --import-corpus build/bench/hostile_avatars \
+	  --avatar build/bench/runtime_test_data/avatar --avatar-unit 1
 	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
 	@$(PY) -m softdeca_train bench-physics --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench

@@ -1,7 +1,8 @@
 // softdeca bench-reliability: the receiver and the recording reader under hostile input on
 // this machine -> build/bench/reliability.json. A flood of iFacialMocap datagrams from many
 // source ports on loopback while recording; a crafted damaged recording; a recording whose
-// disk cannot keep up while a consumer polls.
+// disk cannot keep up while a consumer polls; with an avatar, what fitting a large mesh and a head
+// full of sliver triangles costs.
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -23,8 +24,10 @@
 #include "bench_fifo.h"
 #include "bench_import_memory.h"
 #include "bench_figures.h"
+#include "bench_fit_cost.h"
 #include "bench_recording_memory.h"
 #include "command.h"
+#include "imported_avatar.h"
 #include "json.h"
 #include "live/receiver.h"
 #include "options.h"
@@ -187,7 +190,9 @@ int run_bench_reliability(const Args& args) {
             "path that opens a recording or CSV take takes to refuse a FIFO, and the memory an opened\n"
             "recording holds per frame; with --bundle, the peak memory of loading copies of that bundle\n"
             "grown by one constant-foldable fragment each, just under, just over and far over a budget; with\n"
-            "--import-corpus, the peak memory of reading each hostile avatar against the avatar's size.");
+            "--import-corpus, the peak memory of reading each hostile avatar against the avatar's size; with\n"
+            "--bundle and --avatar, the fit of that avatar subdivided to --fit-vertices vertices (time and\n"
+            "peak memory) and of the avatar with 20,000 sliver triangles added.");
   declare_output_options(o, "reliability", "where the runs write their files");
   o.option("--ports", "N", "source ports of the flood", "200")
       .option("--flood-seconds", "S", "how long the flood lasts", "3")
@@ -195,7 +200,10 @@ int run_bench_reliability(const Args& args) {
       .option("--slow-seconds", "S", "how long the slow-disk run lasts", "3")
       .option("--bundle", "DIR", "a small bundle folder to grow (the runtime test data's bundle)", "")
       .option("--bundle-budget-mib", "N", "the memory budget of the bundle runs", "256")
-      .option("--import-corpus", "DIR", "hostile avatars to read (python -m softdeca_train hostile-avatars)", "");
+      .option("--import-corpus", "DIR", "hostile avatars to read (python -m softdeca_train hostile-avatars)", "")
+      .option("--avatar", "MESH", "an avatar the bundle fits (the runtime test data's avatar folder)", "")
+      .option("--avatar-unit", "X", "the avatar's metres per unit (0: read off its shapes)", "0")
+      .option("--fit-vertices", "N", "the vertices of the large avatar's fit (at least)", "500000");
   if (!o.parse(args)) return 0;
   const std::string scratch = create_output_folders(o);
   const long ports = o.integer("--ports"), mib = o.integer("--resync-mib");
@@ -204,6 +212,10 @@ int run_bench_reliability(const Args& args) {
   if (ports < 2 || ports > 1000 || mib < 1 || mib > 1024 || !(flood_s > 0) || !(slow_s > 0) || budget_mib < 16 ||
       budget_mib > 4096)
     throw UsageError("2 to 1000 ports, 1 to 1024 MiB, positive durations and a 16 to 4096 MiB budget, please");
+  // Subdividing quadruples the vertices: at most a quarter of the limit asked keeps the fit within it.
+  if (o.integer("--fit-vertices") < 1000 || o.integer("--fit-vertices") > long{SOFTDECA_MAX_AVATAR_VERTICES / 4} ||
+      !(o.number("--avatar-unit") >= 0))
+    throw UsageError("--fit-vertices from 1000 to a quarter of the avatar vertex limit and an --avatar-unit of 0 or more, please");
   double load = load_average();
 
   std::fprintf(stderr, "bench-reliability: flood");
@@ -227,6 +239,12 @@ int run_bench_reliability(const Args& args) {
   if (!o.text("--import-corpus").empty()) {
     std::fprintf(stderr, "bench-reliability: import memory\n");
     imports = import_memory_run(o.text("--import-corpus"));
+  }
+  FitCost fits;
+  if (!o.text("--bundle").empty() && !o.text("--avatar").empty()) {
+    std::fprintf(stderr, "bench-reliability: fits\n");
+    fits = fit_cost_run(o.text("--bundle"), o.text("--avatar"), static_cast<std::size_t>(o.integer("--fit-vertices")),
+                        o.number("--avatar-unit"));
   }
 
   char load_text[80];
@@ -292,6 +310,12 @@ int run_bench_reliability(const Args& args) {
                   "over the input's bytes + 125 MB, so that 4 is the bound 4 x the input + 500 MB: %s",
                   imports.avatars, o.text("--import-corpus").c_str(), imports.read, imports.refused, imports.worst.c_str());
     out.raw("reliability.import_peak_rss_over_input", figure(imports.worst_ratio, "ratio", "4", "lower", how + import_text));
+  }
+  if (fits.vertices > 0) {
+    const std::string fit_text = fits.describe(o.text("--avatar"), o.text("--bundle"));
+    out.raw("reliability.fit_s_per_100k_vertices", figure(fits.seconds_per_100k(), "s", "1.5", "lower", how + fit_text));
+    out.raw("reliability.fit_memory_over_target", figure(fits.memory_over_target(), "ratio", "1.0", "lower", how + fit_text));
+    out.raw("reliability.fit_slivers_s", figure(fits.sliver.seconds, "s", "60", "lower", how + fit_text));
   }
   write_text_file(o.text("--out"), out.str(true) + "\n");
   std::printf("%s\n", out.str(true).c_str());

@@ -6,11 +6,13 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 
 #include "bundle/sha256.h"
 #include "file_format.h"
+#include "fit/value_bounds.h"
 
 namespace softdeca::avatar_import {
 
@@ -30,35 +32,10 @@ void require_finite(const std::vector<float>& values, const std::string& what) {
     if (!std::isfinite(values[i])) throw std::runtime_error(what + "vertex " + std::to_string(i / 3) + " is not finite");
 }
 
-// Coordinates an avatar may have in any unit (10,000 km in metres, 10 km in millimetres): a
-// vertex beyond is no part of a mesh but a value that would overflow what is computed from it.
-constexpr double kMaxCoordinate = 1e7;
-// A shape moves a vertex at most this many times the mesh's own size (its bounding box's
-// diagonal): a jaw opens by a fraction of the head, a 3e38 delta is no shape.
-constexpr double kMaxDeltaOverSize = 2.0;
-
-void require_within(const std::vector<float>& values, const std::string& what) {
-  for (std::size_t i = 0; i < values.size(); ++i)
-    if (std::abs(values[i]) > kMaxCoordinate)
-      throw std::runtime_error(what + "vertex " + std::to_string(i / 3) + " lies at " + std::to_string(values[i]) +
-                               ", beyond the 1e7 units any avatar spans");
-}
-
-double size_of(const std::vector<float>& vertices) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
-  for (std::size_t i = 0; i + 2 < vertices.size(); i += 3) {
-    const Eigen::Vector3d p = Eigen::Vector3f(vertices.data() + i).cast<double>();
-    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  }
-  return vertices.empty() ? 0.0 : (hi - lo).norm();
-}
-
 // The checks of one included mesh before anything is copied.
 void check_mesh(const std::string& path, const SourceMesh& mesh, const ShapeChoice& choice) {
   const std::string at = where(path, mesh);
   require_finite(mesh.vertices, at);
-  require_within(mesh.vertices, at);
-  const double largest_delta = kMaxDeltaOverSize * size_of(mesh.vertices);
   const std::size_t n = mesh.vertex_count();
   for (const std::int32_t t : mesh.triangles)
     if (t < 0 || static_cast<std::size_t>(t) >= n)
@@ -70,16 +47,55 @@ void check_mesh(const std::string& path, const SourceMesh& mesh, const ShapeChoi
       throw std::runtime_error(at + "shape '" + shape.name + "' has " + std::to_string(shape.deltas.size() / 3) +
                                " vertices, the mesh " + std::to_string(n));
     require_finite(shape.deltas, at + "shape '" + shape.name + "': ");
-    for (std::size_t i = 0; i + 2 < shape.deltas.size(); i += 3)
-      if (Eigen::Vector3f(shape.deltas.data() + i).cast<double>().norm() > largest_delta)
-        throw std::runtime_error(at + "shape '" + shape.name + "' moves vertex " + std::to_string(i / 3) + " by " +
-                                 std::to_string(Eigen::Vector3f(shape.deltas.data() + i).norm()) + ", more than twice the mesh's own size (" +
-                                 std::to_string(size_of(mesh.vertices)) + ")");
   }
   for (const double v : mesh.transform)
     if (!std::isfinite(v)) throw std::runtime_error(at + "its node's transform is not finite");
   const double det = Eigen::Map<const Matrix>(mesh.transform).topLeftCorner<3, 3>().determinant();
   if (!(std::abs(det) > 1e-30)) throw std::runtime_error(at + "its node's transform is singular (a zero scale)");
+}
+
+std::string number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", x);
+  return text;
+}
+
+std::string point(const Eigen::Vector3d& x) { return "(" + number(x[0]) + ", " + number(x[1]) + ", " + number(x[2]) + ")"; }
+
+// The values the avatar's own size bounds (fit/value_bounds.h), checked once the parts are in
+// their common space: a stray vertex, a shape's delta beyond the avatar's size. The error
+// names the part, its own vertex and the shape by the rig's name.
+void check_values(const AvatarFile& avatar) {
+  const std::size_t n = avatar.vertex_count();
+  const fit::MeshExtent extent = fit::mesh_extent(avatar.neutral.data(), n);
+  const auto part_of = [&](std::size_t v) -> const AvatarPart& {
+    for (const AvatarPart& p : avatar.parts)
+      if (v >= p.first_vertex && v < p.first_vertex + p.vertex_count) return p;
+    return avatar.parts.back();
+  };
+  const auto at = [&](std::size_t v) {
+    const AvatarPart& p = part_of(v);
+    return avatar.path + ": mesh '" + p.name + "': ";
+  };
+  const auto own = [&](std::size_t v) { return std::to_string(v - part_of(v).first_vertex); };
+  const std::int64_t stray = fit::stray_vertex(avatar.neutral.data(), n, extent);
+  if (stray >= 0) {
+    const auto v = static_cast<std::size_t>(stray);
+    throw std::runtime_error(at(v) + "vertex " + own(v) + " lies at " + point(Eigen::Vector3f(&avatar.neutral[3 * v]).cast<double>()) +
+                             ", far outside the mesh: its vertices lie within " + point(extent.lo) + " to " + point(extent.hi) +
+                             " (a stray vertex?)");
+  }
+  for (std::size_t k = 0; k < 52; ++k) {
+    const std::int64_t moved = fit::long_delta(avatar.blendshapes.data() + 3 * k * n, n, extent);
+    if (moved < 0) continue;
+    const auto v = static_cast<std::size_t>(moved);
+    std::string rig_name;
+    for (const ShapeSource& s : avatar.shape_sources[k])
+      if (s.part == part_of(v).name) rig_name = s.rig_name;
+    throw std::runtime_error(at(v) + "shape '" + rig_name + "' moves vertex " + own(v) + " by " +
+                             number(Eigen::Vector3f(&avatar.blendshapes[3 * (k * n + v)]).cast<double>().norm()) +
+                             ", more than " + number(fit::kMaxDeltaReach) + " times the avatar's size (" + number(extent.diagonal()) + ")");
+  }
 }
 
 // A unique name for every part: the report and the outputs name parts by it.
@@ -192,6 +208,7 @@ AvatarFile assemble_avatar(SourceScene scene, const std::string& path, const Sha
     first += part.vertex_count;
     avatar.parts.push_back(std::move(part));
   }
+  check_values(avatar);
   return avatar;
 }
 

@@ -25,6 +25,7 @@ struct ImportLimits {
   std::size_t max_morph_targets = 1024;                      // per mesh
   std::uint64_t max_decoded_bytes = std::uint64_t{1} << 30;  // all vertex data decoded (accessors, compression), together
   std::size_t max_shape_files = 4096;                        // files in an avatar folder's blendshapes/
+  int max_fbx_depth = 64;                                    // an FBX file's nodes (binary) or braces (ASCII) nested
 };
 
 }  // namespace softdeca::avatar_import

@@ -3,6 +3,7 @@
 // order its file gives, so a point cache written in that order loads onto the mesh. assimp reads
 // FBX one vertex per polygon corner; those corners are welded back into the file's vertices
 // (avatar_weld.h).
+#include <assimp/Exceptional.h>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -92,29 +93,71 @@ void declared_unit(const aiScene& scene, SourceScene& out) {
   out.declared_unit = text;
   out.declared_metres_per_unit = centimetres / 100.0;
 }
-}  // namespace
+constexpr const char* kTooLarge = "too large to read: not enough memory";
+constexpr const char* kDamaged = "its structure is damaged (the reader failed inside it)";
 
-bool fbx_files_supported() { return true; }
+// Why assimp failed, in the user's terms: its own messages ("FBX-Parser ...") pass; a C++
+// library's ("std::bad_alloc", "vector::_M_range_check") do not.
+std::string reader_failure(const std::exception_ptr& failure, const std::string& otherwise) {
+  if (!failure) return otherwise;
+  try {
+    std::rethrow_exception(failure);
+  } catch (const std::bad_alloc&) {
+    return kTooLarge;
+  } catch (const DeadlyErrorBase& e) {
+    return e.what();
+  } catch (...) {
+    return kDamaged;
+  }
+}
 
-SourceScene read_fbx_file(const std::string& path, const ImportLimits& limits) {
-  // The file is read once, checked on its open descriptor; assimp parses those bytes.
+// assimp's parse of `bytes`; throws std::runtime_error naming the file and why, never a C++
+// library's own text.
+const aiScene* parse(Assimp::Importer& importer, const std::string& bytes, const std::string& path) {
+  const std::string what = path + ": not a readable FBX file (";
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_ValidateDataStructure | aiProcess_Triangulate, "fbx");
+  } catch (...) {
+    throw std::runtime_error(what + reader_failure(std::current_exception(), kDamaged) + ")");
+  }
+  if (!scene || !scene->mRootNode) throw std::runtime_error(what + reader_failure(importer.GetException(), importer.GetErrorString()) + ")");
+  return scene;
+}
+
+SourceScene read_fbx(const std::string& path, const ImportLimits& limits) {
+  // The file is read once, checked on its open descriptor; assimp parses those bytes once they
+  // pass the scan (fbx_bounds.h): assimp trusts what a file declares.
   const std::string bytes = read_named_file(path, limits.max_file_bytes, "an avatar file");
   if (agreed_format(path, bytes) != FileFormat::fbx) throw std::runtime_error(path + ": not an FBX file");
-  scan_fbx(bytes, path, limits);  // nesting, expansion and values bounded before assimp parses
+  const FbxScan scan = scan_fbx(bytes, path, limits);
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);  // one node per FBX model
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
-  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate;
-  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, "fbx");
-  if (!scene || !scene->mRootNode) throw std::runtime_error(path + ": not a readable FBX file (" + importer.GetErrorString() + ")");
+  const aiScene* scene = parse(importer, bytes, path);
   Reader reader{path, limits, *scene, {}};
   reader.out.format = "FBX";
   reader.out.vertex_order = "the FBX file's vertices in the order its polygons first use them";
   declared_unit(*scene, reader.out);
   reader.walk(*scene->mRootNode, aiMatrix4x4(), 0);
+  // assimp leaves out a mesh whose data does not add up, saying nothing.
+  if (reader.out.meshes.empty() && scan.meshes > 0)
+    throw std::runtime_error(path + ": none of its " + std::to_string(scan.meshes) +
+                             " meshes could be read (their data is damaged or empty)");
   for (SourceMesh& mesh : reader.out.meshes) weld_corners(mesh);
   return std::move(reader.out);
+}
+}  // namespace
+
+bool fbx_files_supported() { return true; }
+
+SourceScene read_fbx_file(const std::string& path, const ImportLimits& limits) {
+  try {
+    return read_fbx(path, limits);
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(path + ": " + kTooLarge);
+  }
 }
 
 }  // namespace softdeca::avatar_import

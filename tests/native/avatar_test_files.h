@@ -1,8 +1,9 @@
 // Users' avatars for the avatar file tests, written as DCC tools write them: binary glTF with
 // morph targets named in mesh.extras.targetNames (Blender, VRM), and binary FBX 7.4 with
 // BlendShape deformers, channels and Shape geometries (Maya, Blender), including in-between
-// shapes. Written here rather than by assimp's exporters: the Debian assimp (5.2) drops glTF
-// target names, writes no FBX blend shapes, and its binary FBX does not read back.
+// shapes, its arrays raw or zlib-compressed. Written here rather than by assimp's exporters:
+// the Debian assimp (5.2) drops glTF target names, writes no FBX blend shapes, and its binary
+// FBX does not read back. Hostile FBX too: nodes nested deep, arrays that expand far.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -13,12 +14,24 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "avatar_file.h"
 #include "softdeca/softdeca.h"
 
 namespace softdeca::test {
+
+// What reading the avatar at `path` is refused with, "" when it reads.
+inline std::string error_of(const std::string& path, const avatar_import::ImportLimits& limits = {}) {
+  try {
+    avatar_import::read_avatar_file(path, avatar_import::ShapeNames(), limits);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
 
 // The canonical index of an ARKit shape by its name (the C ABI's rule).
 inline std::size_t arkit_index(const char* name) {
@@ -57,6 +70,7 @@ struct TestMesh {
 struct TestScene {
   double root_scale = 1;
   double fbx_unit_cm = 1;  // FBX's UnitScaleFactor
+  bool fbx_zlib = false;   // FBX arrays zlib-compressed (as DCCs write large ones)
   std::vector<TestMesh> meshes;
 };
 
@@ -110,6 +124,76 @@ inline void pad(std::string& s, char with) {
   while (s.size() % 4) s += with;
 }
 
+// ---- zlib streams (RFC 1950) of fixed-Huffman deflate blocks (RFC 1951), written by hand ----
+struct BitWriter {
+  std::string out;
+  std::uint32_t held = 0;
+  int count = 0;
+  void bits(std::uint32_t value, int n) {  // the deflate stream's own order: least significant first
+    for (int i = 0; i < n; ++i) put((value >> i) & 1u);
+  }
+  void code(std::uint32_t value, int n) {  // Huffman codes: most significant first
+    for (int i = n - 1; i >= 0; --i) put((value >> i) & 1u);
+  }
+  void put(std::uint32_t bit) {
+    held |= bit << count;
+    if (++count == 8) out += static_cast<char>(held), held = 0, count = 0;
+  }
+  void align() {
+    while (count) put(0);
+  }
+};
+inline void deflate_literal(BitWriter& w, unsigned char v) {
+  if (v < 144) w.code(0x30u + v, 8);
+  else w.code(0x190u + (v - 144u), 9);
+}
+inline void deflate_zero_run(BitWriter& w) {  // 258 bytes copied from one back: length code 285, distance code 0
+  w.code(0xC5, 8);
+  w.code(0, 5);
+}
+inline std::string zlib_finish(BitWriter& w, std::uint32_t adler) {
+  w.code(0, 7);  // end of block
+  w.align();
+  for (int shift = 24; shift >= 0; shift -= 8) w.out += static_cast<char>((adler >> shift) & 0xFF);
+  return std::string("\x78\x01", 2) + w.out;
+}
+// `bytes` as a zlib stream: runs of zeros as copies, everything else as literals.
+inline std::string zlib_stream(const std::string& bytes) {
+  BitWriter w;
+  w.bits(1, 1);  // the final block
+  w.bits(1, 2);  // fixed Huffman codes
+  std::uint32_t a = 1, b = 0;
+  for (std::size_t i = 0; i < bytes.size();) {
+    const auto run = [&] {
+      std::size_t n = 0;
+      while (n < 258 && i + n < bytes.size() && bytes[i + n] == 0) ++n;
+      return n;
+    };
+    if (i > 0 && bytes[i - 1] == 0 && run() == 258) {
+      deflate_zero_run(w);
+      for (int k = 0; k < 258; ++k) b = (b + a) % 65521;
+      i += 258;
+      continue;
+    }
+    const auto v = static_cast<unsigned char>(bytes[i++]);
+    deflate_literal(w, v);
+    a = (a + v) % 65521;
+    b = (b + a) % 65521;
+  }
+  return zlib_finish(w, (b << 16) | a);
+}
+// `n` zero bytes (n >= 1) as a zlib stream of about 13 bits per 258 of them: a zlib bomb.
+inline std::string zlib_zeros(std::uint64_t n) {
+  BitWriter w;
+  w.bits(1, 1);
+  w.bits(1, 2);
+  deflate_literal(w, 0);
+  std::uint64_t left = n - 1;
+  for (; left >= 258; left -= 258) deflate_zero_run(w);
+  for (; left > 0; --left) deflate_literal(w, 0);
+  return zlib_finish(w, static_cast<std::uint32_t>((n % 65521) << 16 | 1));  // Adler-32 of zeros: A = 1, B = n
+}
+
 // ---- binary FBX 7.4: nodes with typed properties ----
 struct FbxProperty {
   char type;
@@ -142,14 +226,25 @@ inline FbxProperty fbx_string(const std::string& s) {
 }
 // An object's name as FBX stores it: "name\0\1Class".
 inline FbxProperty fbx_name(const std::string& name, const std::string& cls) { return fbx_string(name + std::string("\0\1", 2) + cls); }
+// An array property: raw, or zlib-compressed (encoding 1).
 template <class T>
-FbxProperty fbx_array(char type, const std::vector<T>& v) {
+FbxProperty fbx_array(char type, const std::vector<T>& v, bool zlib = false) {
+  std::string data(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  if (zlib) data = zlib_stream(data);
   std::string b;
   append(b, static_cast<std::uint32_t>(v.size()));
-  append(b, std::uint32_t{0});  // not compressed
-  append(b, static_cast<std::uint32_t>(v.size() * sizeof(T)));
-  b.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-  return {type, b};
+  append(b, std::uint32_t{zlib ? 1u : 0u});
+  append(b, static_cast<std::uint32_t>(data.size()));
+  return {type, b + data};
+}
+// An array property of `count` elements of `element_size` bytes, declared so, holding `data`
+// under `encoding` whatever its size: for hostile files.
+inline FbxProperty fbx_array_declared(char type, std::uint32_t count, std::uint32_t encoding, const std::string& data) {
+  std::string b;
+  append(b, count);
+  append(b, encoding);
+  append(b, static_cast<std::uint32_t>(data.size()));
+  return {type, b + data};
 }
 inline std::vector<double> to_doubles(const std::vector<float>& v) { return std::vector<double>(v.begin(), v.end()); }
 
@@ -181,7 +276,7 @@ inline FbxNode fbx_model(std::int64_t id, const std::string& name, const std::st
                                  fbx_p("Lcl Scaling", "Lcl Scaling", "A", s)}}}};
 }
 // A Shape geometry of the vertices a shape moves (as DCCs write them: sparse).
-inline FbxNode fbx_shape(std::int64_t id, const std::string& name, const std::vector<float>& deltas) {
+inline FbxNode fbx_shape(std::int64_t id, const std::string& name, const std::vector<float>& deltas, bool zlib) {
   std::vector<std::int32_t> indexes;
   std::vector<double> moved;
   for (std::size_t i = 0; i < deltas.size() / 3; ++i) {
@@ -192,9 +287,9 @@ inline FbxNode fbx_shape(std::int64_t id, const std::string& name, const std::ve
   return {"Geometry",
           {fbx_long(id), fbx_name(name, "Geometry"), fbx_string("Shape")},
           {{"Version", {fbx_int(100)}, {}},
-           {"Indexes", {fbx_array('i', indexes)}, {}},
-           {"Vertices", {fbx_array('d', moved)}, {}},
-           {"Normals", {fbx_array('d', std::vector<double>(moved.size(), 0.0))}, {}}}};
+           {"Indexes", {fbx_array('i', indexes, zlib)}, {}},
+           {"Vertices", {fbx_array('d', moved, zlib)}, {}},
+           {"Normals", {fbx_array('d', std::vector<double>(moved.size(), 0.0), zlib)}, {}}}};
 }
 }  // namespace files_detail
 
@@ -256,8 +351,10 @@ inline std::string glb_bytes(const TestScene& scene) {
 }
 
 // Binary FBX 7.4: a Model, a Mesh geometry and a BlendShape deformer per mesh, under a Null
-// model for the root; the file's unit is UnitScaleFactor centimetres.
-inline std::string fbx_bytes(const TestScene& scene) {
+// model for the root; the file's unit is UnitScaleFactor centimetres. `edit` and `edit_links`
+// (a test's) may change the Objects and the Connections node before they are written.
+inline std::string fbx_bytes(const TestScene& scene, const std::function<void(files_detail::FbxNode& objects)>& edit = {},
+                             const std::function<void(files_detail::FbxNode& connections)>& edit_links = {}) {
   using namespace files_detail;
   std::vector<FbxNode> top;
   top.push_back({"FBXHeaderExtension", {}, {{"FBXHeaderVersion", {fbx_int(1003)}, {}}, {"FBXVersion", {fbx_int(7400)}, {}}}});
@@ -282,8 +379,8 @@ inline std::string fbx_bytes(const TestScene& scene) {
     for (std::size_t t = 2; t < polygons.size(); t += 3) polygons[t] = ~polygons[t];  // a polygon's last corner, negated
     objects.children.push_back({"Geometry",
                                 {fbx_long(geometry), fbx_name(mesh.name, "Geometry"), fbx_string("Mesh")},
-                                {{"Vertices", {fbx_array('d', to_doubles(mesh.vertices))}, {}},
-                                 {"PolygonVertexIndex", {fbx_array('i', polygons)}, {}},
+                                {{"Vertices", {fbx_array('d', to_doubles(mesh.vertices), scene.fbx_zlib)}, {}},
+                                 {"PolygonVertexIndex", {fbx_array('i', polygons, scene.fbx_zlib)}, {}},
                                  {"GeometryVersion", {fbx_int(124)}, {}}}});
     const double rotation[3] = {0, mesh.rotation_y_degrees, 0};
     objects.children.push_back(fbx_model(model, mesh.name, "Mesh", mesh.translation, rotation, mesh.scale));
@@ -298,22 +395,61 @@ inline std::string fbx_bytes(const TestScene& scene) {
       const std::vector<double> weights = shape.inbetween.empty() ? std::vector<double>{100} : std::vector<double>{50, 100};
       objects.children.push_back({"Deformer",
                                   {fbx_long(channel), fbx_name(shape.name, "SubDeformer"), fbx_string("BlendShapeChannel")},
-                                  {{"Version", {fbx_int(100)}, {}}, {"DeformPercent", {fbx_double(0)}, {}}, {"FullWeights", {fbx_array('d', weights)}, {}}}});
+                                  {{"Version", {fbx_int(100)}, {}}, {"DeformPercent", {fbx_double(0)}, {}}, {"FullWeights", {fbx_array('d', weights, scene.fbx_zlib)}, {}}}});
       connect(channel, deformer);
       if (!shape.inbetween.empty()) {
-        objects.children.push_back(fbx_shape(id, shape.name + "_50", shape.inbetween));
+        objects.children.push_back(fbx_shape(id, shape.name + "_50", shape.inbetween, scene.fbx_zlib));
         connect(id++, channel);
       }
-      objects.children.push_back(fbx_shape(id, shape.name, shape.deltas));
+      objects.children.push_back(fbx_shape(id, shape.name, shape.deltas, scene.fbx_zlib));
       connect(id++, channel);
     }
   }
+  if (edit) edit(objects);
+  if (edit_links) edit_links(connections);
   top.push_back(objects);
   top.push_back(connections);
   std::string out("Kaydara FBX Binary  \0\x1a\0", 23);
   append(out, std::uint32_t{7400});
   for (const FbxNode& node : top) fbx_put(out, node);
   return out + std::string(13, '\0');
+}
+
+// The first node named `name` among `node`'s descendants (depth first), or null.
+inline files_detail::FbxNode* fbx_find(files_detail::FbxNode& node, const std::string& name) {
+  for (files_detail::FbxNode& child : node.children) {
+    if (child.name == name) return &child;
+    if (files_detail::FbxNode* found = fbx_find(child, name)) return found;
+  }
+  return nullptr;
+}
+
+// A binary FBX 7.4 of nodes nested `depth` deep, each the only child of the one above (written
+// without recursion: deep enough to overflow a recursive reader's stack).
+inline std::string fbx_nested_bytes(std::size_t depth) {
+  using files_detail::append;
+  std::string out("Kaydara FBX Binary  \0\x1a\0", 23);
+  append(out, std::uint32_t{7400});
+  std::vector<std::size_t> starts;
+  for (std::size_t d = 0; d < depth; ++d) {
+    starts.push_back(out.size());
+    out += std::string(12, '\0') + std::string(1, '\1') + "N";  // end, 0 properties, 0 bytes; a 1-byte name
+  }
+  std::vector<std::uint32_t> ends(depth);
+  ends[depth - 1] = static_cast<std::uint32_t>(out.size());
+  for (std::size_t d = depth - 1; d-- > 0;) {
+    out += std::string(13, '\0');  // the empty record that ends a node's children
+    ends[d] = static_cast<std::uint32_t>(out.size());
+  }
+  for (std::size_t d = 0; d < depth; ++d) std::memcpy(&out[starts[d]], &ends[d], 4);
+  return out + std::string(13, '\0');
+}
+
+// An ASCII FBX whose header is followed by `depth` nested braces.
+inline std::string fbx_ascii_nested(std::size_t depth) {
+  std::string out = "; FBX 7.4.0 project file\nFBXHeaderExtension:  {\n\tFBXHeaderVersion: 1003\n}\nDeep: ";
+  for (std::size_t d = 0; d < depth; ++d) out += "A: {";
+  return out + std::string(depth, '}') + "\n";
 }
 
 }  // namespace softdeca::test

@@ -22,6 +22,7 @@
 using namespace softdeca::cli;
 using namespace softdeca::avatar_import;
 using softdeca::test::expected_transform;
+using softdeca::test::error_of;
 using softdeca::test::TempDir;
 constexpr auto shape = softdeca::test::arkit_index;
 using softdeca::test::deltas;
@@ -110,14 +111,6 @@ bool has_unused(const AvatarFile& a, const std::string& mesh, const std::string&
   return false;
 }
 
-std::string error_of(const std::string& path, const ImportLimits& limits = {}) {
-  try {
-    read_avatar_file(path, ShapeNames(), limits);
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
 
 std::vector<std::size_t> identity_order(std::size_t n) {
   std::vector<std::size_t> order(n);
@@ -352,7 +345,7 @@ TEST(FbxBounds, DeepNestingLongChainsAndExpandingArraysAreRefusedBeforeAssimp) {
   EXPECT_NE(scan_error(binary_fbx({chain})).find("connected more than 256 deep"), std::string::npos);
   chain.children.push_back({"C", {softdeca::test::files_detail::fbx_string("OO"), softdeca::test::files_detail::fbx_long(301),
                                   softdeca::test::files_detail::fbx_long(1)}, {}});
-  EXPECT_NE(scan_error(binary_fbx({chain})).find("or in a cycle"), std::string::npos);
+  EXPECT_NE(scan_error(binary_fbx({chain})).find("in a cycle"), std::string::npos);
 
   // A zlib array that says it holds 300 million doubles (2.4 GB) in a file of a few bytes.
   std::string bomb;
@@ -361,7 +354,7 @@ TEST(FbxBounds, DeepNestingLongChainsAndExpandingArraysAreRefusedBeforeAssimp) {
   softdeca::test::files_detail::append(bomb, std::uint32_t{4});
   bomb += "abcd";
   const FbxNode vertices{"Vertices", {{'d', bomb}}, {}};
-  EXPECT_NE(scan_error(binary_fbx({vertices})).find("would expand to more than"), std::string::npos);
+  EXPECT_NE(scan_error(binary_fbx({vertices})).find("would expand to 2.24 GiB, more than"), std::string::npos);
 
   std::string truncated = softdeca::test::fbx_bytes(avatar_scene());
   truncated.resize(truncated.size() / 2);

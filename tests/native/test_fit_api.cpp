@@ -312,6 +312,49 @@ TEST_F(FitApi, BadMeshesGetClearErrors) {
   EXPECT_EQ(f.p, nullptr);
 }
 
+TEST_F(FitApi, StrayVerticesAndWildDeltasAreNamedNotMistakenForNoFace) {
+  UserAvatar user(head_);
+  FitPtr f;
+  {
+    UserAvatar far = user;
+    far.neutral[3 * 5] = 1e30f;
+    far.describe();
+    EXPECT_EQ(fit(far.mesh, f), SOFTDECA_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(softdeca_last_error()).find("vertex 5 lies far outside the mesh"), std::string::npos) << softdeca_last_error();
+  }
+  {
+    UserAvatar wild = user;
+    int32_t jaw = -1;
+    ASSERT_EQ(softdeca_blendshape_index("jawOpen", &jaw), SOFTDECA_OK);
+    wild.deltas[3 * (static_cast<std::size_t>(jaw) * wild.vertices() + 9) + 1] = 3e38f;
+    wild.describe();
+    EXPECT_EQ(fit(wild.mesh, f), SOFTDECA_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(softdeca_last_error()).find("blendshape jawOpen moves vertex 9 by more than 2 times the mesh's size"),
+              std::string::npos)
+        << softdeca_last_error();
+  }
+  EXPECT_EQ(f.p, nullptr);
+}
+
+// Long thin triangles from the head's edges to random vertices of it, 100 for each of its own:
+// fitted (the surface query cuts them into pieces near the template) or refused by name, never
+// searched triangle by triangle (the work is bounded in tests/native/test_surface_query.cpp,
+// the time measured by bench-reliability).
+TEST_F(FitApi, AHeadWithTwentyThousandSliversFits) {
+  UserAvatar user(head_);
+  std::mt19937 random(5);
+  const std::size_t head_triangles = head_.triangles.size() / 3;
+  std::uniform_int_distribution<std::size_t> any_triangle(0, head_triangles - 1);
+  std::uniform_int_distribution<std::int32_t> any_vertex(0, static_cast<std::int32_t>(head_.vertices()) - 1);
+  for (int i = 0; i < 20000; ++i) {
+    const std::int32_t* t = user.triangles.data() + 3 * any_triangle(random);
+    user.triangles.insert(user.triangles.end(), {t[0], t[1], any_vertex(random)});
+  }
+  user.describe();
+  FitPtr f;
+  ASSERT_EQ(fit(user.mesh, f), SOFTDECA_OK) << softdeca_last_error();
+}
+
 TEST_F(FitApi, ChangedMeshesOtherBundlesAndDamagedFilesAreRefused) {
   UserAvatar user(head_);
   FitPtr f;

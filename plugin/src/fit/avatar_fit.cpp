@@ -17,6 +17,7 @@
 #include "fit/placement.h"
 #include "fit/registration.h"
 #include "fit/shape_matcher.h"
+#include "fit/value_bounds.h"
 #include "geometry/nearest_points.h"
 #include "stream/arkit_names.h"
 
@@ -61,14 +62,28 @@ void check_mesh(const AvatarMesh& a) {
     if (!std::isfinite(a.neutral[i]))
       throw Error(SOFTDECA_ERROR_NON_FINITE, "the avatar's neutral mesh has a non-finite value at vertex " + std::to_string(i / 3));
   for (std::size_t i = 0; i < 3 * a.triangle_count; ++i)
-    require(a.triangles[i] >= 0 && static_cast<std::size_t>(a.triangles[i]) < a.vertex_count,
-            "the avatar's triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh");
+    expect(a.triangles[i] >= 0 && static_cast<std::size_t>(a.triangles[i]) < a.vertex_count,
+           [&] { return "the avatar's triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh"; });
   for (std::size_t k = 0; k < kShapes; ++k)
     if (a.deltas[k])
       for (std::size_t i = 0; i < 3 * a.vertex_count; ++i)
         if (!std::isfinite(a.deltas[k][i]))
           throw Error(SOFTDECA_ERROR_NON_FINITE, std::string("the avatar's blendshape ") + stream::blendshape_name(k) +
                                                      " has a non-finite value at vertex " + std::to_string(i / 3));
+  // Values bounded by the mesh's own size (fit/value_bounds.h).
+  const MeshExtent extent = mesh_extent(a.neutral, a.vertex_count);
+  const std::int64_t stray = stray_vertex(a.neutral, a.vertex_count, extent);
+  expect(stray < 0, [&] {
+    return "the avatar's vertex " + std::to_string(stray) + " lies far outside the mesh (more than " +
+           std::to_string(static_cast<int>(kStrayReach)) + " times the size of the box its other vertices fill from it): a stray vertex?";
+  });
+  for (std::size_t k = 0; k < kShapes; ++k) {
+    const std::int64_t moved = a.deltas[k] ? long_delta(a.deltas[k], a.vertex_count, extent) : -1;
+    expect(moved < 0, [&] {
+      return std::string("the avatar's blendshape ") + stream::blendshape_name(k) + " moves vertex " + std::to_string(moved) +
+             " by more than " + std::to_string(static_cast<int>(kMaxDeltaReach)) + " times the mesh's size";
+    });
+  }
 }
 
 std::string json_string(const std::string& s) {
@@ -87,16 +102,15 @@ std::string name_list(const std::array<ShapeOrigin, kShapes>& origin, ShapeOrigi
   return o + "]";
 }
 
-// The shapes both meshes move, with their deltas in the template's frame.
+// The shapes both meshes move: the avatar's deltas (its own coordinates) and the template's.
 std::vector<SharedShape> shared_shapes(const TemplateData& t, const AvatarMesh& a, const AvatarFrame& frame,
-                                       const AvatarFrame& tframe, const Eigen::Matrix3d& lin) {
-  const std::size_t n = a.vertex_count, vs = t.skin_vertices;
+                                       const AvatarFrame& tframe) {
+  const std::size_t vs = t.skin_vertices;
   std::vector<SharedShape> shapes;
   for (std::size_t k = 0; k < kShapes; ++k) {
     if (!frame.moves[k] || !tframe.moves[k]) continue;
     SharedShape s;
-    s.avatar.resize(static_cast<Eigen::Index>(n), 3);
-    for (std::size_t v = 0; v < n; ++v) s.avatar.row(static_cast<Eigen::Index>(v)) = (lin * row3(a.deltas[k], v)).transpose();
+    s.avatar = a.deltas[k];
     s.template_.resize(static_cast<Eigen::Index>(vs), 3);
     for (std::size_t v = 0; v < vs; ++v) s.template_.row(static_cast<Eigen::Index>(v)) = row3(t.shapes + k * vs * 3, v).transpose();
     shapes.push_back(std::move(s));
@@ -150,6 +164,11 @@ SkinSurface skin_surface(const AvatarMesh& a, const AvatarFrame& frame, const Me
     const std::int32_t* c = a.triangles + 3 * f;
     if (!s.part[static_cast<std::size_t>(topo.component[static_cast<std::size_t>(c[0])])]) continue;
     if (weld(c[0]) == weld(c[1]) || weld(c[1]) == weld(c[2]) || weld(c[0]) == weld(c[2])) continue;
+    // Corners in a line: a segment, no surface to find a point on.
+    if ((row3(a.neutral, std::size_t(c[1])) - row3(a.neutral, std::size_t(c[0])))
+            .cross(row3(a.neutral, std::size_t(c[2])) - row3(a.neutral, std::size_t(c[0])))
+            .squaredNorm() == 0)
+      continue;
     s.triangles.insert(s.triangles.end(), c, c + 3);
     s.open_edges.push_back(topo.boundary_edges[f]);
   }
@@ -161,6 +180,29 @@ Triangles triangle_rows(const std::int32_t* indices, std::size_t count) {
   Triangles f(static_cast<Eigen::Index>(count), 3);
   for (std::size_t i = 0; i < count * 3; ++i) f(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) = indices[i];
   return f;
+}
+
+// The avatar's skin is searched (geometry/surface_query.h) with its triangles longer than
+// kPieceSize near the template (within kPieceMargin of its box; metres, placed) cut into
+// pieces: a face's triangles are shorter, slivers across the mesh are not. The pieces are
+// bounded: a face and what lies around it need a few thousand, not kMaxExtraPieces.
+constexpr double kPieceSize = 0.01, kPieceMargin = 0.05;
+constexpr std::size_t kMaxExtraPieces = 1000000;
+
+geometry::Cutting cutting_near(const Points& template_skin) {
+  geometry::Cutting c;
+  c.piece_size = kPieceSize;
+  c.lo = template_skin.colwise().minCoeff().transpose() - Eigen::Vector3d::Constant(kPieceMargin);
+  c.hi = template_skin.colwise().maxCoeff().transpose() + Eigen::Vector3d::Constant(kPieceMargin);
+  return c;
+}
+
+void require_searchable(const Points& y, const Triangles& f, const geometry::Cutting& cutting) {
+  const std::size_t budget = static_cast<std::size_t>(f.rows()) + kMaxExtraPieces;
+  if (geometry::SurfaceQuery::entries_needed(y, f, cutting, budget + 1) <= budget) return;
+  throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT,
+              "the avatar's face has more long triangles than can be searched (their parts of 1 cm would be more than " +
+                  std::to_string(kMaxExtraPieces) + "): thin slivers between distant vertices? Remove them");
 }
 
 // What the steps of one fit share.
@@ -177,13 +219,19 @@ struct Session {
   std::unique_ptr<ShapeMatcher> matcher;
   std::vector<float> identity;
 
-  // The avatar in the template's frame on the current placement, and the matcher on it.
+  // The avatar in the template's frame on the current placement, and the matcher on it (its
+  // long triangles cut, within bounds, at the first).
   void place() {
     y.resize(static_cast<Eigen::Index>(a.vertex_count), 3);
     for (std::size_t v = 0; v < a.vertex_count; ++v)
       y.row(static_cast<Eigen::Index>(v)) = at.place.to_template(row3(a.neutral, v)).transpose();
-    matcher = std::make_unique<ShapeMatcher>(y, atri, skin.open_edges, topo.boundary_vertex, data_weight,
-                                             shared_shapes(t, a, at.frame, tframe, at.place.linear));
+    const geometry::Cutting cutting = cutting_near(tskin);
+    if (!matcher) {
+      require_searchable(y, atri, cutting);
+      matcher = std::make_unique<ShapeMatcher>(atri, a.vertex_count, skin.open_edges, topo.boundary_vertex, data_weight,
+                                               shared_shapes(t, a, at.frame, tframe));
+    }
+    matcher->place(y, at.place.linear, cutting);
   }
 };
 
@@ -357,7 +405,8 @@ ShapeSource shape_source(const Session& s, const Points& skin) {
   src.bary.assign(vs * 3, 0.0f);
   src.weight.assign(vs, 0.0f);
   for (std::size_t v = 0; v < vs; ++v) {
-    const geometry::SurfacePoint p = s.matcher->neutral().closest(skin.row(static_cast<Eigen::Index>(v)).transpose());
+    // Beyond kShapeFar the template's own shape is used: no need to look farther.
+    const geometry::SurfacePoint p = s.matcher->neutral().closest(skin.row(static_cast<Eigen::Index>(v)).transpose(), kShapeFar);
     if (p.triangle < 0) continue;
     for (std::size_t k = 0; k < 3; ++k) {
       src.corners[3 * v + k] = s.skin.triangles[3 * static_cast<std::size_t>(p.triangle) + k];

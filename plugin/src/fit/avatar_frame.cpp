@@ -52,7 +52,7 @@ bool starts_with(const char* s, const char* prefix) { return std::string(s).rfin
 
 void check_finite(const float* p, std::size_t n, const std::string& what) {
   for (std::size_t i = 0; i < n; ++i)
-    require(std::isfinite(p[i]), what + " has a non-finite value at vertex " + std::to_string(i / 3));
+    expect(std::isfinite(p[i]), [&] { return what + " has a non-finite value at vertex " + std::to_string(i / 3); });
 }
 
 // The motion-weighted centre and spread of one shape's moving vertices, each vertex weighted by
@@ -183,8 +183,8 @@ AvatarFrame avatar_frame(const AvatarShapes& s) {
   check_finite(s.neutral, 3 * s.vertex_count, "the neutral mesh");
   require(s.triangles != nullptr || s.triangle_count == 0, "triangle_count without triangles");
   for (std::size_t i = 0; i < 3 * s.triangle_count; ++i)
-    require(s.triangles[i] >= 0 && static_cast<std::size_t>(s.triangles[i]) < s.vertex_count,
-            "triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh");
+    expect(s.triangles[i] >= 0 && static_cast<std::size_t>(s.triangles[i]) < s.vertex_count,
+           [&] { return "triangle " + std::to_string(i / 3) + " has a vertex index outside the mesh"; });
   for (std::size_t i = 0; i < kShapes; ++i)
     if (s.deltas[i] != nullptr)
       check_finite(s.deltas[i], 3 * s.vertex_count, std::string("blendshape ") + stream::blendshape_name(i));

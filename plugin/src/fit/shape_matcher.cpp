@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace softdeca::fit {
 
@@ -14,6 +15,8 @@ constexpr double kMinEnergy = 0.005;   // mean squared response (of the largest,
 constexpr double kExplain = 0.1;       // a match must leave at most this share of the response unexplained
 constexpr double kPrior = 0.05;        // the distance's weight in a match's cost, at the search radius
 constexpr double kFineReach = 0.006;   // below this reach only closest points: the fine fit
+constexpr double kThin = 8;            // candidates of a search: one per cell of its radius over this
+constexpr std::int32_t kMaxFan = 64;   // triangles around the best candidate a match is placed on
 
 struct CellKey {
   long x, y, z;
@@ -24,54 +27,107 @@ struct CellHash {
     return static_cast<std::size_t>(k.x * 73856093L ^ k.y * 19349663L ^ k.z * 83492791L);
   }
 };
+CellKey cell_key(const Eigen::Vector3d& p, double cell) {
+  const auto index = [&](double x) { return static_cast<long>(std::clamp(std::floor(x / cell), -1e15, 1e15)); };
+  return {index(p[0]), index(p[1]), index(p[2])};
+}
+// A cell as one number, 21 bits an axis (cells 2 million apart share one: only thinning uses it).
+std::uint64_t packed(const CellKey& k) {
+  constexpr std::uint64_t kMask = (1u << 21) - 1;
+  return (static_cast<std::uint64_t>(k.x) & kMask) | (static_cast<std::uint64_t>(k.y) & kMask) << 21 |
+         (static_cast<std::uint64_t>(k.z) & kMask) << 42;
+}
 
-// Each shape's deltas over its largest (one row of `dims` per vertex).
-std::vector<double> descriptors(const std::vector<const Points*>& shapes, Eigen::Index rows) {
+// Each shape's deltas over its largest (one row of `dims` per vertex), written row by row.
+std::vector<float> avatar_descriptors(const std::vector<SharedShape>& shapes, std::size_t rows) {
   const std::size_t dims = 3 * shapes.size();
-  std::vector<double> d(static_cast<std::size_t>(rows) * dims, 0.0);
+  std::vector<double> scale(shapes.size(), 0.0);
   for (std::size_t s = 0; s < shapes.size(); ++s) {
-    const double peak = shapes[s]->rowwise().norm().maxCoeff();
+    double peak = 0;
+    for (std::size_t v = 0; v < rows; ++v) peak = std::max(peak, Eigen::Vector3f(shapes[s].avatar + 3 * v).cast<double>().squaredNorm());
+    scale[s] = peak > 0 ? 1 / std::sqrt(peak) : 0;
+  }
+  std::vector<float> d(rows * dims);
+  for (std::size_t v = 0; v < rows; ++v)
+    for (std::size_t s = 0; s < shapes.size(); ++s)
+      for (std::size_t c = 0; c < 3; ++c) d[v * dims + 3 * s + c] = static_cast<float>(shapes[s].avatar[3 * v + c] * scale[s]);
+  return d;
+}
+
+std::vector<float> template_descriptors(const std::vector<SharedShape>& shapes, Eigen::Index rows) {
+  const std::size_t dims = 3 * shapes.size();
+  std::vector<float> d(static_cast<std::size_t>(rows) * dims, 0.0f);
+  for (std::size_t s = 0; s < shapes.size(); ++s) {
+    const Points& delta = shapes[s].template_;
+    const double peak = delta.rowwise().norm().maxCoeff();
     if (!(peak > 0)) continue;
     for (Eigen::Index v = 0; v < rows; ++v)
-      for (int c = 0; c < 3; ++c) d[static_cast<std::size_t>(v) * dims + 3 * s + static_cast<std::size_t>(c)] = (*shapes[s])(v, c) / peak;
+      for (int c = 0; c < 3; ++c)
+        d[static_cast<std::size_t>(v) * dims + 3 * s + static_cast<std::size_t>(c)] = static_cast<float>(delta(v, c) / peak);
   }
   return d;
 }
 
-double dot(const double* a, const double* b, std::size_t n) {
+double dot(const float* a, const float* b, std::size_t n) {
   double s = 0;
-  for (std::size_t i = 0; i < n; ++i) s += a[i] * b[i];
+  for (std::size_t i = 0; i < n; ++i) s += double(a[i]) * double(b[i]);
   return s;
 }
 }  // namespace
 
-ShapeMatcher::ShapeMatcher(const Points& avatar, const Triangles& triangles, std::vector<uint8_t> boundary_edges,
+ShapeMatcher::ShapeMatcher(const Triangles& triangles, std::size_t vertices, std::vector<uint8_t> boundary_edges,
                            std::vector<uint8_t> boundary_vertex, std::vector<double> data_weight,
                            const std::vector<SharedShape>& shapes)
-    : boundary_edges_(std::move(boundary_edges)),
+    : triangles_(triangles),
+      boundary_edges_(std::move(boundary_edges)),
       boundary_vertex_(std::move(boundary_vertex)),
       data_weight_(std::move(data_weight)),
       dims_(3 * shapes.size()) {
-  surface_ = std::make_unique<geometry::SurfaceQuery>(avatar, triangles);
-  std::vector<const Points*> a, t;
-  for (const SharedShape& s : shapes) a.push_back(&s.avatar), t.push_back(&s.template_);
   const Eigen::Index vs = static_cast<Eigen::Index>(data_weight_.size());
-  avatar_desc_ = descriptors(a, avatar.rows());
-  template_desc_ = descriptors(t, vs);
+  avatar_desc_ = avatar_descriptors(shapes, vertices);
+  template_desc_ = template_descriptors(shapes, vs);
   energy_.assign(static_cast<std::size_t>(vs), 0.0);
   if (dims_)
     for (Eigen::Index v = 0; v < vs; ++v) {
-      const double* f = template_desc_.data() + static_cast<std::size_t>(v) * dims_;
+      const float* f = template_desc_.data() + static_cast<std::size_t>(v) * dims_;
       energy_[static_cast<std::size_t>(v)] = dot(f, f, dims_) / static_cast<double>(shapes.size());
     }
-  vertex_triangles_.resize(static_cast<std::size_t>(avatar.rows()));
-  avatar_skin_.assign(static_cast<std::size_t>(avatar.rows()), 0);
+  // Each vertex's skin triangles, packed (a count, then the lists in vertex order).
+  first_triangle_.assign(vertices + 1, 0);
   for (Eigen::Index f = 0; f < triangles.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      vertex_triangles_[static_cast<std::size_t>(triangles(f, k))].push_back(static_cast<std::int32_t>(f));
-      avatar_skin_[static_cast<std::size_t>(triangles(f, k))] = 1;
-    }
+    for (int k = 0; k < 3; ++k) ++first_triangle_[static_cast<std::size_t>(triangles(f, k)) + 1];
+  for (std::size_t v = 1; v < first_triangle_.size(); ++v) first_triangle_[v] += first_triangle_[v - 1];
+  vertex_triangles_.resize(static_cast<std::size_t>(first_triangle_.back()));
+  std::vector<std::int32_t> filled(first_triangle_.begin(), first_triangle_.end() - 1);
+  for (Eigen::Index f = 0; f < triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      vertex_triangles_[static_cast<std::size_t>(filled[static_cast<std::size_t>(triangles(f, k))]++)] = static_cast<std::int32_t>(f);
   described_.resize(static_cast<std::size_t>(vs));
+}
+
+void ShapeMatcher::place(const Points& avatar, const Eigen::Matrix3d& to_template, const geometry::Cutting& cutting) {
+  // A placement after the first is a small rigid correction: the tree is kept, its boxes moved.
+  if (surface_) surface_->move(avatar);
+  else surface_ = std::make_unique<geometry::SurfaceQuery>(avatar, triangles_, cutting);
+  // The template's responses in the avatar's axes: the placement's rotation undone.
+  const Eigen::Matrix3d turn = to_template / std::cbrt(std::fabs(to_template.determinant()));
+  template_turned_.resize(template_desc_.size());
+  for (std::size_t i = 0; i < template_desc_.size(); i += 3) {
+    const Eigen::Vector3d d = turn.transpose() * Eigen::Vector3f(template_desc_.data() + i).cast<double>();
+    for (int c = 0; c < 3; ++c) template_turned_[i + static_cast<std::size_t>(c)] = static_cast<float>(d[c]);
+  }
+  // Once: a correction of the placement moves the candidates with the rest.
+  if (candidates_.empty()) {
+    std::vector<std::pair<std::uint64_t, std::int32_t>> cells;  // sorted: the first vertex of each cell kept
+    for (Eigen::Index j = 0; j < avatar.rows(); ++j)
+      if (first_triangle_[static_cast<std::size_t>(j) + 1] > first_triangle_[static_cast<std::size_t>(j)])
+        cells.emplace_back(packed(cell_key(avatar.row(j).transpose(), kFineReach / kThin)), static_cast<std::int32_t>(j));
+    std::sort(cells.begin(), cells.end());
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      if (i == 0 || cells[i].first != cells[i - 1].first) candidates_.push_back(cells[i].second);
+    std::sort(candidates_.begin(), candidates_.end());
+  }
+  searched_reach_ = 0;
 }
 
 std::size_t ShapeMatcher::described() const {
@@ -98,15 +154,15 @@ bool ShapeMatcher::on_boundary(const geometry::SurfacePoint& p) const {
   return true;
 }
 
-geometry::SurfacePoint ShapeMatcher::best_in_triangle(std::int32_t t, const double* target) const {
+geometry::SurfacePoint ShapeMatcher::best_in_triangle(std::int32_t t, const float* target) const {
   const Triangles& f = surface_->triangles();
-  const double* da = avatar_desc_.data() + static_cast<std::size_t>(f(t, 0)) * dims_;
-  const double* db = avatar_desc_.data() + static_cast<std::size_t>(f(t, 1)) * dims_;
-  const double* dc = avatar_desc_.data() + static_cast<std::size_t>(f(t, 2)) * dims_;
+  const float* da = avatar_desc_.data() + static_cast<std::size_t>(f(t, 0)) * dims_;
+  const float* db = avatar_desc_.data() + static_cast<std::size_t>(f(t, 1)) * dims_;
+  const float* dc = avatar_desc_.data() + static_cast<std::size_t>(f(t, 2)) * dims_;
   // |A + u e1 + v e2|^2 over the triangle, A = da - target, e1 = db - da, e2 = dc - da.
   double aa = 0, ae1 = 0, ae2 = 0, e11 = 0, e12 = 0, e22 = 0;
   for (std::size_t i = 0; i < dims_; ++i) {
-    const double a = da[i] - target[i], e1 = db[i] - da[i], e2 = dc[i] - da[i];
+    const double a = double(da[i]) - target[i], e1 = double(db[i]) - da[i], e2 = double(dc[i]) - da[i];
     aa += a * a, ae1 += a * e1, ae2 += a * e2, e11 += e1 * e1, e12 += e1 * e2, e22 += e2 * e2;
   }
   const auto cost = [&](double u, double v) { return aa + 2 * u * ae1 + 2 * v * ae2 + u * u * e11 + 2 * u * v * e12 + v * v * e22; };
@@ -141,21 +197,26 @@ void ShapeMatcher::search(const Points& skin, double radius) const {
   for (Match& m : described_) m.weight = 0;
   if (!dims_) return;
   const Points& y = surface_->vertices();
-  const double cell = radius;
-  const auto key = [&](const Eigen::Vector3d& p) {
-    return CellKey{static_cast<long>(std::floor(p[0] / cell)), static_cast<long>(std::floor(p[1] / cell)),
-                   static_cast<long>(std::floor(p[2] / cell))};
-  };
+  // The candidates by cells of the radius, thinned to one per cell of a kThin-th of it: a
+  // search looks at a bounded number of them however dense the mesh, and a match is then
+  // placed on the triangles around the best.
   std::unordered_map<CellKey, std::vector<std::int32_t>, CellHash> grid;
-  for (Eigen::Index j = 0; j < y.rows(); ++j)
-    if (avatar_skin_[static_cast<std::size_t>(j)]) grid[key(y.row(j).transpose())].push_back(static_cast<std::int32_t>(j));
+  for (const std::int32_t j : candidates_) grid[cell_key(y.row(j).transpose(), radius)].push_back(j);
+  std::unordered_set<std::uint64_t> taken;
+  for (auto& [cell, members] : grid) {
+    taken.clear();
+    std::size_t kept = 0;
+    for (const std::int32_t j : members)
+      if (taken.insert(packed(cell_key(y.row(j).transpose(), radius / kThin))).second) members[kept++] = j;
+    members.resize(kept);
+  }
   const double n_shapes = static_cast<double>(dims_ / 3);
   for (Eigen::Index i = 0; i < skin.rows(); ++i) {
     const double e = energy_[static_cast<std::size_t>(i)];
     if (!(data_weight_[static_cast<std::size_t>(i)] > 0) || e < kMinEnergy) continue;
-    const double* target = template_desc_.data() + static_cast<std::size_t>(i) * dims_;
+    const float* target = template_turned_.data() + static_cast<std::size_t>(i) * dims_;
     const Eigen::Vector3d x = skin.row(i).transpose();
-    const CellKey c = key(x);
+    const CellKey c = cell_key(x, radius);
     double best = std::numeric_limits<double>::infinity();
     std::int32_t best_j = -1;
     for (long dx = -1; dx <= 1; ++dx)
@@ -166,9 +227,12 @@ void ShapeMatcher::search(const Points& skin, double radius) const {
           for (const std::int32_t j : it->second) {
             const double d2 = (y.row(j).transpose() - x).squaredNorm();
             if (d2 > radius * radius) continue;
-            const double* f = avatar_desc_.data() + static_cast<std::size_t>(j) * dims_;
+            const float* f = avatar_desc_.data() + static_cast<std::size_t>(j) * dims_;
             double dd = 0;
-            for (std::size_t k = 0; k < dims_ && dd < best * e * n_shapes; ++k) dd += (f[k] - target[k]) * (f[k] - target[k]);
+            for (std::size_t k = 0; k < dims_ && dd < best * e * n_shapes; ++k) {
+              const double diff = double(f[k]) - double(target[k]);
+              dd += diff * diff;
+            }
             const double cost = dd / (e * n_shapes) + kPrior * d2 / (radius * radius);
             if (cost < best) best = cost, best_j = j;
           }
@@ -176,8 +240,12 @@ void ShapeMatcher::search(const Points& skin, double radius) const {
     if (best_j < 0) continue;
     geometry::SurfacePoint p;
     double p_cost = std::numeric_limits<double>::infinity();
-    for (const std::int32_t t : vertex_triangles_[static_cast<std::size_t>(best_j)]) {
-      const geometry::SurfacePoint q = best_in_triangle(t, target);
+    const auto j = static_cast<std::size_t>(best_j);
+    // A vertex of a few dozen triangles at most in any mesh made for a face; a fan of more is
+    // looked at in part.
+    const std::int32_t end = std::min(first_triangle_[j + 1], first_triangle_[j] + kMaxFan);
+    for (std::int32_t k = first_triangle_[j]; k < end; ++k) {
+      const geometry::SurfacePoint q = best_in_triangle(vertex_triangles_[static_cast<std::size_t>(k)], target);
       const double cost = q.squared_distance / (e * n_shapes) + kPrior * (q.point - x).squaredNorm() / (radius * radius);
       if (cost < p_cost) p_cost = cost, p = q;
     }
