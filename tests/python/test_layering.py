@@ -38,12 +38,14 @@ def test_nothing_below_the_c_abi_includes_it() -> None:
 IMPORT = SRC.parent / "import"
 CLI = SRC.parent / "cli"
 # What the import layer (plugin/import) may include: the library's lower areas it reads with
-# (core's file opening and errors, the bundle's JSON parser and hash), the public header for
-# the names rule, and its own files; never the C ABI's internals or a host (the command line).
+# (core's file opening and errors, the bundle's JSON parser and hash, the one rule for an
+# avatar's values that the fit applies too), the public header for the names rule, and its own
+# files; never the C ABI's internals or a host (the command line).
 IMPORT_MAY_INCLUDE = (
     "core/",
     "bundle/json.h",
     "bundle/sha256.h",
+    "fit/value_bounds.h",
     "softdeca/softdeca.h",
 )
 
