@@ -179,6 +179,44 @@ SlowDisk slow_disk_run(double seconds, double rate, double drain_bytes_per_s) {
   return out;
 }
 
+// The figures of the runs that need inputs (--bundle, --import-corpus, --avatar), where given.
+void optional_figures(JsonObject& out, const std::string& how, const Options& o, long budget_mib, const BundleMemory& bundles,
+                      const ImportMemory& imports, const FitCost& fits) {
+  if (bundles.bundles > 0) {
+    char bundle_text[1024];
+    std::snprintf(bundle_text, sizeof bundle_text,
+                  "%d copies of %s, each grown by one fragment of constant inputs (a ConstantOfShape, an Expand, a "
+                  "ConstantOfShape of a shape made by a Mul, a Gather or a Shape and Concat, a self-Concat, a MatMul "
+                  "outer product) sized just under, just over and 64 times over a %ld MiB budget, "
+                  "loaded in a child process each (%d loaded, %d refused) after the unchanged bundle warmed ONNX "
+                  "Runtime up; the worst peak RSS increase while loading (VmHWM, reset before, over VmRSS before) "
+                  "over the budget: %s",
+                  bundles.bundles, o.text("--bundle").c_str(), budget_mib, bundles.loaded, bundles.refused,
+                  bundles.worst.c_str());
+    out.raw("reliability.bundle_peak_rss_over_budget",
+            figure(bundles.worst_ratio, "ratio", "1.0", "lower", how + bundle_text));
+    out.raw("reliability.runtime_start_rss_mib",
+            figure(double(bundles.runtime_start_bytes) / double(1 << 20), "MiB", "null", "lower",
+                   how + "the peak RSS increase of the first Model::load of " + o.text("--bundle") +
+                       " in a fresh process: ONNX Runtime's start, once a process, outside the memory budget"));
+  }
+  if (imports.avatars > 0) {
+    char import_text[600];
+    std::snprintf(import_text, sizeof import_text,
+                  "the %d avatars of %s that softdeca fit reads (%d read, %d refused), each read in a child "
+                  "process; the worst peak RSS increase while reading (VmHWM, reset before, over VmRSS before) "
+                  "over the input's bytes + 125 MB, so that 4 is the bound 4 x the input + 500 MB: %s",
+                  imports.avatars, o.text("--import-corpus").c_str(), imports.read, imports.refused, imports.worst.c_str());
+    out.raw("reliability.import_peak_rss_over_input", figure(imports.worst_ratio, "ratio", "4", "lower", how + import_text));
+  }
+  if (fits.vertices > 0) {
+    const std::string fit_text = fits.describe(o.text("--avatar"), o.text("--bundle"));
+    out.raw("reliability.fit_s_per_100k_vertices", figure(fits.seconds_per_100k(), "s", "1.5", "lower", how + fit_text));
+    out.raw("reliability.fit_memory_over_target", figure(fits.memory_over_target(), "ratio", "1.0", "lower", how + fit_text));
+    out.raw("reliability.fit_slivers_s", figure(fits.sliver.seconds, "s", "60", "lower", how + fit_text));
+  }
+}
+
 }  // namespace
 
 int run_bench_reliability(const Args& args) {
@@ -284,39 +322,7 @@ int run_bench_reliability(const Args& args) {
                 memory.frames, memory.file_bytes_per_frame);
   out.raw("reliability.recording_bytes_per_frame_in_memory",
           figure(memory.heap_bytes_per_frame, "bytes/frame", "64", "lower", how + memory_text));
-  if (bundles.bundles > 0) {
-    char bundle_text[1024];
-    std::snprintf(bundle_text, sizeof bundle_text,
-                  "%d copies of %s, each grown by one fragment of constant inputs (a ConstantOfShape, an Expand, a "
-                  "ConstantOfShape of a shape made by a Mul, a Gather or a Shape and Concat, a self-Concat, a MatMul "
-                  "outer product) sized just under, just over and 64 times over a %ld MiB budget, "
-                  "loaded in a child process each (%d loaded, %d refused) after the unchanged bundle warmed ONNX "
-                  "Runtime up; the worst peak RSS increase while loading (VmHWM, reset before, over VmRSS before) "
-                  "over the budget: %s",
-                  bundles.bundles, o.text("--bundle").c_str(), budget_mib, bundles.loaded, bundles.refused,
-                  bundles.worst.c_str());
-    out.raw("reliability.bundle_peak_rss_over_budget",
-            figure(bundles.worst_ratio, "ratio", "1.0", "lower", how + bundle_text));
-    out.raw("reliability.runtime_start_rss_mib",
-            figure(double(bundles.runtime_start_bytes) / double(1 << 20), "MiB", "null", "lower",
-                   how + "the peak RSS increase of the first Model::load of " + o.text("--bundle") +
-                       " in a fresh process: ONNX Runtime's start, once a process, outside the memory budget"));
-  }
-  if (imports.avatars > 0) {
-    char import_text[600];
-    std::snprintf(import_text, sizeof import_text,
-                  "the %d avatars of %s that softdeca fit reads (%d read, %d refused), each read in a child "
-                  "process; the worst peak RSS increase while reading (VmHWM, reset before, over VmRSS before) "
-                  "over the input's bytes + 125 MB, so that 4 is the bound 4 x the input + 500 MB: %s",
-                  imports.avatars, o.text("--import-corpus").c_str(), imports.read, imports.refused, imports.worst.c_str());
-    out.raw("reliability.import_peak_rss_over_input", figure(imports.worst_ratio, "ratio", "4", "lower", how + import_text));
-  }
-  if (fits.vertices > 0) {
-    const std::string fit_text = fits.describe(o.text("--avatar"), o.text("--bundle"));
-    out.raw("reliability.fit_s_per_100k_vertices", figure(fits.seconds_per_100k(), "s", "1.5", "lower", how + fit_text));
-    out.raw("reliability.fit_memory_over_target", figure(fits.memory_over_target(), "ratio", "1.0", "lower", how + fit_text));
-    out.raw("reliability.fit_slivers_s", figure(fits.sliver.seconds, "s", "60", "lower", how + fit_text));
-  }
+  optional_figures(out, how, o, budget_mib, bundles, imports, fits);
   write_text_file(o.text("--out"), out.str(true) + "\n");
   std::printf("%s\n", out.str(true).c_str());
   return 0;

@@ -17,9 +17,14 @@ from dataclasses import dataclass
 import igl
 import numpy as np
 
+from softdeca_train.avatars.build import make_avatar
+from softdeca_train.avatars.config import LOW_POLY_VARIANTS
 from softdeca_train.avatars.mesh import AvatarMesh
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
+from softdeca_train.landmarks.arkit_reference import ArkitFace
+from softdeca_train.runtime.fit_check import DEFAULT_BUNDLE, avatar_arrays
 from softdeca_train.runtime.native import NativeFit, NativeModel
+from softdeca_train.template import Template
 
 # The shapes that move skin only on every rig (plugin/src/fit/avatar_fit.cpp, kSkinShapes).
 SKIN_SHAPES = (
@@ -85,12 +90,6 @@ def face_coverage(model: NativeModel, fit: NativeFit, avatar: AvatarMesh) -> Cov
 
 
 def main() -> int:
-    from softdeca_train.avatars.build import make_avatar
-    from softdeca_train.avatars.config import LOW_POLY_VARIANTS
-    from softdeca_train.landmarks.arkit_reference import ArkitFace
-    from softdeca_train.runtime.fit_check import DEFAULT_BUNDLE, avatar_arrays
-    from softdeca_train.template import Template
-
     model, template, face = NativeModel(DEFAULT_BUNDLE), Template.load(), ArkitFace.load()
     for name, config in LOW_POLY_VARIANTS.items():
         avatar = make_avatar(config, template, face)
