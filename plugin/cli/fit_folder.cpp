@@ -1,11 +1,10 @@
 #include "fit_folder.h"
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include "bundle/json.h"
+#include "input_files.h"
 #include "json.h"
 
 namespace softdeca::cli {
@@ -91,16 +90,9 @@ std::string unused_json(const AvatarFile& avatar) {
   return out + "]";
 }
 
+// fit.json as the import reads any file: opened once, never waiting on a FIFO, within its bound.
 std::string read_small_file(const std::string& path) {
-  std::error_code error;
-  const std::uintmax_t size = fs::file_size(path, error);
-  if (error) throw std::runtime_error("cannot read " + path);
-  if (size > kMaxFitJsonBytes) throw std::runtime_error(path + " is too large for a fit's report");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw std::runtime_error("cannot read " + path);
-  return text.str();
+  return avatar_import::read_named_file(path, kMaxFitJsonBytes, "a fit's report");
 }
 
 // The recorded mesh: its absolute path, else its path from the fit folder (both moved together).
