@@ -13,11 +13,10 @@ SOFTDECA_HOSTILE=full (`make test-hostile-full`) runs every attack through both 
 from __future__ import annotations
 
 import os
-import resource
+import signal
 import subprocess
 import sys
 import tempfile
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -96,44 +95,52 @@ class Run:
     peak_rss: int  # bytes (ru_maxrss of the process)
 
 
-def _cap_address_space() -> None:
-    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+# A small Python that runs the command as its child, with the address space capped, and writes
+# the child's peak RSS: a child forked from pytest itself would start with pytest's resident
+# pages (torch, once an earlier test loaded it) as its peak, and could not take the cap.
+SPAWNER = """
+import os, resource, signal, sys
+cap, report = int(sys.argv[1]), sys.argv[2]
+pid = os.fork()
+if pid == 0:
+    resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
+    os.execvp(sys.argv[3], sys.argv[3:])
+_, status, usage = os.wait4(pid, 0)
+with open(report, "w") as f:
+    f.write(str(usage.ru_maxrss))
+if os.WIFSIGNALED(status):
+    signal.signal(os.WTERMSIG(status), signal.SIG_DFL)
+    os.kill(os.getpid(), os.WTERMSIG(status))
+sys.exit(os.WEXITSTATUS(status))
+"""
 
 
 def run_limited(args: list[str], cwd: Path) -> Run:
     """The command in a process of its own: killed after RETURNS_WITHIN_S (then the test
     fails), its address space capped, its peak RSS read from its own rusage."""
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        start = time.monotonic()
-        # The cap is set between fork and exec; this test starts no threads that could hold a lock.
+    with (
+        tempfile.TemporaryFile() as out,
+        tempfile.TemporaryFile() as err,
+        tempfile.TemporaryDirectory() as scratch,
+    ):
+        report = Path(scratch) / "maxrss"
         p = subprocess.Popen(
-            args,
+            [sys.executable, "-c", SPAWNER, str(ADDRESS_SPACE), str(report), *args],
             cwd=cwd,
             stdout=out,
             stderr=err,
-            preexec_fn=_cap_address_space,  # noqa: PLW1509
+            start_new_session=True,  # the spawner and the command: killed together
         )
-        while True:
-            pid, status, usage = os.wait4(p.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.monotonic() - start > RETURNS_WITHIN_S:
-                p.kill()
-                _, status, usage = os.wait4(p.pid, 0)
-                p.returncode = -9
-                pytest.fail(
-                    f"{' '.join(args)} did not return within {RETURNS_WITHIN_S} s"
-                )
-            time.sleep(0.005)
-        p.returncode = os.waitstatus_to_exitcode(status)
+        try:
+            p.wait(timeout=RETURNS_WITHIN_S)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+            pytest.fail(f"{' '.join(args)} did not return within {RETURNS_WITHIN_S} s")
         out.seek(0)
         err.seek(0)
-        return Run(
-            p.returncode,
-            out.read(),
-            err.read().decode(errors="replace"),
-            usage.ru_maxrss * 1024,
-        )
+        peak = int(report.read_text()) * 1024 if report.is_file() else 0
+        return Run(p.returncode, out.read(), err.read().decode(errors="replace"), peak)
 
 
 @pytest.fixture(scope="module")
