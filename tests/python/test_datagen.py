@@ -16,7 +16,13 @@ import torch
 from conftest import SMALL
 from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import KINDS, TEST, TRAIN, GenerateConfig, RunSettings
-from softdeca_train.data.expressions import COVERAGE, expression_sources, load_takes
+from softdeca_train.data.expressions import (
+    COVERAGE,
+    REDUCED_HI,
+    REDUCED_LO,
+    expression_sources,
+    load_takes,
+)
 from softdeca_train.data.format import ARRAYS
 from softdeca_train.data.generate import generate
 from softdeca_train.data.loader import ShardDataset
@@ -190,6 +196,27 @@ def test_plan_is_deterministic_and_ids_unique(template) -> None:
     )
     c = make_plan(other, params, sources)
     assert not np.array_equal(a[0].groups[0].p, c[0].groups[0].p)
+
+
+def test_reduced_real_frames_keep_their_shape_at_a_lower_amplitude() -> None:
+    takes = load_takes(RunSettings(out=".").takes)
+    draws = {}
+    for share in (0.0, 1.0):
+        sources, _ = expression_sources(takes, SMALL.test_takes, SMALL.seed, 0.0)
+        draws[share] = sources[TRAIN].frames(200, 1.0, share)
+    plain, calm = draws[0.0], draws[1.0]
+    assert np.array_equal(plain.source_take, calm.source_take)
+    assert np.array_equal(plain.source_index, calm.source_index)
+    for row, (t, i) in enumerate(
+        zip(plain.source_take, plain.source_index, strict=True)
+    ):
+        assert np.array_equal(takes[t].weights[i], plain.weights[row])
+    big = plain.weights.max(axis=1) > 0.05
+    ratio = calm.weights[big].max(axis=1) / plain.weights[big].max(axis=1)
+    assert np.all((ratio >= REDUCED_LO - 1e-6) & (ratio <= REDUCED_HI + 1e-6))
+    # every weight of a frame is scaled alike: the expression's shape is kept
+    scaled = plain.weights[big] * ratio[:, None]
+    assert np.allclose(calm.weights[big], scaled, atol=1e-6)
 
 
 def test_loader_streams_each_instance_once_and_rebuilds_targets(

@@ -42,6 +42,11 @@ _SAMPLING = (
     ("--lead-in", "lead_in", "frames simulated with fixed dynamics before a sequence ({})"),
     ("--real-share", "real_share", "share of static/sparse frames from real takes ({})"),
     (
+        "--real-reduced-share",
+        "real_reduced_share",
+        "share of those real frames played at a reduced amplitude, calmer talking ({})",
+    ),
+    (
         "--region-share",
         "region_share",
         "share of static/sparse groups with per-region parameter values ({})",

@@ -45,6 +45,9 @@ class GenerateConfig:
     lead_in_gamma: float = 0.5
     lead_in_beta: float = 0.5
     real_share: float = 0.5  # static/sparse frames from real takes; the rest from coverage
+    # Real frames played at a reduced amplitude (weights times U(REDUCED_LO, REDUCED_HI)):
+    # people talking calmer than the recorded ones, the input a live stream mostly carries.
+    real_reduced_share: float = 0.0
     # Takes held out entirely for the test split, by name (file stem): one take of the
     # person most takes come from, and every take of a person no other take shows.
     test_takes: tuple[str, ...] = ("facial", "dao")
@@ -91,6 +94,8 @@ class GenerateConfig:
             problems.append("test_share must be in [0, 1)")
         if not 0.0 <= self.real_share <= 1.0:
             problems.append("real_share must be in [0, 1]")
+        if not 0.0 <= self.real_reduced_share <= 1.0:
+            problems.append("real_reduced_share must be in [0, 1]")
         if not 0.0 <= self.region_share <= 1.0:
             problems.append("region_share must be in [0, 1]")
         if not 1 <= self.level <= 6:
@@ -133,7 +138,13 @@ class GenerateConfig:
     def from_dict(cls, d: dict) -> GenerateConfig:
         names = {f.name for f in fields(cls)}
         # written before range profiles and regional patterns existed
-        d = {"ranges": LEGACY_PROFILE, "region_share": 0.0, "contrasts": False, **d}
+        d = {
+            "ranges": LEGACY_PROFILE,
+            "region_share": 0.0,
+            "contrasts": False,
+            "real_reduced_share": 0.0,
+            **d,
+        }
         if "test_take" in d:  # written when one take was held out
             d["test_takes"] = [d.pop("test_take")]
         if "test_takes" in d:

@@ -16,6 +16,9 @@ from softdeca_train.streaming.takes import TAKE_SUFFIXES, read_take, take_paths
 
 COVERAGE = -1  # source_take of a coverage draw
 MAX_GAP_S = 0.1  # a dynamic window may not span a face-lost gap longer than this
+# A reduced real frame keeps its shape at this share of its amplitude: calm talking is the
+# same mouth shapes at a fraction of an expressive take's weights.
+REDUCED_LO, REDUCED_HI = 0.15, 0.85
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,7 @@ class ExpressionSource:
         self._rng_cov = np.random.default_rng([*seed, 1])
         self._rng_mix = np.random.default_rng([*seed, 2])
         self._rng_win = np.random.default_rng([*seed, 3])
+        self._rng_amp = np.random.default_rng([*seed, 4])
         self._order = np.zeros(0, np.int64)
         self._next_coverage = 0
 
@@ -99,8 +103,10 @@ class ExpressionSource:
         picked, self._order = self._order[:n], self._order[n:]
         return self.pool[picked]
 
-    def frames(self, n: int, real_share: float) -> Draws:
-        """n independent frames, each real with probability real_share, else coverage."""
+    def frames(self, n: int, real_share: float, reduced_share: float = 0.0) -> Draws:
+        """n independent frames, each real with probability real_share, else coverage; a
+        real frame is scaled to a reduced amplitude with probability reduced_share (its own
+        stream: a share of 0 leaves every other draw as it was)."""
         real = self._rng_mix.random(n) < real_share
         w = np.zeros((n, 52), np.float32)
         take = np.full(n, COVERAGE, np.int16)
@@ -110,6 +116,11 @@ class ExpressionSource:
             pairs = self._real(k)
             w[real] = [self.takes[t].weights[i] for t, i in pairs]
             take[real], index[real] = pairs[:, 0], pairs[:, 1]
+            if reduced_share > 0:
+                rows = np.flatnonzero(real)
+                calm = self._rng_amp.random(k) < reduced_share
+                scale = self._rng_amp.uniform(REDUCED_LO, REDUCED_HI, k).astype(np.float32)
+                w[rows[calm]] *= scale[calm, None]
         if n - k:
             w[~real] = self.sampler.sample(self._rng_cov, n - k)
             index[~real] = self._next_coverage + np.arange(n - k)

@@ -100,6 +100,7 @@ def describe_plan(cfg: GenerateConfig, plan: list[ShardSpec], takes: list[Take])
         ],
         "expressions": {
             "real_share": cfg.real_share,
+            "real_reduced_share": cfg.real_reduced_share,
             "coverage": "CoverageSampler fitted to the train takes (data/coverage.py)",
             "source": "source_take = take index (header.takes) and source_index = frame, "
             "or source_take = -1 and source_index = coverage draw of that split",

@@ -191,7 +191,7 @@ def make_plan(
                     if kind == "dynamic":
                         frames = src.window(cfg.lead_in + cfg.sequence_length)
                     else:
-                        frames = src.frames(k, cfg.real_share)
+                        frames = src.frames(k, cfg.real_share, cfg.real_reduced_share)
                 donor_id = donor_seed = noise_seed = -1
                 if kind == "sparse":
                     donor_id = next_identity
