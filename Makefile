@@ -157,7 +157,7 @@ clean: ## remove build/ and out/ (OUT)
 # docs/fuzzing.md, two at a time, niced, new inputs kept in build/fuzz-long/<target>/.
 FUZZ         := build/fuzz
 FUZZ_TARGETS := fit_file softdeca_packet livelinkface_packet ifacialmocap_packet livelinkface_csv recording_reader \
-                bundle_tar bundle_folder manifest onnx_model onnx_graph obj shape_names avatar_folder fbx gltf
+                bundle_tar bundle_folder manifest onnx_model onnx_graph obj shape_names avatar_folder fbx gltf draco
 FUZZ_SECONDS ?= 620
 
 .PHONY: fuzz-build test-fuzz fuzz-long

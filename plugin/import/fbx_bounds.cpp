@@ -610,7 +610,7 @@ class AsciiWalk {
 }  // namespace
 
 std::uint64_t fbx_decoded_budget(std::uint64_t file_bytes, const ImportLimits& limits) {
-  return std::min(limits.max_decoded_bytes, 2 * file_bytes + (std::uint64_t{200} << 20));
+  return limits.decoded_budget(file_bytes);
 }
 
 std::uint64_t fbx_token_budget(std::uint64_t file_bytes, const ImportLimits& limits) {

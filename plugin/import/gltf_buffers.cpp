@@ -127,6 +127,7 @@ std::string_view BinaryData::buffer(std::size_t index) {
         throw Problem(where, "reading it would take the avatar's files past the " + text(limits_.max_total_bytes) +
                                  " bytes an import may read");
       read_ += data.size();
+      budget_.add_input(data.size());
       cached = std::move(data);
     }
     bytes = *cached;

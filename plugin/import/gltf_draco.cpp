@@ -3,6 +3,8 @@
 // before anything is read from it.
 #include <draco/compression/decode.h>
 
+#include <cstring>
+
 #include "gltf_draco.h"
 #include "gltf_json.h"
 
@@ -30,12 +32,17 @@ DracoPrimitive decode_draco(std::string_view bytes, std::uint32_t position_id, s
   if (!position) throw Problem(where, "its Draco mesh has no attribute " + std::to_string(position_id) + " (its POSITION)");
   if (position->num_components() != 3)
     throw Problem(where, "its Draco POSITION has " + std::to_string(position->num_components()) + " components, not 3");
+  // Read as the 32-bit floats glTF's POSITION is, byte for byte: libdraco's ConvertValue would
+  // also read the stream's "normalized" byte as a bool, whatever value the stream gave it.
+  if (position->data_type() != draco::DT_FLOAT32 || position->byte_stride() < 12)
+    throw Problem(where, "its Draco POSITION is not stored as 3 32-bit floats a point");
   DracoPrimitive out;
   out.positions.resize(3 * static_cast<std::size_t>(points));
   for (draco::PointIndex p(0); p < static_cast<std::uint32_t>(points); ++p) {
     const draco::AttributeValueIndex value = position->mapped_index(p);
-    if (value.value() >= position->size() || !position->ConvertValue<float>(value, 3, &out.positions[3 * std::size_t{p.value()}]))
+    if (value.value() >= position->size())
       throw Problem(where, "its Draco POSITION has no value for point " + std::to_string(p.value()));
+    std::memcpy(&out.positions[3 * std::size_t{p.value()}], position->GetAddress(value), 12);
   }
   out.indices.resize(3 * static_cast<std::size_t>(faces));
   for (draco::FaceIndex f(0); f < static_cast<std::uint32_t>(faces); ++f) {

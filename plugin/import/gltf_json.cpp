@@ -144,9 +144,12 @@ std::optional<std::uint64_t> checked_product(std::uint64_t a, std::uint64_t b) {
 }
 
 void DecodeBudget::take(std::uint64_t bytes, const std::string& where) {
-  if (bytes > max_ - used_)
-    throw Problem(where, "decoding it would take the file's decoded data past the " + std::to_string(max_) +
-                             " bytes an avatar may decode to (" + std::to_string(used_) + " already)");
+  const std::uint64_t max = limits_.decoded_budget(input_);
+  if (used_ > max || bytes > max - used_)
+    throw Problem(where, "decoding it would take the file's decoded data past the " + std::to_string(max) + " bytes an avatar of " +
+                             std::to_string(input_) + " bytes may decode to (twice its size plus " +
+                             std::to_string(limits_.decoded_base_bytes) + ", at most " + std::to_string(limits_.max_decoded_bytes) +
+                             "; " + std::to_string(used_) + " already)");
   used_ += bytes;
 }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bundle/json.h"
+#include "import_limits.h"
 
 namespace softdeca::avatar_import::gltf {
 
@@ -74,17 +75,20 @@ inline bool range_within(std::uint64_t offset, std::uint64_t length, std::uint64
   return offset <= size && length <= size - offset;
 }
 
-// The bytes one import decodes (accessors' values, decompressed views, the meshes it returns),
-// against ImportLimits::max_decoded_bytes: taken before each allocation, so a file cannot make
-// the reader allocate more however it shares or repeats its data.
+// The bytes one import decodes (accessors' values, decompressed views, Draco's tables, the
+// meshes it returns), against ImportLimits::decoded_budget of what it has read: taken before
+// each allocation, so a file cannot make the reader allocate more however it shares, repeats or
+// compresses its data. Each external buffer read raises the budget by what it allows.
 class DecodeBudget {
  public:
-  explicit DecodeBudget(std::uint64_t max_bytes) : max_(max_bytes) {}
+  DecodeBudget(const ImportLimits& limits, std::uint64_t input_bytes) : limits_(limits), input_(input_bytes) {}
+  void add_input(std::uint64_t bytes) { input_ += bytes; }
   void take(std::uint64_t bytes, const std::string& where);
   std::uint64_t used() const { return used_; }
 
  private:
-  std::uint64_t max_, used_ = 0;
+  const ImportLimits& limits_;
+  std::uint64_t input_, used_ = 0;
 };
 
 }  // namespace softdeca::avatar_import::gltf

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "gltf_draco.h"
+#include "gltf_draco_header.h"
 
 namespace softdeca::avatar_import::gltf {
 
@@ -159,6 +160,11 @@ struct Geometry {
   std::uint64_t mode = kTriangles;
 };
 
+// What libdraco's decoder holds while it decodes, per declared vertex (attribute values, their
+// quantised and predicted copies, the point map) and face (the corner table and traversal),
+// with margin: counted against the decode budget before it runs.
+constexpr std::uint64_t kDracoTableBytesPerVertex = 96, kDracoTableBytesPerFace = 64;
+
 Geometry read_draco(AccessorReader& reader, const Primitive& p, const ImportLimits& limits) {
   Document& doc = reader.document();
   const Accessor& position = doc.accessor(p.position);
@@ -169,8 +175,19 @@ Geometry read_draco(AccessorReader& reader, const Primitive& p, const ImportLimi
   if (!draco_supported())
     throw Problem(p.where, "this build cannot decode KHR_draco_mesh_compression (it was built without Draco), "
                            "and the primitive has no uncompressed copy");
-  DracoPrimitive d = decode_draco(reader.data().view(view), static_cast<std::uint32_t>(id), position.count, limits.max_triangles,
-                                  ext.where());
+  const std::string_view stream = reader.data().view(view);
+  // libdraco sizes its tables by the counts its stream declares as soon as it reads them:
+  // those may not exceed what the accessors (already within the budget) say the mesh is.
+  const DracoCounts declared = read_draco_counts(stream, ext.where());
+  const std::uint64_t max_faces = p.indices ? doc.accessor(*p.indices).count / 3 : limits.max_triangles;
+  if (declared.vertices > position.count)
+    throw Problem(ext.where(), "its Draco stream declares " + text(declared.vertices) + " vertices, more than its POSITION accessor's " +
+                                   text(position.count));
+  if (declared.faces > max_faces)
+    throw Problem(ext.where(), "its Draco stream declares " + text(declared.faces) + " faces, more than the " + text(max_faces) +
+                                   (p.indices ? " its indices accessor holds" : " an avatar may have"));
+  reader.budget().take(kDracoTableBytesPerVertex * declared.vertices + kDracoTableBytesPerFace * declared.faces, ext.where());
+  DracoPrimitive d = decode_draco(stream, static_cast<std::uint32_t>(id), position.count, max_faces, ext.where());
   reader.budget().take(4 * (d.positions.size() + d.indices.size()), ext.where());
   if (d.positions.size() / 3 != position.count)
     throw Problem(p.where, "its Draco mesh has " + text(d.positions.size() / 3) + " points, its POSITION accessor " +

@@ -67,7 +67,7 @@ SourceScene read(const std::string& path, const ImportLimits& limits) {
   Document doc(Json::parse(container.json, json_limits));
   require_version(doc);
 
-  DecodeBudget budget(limits.max_decoded_bytes);
+  DecodeBudget budget(limits, bytes.size());
   BinaryData data(doc, container, bytes, folder_of(path), limits, budget, bytes.size());
   AccessorReader reader(doc, data, budget);
   const std::vector<Instance> instances = scene_instances(reader, limits);

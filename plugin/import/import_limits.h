@@ -26,6 +26,15 @@ struct ImportLimits {
   std::uint64_t max_decoded_bytes = std::uint64_t{1} << 30;  // all vertex data decoded (accessors, compression), together
   std::size_t max_shape_files = 4096;                        // files in an avatar folder's blendshapes/
   int max_fbx_depth = 64;                                    // an FBX file's nodes (binary) or braces (ASCII) nested
+  std::uint64_t decoded_base_bytes = std::uint64_t{200} << 20;  // decoded data beyond twice the input
+
+  // What one import may decode from `input_bytes` read (vertex data, decompressed arrays,
+  // compressed meshes' tables): twice that plus a constant, within max_decoded_bytes, so a small
+  // file cannot expand into much memory however it repeats, shares or compresses its data.
+  std::uint64_t decoded_budget(std::uint64_t input_bytes) const {
+    const std::uint64_t twice = input_bytes > max_decoded_bytes ? max_decoded_bytes : 2 * input_bytes;
+    return twice + decoded_base_bytes < max_decoded_bytes ? twice + decoded_base_bytes : max_decoded_bytes;
+  }
 };
 
 }  // namespace softdeca::avatar_import

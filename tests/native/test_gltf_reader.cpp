@@ -22,6 +22,7 @@
 
 #include "avatar_test_files.h"
 #include "gltf_draco.h"
+#include "gltf_draco_header.h"
 #include "gltf_meshopt.h"
 #include "gltf_reader.h"
 
@@ -31,6 +32,7 @@
 #if SOFTDECA_TEST_DRACO
 #include <draco/compression/encode.h>
 #include <draco/mesh/mesh.h>
+#include <draco/metadata/geometry_metadata.h>
 #endif
 
 using softdeca::avatar_import::ImportLimits;
@@ -681,6 +683,70 @@ TEST_F(GltfReader, MeshoptCompressedViewsReadWithoutTheirFallback) {
 #endif
 
 #if SOFTDECA_TEST_DRACO
+// libdraco's own streams, each method, with and without metadata (per attribute and for the
+// mesh, with sub-metadata): the counts read ahead of the decoder are the mesh's.
+TEST(DracoHeader, CountsOfTheEncodersStreams) {
+  using softdeca::avatar_import::gltf::read_draco_counts;
+  const int n = 9;  // a 3 x 3 grid of points, 8 triangles
+  std::vector<float> positions;
+  std::vector<std::uint32_t> triangles;
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 3; ++x) positions.insert(positions.end(), {0.01f * x, 0.01f * y, 0.001f * x * y});
+  for (std::uint32_t y = 0; y < 2; ++y)
+    for (std::uint32_t x = 0; x < 2; ++x) {
+      const std::uint32_t c = 3 * y + x;
+      triangles.insert(triangles.end(), {c, c + 1, c + 3, c + 1, c + 4, c + 3});
+    }
+  for (const bool edgebreaker : {false, true})
+    for (const bool metadata : {false, true}) {
+      draco::Mesh mesh;
+      mesh.set_num_points(n);
+      draco::GeometryAttribute position;
+      position.Init(draco::GeometryAttribute::POSITION, nullptr, 3, draco::DT_FLOAT32, false, 12, 0);
+      const int id = mesh.AddAttribute(position, true, n);
+      for (int i = 0; i < n; ++i)
+        mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(static_cast<std::uint32_t>(i)), &positions[3 * i]);
+      for (std::size_t t = 0; t < triangles.size(); t += 3)
+        mesh.AddFace({draco::PointIndex(triangles[t]), draco::PointIndex(triangles[t + 1]), draco::PointIndex(triangles[t + 2])});
+      if (metadata) {
+        auto geometry = std::make_unique<draco::GeometryMetadata>();
+        geometry->AddEntryString("exporter", "a tool");
+        auto inner = std::make_unique<draco::Metadata>();
+        inner->AddEntryInt("level", 2);
+        auto innermost = std::make_unique<draco::Metadata>();
+        innermost->AddEntryString("note", std::string(300, 'x'));
+        inner->AddSubMetadata("deeper", std::move(innermost));
+        geometry->AddSubMetadata("nested", std::move(inner));
+        mesh.AddMetadata(std::move(geometry));
+        auto on_position = std::make_unique<draco::AttributeMetadata>();
+        on_position->AddEntryString("name", "POSITION");
+        mesh.AddAttributeMetadata(id, std::move(on_position));
+      }
+      draco::Encoder encoder;
+      encoder.SetEncodingMethod(edgebreaker ? draco::MESH_EDGEBREAKER_ENCODING : draco::MESH_SEQUENTIAL_ENCODING);
+      draco::EncoderBuffer buffer;
+      ASSERT_TRUE(encoder.EncodeMeshToBuffer(mesh, &buffer).ok());
+      const std::string stream(buffer.data(), buffer.size());
+      const auto counts = read_draco_counts(stream, "test");
+      EXPECT_EQ(counts.edgebreaker, edgebreaker);
+      EXPECT_EQ(counts.faces, triangles.size() / 3) << edgebreaker << metadata;
+      EXPECT_EQ(counts.vertices, static_cast<std::uint64_t>(n)) << edgebreaker << metadata;
+      // Cut short before its counts end, a stream is refused in words (never read past its
+      // end); from there on the counts are read alike.
+      std::size_t shortest = 0;
+      for (; shortest < stream.size(); ++shortest) {
+        try {
+          EXPECT_EQ(read_draco_counts(std::string_view(stream).substr(0, shortest), "test").faces, counts.faces);
+          break;
+        } catch (const std::runtime_error& e) {
+          EXPECT_NE(std::string(e.what()).find("its Draco"), std::string::npos) << e.what();
+        }
+      }
+      EXPECT_GE(shortest, metadata ? 40u : 13u);
+      EXPECT_LT(shortest, stream.size());
+    }
+}
+
 TEST_F(GltfReader, DracoPrimitivesReadWithPlainMorphTargets) {
   ASSERT_TRUE(softdeca::avatar_import::gltf::draco_supported());
   Encoding e;
@@ -1096,9 +1162,44 @@ TEST_F(GltfHostile, CompressedDataThatDoesNotDecodeIsRefused) {
                      "{\"KHR_draco_mesh_compression\":{\"bufferView\":" + std::to_string(view) + ",\"attributes\":{\"POSITION\":0}}}}]}");
   d.nodes.push_back("{\"mesh\":0}");
   EXPECT_TRUE(fails_with(dir_.write("draco.glb", d.glb()),
-                         draco_supported() ? "its KHR_draco_mesh_compression data does not decode"
+                         draco_supported() ? "its KHR_draco_mesh_compression data is not a Draco stream"
                                            : "meshes[0].primitives[0]: this build cannot decode KHR_draco_mesh_compression"));
 }
+
+#if SOFTDECA_TEST_DRACO
+TEST_F(GltfHostile, DracoCountsBeyondTheAccessorsAreRefusedBeforeDecoding) {
+  // A stream of 80 bytes declaring four billion points (sequential) or a billion faces
+  // (edgebreaker): refused by its declared counts, before libdraco sizes anything by them.
+  auto leb128 = [](std::uint64_t v) {
+    std::string out;
+    do {
+      const auto b = static_cast<unsigned char>(v & 0x7F);
+      v >>= 7;
+      out += static_cast<char>(b | (v ? 0x80 : 0));
+    } while (v);
+    return out;
+  };
+  struct Case {
+    bool edgebreaker;
+    std::uint64_t vertices, faces;
+    const char* says;
+  };
+  for (const Case c : {Case{false, 0xFFFFFFF0u, 1, "declares 4294967280 vertices, more than its POSITION accessor's 3"},
+                       Case{true, 3, 0x3FFFFFFFu, "declares 1073741823 faces, more than the 1 its indices accessor holds"}}) {
+    std::string stream = std::string("DRACO") + '\x02' + '\x02' + '\x01' + (c.edgebreaker ? '\x01' : '\x00') + std::string(2, '\0');
+    stream += c.edgebreaker ? std::string(1, '\0') + leb128(c.vertices) + leb128(c.faces) : leb128(c.faces) + leb128(c.vertices);
+    stream += std::string(64, '\x5a');
+    Gltf d;
+    const int view = d.view(stream);
+    d.accessor("{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}");
+    d.accessor("{\"componentType\":5125,\"count\":3,\"type\":\"SCALAR\"}");
+    d.meshes.push_back("{\"name\":\"Teeth\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"extensions\":"
+                       "{\"KHR_draco_mesh_compression\":{\"bufferView\":" + std::to_string(view) + ",\"attributes\":{\"POSITION\":0}}}}]}");
+    d.nodes.push_back("{\"mesh\":0}");
+    EXPECT_TRUE(fails_with(dir_.write("declares.glb", d.glb()), c.says));
+  }
+}
+#endif
 
 #ifndef SOFTDECA_GLTF_DAMAGED_FILES
 #define SOFTDECA_GLTF_DAMAGED_FILES 300

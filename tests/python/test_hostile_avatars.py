@@ -73,6 +73,10 @@ SAYS: dict[str, tuple[str, ...]] = {
     "glb_holds_ply": ("its name says binary glTF",),
     "metres_per_unit_1e-300": ("--metres-per-unit",),
     "obj_face_fan": ("more than the 12000000 triangles",),
+    "gltf_draco_points_2e32": ("its Draco stream declares 4294967280 vertices",),
+    "gltf_draco_edgebreaker_faces_2e30": (
+        "its Draco stream declares 1073741823 faces",
+    ),
 }
 NAMES_FILE = {
     "gltf_diamond_nodes",
@@ -83,6 +87,7 @@ NAMES_FILE = {
     "glb_json_length_0xfffffff0",
     "gltf_byte_stride_4",
     "fbx_zlib_bomb",
+    "gltf_implicit_zeros_49gb",
 }
 VALUES = {"gltf_shape_delta_3e38", "gltf_vertex_1e30"}
 

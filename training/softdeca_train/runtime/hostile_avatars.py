@@ -552,7 +552,92 @@ def _bytes_and_values(w: Writer, fan_mib: int, bomb_mib: int) -> None:
         w.add("fbx_zlib_bomb", _write(d / "avatar.fbx", fbx_zlib_bomb(h, bomb_mib << 20)))
 
 
-GROUPS: list[Callable[[Writer], None]] = [_controls, _buffer_uris, _names_and_folders, _structure]
+def _leb128(value: int) -> bytes:
+    out = bytearray()
+    while True:
+        byte, value = value & 0x7F, value >> 7
+        out.append(byte | (0x80 if value else 0))
+        if not value:
+            return bytes(out)
+
+
+def draco_header(edgebreaker: bool, vertices: int, faces: int) -> bytes:
+    """The start of a Draco 2.2 triangle-mesh stream declaring these counts (then garbage): a
+    decoder that sizes its tables by them before checking them allocates what they say."""
+    head = b"DRACO" + bytes([2, 2, 1, 1 if edgebreaker else 0]) + struct.pack("<H", 0)
+    counts = (
+        bytes([0]) + _leb128(vertices) + _leb128(faces)
+        if edgebreaker
+        else _leb128(faces) + _leb128(vertices)
+    )
+    return head + counts + b"\x5a" * 64
+
+
+def _compressed(w: Writer) -> None:
+    """Compressed and implicit data that declares far more than the file holds."""
+    h = w.head
+    for name, edgebreaker, vertices, faces in (
+        ("gltf_draco_points_2e32", False, 0xFFFFFFF0, 1),
+        ("gltf_draco_edgebreaker_faces_2e30", True, 3, 0x3FFFFFFF),
+    ):
+        d = w.dir(name)
+        g = head_gltf(h)
+        stream = g.view(draco_header(edgebreaker, vertices, faces))
+        position = len(g.doc["accessors"])
+        g.doc["accessors"] += [
+            {"componentType": 5126, "count": 3, "type": "VEC3"},
+            {"componentType": 5125, "count": 3, "type": "SCALAR"},
+        ]
+        draco = {"bufferView": stream, "attributes": {"POSITION": 0}}
+        g.doc["meshes"].append(
+            {
+                "name": "Teeth",
+                "primitives": [
+                    {
+                        "attributes": {"POSITION": position},
+                        "indices": position + 1,
+                        "extensions": {"KHR_draco_mesh_compression": draco},
+                    }
+                ],
+            }
+        )
+        g.doc["nodes"].append({"name": "Teeth", "mesh": len(g.doc["meshes"]) - 1})
+        g.doc["scenes"][0]["nodes"].append(len(g.doc["nodes"]) - 1)
+        g.doc["extensionsUsed"] = g.doc["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+        w.add(name, _write(d / "avatar.glb", g.glb()))
+
+    # Accessors without a bufferView are zeros (glTF 2.0), so a file of a few hundred bytes
+    # declares a 4M-vertex mesh with 1,024 morph targets: 49 GB of zeros.
+    d = w.dir("gltf_implicit_zeros_49gb")
+    g = Gltf()
+    g.doc["accessors"] = [
+        {"componentType": 5126, "count": 4_000_000, "type": "VEC3"},
+        {"componentType": 5125, "count": 3, "type": "SCALAR"},
+    ]
+    primitive = {
+        "attributes": {"POSITION": 0},
+        "indices": 1,
+        "targets": [{"POSITION": 0}] * 1024,
+    }
+    g.doc["meshes"] = [
+        {
+            "name": "Head",
+            "primitives": [primitive],
+            "extras": {"targetNames": [ARKIT_BLENDSHAPES[k % 52] for k in range(1024)]},
+        }
+    ]
+    g.doc["nodes"] = [{"name": "Head", "mesh": 0}]
+    g.doc["scenes"][0]["nodes"] = [0]
+    w.add("gltf_implicit_zeros_49gb", _write(d / "avatar.glb", g.glb()))
+
+
+GROUPS: list[Callable[[Writer], None]] = [
+    _controls,
+    _buffer_uris,
+    _names_and_folders,
+    _structure,
+    _compressed,
+]
 
 
 def write_corpus(out: Path, fan_mib: int = 30, bomb_mib: int = 1024) -> list[Attack]:
