@@ -1,4 +1,5 @@
-"""Shared fixtures: the template (from the ICT cache) and fitted layered head models."""
+"""Shared fixtures: the template (from the ICT cache), the committed bundle in the native library
+and fitted layered head models."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ import bounds
 import pytest
 from softdeca_train.data.config import GenerateConfig, RunSettings
 from softdeca_train.data.generate import generate
+from softdeca_train.runtime.fit_check import DEFAULT_BUNDLE
+from softdeca_train.runtime.native import NativeModel
 from softdeca_train.template import Template
 
 # The small dataset of the data generation and training tests: LHM level 2 (162 vertices per
@@ -32,6 +35,12 @@ SMALL = GenerateConfig(
 @pytest.fixture(scope="session")
 def template() -> Template:
     return Template.load()
+
+
+@pytest.fixture(scope="session")
+def shipped_model() -> NativeModel:
+    """The committed bundle (models/softdeca-default) in the native library."""
+    return NativeModel(DEFAULT_BUNDLE)
 
 
 @pytest.fixture(scope="session")

@@ -51,16 +51,6 @@ FAMILIES = {
 LIMIT_FROM_LINEAR_M = 0.020  # acceptance: no vertex 20 mm from the avatar's own blend
 
 
-@pytest.fixture(scope="module")
-def model() -> NativeModel:
-    return NativeModel(DEFAULT_BUNDLE)
-
-
-@pytest.fixture(scope="module")
-def template() -> Template:
-    return Template.load()
-
-
 def glb_json(path: Path) -> dict:
     data = path.read_bytes()
     (length,) = struct.unpack_from("<I", data, 12)
@@ -112,7 +102,7 @@ def max_distance_m(moves: np.ndarray, replay: dict) -> float:
 
 @pytest.mark.parametrize("family", list(FAMILIES))
 def test_gltf_families_fit_cover_the_face_and_replay(
-    model: NativeModel, template: Template, tmp_path: Path, family: str
+    shipped_model: NativeModel, template: Template, tmp_path: Path, family: str
 ) -> None:
     if family == "vroid" and shutil.which("gltfpack") is None:
         pytest.skip("gltfpack is not installed (.ci/setup installs it)")
@@ -131,7 +121,9 @@ def test_gltf_families_fit_cover_the_face_and_replay(
     assert run.returncode == 0, run.stderr
     quality = json.loads((fit_dir / "fit.json").read_text())["fit"]["quality"]
     assert quality["passed"], quality
-    c = face_coverage(model, NativeFit.load(model, fit_dir / "avatar.fit"), a)
+    c = face_coverage(
+        shipped_model, NativeFit.load(shipped_model, fit_dir / "avatar.fit"), a
+    )
     below(
         c.median_mm,
         1.0,

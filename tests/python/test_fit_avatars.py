@@ -17,7 +17,6 @@ from softdeca_train.face_names import ARKIT_BLENDSHAPES
 from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.paths import default_takes_path
 from softdeca_train.runtime.fit_check import (
-    DEFAULT_BUNDLE,
     FitCheckConfig,
     avatar_arrays,
     check_identity,
@@ -49,8 +48,8 @@ def assert_fit_passes(report: dict) -> None:
 
 
 @pytest.fixture(scope="module")
-def model() -> NativeModel:
-    return NativeModel(DEFAULT_BUNDLE)
+def model(shipped_model: NativeModel) -> NativeModel:
+    return shipped_model
 
 
 @pytest.fixture(scope="module")

@@ -15,9 +15,7 @@ file and the avatar's truth (avatars/mesh.py) share one frame."""
 
 from __future__ import annotations
 
-import json
 import shutil
-import struct
 import subprocess
 from pathlib import Path
 
@@ -25,6 +23,7 @@ import numpy as np
 
 from softdeca_train.avatars.mesh import PARTS, AvatarMesh
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
+from softdeca_train.gltf_writer import GltfWriter
 
 READY_PLAYER_ME_NAMES = {
     "skin": "Wolf3D_Head",
@@ -37,101 +36,6 @@ READY_PLAYER_ME_NAMES = {
 # VRoid's own expressions before the ARKit ones: name -> (ARKit shape, weight) mixes.
 VROID_PRIMITIVES = 7
 VROID_TARGETS = 124
-FLOAT, UINT16, UINT32 = 5126, 5123, 5125
-
-
-class GlbWriter:
-    """A glTF 2.0 document and its binary chunk, built accessor by accessor."""
-
-    def __init__(self) -> None:
-        self.doc: dict = {
-            "asset": {"version": "2.0", "generator": "softdeca_train test avatars"},
-            "scene": 0,
-            "scenes": [{"nodes": []}],
-            "nodes": [],
-            "meshes": [],
-            "materials": [],
-            "buffers": [{"byteLength": 0}],
-            "bufferViews": [],
-            "accessors": [],
-        }
-        self.bin = bytearray()
-
-    def _view(self, data: bytes) -> int:
-        offset = len(self.bin)
-        self.bin += data + b"\0" * (-len(data) % 4)
-        self.doc["buffers"][0]["byteLength"] = len(self.bin)
-        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": offset, "byteLength": len(data)})
-        return len(self.doc["bufferViews"]) - 1
-
-    def _accessor(self, accessor: dict) -> int:
-        self.doc["accessors"].append(accessor)
-        return len(self.doc["accessors"]) - 1
-
-    def vec3(self, values: np.ndarray, bounds: bool = False) -> int:
-        v = np.ascontiguousarray(values, "<f4")
-        a = {"bufferView": self._view(v.tobytes()), "componentType": FLOAT, "count": len(v)}
-        a["type"] = "VEC3"
-        if bounds:  # POSITION needs its bounds (glTF 2.0)
-            a["min"], a["max"] = v.min(axis=0).tolist(), v.max(axis=0).tolist()
-        return self._accessor(a)
-
-    def zeros(self, count: int) -> int:
-        """A VEC3 accessor with no buffer view: `count` zeros."""
-        return self._accessor({"componentType": FLOAT, "count": count, "type": "VEC3"})
-
-    def sparse(self, values: np.ndarray) -> int:
-        """Zeros but for the rows of `values` that are not: a sparse accessor over no view."""
-        rows = np.flatnonzero(np.abs(values).max(axis=1) > 0)
-        if not len(rows):
-            return self.zeros(len(values))
-        wide = len(values) > 0xFFFF
-        moved = np.ascontiguousarray(values[rows], "<f4").tobytes()
-        index = np.ascontiguousarray(rows, "<u4" if wide else "<u2")
-        sparse = {
-            "count": len(rows),
-            "indices": {
-                "bufferView": self._view(index.tobytes()),
-                "componentType": UINT32 if wide else UINT16,
-            },
-            "values": {"bufferView": self._view(moved)},
-        }
-        return self._accessor(
-            {"componentType": FLOAT, "count": len(values), "type": "VEC3", "sparse": sparse}
-        )
-
-    def indices(self, triangles: np.ndarray) -> int:
-        t = np.ascontiguousarray(triangles, "<u4").ravel()
-        return self._accessor(
-            {"bufferView": self._view(t.tobytes()), "componentType": UINT32, "count": len(t)}
-            | {"type": "SCALAR"}
-        )
-
-    def material(self, name: str) -> int:
-        self.doc["materials"].append({"name": name})
-        return len(self.doc["materials"]) - 1
-
-    def mesh_node(self, mesh: dict) -> None:
-        self.doc["meshes"].append(mesh)
-        self.doc["nodes"].append({"name": mesh["name"], "mesh": len(self.doc["meshes"]) - 1})
-        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
-
-    def write(self, path: Path) -> Path:
-        text = json.dumps(self.doc, separators=(",", ":")).encode()
-        text += b" " * (-len(text) % 4)
-        binary = bytes(self.bin)
-        total = 12 + 8 + len(text) + 8 + len(binary)
-        path.write_bytes(
-            b"glTF"
-            + struct.pack("<II", 2, total)
-            + struct.pack("<I", len(text))
-            + b"JSON"
-            + text
-            + struct.pack("<I", len(binary))
-            + b"BIN\0"
-            + binary
-        )
-        return path
 
 
 def _check_metres_y_up(avatar: AvatarMesh) -> None:
@@ -148,7 +52,7 @@ def _part_of_triangles(avatar: AvatarMesh) -> np.ndarray:
 def write_ready_player_me(avatar: AvatarMesh, path: Path) -> Path:
     """One mesh per part, 52 ARKit targets each: zeros with no view, else sparse."""
     _check_metres_y_up(avatar)
-    g = GlbWriter()
+    g = GltfWriter()
     tri_part = _part_of_triangles(avatar)
     for p, part in enumerate(PARTS):
         triangles = avatar.triangles[tri_part == p]
@@ -166,14 +70,14 @@ def write_ready_player_me(avatar: AvatarMesh, path: Path) -> Path:
             "material": g.material(f"{READY_PLAYER_ME_NAMES[part]}_material"),
             "targets": targets,
         }
-        g.mesh_node(
+        g.add_mesh(
             {
                 "name": READY_PLAYER_ME_NAMES[part],
                 "primitives": [primitive],
                 "extras": {"targetNames": list(ARKIT_BLENDSHAPES)},
             }
         )
-    return g.write(path)
+    return g.write_glb(path)
 
 
 def vroid_expressions(deltas: np.ndarray) -> tuple[list[str], list[np.ndarray]]:
@@ -206,7 +110,7 @@ def write_vroid(avatar: AvatarMesh, path: Path, gltfpack: str = "gltfpack") -> P
     program = shutil.which(gltfpack)
     if program is None:
         raise FileNotFoundError("gltfpack is not installed (.ci/setup installs it)")
-    g = GlbWriter()
+    g = GltfWriter()
     position = g.vec3(avatar.neutral, bounds=True)
     own_names, own = vroid_expressions(avatar.deltas)
     targets = [{"POSITION": g.vec3(d)} for d in own + list(avatar.deltas)]
@@ -222,14 +126,14 @@ def write_vroid(avatar: AvatarMesh, path: Path, gltfpack: str = "gltfpack") -> P
                 "targets": targets,
             }
         )
-    g.mesh_node(
+    g.add_mesh(
         {
             "name": "Face",
             "primitives": primitives,
             "extras": {"targetNames": own_names + list(ARKIT_BLENDSHAPES)},
         }
     )
-    plain = g.write(path.with_name(path.stem + "-uncompressed.glb"))
+    plain = g.write_glb(path.with_name(path.stem + "-uncompressed.glb"))
     subprocess.run(
         [program, "-i", str(plain), "-o", str(path), "-cf", "-kn", "-km", "-ke"],
         check=True,

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from softdeca_train.gltf_writer import GltfWriter
 from softdeca_train.mesh_files import write_obj
 from softdeca_train.models.synthetic import synthetic_head
 from softdeca_train.runtime.files import write_rig
@@ -68,74 +69,21 @@ def load_head() -> Head:
 # ---- glTF 2.0 -----------------------------------------------------------------------------
 
 
-class Gltf:
-    """A glTF 2.0 document and its first buffer, built mesh by mesh."""
-
-    def __init__(self) -> None:
-        self.doc: dict = {
-            "asset": {"version": "2.0"},
-            "scene": 0,
-            "scenes": [{"nodes": []}],
-            "nodes": [],
-            "meshes": [],
-            "buffers": [{"byteLength": 0}],
-            "bufferViews": [],
-            "accessors": [],
-        }
-        self.bin = bytearray()
-
-    def view(self, data: bytes) -> int:
-        """A buffer view of `data`, appended to the first buffer."""
-        offset = len(self.bin)
-        self.bin += data + b"\0" * (-len(data) % 4)
-        self.doc["buffers"][0]["byteLength"] = len(self.bin)
-        return self.buffer_view(0, offset, len(data))
-
-    def buffer_view(self, buffer: int, offset: int, length: int) -> int:
-        view = {"buffer": buffer, "byteOffset": offset, "byteLength": length}
-        self.doc["bufferViews"].append(view)
-        return len(self.doc["bufferViews"]) - 1
-
-    def accessor(self, view: int, count: int, kind: str, component: int = 5126) -> int:
-        self.doc["accessors"].append(
-            {"bufferView": view, "componentType": component, "count": count, "type": kind}
-        )
-        return len(self.doc["accessors"]) - 1
-
-    def positions(self, vertices: np.ndarray) -> int:
-        v = np.ascontiguousarray(vertices, "<f4")
-        return self.accessor(self.view(v.tobytes()), len(v), "VEC3")
+class Gltf(GltfWriter):
+    """The writer with whole meshes as the attacks start from them."""
 
     def mesh(self, name: str, vertices: np.ndarray, triangles: np.ndarray, shapes: dict) -> int:
         """A mesh with its morph targets (named in extras.targetNames), used by a new node of
         the scene; returns the mesh's index."""
-        position = self.positions(vertices)
-        t = np.ascontiguousarray(triangles, "<u4").ravel()
-        indices = self.accessor(self.view(t.tobytes()), len(t), "SCALAR", 5125)
-        targets = [{"POSITION": self.positions(d)} for d in shapes.values()]
-        primitive = {"attributes": {"POSITION": position}, "indices": indices, "mode": 4}
+        position = self.vec3(vertices)
+        targets = [{"POSITION": self.vec3(d)} for d in shapes.values()]
+        primitive = {"attributes": {"POSITION": position}, "indices": self.indices(triangles)}
+        primitive["mode"] = 4
         if targets:
             primitive["targets"] = targets
-        mesh = {"name": name, "primitives": [primitive], "extras": {"targetNames": list(shapes)}}
-        self.doc["meshes"].append(mesh)
-        self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1})
-        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
-        return len(self.doc["meshes"]) - 1
-
-    def glb(self) -> bytes:
-        text = json.dumps(self.doc, separators=(",", ":")).encode()
-        text += b" " * (-len(text) % 4)
-        binary = bytes(self.bin)
-        total = 12 + 8 + len(text) + (8 + len(binary) if binary else 0)
-        out = b"glTF" + struct.pack("<II", 2, total) + struct.pack("<I", len(text)) + b"JSON" + text
-        if binary:
-            out += struct.pack("<I", len(binary)) + b"BIN\0" + binary
-        return out
-
-    def gltf(self, uri: str) -> bytes:
-        """The JSON text with the first buffer at `uri` (the caller writes self.bin there)."""
-        self.doc["buffers"][0]["uri"] = uri
-        return json.dumps(self.doc, separators=(",", ":")).encode()
+        return self.add_mesh(
+            {"name": name, "primitives": [primitive], "extras": {"targetNames": list(shapes)}}
+        )
 
 
 def head_gltf(
