@@ -1,7 +1,8 @@
 """The native library's layers (NATIVE_LAYERS): core/ below everything, the C ABI (api/) on
 top, nothing below api/ including it, and every area including only areas of lower layers.
-The import layer (plugin/import) below every host. The training package's layers (PYTHON_LAYERS): no import cycle, areas importing only
-downwards, and imports at module top but for a few explained ones."""
+The import layer (plugin/import) below every host; the command line in by its documented way
+(CLI_MAY_INCLUDE). The training package's layers (PYTHON_LAYERS): no import cycle, areas
+importing only downwards, and imports at module top but for a few explained ones."""
 
 from __future__ import annotations
 
@@ -65,6 +66,44 @@ def test_the_import_layer_includes_no_host() -> None:
     assert not own & cli, f"files in both plugin/import and plugin/cli: {own & cli}"
 
 
+# The command line's way into the library (docs/ARCHITECTURE.md, "Ways into the native
+# library"): the C ABI for models, avatars and fits; the file and stream areas it is the tool
+# for; the import layer; and the few internals its benchmarks measure and its pictures use.
+CLI_MAY_INCLUDE = (
+    "softdeca/softdeca.h",
+    "core/",
+    "bundle/json.h",
+    "recording/",
+    "stream/",
+    "live/",
+    "fit/avatar_frame.h",
+    "fit/limits.h",
+    "geometry/surface_query.h",
+)
+CLI_BENCH_MAY_INCLUDE = ("runtime/model.h", "bundle/bundle_files.h", "bundle/sha256.h")
+
+
+def test_the_command_line_comes_in_by_its_documented_way() -> None:
+    own = {p.name for p in CLI.iterdir() if p.suffix in (".h", ".cpp")}
+    imported = {p.name for p in IMPORT.iterdir() if p.suffix == ".h"}
+    files = [p for p in CLI.iterdir() if p.suffix in (".h", ".cpp")]
+    assert len(files) > 20
+    offenders = []
+    for p in files:
+        bench = p.name.startswith(("bench_", "cmd_bench_"))
+        allowed = CLI_MAY_INCLUDE + (CLI_BENCH_MAY_INCLUDE if bench else ())
+        offenders += [
+            f"{p.name} includes {inc}"
+            for inc in local_includes(p)
+            if inc not in own and inc not in imported and not inc.startswith(allowed)
+        ]
+    assert offenders == []
+    # fitting and evaluating avatars: the C ABI's calls, never the runtime's classes
+    for name in ("cmd_fit.cpp", "cmd_replay.cpp", "runtime_session.cpp", "replay_avatar.cpp"):
+        text = (CLI / name).read_text(encoding="utf-8")
+        assert "runtime::" not in text and "fit::" not in text, name
+
+
 def test_core_depends_on_nothing_but_the_public_header() -> None:
     core = sources("core")
     assert core
@@ -119,8 +158,8 @@ def test_native_areas_include_only_downwards() -> None:
 PACKAGE = Path(__file__).resolve().parents[2] / "training" / "softdeca_train"
 PYTHON_LAYERS: tuple[tuple[str, ...], ...] = (
     # helpers with no dependency inside the package: file locations, command declarations,
-    # benchmark figures, geometry, mesh files, pictures
-    ("paths", "commands", "bench", "geometry", "mesh_files", "render"),
+    # benchmark figures, geometry, mesh and glTF files, pictures
+    ("paths", "commands", "bench", "geometry", "mesh_files", "gltf_writer", "render"),
     # the definitions the plugin shares (plugin/data) and the third-party data
     ("face_names", "parameters", "contact_rules", "third_party_data"),
     # the head template and its regions; the landmarks on it; the layered head model
