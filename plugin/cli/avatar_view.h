@@ -19,7 +19,7 @@ struct AvatarView {
 // The frame of `avatar` (its shapes) with the fit's `metres_per_unit`.
 AvatarView avatar_view(const AvatarFile& avatar, double metres_per_unit);
 
-// The fit report's metres_per_unit (softdeca_avatar_fit_report's JSON).
+// The fit report's metres_per_unit (softdeca_avatar_fit_get_report's JSON).
 double fit_metres_per_unit(const std::string& fit_report);
 
 // JSON: {"metres_per_unit", "parts": [{"first_vertex", "vertex_count", "to_view": 12 numbers}]}

@@ -70,10 +70,10 @@ FifoRefusal fifo_refusal_run(const std::string& scratch) {
       {"convert from CSV", [&] { recording::csv_to_recording(fifo_csv, scratch + "/bench-reliability-out.sdrec", 60); }},
       {"convert to CSV", [&] { recording::recording_to_csv(good, fifo_csv, 60); }},
       {"convert into a recording", [&] { recording::RecordingWriter(fifo, recording::Header{}); }},
-      {"softdeca_player_open",
+      {"softdeca_player_load",
        [&] {
          softdeca_player* player = nullptr;
-         if (softdeca_player_open(fifo.c_str(), &player) != SOFTDECA_OK) throw std::runtime_error(softdeca_last_error());
+         if (softdeca_player_load(fifo.c_str(), &player) != SOFTDECA_OK) throw std::runtime_error(softdeca_last_error());
          softdeca_player_destroy(player);
        }},
       {"receive --out", [&] { receiver.start_recording(fifo, recording::Header{}); }},

@@ -70,12 +70,12 @@ std::string shapes_json(const AvatarFile& avatar) {
   JsonObject shapes;
   for (std::size_t k = 0; k < 52; ++k) {
     if (avatar.shape_sources[k].empty()) {
-      shapes.raw(softdeca_blendshape_name(static_cast<uint32_t>(k)), "null");
+      shapes.raw(softdeca_blendshape_get_name(static_cast<uint32_t>(k)), "null");
       continue;
     }
     JsonObject parts;
     for (const ShapeSource& s : avatar.shape_sources[k]) parts.text(s.part, s.rig_name);
-    shapes.raw(softdeca_blendshape_name(static_cast<uint32_t>(k)), parts.str());
+    shapes.raw(softdeca_blendshape_get_name(static_cast<uint32_t>(k)), parts.str());
   }
   return shapes.str(true);
 }

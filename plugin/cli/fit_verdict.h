@@ -12,7 +12,7 @@ struct Verdict {
   std::string measure, reason;
 };
 
-// The verdict of softdeca_avatar_fit_report's JSON; the measures are printed on stderr.
+// The verdict of softdeca_avatar_fit_get_report's JSON; the measures are printed on stderr.
 Verdict read_verdict(const std::string& report);
 
 }  // namespace softdeca::cli

@@ -31,22 +31,30 @@ int Model::parameter(const std::string& name) const {
 
 Avatar::Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads,
                unsigned precision) {
-  softdeca_avatar_desc d{};
-  d.struct_size = sizeof d;
-  d.neutral = neutral.vertices.data();
-  d.vertex_count = static_cast<uint32_t>(neutral.vertex_count());
-  d.triangles = neutral.triangles.data();
-  d.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
-  d.blendshapes = deltas.empty() ? nullptr : deltas.data();
-  d.blendshape_count = deltas.empty() ? 0 : 52;
-  d.threads = threads;
-  d.precision = static_cast<int32_t>(precision);
-  check(softdeca_avatar_create(model.handle, &d, &handle), "creating the avatar");
+  softdeca_avatar_mesh mesh{};
+  mesh.struct_size = sizeof mesh;
+  mesh.neutral = neutral.vertices.data();
+  mesh.vertex_count = static_cast<uint32_t>(neutral.vertex_count());
+  mesh.triangles = neutral.triangles.data();
+  mesh.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
+  mesh.blendshapes = deltas.empty() ? nullptr : deltas.data();
+  mesh.blendshape_count = deltas.empty() ? 0 : 52;
+  create(model, mesh, nullptr, threads, precision);
 }
 
 Avatar::Avatar(const Model& model, const Fit& fit, const softdeca_avatar_mesh& mesh, unsigned threads, unsigned precision) {
-  check(softdeca_avatar_create_fitted(model.handle, fit.handle, &mesh, threads, static_cast<int32_t>(precision), &handle),
-        "creating the fitted avatar");
+  create(model, mesh, fit.handle, threads, precision);
+}
+
+void Avatar::create(const Model& model, const softdeca_avatar_mesh& mesh, const softdeca_avatar_fit* fit, unsigned threads,
+                    unsigned precision) {
+  softdeca_avatar_desc d{};
+  d.struct_size = sizeof d;
+  d.mesh = &mesh;
+  d.fit = fit;
+  d.threads = threads;
+  d.precision = static_cast<int32_t>(precision);
+  check(softdeca_avatar_create(model.handle, &d, &handle), fit ? "creating the fitted avatar" : "creating the avatar");
 }
 
 Fit::Fit(const Model& model, const softdeca_avatar_mesh& mesh, const softdeca_fit_options& options) {
@@ -62,10 +70,10 @@ void Fit::save(const std::string& path) const { check(softdeca_avatar_fit_save(h
 std::string Fit::report() const {
   std::string text(1 << 16, '\0');
   uint32_t length = 0;
-  softdeca_status status = softdeca_avatar_fit_report(handle, &text[0], static_cast<uint32_t>(text.size()), &length);
+  softdeca_status status = softdeca_avatar_fit_get_report(handle, &text[0], static_cast<uint32_t>(text.size()), &length);
   if (status == SOFTDECA_ERROR_BUFFER_TOO_SMALL) {
     text.assign(std::size_t{length} + 1, '\0');
-    status = softdeca_avatar_fit_report(handle, &text[0], static_cast<uint32_t>(text.size()), &length);
+    status = softdeca_avatar_fit_get_report(handle, &text[0], static_cast<uint32_t>(text.size()), &length);
   }
   check(status, "the fit's report");
   text.resize(length);

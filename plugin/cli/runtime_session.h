@@ -50,6 +50,10 @@ struct Avatar {
   Avatar(const Avatar&) = delete;
   Avatar& operator=(const Avatar&) = delete;
   softdeca_stats stats() const;
+
+ private:
+  void create(const Model& model, const softdeca_avatar_mesh& mesh, const softdeca_avatar_fit* fit, unsigned threads,
+              unsigned precision);
 };
 
 struct FaceRig {  // a neutral mesh and 52 blendshape deltas

@@ -13,7 +13,7 @@ constexpr std::uint64_t kMaxNamesFileBytes = 4u << 20;
 
 int rule_index(const std::string& name) {
   int32_t index = -1;
-  if (softdeca_blendshape_index(name.c_str(), &index) != SOFTDECA_OK) return -1;
+  if (softdeca_blendshape_find_index(name.c_str(), &index) != SOFTDECA_OK) return -1;
   return index;
 }
 
@@ -81,7 +81,7 @@ ShapeChoice choose_shapes(const std::vector<std::string>& names, const ShapeName
       choice.unused.push_back({static_cast<std::size_t>(choice.chosen[k]), "an in-between of the shape of the same name after it"});
       choice.chosen[k] = static_cast<int>(i);
     } else {
-      choice.unused.push_back({i, "'" + *giver[k] + "' already gives " + softdeca_blendshape_name(static_cast<uint32_t>(k))});
+      choice.unused.push_back({i, "'" + *giver[k] + "' already gives " + softdeca_blendshape_get_name(static_cast<uint32_t>(k))});
     }
   }
   return choice;

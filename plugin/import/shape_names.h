@@ -1,5 +1,5 @@
 // Which ARKit shape each of a rig's own shape names gives: the product's one rule
-// (softdeca_blendshape_index, docs/avatars.md), unless a mapping file says otherwise for a name.
+// (softdeca_blendshape_find_index, docs/avatars.md), unless a mapping file says otherwise for a name.
 #pragma once
 
 #include <array>

@@ -36,7 +36,7 @@ inline std::string error_of(const std::string& path, const avatar_import::Import
 // The canonical index of an ARKit shape by its name (the C ABI's rule).
 inline std::size_t arkit_index(const char* name) {
   int32_t index = -1;
-  EXPECT_EQ(softdeca_blendshape_index(name, &index), SOFTDECA_OK);
+  EXPECT_EQ(softdeca_blendshape_find_index(name, &index), SOFTDECA_OK);
   EXPECT_GE(index, 0) << name;
   return static_cast<std::size_t>(index);
 }

@@ -146,7 +146,7 @@ Rig read_rig(const std::string& dir, bool optional) {
   const std::size_t n = rig.neutral.vertices.size();
   rig.deltas.assign(SOFTDECA_BLENDSHAPE_COUNT * n, 0.0f);
   for (uint32_t b = 0; b < SOFTDECA_BLENDSHAPE_COUNT; ++b) {
-    const std::string path = dir + "/blendshapes/" + softdeca_blendshape_name(b) + ".obj";
+    const std::string path = dir + "/blendshapes/" + softdeca_blendshape_get_name(b) + ".obj";
     if (!std::ifstream(path)) continue;  // a shape the avatar lacks: no motion (as softdeca replay)
     const Obj shape = read_obj(path);
     if (shape.vertices.size() != n) throw std::runtime_error(path + ": vertex count differs from the neutral");
@@ -157,14 +157,17 @@ Rig read_rig(const std::string& dir, bool optional) {
 
 // The avatar's rig as the C ABI's avatar, prepared at the given precision.
 softdeca_avatar* make_avatar(softdeca_model* model, const Rig& rig, int32_t precision) {
+  softdeca_avatar_mesh mesh{};
+  mesh.struct_size = sizeof mesh;
+  mesh.neutral = rig.neutral.vertices.data();
+  mesh.vertex_count = static_cast<uint32_t>(rig.neutral.vertices.size() / 3);
+  mesh.triangles = rig.neutral.triangles.data();
+  mesh.triangle_count = static_cast<uint32_t>(rig.neutral.triangles.size() / 3);
+  mesh.blendshapes = rig.deltas.data();
+  mesh.blendshape_count = SOFTDECA_BLENDSHAPE_COUNT;
   softdeca_avatar_desc desc{};
   desc.struct_size = sizeof desc;
-  desc.neutral = rig.neutral.vertices.data();
-  desc.vertex_count = static_cast<uint32_t>(rig.neutral.vertices.size() / 3);
-  desc.triangles = rig.neutral.triangles.data();
-  desc.triangle_count = static_cast<uint32_t>(rig.neutral.triangles.size() / 3);
-  desc.blendshapes = rig.deltas.data();
-  desc.blendshape_count = SOFTDECA_BLENDSHAPE_COUNT;
+  desc.mesh = &mesh;
   desc.precision = precision;
   softdeca_avatar* avatar = nullptr;
   check(softdeca_avatar_create(model, &desc, &avatar), "creating the avatar");
@@ -223,7 +226,7 @@ int run(int argc, char** argv) {
   softdeca_avatar* avatar = make_avatar(model, rig, o.precision);
   check(softdeca_avatar_set_dynamics(avatar, o.dynamic ? SOFTDECA_TRUE : SOFTDECA_FALSE), "dynamics");
   softdeca_player* player = nullptr;
-  check(softdeca_player_open(o.take.c_str(), &player), "opening " + o.take);
+  check(softdeca_player_load(o.take.c_str(), &player), "opening " + o.take);
   const Pc2 expected = read_pc2(o.expected_path);
   if (expected.points != info.head_vertex_count)
     throw std::runtime_error(o.expected_path + " has " + std::to_string(expected.points) + " points, the bundle's head " +
@@ -236,7 +239,7 @@ int run(int argc, char** argv) {
   double worst = 0, motion = 0;
   for (uint32_t f = 0; f < expected.frames; ++f) {
     frame.struct_size = sizeof frame;
-    check(softdeca_player_frame(player, o.first + f, &frame), "take frame " + std::to_string(o.first + f));
+    check(softdeca_player_get_frame(player, o.first + f, &frame), "take frame " + std::to_string(o.first + f));
     if (o.sparse) tracking.evaluate(frame.weights, output);
     else check(softdeca_avatar_evaluate_weights(avatar, frame.weights, SOFTDECA_BLENDSHAPE_COUNT, &output), "frame");
     const float* want = expected.xyz.data() + std::size_t{f} * expected.points * 3;

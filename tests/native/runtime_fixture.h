@@ -70,17 +70,44 @@ struct AvatarPtr {
   ~AvatarPtr() { softdeca_avatar_destroy(p); }
 };
 
-inline softdeca_avatar_desc describe(const Head& h, uint32_t threads = 1, uint32_t precision = SOFTDECA_PRECISION_HALF) {
+// An avatar desc with the mesh it points to, kept together: a copy points at its own mesh.
+struct Described : softdeca_avatar_desc {
+  softdeca_avatar_mesh m{};
+  Described() : softdeca_avatar_desc{} { mesh = &m; }
+  Described(const Described& o) : softdeca_avatar_desc(o), m(o.m) { mesh = &m; }
+  Described& operator=(const Described& o) {
+    softdeca_avatar_desc::operator=(o);
+    m = o.m;
+    mesh = &m;
+    return *this;
+  }
+};
+
+// softdeca_avatar_create of `mesh` on the fit made for it.
+inline softdeca_status create_on_fit(softdeca_model* model, const softdeca_avatar_fit* fit, const softdeca_avatar_mesh* mesh,
+                                     uint32_t threads, int32_t precision, softdeca_avatar** out) {
   softdeca_avatar_desc d{};
   d.struct_size = sizeof d;
-  d.neutral = h.neutral.data();
-  d.vertex_count = h.vertices();
-  d.triangles = h.triangles.data();
-  d.triangle_count = h.triangles.size() / 3;
-  d.blendshapes = h.blendshapes.data();
-  d.blendshape_count = 52;
+  d.mesh = mesh;
+  d.fit = fit;
   d.threads = threads;
   d.precision = precision;
+  return softdeca_avatar_create(model, &d, out);
+}
+
+// The template path's desc of `h` (no fit).
+inline Described describe(const Head& h, uint32_t threads = 1, uint32_t precision = SOFTDECA_PRECISION_HALF) {
+  Described d;
+  d.struct_size = sizeof(softdeca_avatar_desc);
+  d.m.struct_size = sizeof d.m;
+  d.m.neutral = h.neutral.data();
+  d.m.vertex_count = h.vertices();
+  d.m.triangles = h.triangles.data();
+  d.m.triangle_count = h.triangles.size() / 3;
+  d.m.blendshapes = h.blendshapes.data();
+  d.m.blendshape_count = 52;
+  d.threads = threads;
+  d.precision = static_cast<int32_t>(precision);
   return d;
 }
 

@@ -97,7 +97,7 @@ void expect_part(const AvatarFile& avatar, const AvatarPart& part, const TestSce
     expect_near3(&avatar.neutral[3 * v], apply(m, &mesh.vertices[3 * i]), 1e-5, mesh.name + " vertex " + std::to_string(i));
     for (const TestShape& s : mesh.shapes) {
       int32_t k = -1;
-      softdeca_blendshape_index(s.name.c_str(), &k);
+      softdeca_blendshape_find_index(s.name.c_str(), &k);
       if (k < 0) continue;
       expect_near3(&avatar.blendshapes[3 * (static_cast<std::size_t>(k) * n + v)], apply(m, &s.deltas[3 * i], false), 1e-7,
                    mesh.name + " " + s.name + " vertex " + std::to_string(i));

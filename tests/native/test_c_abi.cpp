@@ -49,14 +49,14 @@ TEST(CAbi, RejectsNullsWithAMessage) {
   EXPECT_NE(std::string(softdeca_last_error()).find("vertices is null"), std::string::npos);
   EXPECT_EQ(softdeca_embed_points(kVerts.data(), 4, kTet.data(), 1, p, 1, nullptr, bary, nullptr),
             SOFTDECA_ERROR_INVALID_ARGUMENT);
-  EXPECT_EQ(softdeca_tet_volumes(kVerts.data(), 4, kTet.data(), 1, nullptr), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_compute_tet_volumes(kVerts.data(), 4, kTet.data(), 1, nullptr), SOFTDECA_ERROR_INVALID_ARGUMENT);
 }
 
 TEST(CAbi, RejectsNonFiniteInputAndLeavesOutputsUntouched) {
   std::vector<float> bad = kVerts;
   bad[4] = std::nanf("");
   float vol = 123.0f;
-  EXPECT_EQ(softdeca_tet_volumes(bad.data(), 4, kTet.data(), 1, &vol), SOFTDECA_ERROR_NON_FINITE);
+  EXPECT_EQ(softdeca_compute_tet_volumes(bad.data(), 4, kTet.data(), 1, &vol), SOFTDECA_ERROR_NON_FINITE);
   EXPECT_EQ(vol, 123.0f);
   EXPECT_NE(std::string(softdeca_last_error()).find("vertices[4]"), std::string::npos);
   const float p[3] = {INFINITY, 0, 0};
@@ -71,17 +71,17 @@ TEST(CAbi, RejectsNonFiniteInputAndLeavesOutputsUntouched) {
 TEST(CAbi, RejectsOutOfRangeIndicesAndTooFewVertices) {
   const std::vector<int32_t> bad = {0, 1, 2, 4};
   float vol;
-  EXPECT_EQ(softdeca_tet_volumes(kVerts.data(), 4, bad.data(), 1, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_compute_tet_volumes(kVerts.data(), 4, bad.data(), 1, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(softdeca_last_error()).find("tets[3] = 4"), std::string::npos);
   const std::vector<int32_t> negative = {0, -1, 2, 3};
-  EXPECT_EQ(softdeca_tet_volumes(kVerts.data(), 4, negative.data(), 1, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
-  EXPECT_EQ(softdeca_tet_volumes(kVerts.data(), 3, kTet.data(), 1, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
-  EXPECT_EQ(softdeca_tet_volumes(kVerts.data(), 4, kTet.data(), 0, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_compute_tet_volumes(kVerts.data(), 4, negative.data(), 1, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_compute_tet_volumes(kVerts.data(), 3, kTet.data(), 1, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_compute_tet_volumes(kVerts.data(), 4, kTet.data(), 0, &vol), SOFTDECA_ERROR_INVALID_ARGUMENT);
 }
 
 TEST(CAbi, LastErrorIsPerThread) {
   float vol;
-  ASSERT_NE(softdeca_tet_volumes(nullptr, 4, kTet.data(), 1, &vol), SOFTDECA_OK);
+  ASSERT_NE(softdeca_compute_tet_volumes(nullptr, 4, kTet.data(), 1, &vol), SOFTDECA_OK);
   std::string other;
   std::thread([&] { other = softdeca_last_error(); }).join();
   EXPECT_EQ(other, "");
@@ -90,6 +90,6 @@ TEST(CAbi, LastErrorIsPerThread) {
 
 TEST(CAbi, TetVolume) {
   float vol = 0;
-  ASSERT_EQ(softdeca_tet_volumes(kVerts.data(), 4, kTet.data(), 1, &vol), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_compute_tet_volumes(kVerts.data(), 4, kTet.data(), 1, &vol), SOFTDECA_OK);
   EXPECT_NEAR(vol, 1.0f / 6.0f, 1e-7);
 }

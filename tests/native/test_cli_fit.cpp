@@ -56,7 +56,7 @@ TestScene user_scene(const rt::Head& h) {
   head.triangles = h.triangles;
   const std::size_t n = h.vertices();
   for (uint32_t k = 0; k < 52; ++k) {
-    softdeca::test::TestShape shape{std::string("blendShape1.") + softdeca_blendshape_name(k), {}, {}};
+    softdeca::test::TestShape shape{std::string("blendShape1.") + softdeca_blendshape_get_name(k), {}, {}};
     for (std::size_t i = 0; i < 3 * n; ++i) shape.deltas.push_back(kCentimetres * h.blendshapes[3 * k * n + i]);
     head.shapes.push_back(std::move(shape));
   }
@@ -268,7 +268,7 @@ class CliFitFolder : public ::testing::Test {
         << softdeca_last_error();
     const softdeca_avatar_mesh abi = mesh.abi_mesh();
     rt::AvatarPtr avatar;
-    EXPECT_EQ(softdeca_avatar_create_fitted(model.p, loaded, &abi, 1, 0, &avatar.p), SOFTDECA_OK) << softdeca_last_error();
+    EXPECT_EQ(rt::create_on_fit(model.p, loaded, &abi, 1, 0, &avatar.p), SOFTDECA_OK) << softdeca_last_error();
     softdeca_avatar_fit_destroy(loaded);
   }
   // Nothing but what the test made beside the fit folders: no temporary folder is left.

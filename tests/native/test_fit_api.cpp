@@ -94,9 +94,9 @@ class FitApi : public ::testing::Test {
   }
   std::string report(const FitPtr& f) {
     uint32_t length = 0;
-    softdeca_avatar_fit_report(f.p, nullptr, 0, &length);
+    softdeca_avatar_fit_get_report(f.p, nullptr, 0, &length);
     std::string text(length + 1, '\0');
-    EXPECT_EQ(softdeca_avatar_fit_report(f.p, text.data(), length + 1, &length), SOFTDECA_OK);
+    EXPECT_EQ(softdeca_avatar_fit_get_report(f.p, text.data(), length + 1, &length), SOFTDECA_OK);
     text.resize(length);
     return text;
   }
@@ -155,7 +155,7 @@ TEST_F(FitApi, FitsSavesLoadsAndAnimatesTheUsersOwnMesh) {
   EXPECT_EQ(report(loaded), r);
 
   rt::AvatarPtr a;
-  ASSERT_EQ(softdeca_avatar_create_fitted(model_.p, loaded.p, &user.mesh, 1, SOFTDECA_PRECISION_HALF, &a.p), SOFTDECA_OK)
+  ASSERT_EQ(rt::create_on_fit(model_.p, loaded.p, &user.mesh, 1, SOFTDECA_PRECISION_HALF, &a.p), SOFTDECA_OK)
       << softdeca_last_error();
   ASSERT_EQ(softdeca_avatar_prepare(a.p), SOFTDECA_OK) << softdeca_last_error();
   rt::Buffers physics(user.vertices()), linear(user.vertices());
@@ -254,10 +254,10 @@ TEST_F(FitApi, AFittedAvatarTakesMapsPerAvatarElement) {
   FitPtr f;
   ASSERT_EQ(fit(user.mesh, f), SOFTDECA_OK) << softdeca_last_error();
   rt::AvatarPtr a;
-  ASSERT_EQ(softdeca_avatar_create_fitted(model_.p, f.p, &user.mesh, 1, SOFTDECA_PRECISION_FLOAT, &a.p), SOFTDECA_OK);
+  ASSERT_EQ(rt::create_on_fit(model_.p, f.p, &user.mesh, 1, SOFTDECA_PRECISION_FLOAT, &a.p), SOFTDECA_OK);
   softdeca_parameter_info info{};
   info.struct_size = sizeof info;
-  ASSERT_EQ(softdeca_model_get_parameter(model_.p, 0, &info), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_model_get_parameter_info(model_.p, 0, &info), SOFTDECA_OK);
   std::vector<float> per_vertex(user.vertices(), static_cast<float>(info.default_value));
   EXPECT_EQ(softdeca_avatar_set_parameter_vertices(a.p, 0, per_vertex.data(), static_cast<uint32_t>(per_vertex.size())),
             SOFTDECA_OK)
@@ -325,7 +325,7 @@ TEST_F(FitApi, StrayVerticesAndWildDeltasAreNamedNotMistakenForNoFace) {
   {
     UserAvatar wild = user;
     int32_t jaw = -1;
-    ASSERT_EQ(softdeca_blendshape_index("jawOpen", &jaw), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_blendshape_find_index("jawOpen", &jaw), SOFTDECA_OK);
     wild.deltas[3 * (static_cast<std::size_t>(jaw) * wild.vertices() + 9) + 1] = 3e38f;
     wild.describe();
     EXPECT_EQ(fit(wild.mesh, f), SOFTDECA_ERROR_INVALID_ARGUMENT);
@@ -364,7 +364,7 @@ TEST_F(FitApi, ChangedMeshesOtherBundlesAndDamagedFilesAreRefused) {
   changed.neutral[0] += 1.0f;
   changed.describe();
   rt::AvatarPtr a;
-  EXPECT_EQ(softdeca_avatar_create_fitted(model_.p, f.p, &changed.mesh, 1, 0, &a.p), SOFTDECA_ERROR_FORMAT);
+  EXPECT_EQ(rt::create_on_fit(model_.p, f.p, &changed.mesh, 1, 0, &a.p), SOFTDECA_ERROR_FORMAT);
   EXPECT_NE(std::string(softdeca_last_error()).find("fit it again"), std::string::npos) << softdeca_last_error();
   // another bundle
   rt::ModelPtr other;

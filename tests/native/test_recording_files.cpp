@@ -86,7 +86,7 @@ TEST_F(RecordingFiles, ReadingAFifoIsRefusedAtOnce) {
   EXPECT_FIFO_REFUSED(refused(fifo_, [&] { recording::recording_to_csv(fifo_, dir_ + "/out.csv", 60); }));
   EXPECT_FIFO_REFUSED(refused(fifo_, [&] {
     softdeca_player* player = nullptr;
-    c_abi(softdeca_player_open(fifo_.c_str(), &player));
+    c_abi(softdeca_player_load(fifo_.c_str(), &player));
     softdeca_player_destroy(player);
   }));
 }
@@ -130,7 +130,7 @@ TEST_F(RecordingFiles, AFolderIsAnInvalidArgument) {
   const std::string folder = dir_ + "/folder.sdrec";
   std::filesystem::create_directories(folder);
   softdeca_player* player = nullptr;
-  EXPECT_EQ(softdeca_player_open(folder.c_str(), &player), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_player_load(folder.c_str(), &player), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(std::string(softdeca_last_error()).find("is a folder, not a regular file"), std::string::npos)
       << softdeca_last_error();
   const std::string read = refused(folder, [&] { recording::read_recording(folder); });

@@ -159,11 +159,11 @@ TEST(FrameRule, TheReaderAndThePlayerClampOrLeaveOutAndCount) {
   EXPECT_EQ(rec.frames[1].weights[1], 0.0f);
 
   softdeca_player* player = nullptr;
-  ASSERT_EQ(softdeca_player_open(path.c_str(), &player), SOFTDECA_OK) << softdeca_last_error();
+  ASSERT_EQ(softdeca_player_load(path.c_str(), &player), SOFTDECA_OK) << softdeca_last_error();
   for (uint32_t i = 0; i < 2; ++i) {
     softdeca_frame f{};
     f.struct_size = sizeof f;
-    ASSERT_EQ(softdeca_player_frame(player, i, &f), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_player_get_frame(player, i, &f), SOFTDECA_OK);
     for (float w : f.weights) EXPECT_TRUE(w >= 0 && w <= 1) << w;
   }
   softdeca_player_destroy(player);

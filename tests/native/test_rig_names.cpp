@@ -56,10 +56,10 @@ TEST(RigNames, HostileNamesAreBoundedAndMatchNothing) {
 
 TEST(RigNames, TheCAbiReportsTheIndexAndRefusesNull) {
   int32_t index = 99;
-  ASSERT_EQ(softdeca_blendshape_index("blendShape1.jawOpen", &index), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_blendshape_find_index("blendShape1.jawOpen", &index), SOFTDECA_OK);
   EXPECT_EQ(index, 24);
-  ASSERT_EQ(softdeca_blendshape_index("Basis", &index), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_blendshape_find_index("Basis", &index), SOFTDECA_OK);
   EXPECT_EQ(index, -1);
-  EXPECT_EQ(softdeca_blendshape_index(nullptr, &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
-  EXPECT_EQ(softdeca_blendshape_index("jawOpen", nullptr), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_blendshape_find_index(nullptr, &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_blendshape_find_index("jawOpen", nullptr), SOFTDECA_ERROR_INVALID_ARGUMENT);
 }

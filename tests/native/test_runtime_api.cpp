@@ -51,7 +51,7 @@ TEST_F(Runtime, ModelInfoDescribesTheBundle) {
   p.struct_size = sizeof p;
   uint32_t index = 99;
   ASSERT_EQ(softdeca_model_find_parameter(model.p, "w_skin_strain", &index), SOFTDECA_OK);
-  ASSERT_EQ(softdeca_model_get_parameter(model.p, index, &p), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_model_get_parameter_info(model.p, index, &p), SOFTDECA_OK);
   EXPECT_STREQ(p.name, "w_skin_strain");
   EXPECT_EQ(p.log_scale, 1);
   EXPECT_STREQ(p.domain, "skin_triangle");
@@ -59,14 +59,14 @@ TEST_F(Runtime, ModelInfoDescribesTheBundle) {
   EXPECT_DOUBLE_EQ(p.hi, 100.0);
   uint32_t gravity = 0;
   ASSERT_EQ(softdeca_model_find_parameter(model.p, "gravity_strength", &gravity), SOFTDECA_OK);
-  ASSERT_EQ(softdeca_model_get_parameter(model.p, gravity, &p), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_model_get_parameter_info(model.p, gravity, &p), SOFTDECA_OK);
   EXPECT_STREQ(p.domain, "global");
   p.struct_size = 4;
-  EXPECT_EQ(softdeca_model_get_parameter(model.p, gravity, &p), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_model_get_parameter_info(model.p, gravity, &p), SOFTDECA_ERROR_INVALID_ARGUMENT);
   p.struct_size = sizeof p;
   EXPECT_EQ(softdeca_model_find_parameter(model.p, "no_such", &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(error().find("no_such"), std::string::npos);
-  EXPECT_EQ(softdeca_model_get_parameter(model.p, info.parameter_count, &p), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_model_get_parameter_info(model.p, info.parameter_count, &p), SOFTDECA_ERROR_INVALID_ARGUMENT);
 }
 
 TEST_F(Runtime, ModelQueriesCheckTheirArguments) {
@@ -225,11 +225,18 @@ TEST_F(Runtime, AvatarCreationChecksTheMesh) {
   d.struct_size = 8;
   EXPECT_EQ(softdeca_avatar_create(model.p, &d, &a), SOFTDECA_ERROR_INVALID_ARGUMENT);
   d = describe(head);
-  d.vertex_count -= 1;
+  d.m.vertex_count -= 1;
   EXPECT_EQ(softdeca_avatar_create(model.p, &d, &a), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(error().find("head vertices"), std::string::npos) << error();
   d = describe(head);
-  d.neutral = nullptr;
+  d.m.neutral = nullptr;
+  EXPECT_EQ(softdeca_avatar_create(model.p, &d, &a), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  d = describe(head);
+  d.mesh = nullptr;
+  EXPECT_EQ(softdeca_avatar_create(model.p, &d, &a), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(error().find("desc->mesh"), std::string::npos) << error();
+  d = describe(head);
+  d.m.struct_size = 8;
   EXPECT_EQ(softdeca_avatar_create(model.p, &d, &a), SOFTDECA_ERROR_INVALID_ARGUMENT);
   auto nan_head = head;
   nan_head.neutral[7] = kNaN;
@@ -241,7 +248,7 @@ TEST_F(Runtime, AvatarCreationChecksTheMesh) {
   d = describe(bad_tri);
   EXPECT_EQ(softdeca_avatar_create(model.p, &d, &a), SOFTDECA_ERROR_INVALID_ARGUMENT);
   d = describe(head);
-  d.blendshape_count = 51;
+  d.m.blendshape_count = 51;
   EXPECT_EQ(softdeca_avatar_create(model.p, &d, &a), SOFTDECA_ERROR_INVALID_ARGUMENT);
   auto nan_shapes = head;
   nan_shapes.blendshapes[100] = std::numeric_limits<float>::infinity();

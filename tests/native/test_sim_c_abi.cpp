@@ -70,7 +70,7 @@ std::string last_error() { return softdeca_last_error(); }
 // A simulator parameter's index by name (the ABI addresses parameters by index).
 uint32_t param(const char* name) {
   uint32_t index = 0;
-  EXPECT_EQ(softdeca_parameter_find(name, &index), SOFTDECA_OK) << name;
+  EXPECT_EQ(softdeca_sim_find_parameter(name, &index), SOFTDECA_OK) << name;
   return index;
 }
 }  // namespace
@@ -79,8 +79,8 @@ class SimCAbi : public ::testing::Test {
  protected:
   void SetUp() override {
     ASSERT_EQ(softdeca_sim_create(&mesh.desc, nullptr, &sim), SOFTDECA_OK) << last_error();
-    ASSERT_EQ(softdeca_sim_skin_count(sim, &skin_count), SOFTDECA_OK);
-    ASSERT_EQ(softdeca_sim_vertex_count(sim, &vertex_count), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_sim_get_skin_count(sim, &skin_count), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_sim_get_vertex_count(sim, &vertex_count), SOFTDECA_OK);
     rest_skin.resize(skin_count * 3);
     ASSERT_EQ(softdeca_sim_get_skin(sim, rest_skin.data(), skin_count), SOFTDECA_OK);
     frame.struct_size = sizeof(frame);
@@ -100,13 +100,13 @@ class SimCAbi : public ::testing::Test {
 
 TEST_F(SimCAbi, EnumeratesTheParameters) {
   uint32_t n = 0;
-  ASSERT_EQ(softdeca_parameter_count(&n), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_get_parameter_count(&n), SOFTDECA_OK);
   ASSERT_GT(n, 20u);
   softdeca_parameter_info info{};
   info.struct_size = sizeof(info);
   bool found = false;
   for (uint32_t i = 0; i < n; ++i) {
-    ASSERT_EQ(softdeca_parameter_get_info(i, &info), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_sim_get_parameter_info(i, &info), SOFTDECA_OK);
     if (std::string(info.name) == "w_soft_volume") {
       found = true;
       EXPECT_EQ(param("w_soft_volume"), i);
@@ -116,13 +116,13 @@ TEST_F(SimCAbi, EnumeratesTheParameters) {
     }
   }
   EXPECT_TRUE(found);
-  EXPECT_EQ(softdeca_parameter_get_info(n, &info), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_sim_get_parameter_info(n, &info), SOFTDECA_ERROR_INVALID_ARGUMENT);
   uint32_t index = 7;
-  EXPECT_EQ(softdeca_parameter_find("nope", &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_sim_find_parameter("nope", &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(index, 7u);
-  EXPECT_EQ(softdeca_parameter_find(nullptr, &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_sim_find_parameter(nullptr, &index), SOFTDECA_ERROR_INVALID_ARGUMENT);
   const char* json = nullptr;
-  ASSERT_EQ(softdeca_parameters_json(&json), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_get_parameters_json(&json), SOFTDECA_OK);
   EXPECT_NE(std::string(json).find("\"w_soft_volume\""), std::string::npos);
 }
 
@@ -192,7 +192,7 @@ TEST_F(SimCAbi, RefusesBadInputAndKeepsTheLastGoodOutput) {
   EXPECT_EQ(softdeca_sim_set_parameter(sim, param("max_strain"), 2.0), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(last_error().find("outside its range [0.7, 1.3]"), std::string::npos) << last_error();
   uint32_t count = 0;
-  ASSERT_EQ(softdeca_parameter_count(&count), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_get_parameter_count(&count), SOFTDECA_OK);
   EXPECT_EQ(softdeca_sim_set_parameter(sim, count, 1.0), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(last_error().find("not below"), std::string::npos) << last_error();
   const float few[2] = {1, 1};
@@ -234,13 +234,13 @@ TEST(SimCAbiCreate, RefusesBrokenMeshes) {
   CMesh ok(head());
   softdeca_sim_settings s{};
   s.struct_size = sizeof(s);
-  ASSERT_EQ(softdeca_sim_default_settings(&s), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_settings_init(&s), SOFTDECA_OK);
   s.tolerance = -1;
   EXPECT_EQ(softdeca_sim_create(&ok.desc, &s, &sim), SOFTDECA_ERROR_INVALID_ARGUMENT);
-  ASSERT_EQ(softdeca_sim_default_settings(&s), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_settings_init(&s), SOFTDECA_OK);
   s.tolerance = NAN;
   EXPECT_EQ(softdeca_sim_create(&ok.desc, &s, &sim), SOFTDECA_ERROR_NON_FINITE);
-  ASSERT_EQ(softdeca_sim_default_settings(&s), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_sim_settings_init(&s), SOFTDECA_OK);
   ASSERT_EQ(softdeca_sim_create(&ok.desc, &s, &sim), SOFTDECA_OK) << last_error();
   softdeca_sim_destroy(sim);
   softdeca_sim_destroy(nullptr);

@@ -37,9 +37,9 @@ softdeca_recording_header header() {
 }  // namespace
 
 TEST(StreamCAbi, BlendshapeNames) {
-  EXPECT_STREQ(softdeca_blendshape_name(0), "browDownLeft");
-  EXPECT_STREQ(softdeca_blendshape_name(51), "tongueOut");
-  EXPECT_EQ(softdeca_blendshape_name(52), nullptr);
+  EXPECT_STREQ(softdeca_blendshape_get_name(0), "browDownLeft");
+  EXPECT_STREQ(softdeca_blendshape_get_name(51), "tongueOut");
+  EXPECT_EQ(softdeca_blendshape_get_name(52), nullptr);
 }
 
 TEST(StreamCAbi, RejectsNullsSmallStructsAndBadConfigs) {
@@ -65,12 +65,12 @@ TEST(StreamCAbi, RejectsNullsSmallStructsAndBadConfigs) {
   EXPECT_EQ(r, nullptr);
   softdeca_frame f = blank_frame();
   softdeca_bool got = 7;
-  EXPECT_EQ(softdeca_receiver_next(nullptr, 0, &f, &got), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_receiver_get_next(nullptr, 0, &f, &got), SOFTDECA_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(got, 7);
   softdeca_receiver_destroy(nullptr);
   softdeca_player* p = nullptr;
-  EXPECT_EQ(softdeca_player_open(temp_path("none.sdrec").c_str(), &p), SOFTDECA_ERROR_IO);
-  EXPECT_EQ(softdeca_player_open(nullptr, &p), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_player_load(temp_path("none.sdrec").c_str(), &p), SOFTDECA_ERROR_IO);
+  EXPECT_EQ(softdeca_player_load(nullptr, &p), SOFTDECA_ERROR_INVALID_ARGUMENT);
   softdeca_player_destroy(nullptr);
   softdeca_recorder_destroy(nullptr);
 }
@@ -115,32 +115,32 @@ TEST(StreamCAbi, RecorderRejectsBadFramesAndPlayerPlaysWhatWasWritten) {
   softdeca_recorder_destroy(rec);
 
   softdeca_player* p = nullptr;
-  ASSERT_EQ(softdeca_player_open(path.c_str(), &p), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_load(path.c_str(), &p), SOFTDECA_OK);
   softdeca_recording_info info{};
   info.struct_size = sizeof info;
-  ASSERT_EQ(softdeca_player_info(p, &info), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_get_info(p, &info), SOFTDECA_OK);
   EXPECT_EQ(info.frame_count, 5u);
   EXPECT_NEAR(info.duration, 0.4, 1e-12);
   EXPECT_STREQ(info.device, "abi test");
   int32_t out_idx[2];
   uint32_t count = 0;
-  EXPECT_EQ(softdeca_player_profile(p, &id, out_idx, 2, &count), SOFTDECA_ERROR_BUFFER_TOO_SMALL);
+  EXPECT_EQ(softdeca_player_get_profile(p, &id, out_idx, 2, &count), SOFTDECA_ERROR_BUFFER_TOO_SMALL);
   EXPECT_EQ(count, 3u);
   int32_t all_idx[3];
-  ASSERT_EQ(softdeca_player_profile(p, &id, all_idx, 3, &count), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_get_profile(p, &id, all_idx, 3, &count), SOFTDECA_OK);
   EXPECT_EQ(all_idx[2], 9);
   float n[6];
   uint32_t vertices = 0;
-  ASSERT_EQ(softdeca_player_neutral(p, n, 2, &vertices), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_get_neutral(p, n, 2, &vertices), SOFTDECA_OK);
   EXPECT_EQ(vertices, 2u);
   EXPECT_EQ(n[5], 0.5f);
 
   softdeca_frame f = blank_frame();
-  ASSERT_EQ(softdeca_player_frame_at(p, 0.25, &f), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_get_frame_at(p, 0.25, &f), SOFTDECA_OK);
   EXPECT_NEAR(f.weights[24], 0.5f, 1e-6);
   EXPECT_NEAR(f.capture_time, 10.25, 1e-9);
   EXPECT_EQ(f.landmark_count, 3u);
-  EXPECT_EQ(softdeca_player_frame(p, 5, &f), SOFTDECA_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(softdeca_player_get_frame(p, 5, &f), SOFTDECA_ERROR_INVALID_ARGUMENT);
   ASSERT_EQ(softdeca_player_set_loop(p, SOFTDECA_TRUE), SOFTDECA_OK);
   ASSERT_EQ(softdeca_player_set_speed(p, 2), SOFTDECA_OK);
   EXPECT_EQ(softdeca_player_set_speed(p, -1), SOFTDECA_ERROR_INVALID_ARGUMENT);
@@ -149,10 +149,10 @@ TEST(StreamCAbi, RecorderRejectsBadFramesAndPlayerPlaysWhatWasWritten) {
   ASSERT_EQ(softdeca_player_advance(p, 0.1, &f, &ended), SOFTDECA_OK);  // 0.3 + 0.2 wraps to 0.1
   EXPECT_EQ(ended, 0);
   double pos = 0;
-  ASSERT_EQ(softdeca_player_position(p, &pos), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_get_position(p, &pos), SOFTDECA_OK);
   EXPECT_NEAR(pos, 0.1, 1e-9);
   EXPECT_NEAR(f.weights[24], 0.2f, 1e-6);
-  EXPECT_EQ(softdeca_player_frame_at(p, NAN, &f), SOFTDECA_ERROR_NON_FINITE);
+  EXPECT_EQ(softdeca_player_get_frame_at(p, NAN, &f), SOFTDECA_ERROR_NON_FINITE);
   softdeca_player_destroy(p);
   std::remove(path.c_str());
 }
@@ -167,7 +167,7 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
   softdeca_receiver* r = nullptr;
   ASSERT_EQ(softdeca_receiver_create(&c, &r), SOFTDECA_OK) << softdeca_last_error();
   uint32_t port = 0;
-  ASSERT_EQ(softdeca_receiver_port(r, &port), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_receiver_get_port(r, &port), SOFTDECA_OK);
   ASSERT_GT(port, 0u);
   const std::string path = temp_path("received.sdrec");
   softdeca_recording_header h = header();
@@ -178,14 +178,14 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
   softdeca_frame f = blank_frame();
   softdeca_bool got = 0;
   for (int i = 0; i < 10; ++i) {
-    ASSERT_EQ(softdeca_receiver_next(r, 10.0, &f, &got), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_receiver_get_next(r, 10.0, &f, &got), SOFTDECA_OK);
     ASSERT_EQ(got, 1);
     EXPECT_EQ(f.sequence, static_cast<uint32_t>(i));
     EXPECT_EQ(f.flags & SOFTDECA_FRAME_HAS_SEQUENCE, SOFTDECA_FRAME_HAS_SEQUENCE);
   }
-  ASSERT_EQ(softdeca_receiver_latest(r, &f, &got), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_receiver_get_latest(r, &f, &got), SOFTDECA_OK);
   EXPECT_EQ(f.sequence, 9u);
-  ASSERT_EQ(softdeca_receiver_next(r, 0, &f, &got), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_receiver_get_next(r, 0, &f, &got), SOFTDECA_OK);
   EXPECT_EQ(got, 0);
   softdeca_receiver_stats st{};
   st.struct_size = sizeof st;
@@ -197,7 +197,7 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
   EXPECT_EQ(recorded, 10u);
   uint32_t id = 1;
   uint32_t count = 9;
-  ASSERT_EQ(softdeca_receiver_profile(r, &id, nullptr, 0, &count), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_receiver_get_profile(r, &id, nullptr, 0, &count), SOFTDECA_OK);
   EXPECT_EQ(count, 0u);
   EXPECT_EQ(id, 0u);
   softdeca_bool sent = 0;
@@ -206,10 +206,10 @@ TEST(StreamCAbi, ReceivesRecordsAndReportsOverLoopback) {
   softdeca_receiver_destroy(r);
 
   softdeca_player* p = nullptr;
-  ASSERT_EQ(softdeca_player_open(path.c_str(), &p), SOFTDECA_OK);
+  ASSERT_EQ(softdeca_player_load(path.c_str(), &p), SOFTDECA_OK);
   softdeca_recording_info info{};
   info.struct_size = sizeof info;
-  softdeca_player_info(p, &info);
+  softdeca_player_get_info(p, &info);
   EXPECT_EQ(info.frame_count, 10u);
   softdeca_player_destroy(p);
   std::remove(path.c_str());

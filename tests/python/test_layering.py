@@ -99,7 +99,12 @@ def test_the_command_line_comes_in_by_its_documented_way() -> None:
         ]
     assert offenders == []
     # fitting and evaluating avatars: the C ABI's calls, never the runtime's classes
-    for name in ("cmd_fit.cpp", "cmd_replay.cpp", "runtime_session.cpp", "replay_avatar.cpp"):
+    for name in (
+        "cmd_fit.cpp",
+        "cmd_replay.cpp",
+        "runtime_session.cpp",
+        "replay_avatar.cpp",
+    ):
         text = (CLI / name).read_text(encoding="utf-8")
         assert "runtime::" not in text and "fit::" not in text, name
 

@@ -1,5 +1,5 @@
 /// ARKit's 52 blendshapes in the product's canonical order: the alphabetical order of
-/// `ARFaceAnchor.BlendShapeLocation` raw values, as in the C ABI (`softdeca_blendshape_name`). The
+/// `ARFaceAnchor.BlendShapeLocation` raw values, as in the C ABI (`softdeca_blendshape_get_name`). The
 /// list is plugin/data/face_names.json's (a test checks this copy against that file).
 public enum ARKitBlendshapes {
     public static let names: [String] = [

@@ -16,7 +16,7 @@
  *      travel as int32_t).
  *   3. Every function returns a softdeca_status, except: the *_destroy functions, which return
  *      void and accept NULL (a no-op); and the static queries softdeca_abi_version,
- *      softdeca_version, softdeca_last_error, softdeca_status_name and softdeca_blendshape_name.
+ *      softdeca_version, softdeca_last_error, softdeca_status_name and softdeca_blendshape_get_name.
  *      On failure the reason is available from softdeca_last_error() on the same thread, and
  *      output buffers are left untouched.
  *   4. Booleans are softdeca_bool (int32_t): 0 is false, 1 is true; inputs take any non-zero
@@ -25,7 +25,7 @@
  *      into meshes (triangles, tetrahedra, vertex lists, landmark profiles) are int32_t.
  *      Only running totals in *_stats structs (frames, datagrams, bytes) are uint64_t.
  *   6. Parameters: every parameter list has a count, a softdeca_parameter_info by index and a
- *      lookup by name (softdeca_parameter_find for the simulator's, softdeca_model_find_parameter
+ *      lookup by name (softdeca_sim_find_parameter for the simulator's, softdeca_model_find_parameter
  *      for a bundle's). Every function that reads or writes a parameter takes its uint32_t
  *      index, so any parameter is addressable by index directly and by name through the lookup.
  *      Scalar parameter values are double; per-element maps are float arrays.
@@ -33,6 +33,18 @@
  *      non-finite values are rejected with a status, never with a crash or an exception.
  *   8. No callbacks into the caller; strings are NUL-terminated UTF-8, owned by the library when
  *      returned (their lifetime is stated) and copied when passed in.
+ *   9. Names. A function is softdeca_<noun>_<verb>[_<what>]: the noun is the handle it acts on
+ *      (model, avatar, avatar_fit, sim, player, receiver, recorder) or the list it reads
+ *      (blendshape), written once and first. A handle is made by _create (from values) or _load
+ *      (from a file or bytes: a bundle, a saved fit, a recording; _load_memory for bytes) and
+ *      released by _destroy. Reading is _get_<what> (_get_<what>_count for a count), changing
+ *      is _set_<what>, finding an index by name is _find_<what>; every other verb says what
+ *      the call does (evaluate, prepare, calibrate, reset, save, seek, advance, write, start,
+ *      stop, request, solve, step). A struct's defaults come from <struct>_init. Calls on no
+ *      handle start with their verb (softdeca_convert_..., softdeca_export_...,
+ *      softdeca_embed_points, softdeca_compute_tet_volumes), and four library-wide queries keep
+ *      the C idiom: softdeca_abi_version, softdeca_version, softdeca_last_error and
+ *      softdeca_status_name. tests/python/test_abi_names.py holds every declaration to this.
  *
  * Units are metres; the frame is right-handed, +Y up, +Z out of the face (ARKit's face-anchor
  * frame). Arrays of 3D points are packed xyz floats. The library keeps no global mutable state
@@ -73,7 +85,7 @@ typedef enum softdeca_status {
 } softdeca_status;
 
 /* The version of the ABI convention and signatures in this header; see softdeca_abi_version. */
-#define SOFTDECA_ABI_VERSION 2u
+#define SOFTDECA_ABI_VERSION 3u
 
 /* softdeca_bool: 0 false, 1 true (inputs: non-zero is true). */
 typedef int32_t softdeca_bool;
@@ -173,7 +185,7 @@ SOFTDECA_API softdeca_status softdeca_model_get_info(const softdeca_model* model
  * an avatar made from it lives. Per-face / per-vertex maps are accepted unless domain is
  * "global". */
 struct softdeca_parameter_info;
-SOFTDECA_API softdeca_status softdeca_model_get_parameter(const softdeca_model* model, uint32_t index,
+SOFTDECA_API softdeca_status softdeca_model_get_parameter_info(const softdeca_model* model, uint32_t index,
                                                           struct softdeca_parameter_info* out_info);
 /* Index of a parameter by name; SOFTDECA_ERROR_INVALID_ARGUMENT if there is none. */
 SOFTDECA_API softdeca_status softdeca_model_find_parameter(const softdeca_model* model, const char* name,
@@ -201,19 +213,45 @@ typedef enum softdeca_precision {
   SOFTDECA_PRECISION_INT8 = 2   /* int8 with a scale per 8 elements and latent: a quarter of float */
 } softdeca_precision;
 
-typedef struct softdeca_avatar_desc {
-  uint32_t struct_size;            /* sizeof(softdeca_avatar_desc) */
-  const float* neutral;     /* vertex_count * 3 floats: the avatar's neutral head       */
-  uint32_t vertex_count;      /* must equal head_vertex_count                              */
-  const int32_t* triangles; /* triangle_count * 3 indices over the whole head: normals   */
+typedef struct softdeca_avatar_fit softdeca_avatar_fit; /* opaque: a user's own avatar, below */
+
+/* An avatar mesh in its own coordinates (right-handed: a left-handed host mirrors one axis)
+ * and its own units. The mesh may be several parts (head, eyes, teeth, body) concatenated.
+ * A mesh in the bundle's template topology (the template path) has head_vertex_count vertices,
+ * is in metres in the library's frame, and may come without shapes (blendshapes NULL,
+ * blendshape_count 0: then only evaluate_surface and evaluate_landmarks run). */
+typedef struct softdeca_avatar_mesh {
+  uint32_t struct_size;      /* sizeof(softdeca_avatar_mesh) */
+  const float* neutral;      /* vertex_count * 3 floats */
+  uint32_t vertex_count;     /* 3 .. SOFTDECA_MAX_AVATAR_VERTICES */
+  const int32_t* triangles;  /* triangle_count * 3 vertex indices */
   uint32_t triangle_count;
-  const float* blendshapes; /* NULL, or blendshape_count * vertex_count * 3 floats: the
-                               avatar's own 52 ARKit shapes (or the template's) as deltas
-                               from the neutral, canonical order                         */
-  uint32_t blendshape_count;  /* 0 or 52 */
-  uint32_t threads;         /* threads per frame: 0 or 1 the caller only; 2 or more: the
-                               caller plus helper threads owned by the avatar (max 8)    */
-  int32_t precision;        /* softdeca_precision */
+  const float* blendshapes;  /* 52 * vertex_count * 3 floats: the rig's ARKit shapes as deltas in
+                                canonical order; a shape the rig lacks is all zeros (found by
+                                softdeca_blendshape_find_index from the rig's own names) */
+  uint32_t blendshape_count; /* 52 (0 with blendshapes NULL: the template path only) */
+  const float* landmarks;    /* NULL, or landmark_count * 3 floats: the bundle's landmarks on the
+                                avatar's neutral, in the bundle's order (optional guides; needed
+                                only for a rig without ARKit shapes) */
+  uint32_t landmark_count;   /* 0 or the bundle's landmark_count (for the fit; an avatar ignores
+                                them) */
+} softdeca_avatar_mesh;
+
+#define SOFTDECA_MAX_AVATAR_VERTICES 4000000u
+
+/* One avatar, whichever mesh the user has: a mesh in the template's topology with no fit (the
+ * template path), or any mesh with the fit made for it (softdeca_avatar_fit_create or _load;
+ * checked by a hash of the mesh's neutral and triangles: a changed mesh is refused with
+ * SOFTDECA_ERROR_FORMAT). Every softdeca_avatar_* call then works in the mesh's own vertices
+ * (outputs hold vertex_count vertices; parameter maps are given per mesh triangle or vertex),
+ * except evaluate_surface, which takes a surface in the template's topology (no fit). */
+typedef struct softdeca_avatar_desc {
+  uint32_t struct_size;               /* sizeof(softdeca_avatar_desc) */
+  const softdeca_avatar_mesh* mesh;   /* the avatar's mesh (its arrays are copied) */
+  const softdeca_avatar_fit* fit;     /* NULL: mesh is in the template's topology; else mesh's fit */
+  uint32_t threads;                   /* threads per frame: 0 or 1 the caller only; 2 or more: the
+                                         caller plus helper threads owned by the avatar (max 8) */
+  int32_t precision;                  /* softdeca_precision */
 } softdeca_avatar_desc;
 
 /* Checks the mesh (sizes, finite values, indices, no degenerate skin triangle) and runs the
@@ -223,7 +261,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
 /* NULL is a no-op. */
 SOFTDECA_API void softdeca_avatar_destroy(softdeca_avatar* avatar);
 
-/* Material parameters (see softdeca_model_get_parameter), effective at the next prepare.
+/* Material parameters (see softdeca_model_get_parameter_info), effective at the next prepare.
  * A global value replaces any map. Maps give one value per skin triangle (skin_triangle_count,
  * in the bundle's triangulation) or per skin vertex (skin_vertex_count); the other element
  * kind is derived (face -> vertex: area-weighted mean of the incident faces; vertex -> face:
@@ -327,29 +365,8 @@ SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* av
  * SoftDECA and SparseSoftDECA on the registered template and returns the avatar's own
  * vertices: its own linear blend plus the physics' correction carried through the embedding
  * (docs/avatars.md). Vertices away from the face move exactly as the avatar's rig moves them.
- * Needs a bundle with the template head (format version 5). */
-
-typedef struct softdeca_avatar_fit softdeca_avatar_fit;
-
-/* An avatar mesh in its own coordinates (right-handed: a left-handed host mirrors one axis)
- * and its own units. The mesh may be several parts (head, eyes, teeth, body) concatenated. */
-typedef struct softdeca_avatar_mesh {
-  uint32_t struct_size;      /* sizeof(softdeca_avatar_mesh) */
-  const float* neutral;      /* vertex_count * 3 floats */
-  uint32_t vertex_count;     /* 3 .. SOFTDECA_MAX_AVATAR_VERTICES */
-  const int32_t* triangles;  /* triangle_count * 3 vertex indices */
-  uint32_t triangle_count;
-  const float* blendshapes;  /* 52 * vertex_count * 3 floats: the rig's ARKit shapes as deltas in
-                                canonical order; a shape the rig lacks is all zeros (found by
-                                softdeca_blendshape_index from the rig's own names) */
-  uint32_t blendshape_count; /* 52 */
-  const float* landmarks;    /* NULL, or landmark_count * 3 floats: the bundle's landmarks on the
-                                avatar's neutral, in the bundle's order (optional guides; needed
-                                only for a rig without ARKit shapes) */
-  uint32_t landmark_count;   /* 0 or the bundle's landmark_count */
-} softdeca_avatar_mesh;
-
-#define SOFTDECA_MAX_AVATAR_VERTICES 4000000u
+ * Needs a bundle with the template head (format version 5). The avatar is made by
+ * softdeca_avatar_create with the fit in its softdeca_avatar_desc. */
 
 typedef struct softdeca_fit_options {
   uint32_t struct_size;     /* sizeof(softdeca_fit_options) */
@@ -390,7 +407,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_load(const softdeca_model* mode
  * docs/avatars.md): NUL-terminated into buffer when
  * capacity suffices; *out_length (may be NULL) receives the length without the NUL either way
  * (SOFTDECA_ERROR_BUFFER_TOO_SMALL when it does not fit). */
-SOFTDECA_API softdeca_status softdeca_avatar_fit_report(const softdeca_avatar_fit* fit, char* buffer,
+SOFTDECA_API softdeca_status softdeca_avatar_fit_get_report(const softdeca_avatar_fit* fit, char* buffer,
                                                         uint32_t capacity, uint32_t* out_length);
 
 /* The registered template skin (skin_vertex_count points) in the avatar's units and axes, and
@@ -398,15 +415,6 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_report(const softdeca_avatar_fi
 SOFTDECA_API softdeca_status softdeca_avatar_fit_get_registered(const softdeca_avatar_fit* fit, float* out_points,
                                                                 uint32_t point_capacity, uint32_t* out_vertex_count);
 
-/* An avatar on the user's own mesh: `mesh` is the mesh the fit was made for (checked by a hash
- * of its neutral and triangles: a changed mesh is refused with SOFTDECA_ERROR_FORMAT). Every
- * softdeca_avatar_* call then works in the avatar's own vertices (outputs hold vertex_count
- * vertices; parameter maps are given per avatar triangle or vertex and reach the template
- * through the fit), except evaluate_surface, which needs the template's topology.
- * threads and precision as in softdeca_avatar_desc. */
-SOFTDECA_API softdeca_status softdeca_avatar_create_fitted(const softdeca_model* model, const softdeca_avatar_fit* fit,
-                                                           const softdeca_avatar_mesh* mesh, uint32_t threads,
-                                                           int32_t precision, softdeca_avatar** out_avatar);
 
 /* ---- Geometry -------------------------------------------------------------------------- */
 
@@ -430,7 +438,7 @@ SOFTDECA_API softdeca_status softdeca_embed_points(
 
 /* Signed volumes of tetrahedra (positive for the orientation of the layered head model;
  * (b-a) . ((c-a) x (d-a)) / 6). out_volumes holds tet_count floats. */
-SOFTDECA_API softdeca_status softdeca_tet_volumes(
+SOFTDECA_API softdeca_status softdeca_compute_tet_volumes(
     const float* vertices, uint32_t vertex_count, const int32_t* tets, uint32_t tet_count,
     float* out_volumes);
 
@@ -442,7 +450,7 @@ SOFTDECA_API softdeca_status softdeca_tet_volumes(
  * skull wraps, skull, eyes) and whose output skin S rides in the outer tet layer through a fixed
  * barycentric embedding. Soft Dirichlet targets on S (and landmarks, SparseSoftDECA) drive it.
  * The material parameters p are the list of plugin/data/parameters.json, compiled in:
- * enumerate it with softdeca_parameter_count / softdeca_parameter_get_info.
+ * enumerate it with softdeca_sim_get_parameter_count / softdeca_sim_get_parameter_info.
  * Arrays are packed row by row.
  */
 
@@ -460,12 +468,12 @@ typedef struct softdeca_parameter_info {
   softdeca_bool log_scale;      /* sample uniformly in log space */
 } softdeca_parameter_info;
 
-SOFTDECA_API softdeca_status softdeca_parameter_count(uint32_t* out_count);
-SOFTDECA_API softdeca_status softdeca_parameter_get_info(uint32_t index, softdeca_parameter_info* out_info);
+SOFTDECA_API softdeca_status softdeca_sim_get_parameter_count(uint32_t* out_count);
+SOFTDECA_API softdeca_status softdeca_sim_get_parameter_info(uint32_t index, softdeca_parameter_info* out_info);
 /* Index of a simulator parameter by name; SOFTDECA_ERROR_INVALID_ARGUMENT if there is none. */
-SOFTDECA_API softdeca_status softdeca_parameter_find(const char* name, uint32_t* out_index);
+SOFTDECA_API softdeca_status softdeca_sim_find_parameter(const char* name, uint32_t* out_index);
 /* plugin/data/parameters.json as compiled in (static string, never freed). */
-SOFTDECA_API softdeca_status softdeca_parameters_json(const char** out_json);
+SOFTDECA_API softdeca_status softdeca_sim_get_parameters_json(const char** out_json);
 
 /* One side of a lip or teeth collision: skin points that must stay on the outer side of an
  * oriented surface (normals by the right-hand rule point to where the points belong). */
@@ -523,7 +531,7 @@ typedef struct softdeca_sim_settings {
 } softdeca_sim_settings;
 
 /* Fills the defaults (struct_size must be set). */
-SOFTDECA_API softdeca_status softdeca_sim_default_settings(softdeca_sim_settings* settings);
+SOFTDECA_API softdeca_status softdeca_sim_settings_init(softdeca_sim_settings* settings);
 
 /* Validates the mesh and creates a simulator with the default parameters. settings may be
  * NULL. The arrays are copied; the caller may free them afterwards. */
@@ -533,11 +541,11 @@ SOFTDECA_API softdeca_status softdeca_sim_create(const softdeca_sim_mesh* mesh,
 /* NULL is a no-op. */
 SOFTDECA_API void softdeca_sim_destroy(softdeca_sim* sim);
 
-SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, uint32_t* out_count);
-SOFTDECA_API softdeca_status softdeca_sim_skin_count(const softdeca_sim* sim, uint32_t* out_count);
+SOFTDECA_API softdeca_status softdeca_sim_get_vertex_count(const softdeca_sim* sim, uint32_t* out_count);
+SOFTDECA_API softdeca_status softdeca_sim_get_skin_count(const softdeca_sim* sim, uint32_t* out_count);
 
-/* Parameter `index` of the simulator's list (softdeca_parameter_get_info; by name through
- * softdeca_parameter_find) set to one value everywhere (out of range: INVALID_ARGUMENT, nothing
+/* Parameter `index` of the simulator's list (softdeca_sim_get_parameter_info; by name through
+ * softdeca_sim_find_parameter) set to one value everywhere (out of range: INVALID_ARGUMENT, nothing
  * changes). */
 SOFTDECA_API softdeca_status softdeca_sim_set_parameter(softdeca_sim* sim, uint32_t index, double value);
 SOFTDECA_API softdeca_status softdeca_sim_get_parameter(const softdeca_sim* sim, uint32_t index,
@@ -601,7 +609,7 @@ SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, floa
 /* ==== Streaming and recorded takes =====================================================
  * Face frames arrive live over UDP (our protocol, docs/protocol.md; Epic's Live Link Face app;
  * iFacialMocap) or from recording files (docs/recording.md), and all come out as one canonical
- * frame: 52 weights in canonical ARKit order (softdeca_blendshape_name), poses and landmarks in
+ * frame: 52 weights in canonical ARKit order (softdeca_blendshape_get_name), poses and landmarks in
  * metres in ARKit's face-anchor frame.
  * The receiver's functions may be called from any thread, concurrently, except
  * softdeca_receiver_destroy, which must follow every other call on that receiver; a recorder or
@@ -613,14 +621,14 @@ SOFTDECA_API softdeca_status softdeca_sim_get_skin(const softdeca_sim* sim, floa
 
 /* Canonical name of blendshape `index` ("browDownLeft" = 0 ... "tongueOut" = 51), or NULL when
  * index >= 52. Static strings. */
-SOFTDECA_API const char* softdeca_blendshape_name(uint32_t index);
+SOFTDECA_API const char* softdeca_blendshape_get_name(uint32_t index);
 
 /* The canonical index of the ARKit blendshape a rig's own shape name denotes, or -1 in
  * *out_index: ARKit's names in any case, behind a prefix or namespace ("blendShape1.eyeBlinkLeft",
  * "AK_07_EyeBlinkLeft"), with the side as a suffix ("eyeBlink_L", "eyeBlink.R", "eyeBlinkL"),
  * in snake case ("mouth_smile_l"); a word after the name ("eyeBlinkLeft_corrective") means no
  * match. The one rule of the product for rigs' names (docs/avatars.md). */
-SOFTDECA_API softdeca_status softdeca_blendshape_index(const char* name, int32_t* out_index);
+SOFTDECA_API softdeca_status softdeca_blendshape_find_index(const char* name, int32_t* out_index);
 
 typedef enum softdeca_tracking {
   SOFTDECA_TRACKING_LOST = 0,
@@ -672,8 +680,8 @@ typedef struct softdeca_receiver_config {
   int32_t format;           /* softdeca_stream_format */
   const char* bind_address; /* numeric IPv4 or IPv6 address; NULL: "127.0.0.1" (loopback), or
                              * "0.0.0.0" (all IPv4) with listen_network */
-  uint32_t port;            /* 0: any free port (softdeca_receiver_port tells which) */
-  uint32_t queue_capacity;  /* delivered frames kept for softdeca_receiver_next, 1 to 65536 */
+  uint32_t port;            /* 0: any free port (softdeca_receiver_get_port tells which) */
+  uint32_t queue_capacity;  /* delivered frames kept for softdeca_receiver_get_next, 1 to 65536 */
   double jitter_delay;      /* seconds in [0, 5] that frames wait to be put in order; 0: none */
   /* Security (docs/security.md). */
   softdeca_bool listen_network; /* 1: may bind a network address; 0: loopback addresses only */
@@ -694,15 +702,15 @@ SOFTDECA_API softdeca_status softdeca_receiver_create(const softdeca_receiver_co
                                                       softdeca_receiver** out_receiver);
 /* Stops the thread and frees the receiver (and ends its recording). NULL is ignored. */
 SOFTDECA_API void softdeca_receiver_destroy(softdeca_receiver* receiver);
-SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* receiver,
+SOFTDECA_API softdeca_status softdeca_receiver_get_port(const softdeca_receiver* receiver,
                                                     uint32_t* out_port);
 /* The oldest delivered frame not yet taken, waiting up to `timeout` seconds (0: do not wait).
  * *out_received is true when a frame was written, else false. */
-SOFTDECA_API softdeca_status softdeca_receiver_next(softdeca_receiver* receiver, double timeout,
+SOFTDECA_API softdeca_status softdeca_receiver_get_next(softdeca_receiver* receiver, double timeout,
                                                     softdeca_frame* out_frame,
                                                     softdeca_bool* out_received);
 /* The newest delivered frame, taken or not (what an avatar shows now). */
-SOFTDECA_API softdeca_status softdeca_receiver_latest(const softdeca_receiver* receiver,
+SOFTDECA_API softdeca_status softdeca_receiver_get_latest(const softdeca_receiver* receiver,
                                                       softdeca_frame* out_frame,
                                                       softdeca_bool* out_received);
 
@@ -744,11 +752,11 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
 /* The landmark profile of the newest landmark frames (else the newest profile received):
  * its id and ARKit vertex indices. *out_count is always set to the profile's size (0 and id 0
  * when there is none yet); SOFTDECA_ERROR_BUFFER_TOO_SMALL when capacity is smaller. */
-SOFTDECA_API softdeca_status softdeca_receiver_profile(const softdeca_receiver* receiver,
+SOFTDECA_API softdeca_status softdeca_receiver_get_profile(const softdeca_receiver* receiver,
                                                        uint32_t* out_id, int32_t* out_indices,
                                                        uint32_t capacity, uint32_t* out_count);
 /* The sender's neutral face mesh (calibration), xyz per vertex; *out_vertex_count as above. */
-SOFTDECA_API softdeca_status softdeca_receiver_neutral(const softdeca_receiver* receiver,
+SOFTDECA_API softdeca_status softdeca_receiver_get_neutral(const softdeca_receiver* receiver,
                                                        float* out_xyz, uint32_t vertex_capacity,
                                                        uint32_t* out_vertex_count);
 /* Asks the current sender (our protocol) for its neutral mesh; *out_sent false without a sender. */
@@ -818,16 +826,16 @@ typedef struct softdeca_player softdeca_player;
  * (docs/recording.md, "Values"). SOFTDECA_ERROR_FORMAT when its header is unreadable, it has
  * no frame or it is over 1 GiB; SOFTDECA_ERROR_INVALID_ARGUMENT when `path` is not a regular
  * file (a FIFO, a folder: refused without blocking). */
-SOFTDECA_API softdeca_status softdeca_player_open(const char* path, softdeca_player** out_player);
+SOFTDECA_API softdeca_status softdeca_player_load(const char* path, softdeca_player** out_player);
 /* NULL is ignored. */
 SOFTDECA_API void softdeca_player_destroy(softdeca_player* player);
-SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player,
+SOFTDECA_API softdeca_status softdeca_player_get_info(const softdeca_player* player,
                                                   softdeca_recording_info* out_info);
 /* Frame `index` as recorded (frames sorted by capture time). */
-SOFTDECA_API softdeca_status softdeca_player_frame(const softdeca_player* player, uint32_t index,
+SOFTDECA_API softdeca_status softdeca_player_get_frame(const softdeca_player* player, uint32_t index,
                                                    softdeca_frame* out_frame);
 /* The frame `time` seconds after the first (clamped to the recording), interpolated. */
-SOFTDECA_API softdeca_status softdeca_player_frame_at(const softdeca_player* player, double time,
+SOFTDECA_API softdeca_status softdeca_player_get_frame_at(const softdeca_player* player, double time,
                                                       softdeca_frame* out_frame);
 SOFTDECA_API softdeca_status softdeca_player_seek(softdeca_player* player, double time);
 /* Playback speed in [0, 1000]; 1 is real time, 0 pauses. */
@@ -838,13 +846,13 @@ SOFTDECA_API softdeca_status softdeca_player_set_loop(softdeca_player* player, s
 SOFTDECA_API softdeca_status softdeca_player_advance(softdeca_player* player, double dt,
                                                      softdeca_frame* out_frame,
                                                      softdeca_bool* out_ended);
-SOFTDECA_API softdeca_status softdeca_player_position(const softdeca_player* player,
+SOFTDECA_API softdeca_status softdeca_player_get_position(const softdeca_player* player,
                                                       double* out_time);
 /* The recording's newest landmark profile and neutral mesh, as for the receiver. */
-SOFTDECA_API softdeca_status softdeca_player_profile(const softdeca_player* player,
+SOFTDECA_API softdeca_status softdeca_player_get_profile(const softdeca_player* player,
                                                      uint32_t* out_id, int32_t* out_indices,
                                                      uint32_t capacity, uint32_t* out_count);
-SOFTDECA_API softdeca_status softdeca_player_neutral(const softdeca_player* player,
+SOFTDECA_API softdeca_status softdeca_player_get_neutral(const softdeca_player* player,
                                                      float* out_xyz, uint32_t vertex_capacity,
                                                      uint32_t* out_vertex_count);
 

@@ -137,7 +137,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_load(const softdeca_model* mode
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_fit_report(const softdeca_avatar_fit* fit, char* buffer, uint32_t capacity,
+SOFTDECA_API softdeca_status softdeca_avatar_fit_get_report(const softdeca_avatar_fit* fit, char* buffer, uint32_t capacity,
                                                         uint32_t* out_length) {
   return guarded(__func__, [&] {
     const std::string& r = fit_of(fit).fit.report;
@@ -170,24 +170,23 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_get_registered(const softdeca_a
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_avatar_create_fitted(const softdeca_model* model, const softdeca_avatar_fit* fit,
-                                                           const softdeca_avatar_mesh* mesh, uint32_t threads, int32_t precision,
-                                                           softdeca_avatar** out_avatar) {
-  return guarded(__func__, [&] {
-    const runtime::Model& m = model_of(model);
-    const softdeca_avatar_fit& f = fit_of(fit);
-    require_not_null(out_avatar, "out_avatar");
-    require(f.bundle_sha256 == m.manifest_sha256(), "the fit was made for another bundle: fit the avatar again with this one");
-    const fit::AvatarMesh a = mesh_of(mesh, m);
-    require(threads <= 8, "threads must be at most 8");
-    runtime::FittedAvatarDesc d;
-    d.fit = &f.fit;
-    d.mesh = &a;
-    d.threads = threads == 0 ? 1 : threads;
-    d.precision = precision_of(precision, "precision");
-    create_handle(out_avatar, "out_avatar",
-                  [&](softdeca_avatar& h) { h.fitted = std::make_unique<runtime::FittedAvatar>(model->model, d); });
-  });
+}  // extern "C"
+
+namespace softdeca {
+
+std::unique_ptr<runtime::FittedAvatar> fitted_avatar(const softdeca_model* model, const softdeca_avatar_fit* fit,
+                                                     const softdeca_avatar_mesh* mesh, std::size_t threads,
+                                                     runtime::Precision precision) {
+  const runtime::Model& m = model_of(model);
+  const softdeca_avatar_fit& f = fit_of(fit);
+  require(f.bundle_sha256 == m.manifest_sha256(), "the fit was made for another bundle: fit the avatar again with this one");
+  const fit::AvatarMesh a = mesh_of(mesh, m);
+  runtime::FittedAvatarDesc d;
+  d.fit = &f.fit;
+  d.mesh = &a;
+  d.threads = threads;
+  d.precision = precision;
+  return std::make_unique<runtime::FittedAvatar>(model->model, d);
 }
 
-}  // extern "C"
+}  // namespace softdeca

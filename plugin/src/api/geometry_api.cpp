@@ -64,7 +64,7 @@ SOFTDECA_API softdeca_status softdeca_embed_points(const float* vertices, uint32
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_tet_volumes(const float* vertices, uint32_t vertex_count,
+SOFTDECA_API softdeca_status softdeca_compute_tet_volumes(const float* vertices, uint32_t vertex_count,
                                                   const int32_t* tets, uint32_t tet_count,
                                                   float* out_volumes) {
   return guarded(__func__, [&] {

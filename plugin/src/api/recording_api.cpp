@@ -121,7 +121,7 @@ SOFTDECA_API void softdeca_recorder_destroy(softdeca_recorder* recorder) {
   destroy_handle(__func__, recorder);
 }
 
-SOFTDECA_API softdeca_status softdeca_player_open(const char* path, softdeca_player** out_player) {
+SOFTDECA_API softdeca_status softdeca_player_load(const char* path, softdeca_player** out_player) {
   return guarded(__func__, [&] {
     require_not_null(path, "path");
     create_handle(out_player, "out_player", [&](softdeca_player& p) {
@@ -134,7 +134,7 @@ SOFTDECA_API void softdeca_player_destroy(softdeca_player* player) {
   destroy_handle(__func__, player);
 }
 
-SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player, softdeca_recording_info* out) {
+SOFTDECA_API softdeca_status softdeca_player_get_info(const softdeca_player* player, softdeca_recording_info* out) {
   return guarded(__func__, [&] {
     const auto& p = player_of(player);
     require_struct(out, "out_info");
@@ -152,7 +152,7 @@ SOFTDECA_API softdeca_status softdeca_player_info(const softdeca_player* player,
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_player_frame(const softdeca_player* player, uint32_t index,
+SOFTDECA_API softdeca_status softdeca_player_get_frame(const softdeca_player* player, uint32_t index,
                                                    softdeca_frame* out_frame) {
   return guarded(__func__, [&] {
     const auto& p = player_of(player);
@@ -163,7 +163,7 @@ SOFTDECA_API softdeca_status softdeca_player_frame(const softdeca_player* player
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_player_frame_at(const softdeca_player* player, double time,
+SOFTDECA_API softdeca_status softdeca_player_get_frame_at(const softdeca_player* player, double time,
                                                       softdeca_frame* out_frame) {
   return guarded(__func__, [&] {
     const auto& p = player_of(player);
@@ -197,7 +197,7 @@ SOFTDECA_API softdeca_status softdeca_player_advance(softdeca_player* player, do
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_player_position(const softdeca_player* player, double* out_time) {
+SOFTDECA_API softdeca_status softdeca_player_get_position(const softdeca_player* player, double* out_time) {
   return guarded(__func__, [&] {
     const auto& p = player_of(player);
     require_not_null(out_time, "out_time");
@@ -205,7 +205,7 @@ SOFTDECA_API softdeca_status softdeca_player_position(const softdeca_player* pla
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_player_profile(const softdeca_player* player, uint32_t* out_id,
+SOFTDECA_API softdeca_status softdeca_player_get_profile(const softdeca_player* player, uint32_t* out_id,
                                                      int32_t* out_indices, uint32_t capacity, uint32_t* out_count) {
   return guarded(__func__, [&] {
     const auto& profiles = player_of(player).recording().profiles;
@@ -213,7 +213,7 @@ SOFTDECA_API softdeca_status softdeca_player_profile(const softdeca_player* play
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_player_neutral(const softdeca_player* player, float* out_xyz,
+SOFTDECA_API softdeca_status softdeca_player_get_neutral(const softdeca_player* player, float* out_xyz,
                                                      uint32_t vertex_capacity, uint32_t* out_vertex_count) {
   return guarded(__func__, [&] {
     abi::neutral_to_abi(player_of(player).recording().neutral, out_xyz, vertex_capacity, out_vertex_count);

@@ -107,7 +107,7 @@ SOFTDECA_API softdeca_status softdeca_model_get_info(const softdeca_model* model
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_model_get_parameter(const softdeca_model* model, uint32_t index,
+SOFTDECA_API softdeca_status softdeca_model_get_parameter_info(const softdeca_model* model, uint32_t index,
                                                           softdeca_parameter_info* out_info) {
   return guarded(__func__, [&] {
     const Model& m = model_of(model);
@@ -193,32 +193,44 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
     const Model& m = model_of(model);
     require_struct(desc, "desc");
     require_not_null(out_avatar, "out_avatar");
-    const std::size_t vh = static_cast<std::size_t>(m.manifest().head_vertices);
-    require_not_null(desc->neutral, "desc->neutral");
-    require(desc->vertex_count == vh, "desc->vertex_count is " + std::to_string(desc->vertex_count) +
-                                          "; the bundle's template has " + std::to_string(vh) + " head vertices");
-    require_finite(desc->neutral, vh * 3, "desc->neutral");
-    require_not_null(desc->triangles, "desc->triangles");
-    require(desc->triangle_count >= 1 && desc->triangle_count < (std::size_t{1} << 28), "desc->triangle_count is out of range");
-    for (std::size_t i = 0; i < desc->triangle_count * 3; ++i)
-      require(desc->triangles[i] >= 0 && static_cast<std::size_t>(desc->triangles[i]) < vh,
-              "desc->triangles[" + std::to_string(i) + "] = " + std::to_string(desc->triangles[i]) + " is not a vertex index");
-    require(desc->blendshape_count == 0 || desc->blendshape_count == runtime::kBlendshapeCount,
-            "desc->blendshape_count must be 0 or 52");
-    if (desc->blendshape_count) {
-      require_not_null(desc->blendshapes, "desc->blendshapes");
-      require_finite(desc->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->blendshapes");
-    }
     require(desc->threads <= kMaxThreads, "desc->threads must be at most " + std::to_string(kMaxThreads));
+    const std::size_t threads = desc->threads == 0 ? 1 : desc->threads;
+    const runtime::Precision precision = precision_of(desc->precision, "desc->precision");
+    if (desc->fit) {  // any mesh, on its fit
+      create_handle(out_avatar, "out_avatar", [&](softdeca_avatar& h) {
+        h.fitted = fitted_avatar(model, desc->fit, desc->mesh, threads, precision);
+      });
+      return;
+    }
+    // the template path: the mesh in the template's topology
+    const softdeca_avatar_mesh* mesh = desc->mesh;
+    require_struct(mesh, "desc->mesh");
+    const std::size_t vh = static_cast<std::size_t>(m.manifest().head_vertices);
+    require_not_null(mesh->neutral, "desc->mesh->neutral");
+    require(mesh->vertex_count == vh, "desc->mesh->vertex_count is " + std::to_string(mesh->vertex_count) +
+                                          "; the bundle's template has " + std::to_string(vh) +
+                                          " head vertices (another mesh needs its fit in desc->fit)");
+    require_finite(mesh->neutral, vh * 3, "desc->mesh->neutral");
+    require_not_null(mesh->triangles, "desc->mesh->triangles");
+    require(mesh->triangle_count >= 1 && mesh->triangle_count < (std::size_t{1} << 28), "desc->mesh->triangle_count is out of range");
+    for (std::size_t i = 0; i < mesh->triangle_count * 3; ++i)
+      require(mesh->triangles[i] >= 0 && static_cast<std::size_t>(mesh->triangles[i]) < vh,
+              "desc->mesh->triangles[" + std::to_string(i) + "] = " + std::to_string(mesh->triangles[i]) + " is not a vertex index");
+    require(mesh->blendshape_count == 0 || mesh->blendshape_count == runtime::kBlendshapeCount,
+            "desc->mesh->blendshape_count must be 0 or 52");
+    if (mesh->blendshape_count) {
+      require_not_null(mesh->blendshapes, "desc->mesh->blendshapes");
+      require_finite(mesh->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->mesh->blendshapes");
+    }
     runtime::AvatarDesc d;
-    d.neutral = desc->neutral;
+    d.neutral = mesh->neutral;
     d.vertex_count = vh;
-    d.triangles = desc->triangles;
-    d.triangle_count = desc->triangle_count;
-    d.blendshapes = desc->blendshape_count ? desc->blendshapes : nullptr;
-    d.blendshape_count = desc->blendshape_count;
-    d.threads = desc->threads == 0 ? 1 : desc->threads;
-    d.precision = precision_of(desc->precision, "desc->precision");
+    d.triangles = mesh->triangles;
+    d.triangle_count = mesh->triangle_count;
+    d.blendshapes = mesh->blendshape_count ? mesh->blendshapes : nullptr;
+    d.blendshape_count = mesh->blendshape_count;
+    d.threads = threads;
+    d.precision = precision;
     create_handle(out_avatar, "out_avatar",
                   [&](softdeca_avatar& h) { h.avatar = std::make_unique<Avatar>(model->model, d); });
   });

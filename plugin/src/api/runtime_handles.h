@@ -43,4 +43,10 @@ inline runtime::Precision precision_of(int32_t precision, const char* name) {
                                                 : runtime::Precision::Half;
 }
 
+// A user's own avatar on the fit made for `mesh` (fit_api.cpp): the fit's bundle and the mesh
+// checked, then the avatar made; softdeca_avatar_create's way for a desc with a fit.
+std::unique_ptr<runtime::FittedAvatar> fitted_avatar(const softdeca_model* model, const softdeca_avatar_fit* fit,
+                                                     const softdeca_avatar_mesh* mesh, std::size_t threads,
+                                                     runtime::Precision precision);
+
 }  // namespace softdeca

@@ -211,14 +211,14 @@ void advance(softdeca_sim* sim, const softdeca_sim_frame* frame, softdeca_sim_st
 
 extern "C" {
 
-SOFTDECA_API softdeca_status softdeca_parameter_count(uint32_t* out_count) {
+SOFTDECA_API softdeca_status softdeca_sim_get_parameter_count(uint32_t* out_count) {
   return guarded(__func__, [&] {
     require_not_null(out_count, "out_count");
     *out_count = static_cast<uint32_t>(parameter_table().size());
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_parameter_get_info(uint32_t index, softdeca_parameter_info* out) {
+SOFTDECA_API softdeca_status softdeca_sim_get_parameter_info(uint32_t index, softdeca_parameter_info* out) {
   return guarded(__func__, [&] {
     require_struct(out, "out_info");
     const ParameterInfo& p = parameter_info(parameter(index));
@@ -233,7 +233,7 @@ SOFTDECA_API softdeca_status softdeca_parameter_get_info(uint32_t index, softdec
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_parameter_find(const char* name, uint32_t* out_index) {
+SOFTDECA_API softdeca_status softdeca_sim_find_parameter(const char* name, uint32_t* out_index) {
   return guarded(__func__, [&] {
     require_not_null(name, "name");
     require_not_null(out_index, "out_index");
@@ -241,14 +241,14 @@ SOFTDECA_API softdeca_status softdeca_parameter_find(const char* name, uint32_t*
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_parameters_json(const char** out_json) {
+SOFTDECA_API softdeca_status softdeca_sim_get_parameters_json(const char** out_json) {
   return guarded(__func__, [&] {
     require_not_null(out_json, "out_json");
     *out_json = parameters_json();
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_default_settings(softdeca_sim_settings* s) {
+SOFTDECA_API softdeca_status softdeca_sim_settings_init(softdeca_sim_settings* s) {
   return guarded(__func__, [&] {
     require_struct(s, "settings");
     const SolverSettings d;
@@ -280,7 +280,7 @@ SOFTDECA_API void softdeca_sim_destroy(softdeca_sim* sim) {
   destroy_handle(__func__, sim);
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, uint32_t* out_count) {
+SOFTDECA_API softdeca_status softdeca_sim_get_vertex_count(const softdeca_sim* sim, uint32_t* out_count) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     require_not_null(out_count, "out_count");
@@ -288,7 +288,7 @@ SOFTDECA_API softdeca_status softdeca_sim_vertex_count(const softdeca_sim* sim, 
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_sim_skin_count(const softdeca_sim* sim, uint32_t* out_count) {
+SOFTDECA_API softdeca_status softdeca_sim_get_skin_count(const softdeca_sim* sim, uint32_t* out_count) {
   return guarded(__func__, [&] {
     require_not_null(sim, "sim");
     require_not_null(out_count, "out_count");

@@ -33,9 +33,9 @@ void frame_out(softdeca_frame* out, softdeca_bool* out_received, bool got, const
 
 extern "C" {
 
-SOFTDECA_API const char* softdeca_blendshape_name(uint32_t index) { return stream::blendshape_name(index); }
+SOFTDECA_API const char* softdeca_blendshape_get_name(uint32_t index) { return stream::blendshape_name(index); }
 
-SOFTDECA_API softdeca_status softdeca_blendshape_index(const char* name, int32_t* out_index) {
+SOFTDECA_API softdeca_status softdeca_blendshape_find_index(const char* name, int32_t* out_index) {
   return guarded(__func__, [&] {
     require_not_null(name, "name");
     require_not_null(out_index, "out_index");
@@ -88,7 +88,7 @@ SOFTDECA_API void softdeca_receiver_destroy(softdeca_receiver* receiver) {
   destroy_handle(__func__, receiver);
 }
 
-SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* receiver, uint32_t* out_port) {
+SOFTDECA_API softdeca_status softdeca_receiver_get_port(const softdeca_receiver* receiver, uint32_t* out_port) {
   return guarded(__func__, [&] {
     const auto& r = receiver_of(receiver);
     require_not_null(out_port, "out_port");
@@ -96,7 +96,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_port(const softdeca_receiver* rec
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_receiver_next(softdeca_receiver* receiver, double timeout,
+SOFTDECA_API softdeca_status softdeca_receiver_get_next(softdeca_receiver* receiver, double timeout,
                                                     softdeca_frame* out_frame, softdeca_bool* out_received) {
   return guarded(__func__, [&] {
     auto& r = receiver_of(receiver);
@@ -108,7 +108,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_next(softdeca_receiver* receiver,
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_receiver_latest(const softdeca_receiver* receiver,
+SOFTDECA_API softdeca_status softdeca_receiver_get_latest(const softdeca_receiver* receiver,
                                                       softdeca_frame* out_frame, softdeca_bool* out_received) {
   return guarded(__func__, [&] {
     const auto& r = receiver_of(receiver);
@@ -157,7 +157,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_stats(const softdeca_receiver
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_receiver_profile(const softdeca_receiver* receiver, uint32_t* out_id,
+SOFTDECA_API softdeca_status softdeca_receiver_get_profile(const softdeca_receiver* receiver, uint32_t* out_id,
                                                        int32_t* out_indices, uint32_t capacity,
                                                        uint32_t* out_count) {
   return guarded(__func__, [&] {
@@ -167,7 +167,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_profile(const softdeca_receiver* 
   });
 }
 
-SOFTDECA_API softdeca_status softdeca_receiver_neutral(const softdeca_receiver* receiver, float* out_xyz,
+SOFTDECA_API softdeca_status softdeca_receiver_get_neutral(const softdeca_receiver* receiver, float* out_xyz,
                                                        uint32_t vertex_capacity, uint32_t* out_vertex_count) {
   return guarded(__func__, [&] {
     std::vector<float> xyz;

@@ -3,7 +3,7 @@
 // ("blendShape1.eyeBlinkLeft", "BlendShape.EyeBlinkLeft", "AK_07_EyeBlinkLeft", "Face.jawOpen"),
 // with the side as a suffix ("eyeBlink_L", "eyeBlink.R", "mouthSmile_Left", "eyeBlinkL") and
 // in snake case ("mouth_smile_l"). This is the one rule every part of the product uses (the C
-// ABI's softdeca_blendshape_index, hence Unity and Python, and the CLI's avatar folders).
+// ABI's softdeca_blendshape_find_index, hence Unity and Python, and the CLI's avatar folders).
 #pragma once
 
 #include <string_view>

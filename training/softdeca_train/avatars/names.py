@@ -1,5 +1,5 @@
 """Blendshape names as rigs spell them. Every style reads back to its ARKit shape under the
-library's rule for rigs' names (softdeca_blendshape_index, docs/avatars.md)."""
+library's rule for rigs' names (softdeca_blendshape_find_index, docs/avatars.md)."""
 
 from __future__ import annotations
 

@@ -40,7 +40,7 @@ def _key(text: str) -> str:
 
 def canonical_shape_name(stem: str) -> str | None:
     """The canonical ARKit name of a file stem ("eyeBlink_L", "EyeBlinkLeft", "eye_blink_left"
-    all give "eyeBlinkLeft"; the library's rule for rigs' names, softdeca_blendshape_index),
+    all give "eyeBlinkLeft"; the library's rule for rigs' names, softdeca_blendshape_find_index),
     "neutral" for a rest shape, None if it is not an ARKit shape."""
     if _key(stem) in NEUTRAL_NAMES:
         return "neutral"

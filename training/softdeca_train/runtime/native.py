@@ -14,7 +14,7 @@ import numpy as np
 from softdeca_train.paths import REPO_ROOT
 
 SOFTDECA_OK = 0
-ABI_VERSION = 2  # SOFTDECA_ABI_VERSION of the header these structs mirror
+ABI_VERSION = 3  # SOFTDECA_ABI_VERSION of the header these structs mirror
 PRECISIONS = {"half": 0, "float": 1, "int8": 2}  # softdeca_precision
 STATUS_NAMES = {
     0: "ok",
@@ -81,31 +81,27 @@ class ParameterInfo(C.Structure):
     ]
 
 
-# softdeca_avatar_desc and softdeca_avatar_mesh begin alike: a mesh and its blendshapes.
-_MESH_FIELDS = [
-    ("struct_size", C.c_uint32),
-    ("neutral", C.POINTER(C.c_float)),
-    ("vertex_count", C.c_uint32),
-    ("triangles", C.POINTER(C.c_int32)),
-    ("triangle_count", C.c_uint32),
-    ("blendshapes", C.POINTER(C.c_float)),
-    ("blendshape_count", C.c_uint32),
-]
+class AvatarMesh(C.Structure):
+    _fields_ = [
+        ("struct_size", C.c_uint32),
+        ("neutral", C.POINTER(C.c_float)),
+        ("vertex_count", C.c_uint32),
+        ("triangles", C.POINTER(C.c_int32)),
+        ("triangle_count", C.c_uint32),
+        ("blendshapes", C.POINTER(C.c_float)),
+        ("blendshape_count", C.c_uint32),
+        ("landmarks", C.POINTER(C.c_float)),
+        ("landmark_count", C.c_uint32),
+    ]
 
 
 class AvatarDesc(C.Structure):
     _fields_ = [
-        *_MESH_FIELDS,
+        ("struct_size", C.c_uint32),
+        ("mesh", C.POINTER(AvatarMesh)),
+        ("fit", C.c_void_p),
         ("threads", C.c_uint32),
         ("precision", C.c_int32),
-    ]
-
-
-class AvatarMesh(C.Structure):
-    _fields_ = [
-        *_MESH_FIELDS,
-        ("landmarks", C.POINTER(C.c_float)),
-        ("landmark_count", C.c_uint32),
     ]
 
 
@@ -168,18 +164,17 @@ SIGNATURES: dict[str, tuple[type | None, tuple[type, ...]]] = {
     "softdeca_abi_version": (C.c_uint32, ()),
     "softdeca_version": (_STR, ()),
     "softdeca_last_error": (_STR, ()),
-    "softdeca_blendshape_index": (_STATUS, (_STR, _PTR)),
+    "softdeca_blendshape_find_index": (_STATUS, (_STR, _PTR)),
     "softdeca_model_load": (_STATUS, (_STR, _PTR, _PTR)),
     "softdeca_model_load_memory": (_STATUS, (_PTR, _U32, _PTR, _PTR)),
     "softdeca_model_destroy": (None, (_PTR,)),
     "softdeca_model_get_info": (_STATUS, (_PTR, _PTR)),
-    "softdeca_model_get_parameter": (_STATUS, (_PTR, _U32, _PTR)),
+    "softdeca_model_get_parameter_info": (_STATUS, (_PTR, _U32, _PTR)),
     "softdeca_model_find_parameter": (_STATUS, (_PTR, _STR, _PTR)),
     "softdeca_model_get_landmark_vertices": (_STATUS, (_PTR, _PTR, _U32)),
     "softdeca_model_get_skin_triangles": (_STATUS, (_PTR, _PTR, _U32)),
     "softdeca_model_evaluate_landmarks": (_STATUS, (_PTR, _PTR, _U32, _PTR, _U32)),
     "softdeca_avatar_create": (_STATUS, (_PTR, _PTR, _PTR)),
-    "softdeca_avatar_create_fitted": (_STATUS, (_PTR, _PTR, _PTR, _U32, _I32, _PTR)),
     "softdeca_avatar_destroy": (None, (_PTR,)),
     "softdeca_avatar_set_parameter": (_STATUS, (_PTR, _U32, C.c_double)),
     "softdeca_avatar_set_parameter_faces": (_STATUS, (_PTR, _U32, _PTR, _U32)),
@@ -199,7 +194,7 @@ SIGNATURES: dict[str, tuple[type | None, tuple[type, ...]]] = {
     "softdeca_avatar_fit_destroy": (None, (_PTR,)),
     "softdeca_avatar_fit_save": (_STATUS, (_PTR, _STR)),
     "softdeca_avatar_fit_load": (_STATUS, (_PTR, _STR, _PTR)),
-    "softdeca_avatar_fit_report": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
+    "softdeca_avatar_fit_get_report": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
     "softdeca_avatar_fit_get_registered": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
 }
 
@@ -239,9 +234,10 @@ def check(status: int) -> None:
 
 def blendshape_index(name: str) -> int:
     """The canonical index (0..51) of the ARKit shape a rig's name denotes, or -1: the library's
-    one rule for rigs' names (softdeca_blendshape_index; "eyeBlink_L", "AK_07_EyeBlinkLeft")."""
+    one rule for rigs' names (softdeca_blendshape_find_index; "eyeBlink_L",
+    "AK_07_EyeBlinkLeft")."""
     index = C.c_int32(-1)
-    check(lib().softdeca_blendshape_index(name.encode(), C.byref(index)))
+    check(lib().softdeca_blendshape_find_index(name.encode(), C.byref(index)))
     return index.value
 
 
@@ -287,7 +283,7 @@ class NativeModel:
     def parameter(self, index: int) -> ParameterInfo:
         p = ParameterInfo()
         p.struct_size = C.sizeof(ParameterInfo)
-        check(lib().softdeca_model_get_parameter(self.handle, C.c_uint32(index), C.byref(p)))
+        check(lib().softdeca_model_get_parameter_info(self.handle, C.c_uint32(index), C.byref(p)))
         return p
 
     def find_parameter(self, name: str) -> int:
@@ -339,7 +335,7 @@ class AvatarArrays:
         self.triangles = np.ascontiguousarray(triangles, dtype=np.int32)
         self.deltas = _f32(deltas)
         self.landmarks = None if landmarks is None else _f32(landmarks)
-        self.desc = AvatarMesh(
+        self.abi = AvatarMesh(
             C.sizeof(AvatarMesh),
             _ptr(self.neutral),
             len(self.neutral),
@@ -370,7 +366,7 @@ class NativeFit:
         handle = C.c_void_p()
         check(
             lib().softdeca_avatar_fit_create(
-                model.handle, C.byref(mesh.desc), C.byref(opts), C.byref(handle)
+                model.handle, C.byref(mesh.abi), C.byref(opts), C.byref(handle)
             )
         )
         return cls(handle)
@@ -386,9 +382,9 @@ class NativeFit:
 
     def report(self) -> dict:
         length = C.c_uint32()
-        lib().softdeca_avatar_fit_report(self.handle, None, 0, C.byref(length))
+        lib().softdeca_avatar_fit_get_report(self.handle, None, 0, C.byref(length))
         buf = C.create_string_buffer(length.value + 1)
-        check(lib().softdeca_avatar_fit_report(self.handle, buf, len(buf), C.byref(length)))
+        check(lib().softdeca_avatar_fit_get_report(self.handle, buf, len(buf), C.byref(length)))
         return json.loads(buf.value.decode())
 
     def registered(self, skin_vertices: int) -> np.ndarray:
@@ -428,20 +424,29 @@ class NativeAvatar:
         n = _f32(neutral)
         t = np.ascontiguousarray(triangles, dtype=np.int32)
         b = None if blendshapes is None else _f32(blendshapes)
-        desc = AvatarDesc(
-            C.sizeof(AvatarDesc),
+        mesh = AvatarMesh(
+            C.sizeof(AvatarMesh),
             _ptr(n),
             len(n),
             _ptr(t, C.c_int32),
             len(t),
             _ptr(b),
             0 if b is None else len(b),
-            threads,
-            PRECISIONS[precision],
+            None,
+            0,
         )
         self.handle = C.c_void_p()
-        check(lib().softdeca_avatar_create(model.handle, C.byref(desc), C.byref(self.handle)))
+        self._create(mesh, None, threads, precision)
         self._buffers(self.vh)
+
+    def _create(
+        self, mesh: AvatarMesh, fit: C.c_void_p | None, threads: int, precision: str
+    ) -> None:
+        """softdeca_avatar_create: the template path (no fit) or the mesh on its fit."""
+        desc = AvatarDesc(
+            C.sizeof(AvatarDesc), C.pointer(mesh), fit, threads, PRECISIONS[precision]
+        )
+        check(lib().softdeca_avatar_create(self.model.handle, C.byref(desc), C.byref(self.handle)))
 
     @classmethod
     def fitted(
@@ -456,16 +461,7 @@ class NativeAvatar:
         self = cls.__new__(cls)
         self.model, self.fit, self.mesh = model, fit, mesh
         self.handle = C.c_void_p()
-        check(
-            lib().softdeca_avatar_create_fitted(
-                model.handle,
-                fit.handle,
-                C.byref(mesh.desc),
-                C.c_uint32(threads),
-                C.c_int32(PRECISIONS[precision]),
-                C.byref(self.handle),
-            )
-        )
+        self._create(mesh.abi, fit.handle, threads, precision)
         self.vh = len(mesh.neutral)
         self._buffers(self.vh)
         return self

@@ -76,24 +76,49 @@ namespace SoftDeca
             if (blendshapes != null && blendshapes.Length != 52 * neutral.Length)
                 throw new ArgumentException("blendshapes must hold 52 * " + vertexCount + " * 3 floats, not " + blendshapes.Length,
                                             "blendshapes");
-            var desc = AvatarDesc.Create();
-            desc.VertexCount = (uint)vertexCount;
-            desc.TriangleCount = (uint)(triangles.Length / 3);
-            desc.BlendshapeCount = blendshapes == null ? 0u : 52u;
-            desc.Threads = threads;
-            desc.Precision = (int)precision;
+            var mesh = NativeAvatarMesh.Create();
+            mesh.VertexCount = (uint)vertexCount;
+            mesh.TriangleCount = (uint)(triangles.Length / 3);
+            mesh.BlendshapeCount = blendshapes == null ? 0u : 52u;
             IntPtr native;
             Status s;
             fixed (float* n = neutral)
             fixed (int* t = triangles)
             fixed (float* b = blendshapes)
             {
-                desc.Neutral = (IntPtr)n;
-                desc.Triangles = (IntPtr)t;
-                desc.Blendshapes = (IntPtr)b;
-                s = NativeMethods.softdeca_avatar_create(model.Handle, ref desc, out native);
+                mesh.Neutral = (IntPtr)n;
+                mesh.Triangles = (IntPtr)t;
+                mesh.Blendshapes = (IntPtr)b;
+                s = CreateNative(model, ref mesh, null, threads, precision, out native);
             }
             return Adopt(s, native);
+        }
+
+        // softdeca_avatar_create: the mesh on its fit, or (fit null) in the template's topology.
+        private static Status CreateNative(Model model, ref NativeAvatarMesh mesh, AvatarFit fit, uint threads, Precision precision,
+                                           out IntPtr native)
+        {
+            var desc = AvatarDesc.Create();
+            desc.Threads = threads;
+            desc.Precision = (int)precision;
+            bool added = false;
+            try
+            {
+                if (fit != null)
+                {
+                    fit.Handle.DangerousAddRef(ref added);  // alive while the library reads it
+                    desc.Fit = fit.Handle.DangerousGetHandle();
+                }
+                fixed (NativeAvatarMesh* m = &mesh)
+                {
+                    desc.Mesh = (IntPtr)m;
+                    return NativeMethods.softdeca_avatar_create(model.Handle, ref desc, out native);
+                }
+            }
+            finally
+            {
+                if (added) fit.Handle.DangerousRelease();
+            }
         }
 
         private static AvatarHandle CreateFitted(Model model, AvatarFit fit, AvatarMesh mesh, uint threads, Precision precision)
@@ -104,8 +129,7 @@ namespace SoftDeca
             IntPtr native;
             Status s;
             using (var pinned = new PinnedAvatarMesh(mesh))
-                s = NativeMethods.softdeca_avatar_create_fitted(model.Handle, fit.Handle, ref pinned.Native, threads, (int)precision,
-                                                                out native);
+                s = CreateNative(model, ref pinned.Native, fit, threads, precision, out native);
             return Adopt(s, native);
         }
 

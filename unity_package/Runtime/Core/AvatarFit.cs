@@ -136,11 +136,11 @@ namespace SoftDeca
             var buffer = new byte[4096];
             uint length;
             Status s;
-            fixed (byte* b = buffer) s = NativeMethods.softdeca_avatar_fit_report(Handle, b, (uint)buffer.Length, out length);
+            fixed (byte* b = buffer) s = NativeMethods.softdeca_avatar_fit_get_report(Handle, b, (uint)buffer.Length, out length);
             if (s == Status.BufferTooSmall)
             {
                 buffer = new byte[length + 1];
-                fixed (byte* b = buffer) s = NativeMethods.softdeca_avatar_fit_report(Handle, b, (uint)buffer.Length, out length);
+                fixed (byte* b = buffer) s = NativeMethods.softdeca_avatar_fit_get_report(Handle, b, (uint)buffer.Length, out length);
             }
             Library.Check(s);
             return Encoding.UTF8.GetString(buffer, 0, (int)length);

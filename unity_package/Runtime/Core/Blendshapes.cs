@@ -27,7 +27,7 @@ namespace SoftDeca
                 {
                     Library.EnsureCompatible();
                     var names = new string[Count];
-                    for (uint i = 0; i < Count; ++i) names[i] = Utf8.FromNative(NativeMethods.softdeca_blendshape_name(i));
+                    for (uint i = 0; i < Count; ++i) names[i] = Utf8.FromNative(NativeMethods.softdeca_blendshape_get_name(i));
                     canonical = names;
                 }
                 return (string[])canonical.Clone();
@@ -38,7 +38,7 @@ namespace SoftDeca
         /// The canonical index of the ARKit shape a name denotes, or -1: ARKit's names in any case,
         /// behind a prefix or namespace ("blendShape1.eyeBlinkLeft", "AK_07_EyeBlinkLeft"), with
         /// the side as a suffix ("eyeBlink_L", "eyeBlink.R"). The library's rule
-        /// (softdeca_blendshape_index), the same for every part of the product.
+        /// (softdeca_blendshape_find_index), the same for every part of the product.
         /// </summary>
         public static unsafe int CanonicalIndex(string name)
         {
@@ -47,7 +47,7 @@ namespace SoftDeca
             byte[] text = Utf8.ToNative(name, "name");
             int index;
             Status s;
-            fixed (byte* p = text) s = NativeMethods.softdeca_blendshape_index(p, out index);
+            fixed (byte* p = text) s = NativeMethods.softdeca_blendshape_find_index(p, out index);
             Library.Check(s);
             return index;
         }

@@ -42,7 +42,7 @@ namespace SoftDeca
             for (uint k = 0; k < info.ParameterCount; ++k)
             {
                 var p = NativeParameterInfo.Create();
-                Library.Check(NativeMethods.softdeca_model_get_parameter(handle, k, ref p));
+                Library.Check(NativeMethods.softdeca_model_get_parameter_info(handle, k, ref p));
                 parameters[k] = new ParameterInfo
                 {
                     Index = (int)k,

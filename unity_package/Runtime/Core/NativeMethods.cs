@@ -9,7 +9,7 @@ namespace SoftDeca
     internal static unsafe class NativeMethods
     {
         /// <summary>SOFTDECA_ABI_VERSION of the header these declarations mirror.</summary>
-        public const uint AbiVersion = 2;
+        public const uint AbiVersion = 3;
 
 #if (UNITY_IOS || UNITY_TVOS || UNITY_VISIONOS) && !UNITY_EDITOR
         // iOS links the static library into the app.
@@ -24,8 +24,8 @@ namespace SoftDeca
         [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_version();
         [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_last_error();
         [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_status_name(Status status);
-        [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_blendshape_name(uint index);
-        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_blendshape_index(byte* name, out int index);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern IntPtr softdeca_blendshape_get_name(uint index);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_blendshape_find_index(byte* name, out int index);
 
         // ---- model ----
         [DllImport(Library, CallingConvention = Cdecl)]
@@ -36,7 +36,7 @@ namespace SoftDeca
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_model_get_info(ModelHandle model, ref ModelInfo info);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_model_get_parameter(ModelHandle model, uint index, ref NativeParameterInfo info);
+        public static extern Status softdeca_model_get_parameter_info(ModelHandle model, uint index, ref NativeParameterInfo info);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_model_find_parameter(ModelHandle model, byte* name, out uint index);
         [DllImport(Library, CallingConvention = Cdecl)]
@@ -92,30 +92,27 @@ namespace SoftDeca
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_avatar_fit_load(ModelHandle model, byte* path, out IntPtr fit);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_avatar_fit_report(AvatarFitHandle fit, byte* buffer, uint capacity, out uint length);
+        public static extern Status softdeca_avatar_fit_get_report(AvatarFitHandle fit, byte* buffer, uint capacity, out uint length);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_avatar_fit_get_registered(AvatarFitHandle fit, float* points, uint pointCapacity,
                                                                        out uint vertexCount);
-        [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_avatar_create_fitted(ModelHandle model, AvatarFitHandle fit, ref NativeAvatarMesh mesh,
-                                                                  uint threads, int precision, out IntPtr avatar);
 
         // ---- receiver ----
         [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_receiver_config_init(ref ReceiverConfig config);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_receiver_create(ref ReceiverConfig config, out IntPtr receiver);
         [DllImport(Library, CallingConvention = Cdecl)] public static extern void softdeca_receiver_destroy(IntPtr receiver);
-        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_receiver_port(ReceiverHandle receiver, out uint port);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_receiver_get_port(ReceiverHandle receiver, out uint port);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_receiver_next(ReceiverHandle receiver, double timeout, ref Frame frame, out int received);
+        public static extern Status softdeca_receiver_get_next(ReceiverHandle receiver, double timeout, ref Frame frame, out int received);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_receiver_latest(ReceiverHandle receiver, ref Frame frame, out int received);
+        public static extern Status softdeca_receiver_get_latest(ReceiverHandle receiver, ref Frame frame, out int received);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_receiver_get_stats(ReceiverHandle receiver, ref ReceiverStats stats);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_receiver_profile(ReceiverHandle receiver, out uint id, int* indices, uint capacity, out uint count);
+        public static extern Status softdeca_receiver_get_profile(ReceiverHandle receiver, out uint id, int* indices, uint capacity, out uint count);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_receiver_neutral(ReceiverHandle receiver, float* xyz, uint vertexCapacity, out uint vertexCount);
+        public static extern Status softdeca_receiver_get_neutral(ReceiverHandle receiver, float* xyz, uint vertexCapacity, out uint vertexCount);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_receiver_request_neutral(ReceiverHandle receiver, out int sent);
         [DllImport(Library, CallingConvention = Cdecl)]
@@ -133,24 +130,24 @@ namespace SoftDeca
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_recorder_write_neutral(RecorderHandle recorder, float* xyz, uint vertexCount);
         [DllImport(Library, CallingConvention = Cdecl)] public static extern void softdeca_recorder_destroy(IntPtr recorder);
-        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_player_open(byte* path, out IntPtr player);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_player_load(byte* path, out IntPtr player);
         [DllImport(Library, CallingConvention = Cdecl)] public static extern void softdeca_player_destroy(IntPtr player);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_player_info(PlayerHandle player, ref NativeRecordingInfo info);
+        public static extern Status softdeca_player_get_info(PlayerHandle player, ref NativeRecordingInfo info);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_player_frame(PlayerHandle player, uint index, ref Frame frame);
+        public static extern Status softdeca_player_get_frame(PlayerHandle player, uint index, ref Frame frame);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_player_frame_at(PlayerHandle player, double time, ref Frame frame);
+        public static extern Status softdeca_player_get_frame_at(PlayerHandle player, double time, ref Frame frame);
         [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_player_seek(PlayerHandle player, double time);
         [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_player_set_speed(PlayerHandle player, double speed);
         [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_player_set_loop(PlayerHandle player, int loop);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_player_advance(PlayerHandle player, double dt, ref Frame frame, out int ended);
-        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_player_position(PlayerHandle player, out double time);
+        [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_player_get_position(PlayerHandle player, out double time);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_player_profile(PlayerHandle player, out uint id, int* indices, uint capacity, out uint count);
+        public static extern Status softdeca_player_get_profile(PlayerHandle player, out uint id, int* indices, uint capacity, out uint count);
         [DllImport(Library, CallingConvention = Cdecl)]
-        public static extern Status softdeca_player_neutral(PlayerHandle player, float* xyz, uint vertexCapacity, out uint vertexCount);
+        public static extern Status softdeca_player_get_neutral(PlayerHandle player, float* xyz, uint vertexCapacity, out uint vertexCount);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_convert_livelinkface_csv(byte* csvPath, byte* recordingPath, double timecodeRate,
                                                                       ref ConvertReport report);

@@ -111,12 +111,8 @@ namespace SoftDeca
     public unsafe struct AvatarDesc
     {
         public uint StructSize;
-        public IntPtr Neutral;
-        public uint VertexCount;
-        public IntPtr Triangles;
-        public uint TriangleCount;
-        public IntPtr Blendshapes;
-        public uint BlendshapeCount;
+        public IntPtr Mesh;
+        public IntPtr Fit;
         public uint Threads;
         public int Precision;
 

@@ -56,7 +56,7 @@ namespace SoftDeca
             get
             {
                 uint port;
-                Library.Check(NativeMethods.softdeca_receiver_port(Handle, out port));
+                Library.Check(NativeMethods.softdeca_receiver_get_port(Handle, out port));
                 return (int)port;
             }
         }
@@ -66,7 +66,7 @@ namespace SoftDeca
         {
             frame.StructSize = (uint)sizeof(Frame);
             int received;
-            Library.Check(NativeMethods.softdeca_receiver_next(Handle, timeout, ref frame, out received));
+            Library.Check(NativeMethods.softdeca_receiver_get_next(Handle, timeout, ref frame, out received));
             return received != 0;
         }
 
@@ -75,7 +75,7 @@ namespace SoftDeca
         {
             frame.StructSize = (uint)sizeof(Frame);
             int received;
-            Library.Check(NativeMethods.softdeca_receiver_latest(Handle, ref frame, out received));
+            Library.Check(NativeMethods.softdeca_receiver_get_latest(Handle, ref frame, out received));
             return received != 0;
         }
 
@@ -90,11 +90,11 @@ namespace SoftDeca
         public float[] Neutral()
         {
             uint count;
-            Status s = NativeMethods.softdeca_receiver_neutral(Handle, null, 0, out count);
+            Status s = NativeMethods.softdeca_receiver_get_neutral(Handle, null, 0, out count);
             if (s != Status.Ok && s != Status.BufferTooSmall) Library.Throw(s);
             var xyz = new float[count * 3];
             if (count == 0) return xyz;
-            fixed (float* p = xyz) Library.Check(NativeMethods.softdeca_receiver_neutral(Handle, p, count, out count));
+            fixed (float* p = xyz) Library.Check(NativeMethods.softdeca_receiver_get_neutral(Handle, p, count, out count));
             return xyz;
         }
 

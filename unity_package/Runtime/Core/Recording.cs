@@ -117,12 +117,12 @@ namespace SoftDeca
             byte[] p = Utf8.ToNative(path, "path");
             IntPtr native;
             Status s;
-            fixed (byte* pp = p) s = NativeMethods.softdeca_player_open(pp, out native);
+            fixed (byte* pp = p) s = NativeMethods.softdeca_player_load(pp, out native);
             Library.Check(s);
             handle = new PlayerHandle();
             handle.Adopt(native);
             var n = new NativeRecordingInfo { StructSize = (uint)sizeof(NativeRecordingInfo) };
-            Library.Check(NativeMethods.softdeca_player_info(handle, ref n));
+            Library.Check(NativeMethods.softdeca_player_get_info(handle, ref n));
             info = new RecordingInfo
             {
                 FrameCount = (int)n.FrameCount,
@@ -142,14 +142,14 @@ namespace SoftDeca
         {
             if (index < 0) throw new ArgumentOutOfRangeException("index", "a frame index is not negative");
             frame.StructSize = (uint)sizeof(Frame);
-            Library.Check(NativeMethods.softdeca_player_frame(Handle, (uint)index, ref frame));
+            Library.Check(NativeMethods.softdeca_player_get_frame(Handle, (uint)index, ref frame));
         }
 
         /// <summary>The frame time seconds after the first (clamped), interpolated.</summary>
         public void FrameAt(double time, ref Frame frame)
         {
             frame.StructSize = (uint)sizeof(Frame);
-            Library.Check(NativeMethods.softdeca_player_frame_at(Handle, time, ref frame));
+            Library.Check(NativeMethods.softdeca_player_get_frame_at(Handle, time, ref frame));
         }
 
         public void Seek(double time) { Library.Check(NativeMethods.softdeca_player_seek(Handle, time)); }
@@ -174,7 +174,7 @@ namespace SoftDeca
             get
             {
                 double t;
-                Library.Check(NativeMethods.softdeca_player_position(Handle, out t));
+                Library.Check(NativeMethods.softdeca_player_get_position(Handle, out t));
                 return t;
             }
         }
@@ -183,11 +183,11 @@ namespace SoftDeca
         public float[] Neutral()
         {
             uint count;
-            Status s = NativeMethods.softdeca_player_neutral(Handle, null, 0, out count);
+            Status s = NativeMethods.softdeca_player_get_neutral(Handle, null, 0, out count);
             if (s != Status.Ok && s != Status.BufferTooSmall) Library.Throw(s);
             var xyz = new float[count * 3];
             if (count == 0) return xyz;
-            fixed (float* p = xyz) Library.Check(NativeMethods.softdeca_player_neutral(Handle, p, count, out count));
+            fixed (float* p = xyz) Library.Check(NativeMethods.softdeca_player_get_neutral(Handle, p, count, out count));
             return xyz;
         }
 

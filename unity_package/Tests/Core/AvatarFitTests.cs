@@ -1,5 +1,5 @@
 // A user's own avatar through the bindings of the native fit (softdeca_avatar_fit_*,
-// softdeca_avatar_create_fitted): the fixture's head as a user's avatar would come (its vertices
+// softdeca_avatar_create with the fit): the fixture's head as a user's avatar would come (its vertices
 // shuffled, in centimetres, above a body no shape moves) is fitted, saved, loaded and animated,
 // and the library's errors arrive with its messages.
 // Category "AvatarFit" (tests/unity/run leaves it out when SOFTDECA_UNITY_EXCLUDE names it).
