@@ -109,6 +109,28 @@ def test_the_command_line_comes_in_by_its_documented_way() -> None:
         assert "runtime::" not in text and "fit::" not in text, name
 
 
+def test_the_c_abi_has_one_avatar_whatever_its_mesh() -> None:
+    """One avatar type behind the handle, one creation and one per-frame path: runtime_api.cpp
+    never asks which kind of mesh an avatar has (a template-topology mesh is the identity fit,
+    runtime/fitted_avatar.h)."""
+    handles = (SRC / "api" / "runtime_handles.h").read_text(encoding="utf-8")
+    body = re.search(r"struct softdeca_avatar \{(.*?)\};", handles, re.DOTALL)
+    assert body, "runtime_handles.h defines no softdeca_avatar"
+    members = [
+        line for line in body.group(1).splitlines() if line.strip().endswith(";")
+    ]
+    assert len(members) == 1, members
+    api = (SRC / "api" / "runtime_api.cpp").read_text(encoding="utf-8")
+    decisions = [
+        line.strip()
+        for line in api.splitlines()
+        if re.search(r"\b(if|while|switch)\s*\(| \? ", line)
+    ]
+    assert decisions, "no decision found: the search is broken"
+    on_kind = [d for d in decisions if re.search(r"fit|identity|kind|template", d)]
+    assert on_kind == [], on_kind
+
+
 def test_core_depends_on_nothing_but_the_public_header() -> None:
     core = sources("core")
     assert core

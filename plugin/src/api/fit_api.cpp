@@ -174,10 +174,48 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_get_registered(const softdeca_a
 
 namespace softdeca {
 
-std::unique_ptr<runtime::FittedAvatar> fitted_avatar(const softdeca_model* model, const softdeca_avatar_fit* fit,
-                                                     const softdeca_avatar_mesh* mesh, std::size_t threads,
-                                                     runtime::Precision precision) {
+namespace {
+// A mesh in the template's topology, checked as the template path takes it (shapes optional).
+runtime::AvatarDesc template_mesh(const softdeca_avatar_mesh* mesh, const runtime::Model& m) {
+  require_struct(mesh, "desc->mesh");
+  const std::size_t vh = static_cast<std::size_t>(m.manifest().head_vertices);
+  require_not_null(mesh->neutral, "desc->mesh->neutral");
+  require(mesh->vertex_count == vh, "desc->mesh->vertex_count is " + std::to_string(mesh->vertex_count) +
+                                        "; the bundle's template has " + std::to_string(vh) +
+                                        " head vertices (another mesh needs its fit in desc->fit)");
+  require_finite(mesh->neutral, vh * 3, "desc->mesh->neutral");
+  require_not_null(mesh->triangles, "desc->mesh->triangles");
+  require(mesh->triangle_count >= 1 && mesh->triangle_count < (std::size_t{1} << 28), "desc->mesh->triangle_count is out of range");
+  for (std::size_t i = 0; i < mesh->triangle_count * 3; ++i)
+    require(mesh->triangles[i] >= 0 && static_cast<std::size_t>(mesh->triangles[i]) < vh,
+            "desc->mesh->triangles[" + std::to_string(i) + "] = " + std::to_string(mesh->triangles[i]) + " is not a vertex index");
+  require(mesh->blendshape_count == 0 || mesh->blendshape_count == runtime::kBlendshapeCount,
+          "desc->mesh->blendshape_count must be 0 or 52");
+  if (mesh->blendshape_count) {
+    require_not_null(mesh->blendshapes, "desc->mesh->blendshapes");
+    require_finite(mesh->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->mesh->blendshapes");
+  }
+  runtime::AvatarDesc d;
+  d.neutral = mesh->neutral;
+  d.vertex_count = vh;
+  d.triangles = mesh->triangles;
+  d.triangle_count = mesh->triangle_count;
+  d.blendshapes = mesh->blendshape_count ? mesh->blendshapes : nullptr;
+  d.blendshape_count = mesh->blendshape_count;
+  return d;
+}
+}  // namespace
+
+std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
+                                                      const softdeca_avatar_fit* fit, std::size_t threads,
+                                                      runtime::Precision precision) {
   const runtime::Model& m = model_of(model);
+  if (!fit) {  // the identity fit
+    runtime::AvatarDesc d = template_mesh(mesh, m);
+    d.threads = threads;
+    d.precision = precision;
+    return std::make_unique<runtime::FittedAvatar>(model->model, d);
+  }
   const softdeca_avatar_fit& f = fit_of(fit);
   require(f.bundle_sha256 == m.manifest_sha256(), "the fit was made for another bundle: fit the avatar again with this one");
   const fit::AvatarMesh a = mesh_of(mesh, m);

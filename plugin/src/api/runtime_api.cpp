@@ -16,21 +16,19 @@ using runtime::Model;
 
 constexpr std::size_t kMaxThreads = 8;
 
-// The avatar that holds parameters, identity, preparation and dynamics: for a fitted avatar,
-// the registered template's.
-Avatar& avatar_of(softdeca_avatar* a) {
+// The avatar, on its mesh: its frames, maps and memory.
+runtime::FittedAvatar& on_mesh(softdeca_avatar* a) {
   require_not_null(a, "avatar");
-  return a->fitted ? a->fitted->core() : *a->avatar;
+  return *a->avatar;
 }
+
+// Its core, which holds parameters, identity, preparation and dynamics (the registered
+// template's avatar; the mesh's own for the template's topology).
+Avatar& avatar_of(softdeca_avatar* a) { return on_mesh(a).core(); }
 
 const Avatar& avatar_of(const softdeca_avatar* a) {
   require_not_null(a, "avatar");
-  return a->fitted ? a->fitted->core() : *a->avatar;
-}
-
-runtime::FittedAvatar* fitted_of(softdeca_avatar* a) {
-  require_not_null(a, "avatar");
-  return a->fitted.get();
+  return a->avatar->core();
 }
 
 runtime::Output output_of(const softdeca_output* o) {
@@ -190,49 +188,14 @@ SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_mo
 SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model, const softdeca_avatar_desc* desc,
                                                     softdeca_avatar** out_avatar) {
   return guarded(__func__, [&] {
-    const Model& m = model_of(model);
+    model_of(model);
     require_struct(desc, "desc");
     require_not_null(out_avatar, "out_avatar");
     require(desc->threads <= kMaxThreads, "desc->threads must be at most " + std::to_string(kMaxThreads));
     const std::size_t threads = desc->threads == 0 ? 1 : desc->threads;
     const runtime::Precision precision = precision_of(desc->precision, "desc->precision");
-    if (desc->fit) {  // any mesh, on its fit
-      create_handle(out_avatar, "out_avatar", [&](softdeca_avatar& h) {
-        h.fitted = fitted_avatar(model, desc->fit, desc->mesh, threads, precision);
-      });
-      return;
-    }
-    // the template path: the mesh in the template's topology
-    const softdeca_avatar_mesh* mesh = desc->mesh;
-    require_struct(mesh, "desc->mesh");
-    const std::size_t vh = static_cast<std::size_t>(m.manifest().head_vertices);
-    require_not_null(mesh->neutral, "desc->mesh->neutral");
-    require(mesh->vertex_count == vh, "desc->mesh->vertex_count is " + std::to_string(mesh->vertex_count) +
-                                          "; the bundle's template has " + std::to_string(vh) +
-                                          " head vertices (another mesh needs its fit in desc->fit)");
-    require_finite(mesh->neutral, vh * 3, "desc->mesh->neutral");
-    require_not_null(mesh->triangles, "desc->mesh->triangles");
-    require(mesh->triangle_count >= 1 && mesh->triangle_count < (std::size_t{1} << 28), "desc->mesh->triangle_count is out of range");
-    for (std::size_t i = 0; i < mesh->triangle_count * 3; ++i)
-      require(mesh->triangles[i] >= 0 && static_cast<std::size_t>(mesh->triangles[i]) < vh,
-              "desc->mesh->triangles[" + std::to_string(i) + "] = " + std::to_string(mesh->triangles[i]) + " is not a vertex index");
-    require(mesh->blendshape_count == 0 || mesh->blendshape_count == runtime::kBlendshapeCount,
-            "desc->mesh->blendshape_count must be 0 or 52");
-    if (mesh->blendshape_count) {
-      require_not_null(mesh->blendshapes, "desc->mesh->blendshapes");
-      require_finite(mesh->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->mesh->blendshapes");
-    }
-    runtime::AvatarDesc d;
-    d.neutral = mesh->neutral;
-    d.vertex_count = vh;
-    d.triangles = mesh->triangles;
-    d.triangle_count = mesh->triangle_count;
-    d.blendshapes = mesh->blendshape_count ? mesh->blendshapes : nullptr;
-    d.blendshape_count = mesh->blendshape_count;
-    d.threads = threads;
-    d.precision = precision;
     create_handle(out_avatar, "out_avatar",
-                  [&](softdeca_avatar& h) { h.avatar = std::make_unique<Avatar>(model->model, d); });
+                  [&](softdeca_avatar& h) { h.avatar = avatar_on_mesh(model, desc->mesh, desc->fit, threads, precision); });
   });
 }
 
@@ -250,18 +213,16 @@ SOFTDECA_API softdeca_status softdeca_avatar_set_parameter(softdeca_avatar* avat
 SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_faces(softdeca_avatar* avatar, uint32_t index, const float* values,
                                                                  uint32_t face_count) {
   return guarded(__func__, [&] {
-    Avatar& a = avatar_of(avatar);
-    if (auto* f = fitted_of(avatar)) f->set_parameter_faces(parameter_index(a.model(), index), values, face_count);
-    else a.set_parameter_faces(parameter_index(a.model(), index), values, face_count);
+    runtime::FittedAvatar& a = on_mesh(avatar);
+    a.set_parameter_faces(parameter_index(a.core().model(), index), values, face_count);
   });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_set_parameter_vertices(softdeca_avatar* avatar, uint32_t index,
                                                                     const float* values, uint32_t vertex_count) {
   return guarded(__func__, [&] {
-    Avatar& a = avatar_of(avatar);
-    if (auto* f = fitted_of(avatar)) f->set_parameter_vertices(parameter_index(a.model(), index), values, vertex_count);
-    else a.set_parameter_vertices(parameter_index(a.model(), index), values, vertex_count);
+    runtime::FittedAvatar& a = on_mesh(avatar);
+    a.set_parameter_vertices(parameter_index(a.core().model(), index), values, vertex_count);
   });
 }
 
@@ -295,8 +256,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_prepare(softdeca_avatar* avatar) {
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* avatar, const float* weights,
                                                               uint32_t weight_count, const softdeca_output* output) {
   return guarded(__func__, [&] {
-    if (auto* f = fitted_of(avatar)) f->evaluate_weights(weights, weight_count, output_of(output));
-    else avatar_of(avatar).evaluate_weights(weights, weight_count, output_of(output));
+    on_mesh(avatar).evaluate_weights(weights, weight_count, output_of(output));
   });
 }
 
@@ -304,9 +264,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_evaluate_surface(softdeca_avatar* a
                                                               uint32_t weight_count, const float* surface, uint32_t vertex_count,
                                                               const softdeca_output* output) {
   return guarded(__func__, [&] {
-    require(fitted_of(avatar) == nullptr,
-            "evaluate_surface takes a surface in the template's topology: a fitted avatar takes weights or landmarks");
-    avatar_of(avatar).evaluate_surface(weights, weight_count, surface, vertex_count, output_of(output));
+    on_mesh(avatar).evaluate_surface(weights, weight_count, surface, vertex_count, output_of(output));
   });
 }
 
@@ -318,16 +276,14 @@ SOFTDECA_API softdeca_status softdeca_avatar_calibrate_landmarks(softdeca_avatar
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_landmarks(softdeca_avatar* avatar, const float* points,
                                                                 uint32_t point_count, const softdeca_output* output) {
   return guarded(__func__, [&] {
-    if (auto* f = fitted_of(avatar)) f->evaluate_landmarks(points, point_count, output_of(output));
-    else avatar_of(avatar).evaluate_landmarks(points, point_count, output_of(output));
+    on_mesh(avatar).evaluate_landmarks(points, point_count, output_of(output));
   });
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_linear(softdeca_avatar* avatar, const float* weights, uint32_t weight_count,
                                                              const softdeca_output* output) {
   return guarded(__func__, [&] {
-    if (auto* f = fitted_of(avatar)) f->evaluate_linear(weights, weight_count, output_of(output));
-    else avatar_of(avatar).evaluate_linear(weights, weight_count, output_of(output));
+    on_mesh(avatar).evaluate_linear(weights, weight_count, output_of(output));
   });
 }
 
@@ -359,7 +315,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* av
     out_stats->prepare_ms = s.prepare_ms;
     out_stats->prepare_networks_ms = s.prepare_networks_ms;
     out_stats->factorisation_ms = s.factorisation_ms;
-    out_stats->memory_bytes = s.memory_bytes + (avatar->fitted ? avatar->fitted->bytes() : 0);
+    out_stats->memory_bytes = s.memory_bytes + avatar->avatar->bytes();
     out_stats->prepare_physics_ms = s.prepare_physics_ms;
     out_stats->physics_iterations = static_cast<uint32_t>(s.physics_iterations);
     out_stats->reserved = 0;

@@ -15,11 +15,10 @@ struct softdeca_model {
   std::shared_ptr<const softdeca::runtime::Model> model;
 };
 
-// A template-topology avatar, or a user's own avatar on its fit (then `fitted` is set and
-// `avatar` is null: the registered template's avatar is fitted->core()).
+// Every avatar, whichever mesh: on its fit, or on the identity fit of the template's topology
+// (runtime/fitted_avatar.h); its core holds parameters, identity, preparation and dynamics.
 struct softdeca_avatar {
-  std::unique_ptr<softdeca::runtime::Avatar> avatar;
-  std::unique_ptr<softdeca::runtime::FittedAvatar> fitted;
+  std::unique_ptr<softdeca::runtime::FittedAvatar> avatar;
 };
 
 struct softdeca_avatar_fit {
@@ -43,10 +42,10 @@ inline runtime::Precision precision_of(int32_t precision, const char* name) {
                                                 : runtime::Precision::Half;
 }
 
-// A user's own avatar on the fit made for `mesh` (fit_api.cpp): the fit's bundle and the mesh
-// checked, then the avatar made; softdeca_avatar_create's way for a desc with a fit.
-std::unique_ptr<runtime::FittedAvatar> fitted_avatar(const softdeca_model* model, const softdeca_avatar_fit* fit,
-                                                     const softdeca_avatar_mesh* mesh, std::size_t threads,
-                                                     runtime::Precision precision);
+// The avatar on `mesh` (fit_api.cpp): through `fit`, its bundle and the mesh checked; without
+// one, the mesh in the template's topology as the identity fit. softdeca_avatar_create's one way.
+std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
+                                                      const softdeca_avatar_fit* fit, std::size_t threads,
+                                                      runtime::Precision precision);
 
 }  // namespace softdeca

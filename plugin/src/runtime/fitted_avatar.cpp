@@ -90,6 +90,9 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   normals_ = geometry::Normals(triangles_, n_);
 }
 
+FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
+    : core_(std::make_unique<Avatar>(std::move(model), d)), identity_(true), n_(d.vertex_count) {}
+
 std::size_t FittedAvatar::bytes() const {
   return (neutral_.size() + registered_skin_.size() + head_out_.size() + field_.size()) * 4 + triangles_.size() * 4 +
          blendshapes_.bytes() + normals_.bytes() + embedding_.size() * 28 + source_.corners.size() * 4 +
@@ -126,6 +129,7 @@ void FittedAvatar::finish(const Output& out) {
 }
 
 void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
+  if (identity_) return core_->evaluate_weights(weights, count, out);
   FrameGuard guard(busy_);
   check_output_capacity(out, n_);
   core_->evaluate_weights(weights, count, core_output());  // checks the weights
@@ -137,6 +141,7 @@ void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, con
 }
 
 void FittedAvatar::evaluate_landmarks(const float* points, std::size_t count, const Output& out) {
+  if (identity_) return core_->evaluate_landmarks(points, count, out);
   FrameGuard guard(busy_);
   check_output_capacity(out, n_);
   core_->evaluate_landmarks(points, count, core_output());
@@ -147,6 +152,7 @@ void FittedAvatar::evaluate_landmarks(const float* points, std::size_t count, co
 }
 
 void FittedAvatar::evaluate_linear(const float* weights, std::size_t count, const Output& out) {
+  if (identity_) return core_->evaluate_linear(weights, count, out);
   FrameGuard guard(busy_);
   check_output_capacity(out, n_);
   core_->evaluate_linear(weights, count, core_output());  // checks the weights, counts the frame
@@ -154,7 +160,15 @@ void FittedAvatar::evaluate_linear(const float* weights, std::size_t count, cons
   finish(out);
 }
 
+void FittedAvatar::evaluate_surface(const float* weights, std::size_t count, const float* surface, std::size_t vertices,
+                                    const Output& out) {
+  require(identity_, "evaluate_surface takes a surface in the template's topology: an avatar on its own mesh takes weights or "
+                     "landmarks");
+  core_->evaluate_surface(weights, count, surface, vertices, out);
+}
+
 void FittedAvatar::set_parameter_vertices(int index, const float* values, std::size_t count) {
+  if (identity_) return core_->set_parameter_vertices(index, values, count);
   require_not_null(values, "values");
   expect(count == n_, [&] {
     return "a fitted avatar's vertex map has one value per avatar vertex (" + std::to_string(n_) + "), got " +
@@ -173,6 +187,7 @@ void FittedAvatar::set_parameter_vertices(int index, const float* values, std::s
 }
 
 void FittedAvatar::set_parameter_faces(int index, const float* values, std::size_t count) {
+  if (identity_) return core_->set_parameter_faces(index, values, count);
   require_not_null(values, "values");
   const std::size_t nt = triangles_.size() / 3;
   expect(count == nt, [&] {

@@ -1,8 +1,13 @@
-// A user's own avatar at run time: SoftDECA and SparseSoftDECA run on the registered template
-// (an Avatar in the template's topology, made from the fit), and every frame returns the
-// avatar's own vertices: its own linear blend plus the models' correction carried through the
-// fit's embedding (SparseSoftDECA: its whole deformation). Vertices the embedding does not hold
-// move exactly as the avatar's rig moves them.
+// Every avatar at run time, whichever mesh the user has: SoftDECA and SparseSoftDECA run on the
+// registered template (an Avatar in the template's topology, made from the fit), and every frame
+// returns the avatar's own vertices: its own linear blend plus the models' correction carried
+// through the fit's embedding (SparseSoftDECA: its whole deformation). Vertices the embedding
+// does not hold move exactly as the avatar's rig moves them.
+//
+// A mesh in the template's topology is the identity fit: the registered template is the mesh
+// itself and the embedding the identity, so the core's frame is the avatar's, with nothing to
+// carry (the template path, at the core's own cost). The C ABI's handle holds one of these
+// whatever the mesh, and calls it alike.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,7 +32,10 @@ struct FittedAvatarDesc {
 
 class FittedAvatar {
  public:
+  // The user's mesh through its fit.
   FittedAvatar(std::shared_ptr<const Model> model, const FittedAvatarDesc& desc);
+  // A mesh in the template's topology: the identity fit.
+  FittedAvatar(std::shared_ptr<const Model> model, const AvatarDesc& desc);
 
   // The registered template's avatar: parameters, identity, prepare, dynamics, calibration.
   Avatar& core() { return *core_; }
@@ -42,7 +50,11 @@ class FittedAvatar {
   void evaluate_weights(const float* weights, std::size_t count, const Output& out);
   void evaluate_landmarks(const float* points, std::size_t count, const Output& out);
   void evaluate_linear(const float* weights, std::size_t count, const Output& out);
+  // A surface in the template's topology: the identity fit's only (another mesh's correction
+  // comes from its weights or landmarks).
+  void evaluate_surface(const float* weights, std::size_t count, const float* surface, std::size_t vertices, const Output& out);
 
+  // What the avatar holds besides its core (nothing for the identity fit).
   std::size_t bytes() const;
 
  private:
@@ -53,6 +65,7 @@ class FittedAvatar {
   void finish(const Output& out);
 
   std::unique_ptr<Avatar> core_;
+  bool identity_ = false;  // the template's own topology: the core's frame is the avatar's
   std::size_t n_ = 0, vs_ = 0, vh_ = 0;
   std::vector<float> neutral_;  // the avatar's own, n x 3
   std::vector<std::int32_t> triangles_;
