@@ -31,6 +31,51 @@ def test_the_constant_slot_is_one_and_the_skip_is_linear() -> None:
     assert torch.allclose(enc(2 * w)[:, :-1], 2 * enc(w)[:, :-1])
 
 
+@pytest.mark.parametrize("tau", [0.0, 0.1])
+def test_with_a_rest_gate_the_codes_are_zero_at_rest(tau: float) -> None:
+    """Exact at rest by construction: z(0) = 0 in every slot (to float32 rounding: the two
+    evaluations of the network differ in their batch), the network's own output at zero taken
+    out inside the model, not a constant subtracted afterwards; the constant slot is the gate,
+    |w|^2 / (|w|^2 + tau^2) (0 for tau 0), rising with the expression."""
+    sizes = replace(TEST_SIZES, rest_gate=tau)
+    enc = WeightEncoder(52, sizes, linear_skip=True, constant_slot=True)
+    with torch.no_grad():
+        for layer in enc.net:
+            if isinstance(layer, torch.nn.Linear):
+                layer.bias.normal_()  # a network whose output at zero is far from zero
+    w = torch.rand(5, 52) * torch.tensor([[0.0], [0.01], [0.1], [0.5], [1.0]])
+    z = enc(w).detach()
+    assert enc.net(enc.rest).abs().max() > 0.1  # what is taken out
+    below(z[0].abs().max().item(), 1e-6, "float32 rounding of the network at rest")
+    assert (z[1:, :-1].abs().amax(dim=1) > 1e-4).all()
+    gate = z[:, -1]
+    if tau == 0:
+        assert torch.equal(gate, torch.zeros_like(gate))
+    else:
+        assert (torch.diff(gate) > 0).all() and (gate < 1).all()
+        s = (w * w).sum(dim=1)
+        assert torch.allclose(gate, s / (s + tau * tau))
+
+
+def test_with_a_rest_gate_the_residual_stage_is_zero_at_rest() -> None:
+    from softdeca_train.models.parameters import load_parameter_specs
+    from softdeca_train.models.residual import ResidualSizes, ResidualStage
+    from softdeca_train.models.synthetic import TEST_PARAMETERS
+
+    specs = load_parameter_specs(TEST_PARAMETERS)
+    labels = np.array([0, 0, 1, 1, 2, 2])
+    for tau, at_rest_is_zero in ((None, False), (0.0, True), (0.2, True)):
+        stage = ResidualStage(labels, specs, ResidualSizes(3, 8, 2, 0.0, rest_gate=tau))
+        with torch.no_grad():
+            stage.table.normal_()
+        stage.eval()
+        p = torch.tensor([[s.default for s in specs]] * len(labels))
+        with torch.no_grad():
+            rest = stage(torch.zeros(1, 52), p).abs().max().item()
+            moving = stage(torch.rand(1, 52), p).abs().max().item()
+        assert (rest < 1e-5 * moving) == at_rest_is_zero, (tau, rest, moving)
+
+
 def test_local_features_carry_the_gravity_load_of_the_baselines(small) -> None:
     folder, _ = small
     run = Run(folder / "run-local", RunConfig(str(folder), "test", seed=3))

@@ -293,6 +293,13 @@ def test_bundle_at_softdecas_start_is_exported_and_evaluated(small, tmp_path) ->
         json.loads((fresh.folder / "softdeca.summary.json").read_text())["steps"] == 0
     )
     _check_export_deviation(read_manifest(bundle))
+    # a new run is exact at rest (rest gate 0): the exported networks give no correction at
+    # w = 0, whatever their weights, in the bundle as the runtime runs it
+    assert fresh.config.rest_gate == 0.0
+    nets = OnnxNetworks(bundle)
+    zero = np.zeros((1, 52), np.float32)
+    assert np.abs(nets.f_w(zero)).max() < 1e-6  # float32 rounding of the network at rest
+    assert np.abs(nets.f_w(np.full((1, 52), 0.3, np.float32))[:, :-1]).max() > 1e-4
     readme = write_report(fresh, bundle, tmp_path / "report", progress=False)
     doc = json.loads((tmp_path / "report" / "evaluation.json").read_text())
     assert np.isfinite(doc["errors"]["softdeca"]["mean_mm"])

@@ -33,6 +33,22 @@ class NetworkSizes:
     residual_hidden: int = 256
     residual_members: int = 5
     residual_steps: int = 3000
+    # SoftDECA at rest (rest_gate): None, the correction is g(w) with a constant part (bundles
+    # trained before); a number tau, exact at rest by construction: every network of w gives
+    # g(w) - g(0), and the part that does not depend on w is scaled by |w|^2 / (|w|^2 + tau^2),
+    # 0 at rest (tau = 0: left out).
+    rest_gate: float | None = None
+
+
+def rest_gate(weights: torch.Tensor, tau: float | None) -> torch.Tensor:
+    """(B, 1): the share of SoftDECA's w-independent correction a frame gets (NetworkSizes.
+    rest_gate): 1 without a gate; |w|^2 / (|w|^2 + tau^2), exactly 0 at rest, with one."""
+    if tau is None:
+        return torch.ones_like(weights[:, :1])
+    if tau == 0:
+        return torch.zeros_like(weights[:, :1])
+    s = (weights * weights).sum(dim=1, keepdim=True)
+    return s / (s + tau * tau)
 
 
 class Normalise(nn.Module):

@@ -27,6 +27,7 @@ from softdeca_train.models.blocks import (
     gravity_columns,
     gravity_load,
     region_means,
+    rest_gate,
 )
 from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.residual import ResidualSizes, ResidualStage
@@ -76,7 +77,12 @@ class WeightEncoder(nn.Module):
     """f_w: blendshape weights -> latent code z (per frame). Options: `linear_skip` adds a
     linear map of w to the MLP's output (the part of the correction linear in w starts there
     in closed form); `constant_slot` makes the last entry of z a constant 1, so the
-    hypernetwork's entry for it is a correction that does not depend on w (p's own)."""
+    hypernetwork's entry for it is a correction that does not depend on w (p's own).
+
+    With sizes.rest_gate set, z is exact at rest by construction: the MLP gives net(w) -
+    net(0) (the zero frame a constant of the network, so the export computes the same) and the
+    constant slot is the rest gate (models/blocks.py rest_gate), so z(0) = 0 and every
+    correction built on z vanishes at rest."""
 
     def __init__(
         self,
@@ -87,16 +93,21 @@ class WeightEncoder(nn.Module):
     ) -> None:
         super().__init__()
         self.constant_slot = constant_slot
+        self.rest_tau = sizes.rest_gate
         free = sizes.latent - 1 if constant_slot else sizes.latent
         self.net = mlp([n_weights, *sizes.f_w_hidden, free])
         self.skip = nn.Linear(n_weights, free, bias=False) if linear_skip else None
+        # not in the state: checkpoints and bundles written before it load as they are
+        self.register_buffer("rest", torch.zeros(1, n_weights), persistent=False)
 
     def forward(self, weights: torch.Tensor) -> torch.Tensor:
         z = self.net(weights)
+        if self.rest_tau is not None:
+            z = z - self.net(self.rest)
         if self.skip is not None:
             z = z + self.skip(weights)
         if self.constant_slot:
-            z = torch.cat([z, torch.ones_like(z[:, :1])], dim=1)
+            z = torch.cat([z, rest_gate(weights, self.rest_tau)], dim=1)
         return z
 
 

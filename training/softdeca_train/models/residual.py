@@ -30,6 +30,7 @@ from softdeca_train.models.blocks import (
     gravity_columns,
     gravity_load,
     region_means,
+    rest_gate,
 )
 from softdeca_train.models.parameters import ParameterSpec
 
@@ -46,10 +47,18 @@ class ResidualSizes:
     hidden: int = 256
     members: int = 5
     dropout: float = 0.3
+    # NetworkSizes.rest_gate: None, coefficients c(w) and the mean mode at 1; a number, the
+    # coefficients c(w) - c(0) and the mean mode at the rest gate, so the stage is 0 at rest
+    rest_gate: float | None = None
 
     @staticmethod
     def of(sizes: NetworkSizes) -> ResidualSizes:
-        return ResidualSizes(sizes.residual_modes, sizes.residual_hidden, sizes.residual_members)
+        return ResidualSizes(
+            sizes.residual_modes,
+            sizes.residual_hidden,
+            sizes.residual_members,
+            rest_gate=sizes.rest_gate,
+        )
 
 
 DEFAULT_SIZES = ResidualSizes()
@@ -138,8 +147,8 @@ class ResidualStage(nn.Module):
             parts.append(x @ first.weight[:, n:].T + first.bias)
         return torch.cat(parts, dim=1)
 
-    def coefficients(self, weights: torch.Tensor, condition: torch.Tensor) -> torch.Tensor:
-        """(B, modes + 1): the members' mean, then the mean mode's constant 1."""
+    def members_mean(self, weights: torch.Tensor, condition: torch.Tensor) -> torch.Tensor:
+        """(B, modes): the members' mean output for these weights and that condition."""
         n, h = N_WEIGHTS, self.sizes.hidden
         xw = (weights - self.input_mean[:n]) / self.input_std[:n]
         out = 0
@@ -148,8 +157,16 @@ class ResidualStage(nn.Module):
             assert isinstance(first, nn.Linear)
             a = xw @ first.weight[:, :n].T + condition[:, i * h : (i + 1) * h]
             out = out + m[1:](a)
-        c = out / len(self.members)
-        return torch.cat([c, torch.ones_like(c[:, :1])], dim=1)
+        return out / len(self.members)
+
+    def coefficients(self, weights: torch.Tensor, condition: torch.Tensor) -> torch.Tensor:
+        """(B, modes + 1): the members' mean, then the mean mode's coefficient (1; with a rest
+        gate, c(w) - c(0) and the gate: 0 at rest)."""
+        tau = self.sizes.rest_gate
+        c = self.members_mean(weights, condition)
+        if tau is not None:
+            c = c - self.members_mean(torch.zeros_like(weights[:1]), condition)
+        return torch.cat([c, rest_gate(weights, tau)], dim=1)
 
     def forward(self, weights: torch.Tensor, parameters: torch.Tensor) -> torch.Tensor:
         c = self.coefficients(weights, self.condition(parameters))
@@ -158,18 +175,26 @@ class ResidualStage(nn.Module):
     # ---- fitting ---------------------------------------------------------------------------
     @torch.no_grad()
     def set_modes(
-        self, residual: torch.Tensor, contrasts: torch.Tensor | None = None, extra: int = 0
+        self,
+        residual: torch.Tensor,
+        contrasts: torch.Tensor | None = None,
+        extra: int = 0,
+        gates: torch.Tensor | None = None,
     ) -> torch.Tensor:
         """Take the mean and leading modes of `residual` (N, V, 3) metres as the table and
         return the modes' coefficients per frame (N, modes), in units of each mode's spread
         (the table holds the modes scaled by it). With `contrasts` (M, V, 3), differences
         between frames that differ in one factor of p, the last `extra` modes are theirs
         (orthogonal to the others): the response to p is small next to what differs between
-        heads and expressions, and the residual's leading modes alone miss part of it."""
+        heads and expressions, and the residual's leading modes alone miss part of it.
+        `gates` (N, 1): each frame's coefficient of the mean mode (the rest gate; 1 without):
+        the mean is then their least-squares mean, and what is left of it is fitted by modes."""
         n, k = len(residual), self.sizes.modes
         r = residual.reshape(n, -1).double()
-        mean = r.mean(0)
-        rc = r - mean
+        g = torch.ones(n, dtype=torch.float64) if gates is None else gates.double().reshape(n)
+        weight = float((g * g).sum())
+        mean = (g[:, None] * r).sum(0) / weight if weight > 0 else torch.zeros_like(r[0])
+        rc = r - g[:, None] * mean
         extra = 0 if contrasts is None else min(extra, k)
         basis = _leading_rows(rc, k - extra)  # (k1, 3V) orthonormal
         scale = _rms(rc @ basis.T)
@@ -215,10 +240,27 @@ class ResidualStage(nn.Module):
             constant = std < 1e-3
             self.input_std.copy_(torch.where(constant, torch.ones_like(std), std))
         xn = (x - self.input_mean) / self.input_std
+        tau = self.sizes.rest_gate
+        gates = rest_gate(weights.float(), tau)
+        # With a rest gate, a member's coefficients are m(x) - m(x at rest): the same frame's
+        # inputs with every weight 0, under the same dropout mask.
+        x0 = x.clone()
+        x0[:, :N_WEIGHTS] = 0.0
+        xn0 = (x0 - self.input_mean) / self.input_std
+
+        def out(m: nn.Module, rows: torch.Tensor) -> torch.Tensor:
+            if tau is None:
+                return m(xn[rows])
+            seed = int(torch.randint(0, 2**31 - 1, (1,)))
+            torch.manual_seed(seed)
+            y = m(xn[rows])
+            torch.manual_seed(seed)
+            return y - m(xn0[rows])
+
         contrasts = None
         if pairs is not None and len(pairs):
             contrasts = residual[pairs[:, 0]] - residual[pairs[:, 1]]
-        target = self.set_modes(residual, contrasts, cfg.contrast_modes)
+        target = self.set_modes(residual, contrasts, cfg.contrast_modes, gates)
         if contrasts is not None:
             assert pairs is not None
             change = target[pairs[:, 0]] - target[pairs[:, 1]]
@@ -236,7 +278,7 @@ class ResidualStage(nn.Module):
             with torch.enable_grad():  # also when called under no_grad (a model's start)
                 for _ in range(cfg.steps):
                     idx = torch.randint(0, len(xn), (min(cfg.batch, len(xn)),), generator=gen)
-                    loss = ((m(xn[idx]) - target[idx]) ** 2).mean()
+                    loss = ((out(m, idx) - target[idx]) ** 2).mean()
                     if contrasts is not None:
                         assert pairs is not None
                         j = torch.randint(
@@ -246,9 +288,9 @@ class ResidualStage(nn.Module):
                         # the response, not two masks' noise
                         seed = int(torch.randint(0, 2**31 - 1, (1,), generator=gen))
                         torch.manual_seed(seed)
-                        ya = m(xn[pairs[j, 0]])
+                        ya = out(m, pairs[j, 0])
                         torch.manual_seed(seed)
-                        yb = m(xn[pairs[j, 1]])
+                        yb = out(m, pairs[j, 1])
                         miss = ((ya - yb - change[j]) ** 2).mean() / change_scale
                         loss = loss + cfg.contrast_weight * miss
                     opt.zero_grad()
@@ -263,8 +305,9 @@ class ResidualStage(nn.Module):
                 first.weight[:, constant] = 0.0
         bar.close()
         with torch.no_grad():
-            c = torch.stack([m(xn) for m in self.members]).mean(0)
-            c = torch.cat([c, torch.ones_like(c[:, :1])], dim=1)
+            every = torch.arange(len(xn))
+            c = torch.stack([out(m, every) for m in self.members]).mean(0)
+            c = torch.cat([c, gates], dim=1)
             fitted = torch.einsum("bk,vkc->bvc", c, self.table)
             before = residual.norm(dim=-1).mean()
             after = (residual - fitted).norm(dim=-1).mean()

@@ -39,6 +39,13 @@ def _run_args(p: argparse.ArgumentParser, dataset_required: bool = True) -> None
         "when the run folder is new)",
     )
     p.add_argument("--sizes", choices=["full", "test"], default="full", help="network sizes")
+    p.add_argument(
+        "--rest-gate",
+        default="0",
+        help="SoftDECA at rest: 0, exact (its correction g(w) - g(0)); TAU > 0, exact with the "
+        "part independent of w gated by |w|^2 / (|w|^2 + TAU^2); 'none', the form of the "
+        "bundles trained before (a constant part) (0; with --dataset, when the run is new)",
+    )
     p.add_argument("--seed", type=int, default=0, help="training seed (0)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
@@ -54,8 +61,16 @@ def _open_run(args: argparse.Namespace):  # -> Run
     if args.dataset:
         contrasts = str(Path(args.contrasts)) if args.contrasts else None
         more = tuple(str(Path(d)) for d in args.more_static)
+        gate = None if args.rest_gate.lower() == "none" else float(args.rest_gate)
+        if gate is not None and gate < 0:
+            raise SystemExit("--rest-gate is 'none' or a number >= 0")
         config = RunConfig(
-            str(Path(args.dataset)), args.sizes, args.seed, contrasts=contrasts, more_static=more
+            str(Path(args.dataset)),
+            args.sizes,
+            args.seed,
+            contrasts=contrasts,
+            more_static=more,
+            rest_gate=gate,
         )
         return Run(args.run, config)
     if args.contrasts or args.more_static:

@@ -17,6 +17,7 @@ from tqdm import tqdm
 from softdeca_train.data.personalise import personalise
 from softdeca_train.data.plan import FIXED
 from softdeca_train.landmarks.arkit_reference import ArkitFace
+from softdeca_train.models.blocks import rest_gate
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.models.networks import (
     EXPRESSION_SLOTS,
@@ -260,15 +261,20 @@ class SoftDecaHybrid(Trainable):
             None if regions is None else ResidualStage(regions, specs, ResidualSizes.of(sizes))
         )
 
+    def gated(self, weights: torch.Tensor, own: torch.Tensor) -> torch.Tensor:
+        """(V, B, F): each vertex's local features `own` (V, F) as the constant slot weighs
+        them in each frame: times the rest gate (1 without one; models/blocks.py)."""
+        gate = rest_gate(weights.double(), self.f_w.rest_tau)[:, 0]  # (B,)
+        return own[:, None] * gate[None, :, None]
+
     def vertex_features(self, weights: torch.Tensor, p_vertices: torch.Tensor) -> torch.Tensor:
         """(V, B, 52 + 1 + P + 3): [w, local features of each vertex] (the vertex stage's
-        linear inputs, in the networks' own normalisation)."""
+        linear inputs, in the networks' own normalisation; the local features weighed by the
+        rest gate, so a start exact at rest is fitted as such)."""
         assert self.f_ph_v.local is not None
         own = self.f_ph_v.local.features(p_vertices).double()  # (V, 1 + P + 3)
         b, v = len(weights), len(own)
-        return torch.cat(
-            [weights.double()[None].expand(v, b, -1), own[:, None].expand(v, b, -1)], dim=2
-        )
+        return torch.cat([weights.double()[None].expand(v, b, -1), self.gated(weights, own)], dim=2)
 
     @torch.no_grad()
     def code_features(self, weights: torch.Tensor, p_vertices: torch.Tensor) -> torch.Tensor:
@@ -280,7 +286,7 @@ class SoftDecaHybrid(Trainable):
         z = self.f_w(weights).double()[:, :-1]  # (B, r), the constant slot left out
         own = local.features(p_vertices).double()  # (V, F)
         v, b = len(own), len(z)
-        parts = [z[None].expand(v, b, -1), own[:, None].expand(v, b, -1)]
+        parts = [z[None].expand(v, b, -1), self.gated(weights, own)]
         if local.slots:
             e = local.slot_features(p_vertices).double()  # (V, E)
             prod = torch.einsum("bs,ve->vbse", z[:, : local.slots], e)

@@ -46,9 +46,18 @@ class RunConfig:
     # datasets generated like `dataset` (its range profile and level, another seed) whose
     # static train frames join SoftDECA's closed-form start and residual stage
     more_static: tuple[str, ...] = ()
+    # SoftDECA exact at rest (NetworkSizes.rest_gate): 0 (new runs), its correction g(w) - g(0)
+    # with no part independent of w; tau > 0, that part gated by |w|^2 / (|w|^2 + tau^2);
+    # None, the form of the runs before (a constant part, not exact at rest)
+    rest_gate: float | None = 0.0
 
     def __post_init__(self) -> None:  # run.json holds a list (and a caller may give paths)
         object.__setattr__(self, "more_static", tuple(str(d) for d in self.more_static))
+
+
+def _read_config(path: Path) -> RunConfig:
+    """A run's run.json; one written before the rest gate existed trained without one."""
+    return RunConfig(**{"rest_gate": None, **json.loads(path.read_text())})
 
 
 class Run:
@@ -58,15 +67,16 @@ class Run:
         if config is None:
             if not path.is_file():
                 raise FileNotFoundError(f"{self.folder} is not a training run (no run.json)")
-            config = RunConfig(**json.loads(path.read_text()))
+            config = _read_config(path)
         elif path.is_file():
-            old = RunConfig(**json.loads(path.read_text()))
-            key = lambda c: (c.dataset, c.sizes, c.seed, c.contrasts, c.more_static)  # noqa: E731
+            old = _read_config(path)
+            key = lambda c: (c.dataset, c.sizes, c.seed, c.contrasts, c.more_static, c.rest_gate)  # noqa: E731
             if key(old) != key(config):
                 raise ValueError(
                     f"{self.folder} trains on {old.dataset} ({old.sizes}, seed {old.seed}, "
-                    f"contrasts {old.contrasts}, more static data {list(old.more_static)}); use "
-                    "another folder for another dataset, sizes, seed, contrasts or more data"
+                    f"contrasts {old.contrasts}, more static data {list(old.more_static)}, "
+                    f"rest gate {old.rest_gate}); use another folder for another dataset, "
+                    "sizes, seed, contrasts, more data or rest gate"
                 )
         else:
             self.folder.mkdir(parents=True, exist_ok=True)
@@ -126,7 +136,7 @@ class Run:
 
     @property
     def sizes(self) -> NetworkSizes:
-        return SIZES[self.config.sizes]
+        return replace(SIZES[self.config.sizes], rest_gate=self.config.rest_gate)
 
     @cached_property
     def specs(self) -> tuple[ParameterSpec, ...]:
