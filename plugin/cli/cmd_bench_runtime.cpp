@@ -3,6 +3,8 @@
 // and with two threads; prepare time, memory per avatar, and the error the compact hyper-tensor
 // storage adds (half and int8 against float, same frames). Writes the benchmark JSON of
 // docs/ARCHITECTURE.md, Conventions ({figure: {value, unit, target, better, how}}).
+// Kept whole: every figure is measured in one run on the same inputs (take, avatars, bundles),
+// so their ratios hold; each figure's measurement is a function of its own.
 #include <chrono>
 #include <ctime>
 #include <cmath>

@@ -1,3 +1,6 @@
+// The FBX structure scan before assimp (fbx_bounds.h).
+// Kept whole: the binary and the ASCII walk share the budgets, the object graph and its checks;
+// apart, each would need the other's state.
 #include "fbx_bounds.h"
 
 #if SOFTDECA_HAVE_ZLIB

@@ -4,6 +4,7 @@
 // is judged poor in its report; hostile meshes and fit files get errors: a saved fit with any bit
 // flipped, or with values no fit holds under a matching checksum, is refused, and saves from many
 // threads to one path always leave a fit that loads.
+// Kept whole: every case runs on one fixture (the bundle and the user's head), built once.
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>

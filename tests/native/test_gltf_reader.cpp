@@ -3,6 +3,8 @@
 // EXT_meshopt_compression, KHR_draco_mesh_compression, several primitives, each place target
 // names are kept, VRM 0.x and 1.0 expressions, gltfpack's output) reads as the plain file does,
 // within the encoding's quantisation step; hostile files get errors that say what is wrong, fast.
+// Kept whole: every encoding is compared with the same plain file, all written by this file's
+// writer; the hostile cases edit that file.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>

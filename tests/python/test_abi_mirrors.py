@@ -3,7 +3,9 @@
 native.py) mirror them by hand. These tests parse the header and hold every mirror to it: the
 same fields in the same order with the same types (and names, up to the languages' spelling),
 the same ABI version, and C#'s P/Invoke declarations (NativeMethods.cs) the header's
-signatures, and Python's function table (native.SIGNATURES) the same."""
+signatures, and Python's function table (native.SIGNATURES) the same.
+
+Kept whole: one parser of the header, and every mirror held to what it read."""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """No function over MAX_LINES lines in the C++ and Python sources unless a comment just above it
 says why it must be one (a line starting `Kept whole:`). Long functions are split into named
-steps; the few that read better whole say so where they are defined.
+steps; the few that read better whole say so where they are defined. Likewise no source file
+over MAX_FILE_LINES lines unless its opening comment says why it is one file (`Kept whole:`).
 
 Run as a script to list every long function: `python tests/python/test_function_length.py`."""
 
@@ -15,6 +16,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 MAX_LINES = 120
+MAX_FILE_LINES = 500
+FILE_SUFFIXES = (".py", ".cpp", ".h", ".cs", ".swift", ".c")
 MARKER = re.compile(r"^\s*(//|#)\s*Kept whole:", re.IGNORECASE)
 CPP_SUFFIXES = (".cpp", ".h", ".hpp", ".cc", ".mm")
 
@@ -212,6 +215,36 @@ def test_no_long_function_without_a_reason() -> None:
 def test_the_allow_list_holds_only_long_functions() -> None:
     long = {f.key for f in long_functions()}
     assert sorted(ALLOWED - long) == [], "no longer long: remove from ALLOWED"
+
+
+def file_explained(path: Path) -> bool:
+    """A `Kept whole:` line in the file's opening comment (its first 40 lines)."""
+    head = path.read_text(encoding="utf-8", errors="replace").splitlines()[:40]
+    return any(re.search(r"(//|#|\*|^)\s*Kept whole:", line) for line in head)
+
+
+def long_files() -> list[tuple[str, int]]:
+    out = []
+    for p in tracked(FILE_SUFFIXES):
+        n = len(p.read_text(encoding="utf-8", errors="replace").splitlines())
+        if n > MAX_FILE_LINES and not file_explained(p):
+            out.append((p.relative_to(ROOT).as_posix(), n))
+    return out
+
+
+def test_no_long_file_without_a_reason() -> None:
+    assert len(tracked(FILE_SUFFIXES)) > 300
+    assert long_files() == [], (
+        "split these, or say in the opening comment why one is one file"
+    )
+
+
+def test_a_long_file_is_found_and_its_reason_read(tmp_path: Path) -> None:
+    long = tmp_path / "long.py"
+    long.write_text('"""A module."""\n' + "x = 1\n" * (MAX_FILE_LINES + 1))
+    assert not file_explained(long)
+    long.write_text('"""A module.\n\nKept whole: one table."""\n' + "x = 1\n" * 600)
+    assert file_explained(long)
 
 
 if __name__ == "__main__":

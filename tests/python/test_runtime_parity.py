@@ -8,7 +8,10 @@ up to ~1 mm, so storage errors are relative to that):
   int8  hyper-tensors: 0.02 mm  (int8 with a scale per 8 elements and latent)
 With the physics at prepare (localised SoftDECA cases) a frame also carries the model at rest
 under two more parameter sets, each stored the same way: three times the bound.
-Measured values are printed (pytest -s) and recorded in docs/runtime.md."""
+Measured values are printed (pytest -s) and recorded in docs/runtime.md.
+
+Kept whole: every case shares the fixtures (the bundle, the reference runtime, the take)
+built once per module."""
 
 from __future__ import annotations
 

@@ -1,7 +1,9 @@
 /*
  * SoftDECA native library: the public C ABI.
  *
- * This header is the only way into the library, from Unity (P/Invoke), Python or the CLI.
+ * This header is the way into the library for every host: Unity (P/Invoke), Python (ctypes)
+ * and the command line (docs/ARCHITECTURE.md, "Ways into the native library").
+ * Kept whole: every binding and the mirror tests read the whole C ABI from this one file.
  *
  * ABI CONVENTION (holds for every declaration below; a binding can rely on it mechanically):
  *   1. Versions. SOFTDECA_ABI_VERSION is the version of this convention and of every signature

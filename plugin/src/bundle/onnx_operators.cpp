@@ -1,3 +1,5 @@
+// The operator allow-list and each operator's static shape rule (onnx_operators.h).
+// Kept whole: one table, each operator beside its rule, so none is allowed without one.
 #include "bundle/onnx_operators.h"
 
 #include <algorithm>

@@ -1,3 +1,6 @@
+// The whole fit of a user's avatar (avatar_fit.h), its steps in the order they run.
+// Kept whole: the steps hand each other the mesh's frame, parts and matches; each step is a
+// function of its own and its algorithm lives in its own file (registration, placement, ...).
 #include "fit/avatar_fit.h"
 
 #include <Eigen/Geometry>

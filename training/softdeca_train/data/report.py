@@ -6,7 +6,9 @@
   takes' frames, the rest from the fitted coverage sampler);
 - identities: the coefficients h against N(0, 1), and the spread of the neutral heads;
 - |T - S| (mm) per region and kind: mean and percentiles. This is the yardstick the
-  networks' errors are read against: an error near it means the network learnt nothing."""
+  networks' errors are read against: an error near it means the network learnt nothing.
+
+Kept whole: every figure comes from the one streaming pass over the shards."""
 
 from __future__ import annotations
 

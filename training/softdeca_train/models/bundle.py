@@ -1,6 +1,9 @@
 """The model bundle: writing it (ONNX export + manifest), packing it into one tar for hosts
 that ship it as an asset, and reading it back (manifest, topology, networks through
-onnxruntime). The format is specified in docs/bundle.md; the native runtime reads the same."""
+onnxruntime). The format is specified in docs/bundle.md; the native runtime reads the same.
+
+Kept whole: the bundle's writer and its reader (the export, the ONNX check,
+OnnxNetworks) side by side, so the contract cannot drift between them."""
 
 from __future__ import annotations
 

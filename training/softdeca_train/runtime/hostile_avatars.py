@@ -6,7 +6,9 @@ command is given; tests/python/test_hostile_avatars.py runs them and `softdeca
 bench-reliability --import-corpus` measures the memory of each import.
 
 Attacks that name a file outside their avatar's folder place a secret file there, whose bytes
-must never be read; FIFOs are made where a file should be (nobody writes to them)."""
+must never be read; FIFOs are made where a file should be (nobody writes to them).
+
+Kept whole: the corpus is one list: each attack beside the file it writes."""
 
 from __future__ import annotations
 

@@ -1,6 +1,9 @@
 """ctypes binding of the runtime's C ABI (plugin/include/softdeca/softdeca.h): what Unity's
 P/Invoke layer does, from Python, for the parity tests, the benchmarks and the replay tools.
-Every call checks its status and raises NativeError with the library's message."""
+Every call checks its status and raises NativeError with the library's message.
+
+Kept whole: the ctypes mirror of the C ABI, its structs and its function table, read
+as one against the header (tests/python/test_abi_mirrors.py)."""
 
 from __future__ import annotations
 

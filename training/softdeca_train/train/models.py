@@ -1,7 +1,10 @@
 """The trainable models, each as `loss(batch)` and `predict(batch)` over a Batch: SoftDECA
 (deformation gradients through the differentiable deformation transfer, eq. 16-19), its
 vertex-position variant, SparseSoftDECA (eq. 25), the dynamics stage (eq. 21) over a frozen
-static model, and the Table 1 baselines. Errors are per-vertex Euclidean distances on S."""
+static model, and the Table 1 baselines. Errors are per-vertex Euclidean distances on S.
+
+Kept whole: the registry's models share the Batch handling, the features and the
+losses defined here; each model is a class of its own."""
 
 from __future__ import annotations
 

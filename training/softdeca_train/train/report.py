@@ -1,7 +1,9 @@
 """`evaluate`: the evaluation report of a training run and its bundle (markdown + PNG plots +
 per-vertex error heat maps), the Table 1 and Table 2 analogues of the paper, and the figures
 of build/bench/models.json. The bundle's own rows run the exported ONNX networks end to end
-as a host would: identity estimated by the bundle's encoder, ONNX hypernetworks, DT."""
+as a host would: identity estimated by the bundle's encoder, ONNX hypernetworks, DT.
+
+Kept whole: every section is written from the one set of measured errors."""
 
 from __future__ import annotations
 
