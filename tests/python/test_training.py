@@ -298,9 +298,8 @@ def test_bundle_at_softdecas_start_is_exported_and_evaluated(small, tmp_path) ->
     assert fresh.config.rest_gate == 0.0
     nets = OnnxNetworks(bundle)
     zero = np.zeros((1, 52), np.float32)
-    assert (
-        np.abs(nets.f_w(zero)).max() < 1e-6
-    )  # float32 rounding of the network at rest
+    # float32 rounding of the network at rest
+    assert np.abs(nets.f_w(zero)).max() < 1e-6
     assert np.abs(nets.f_w(np.full((1, 52), 0.3, np.float32))[:, :-1]).max() > 1e-4
     readme = write_report(fresh, bundle, tmp_path / "report", progress=False)
     doc = json.loads((tmp_path / "report" / "evaluation.json").read_text())
