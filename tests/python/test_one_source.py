@@ -219,13 +219,11 @@ ONE_HOME: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
             "_column",  # ParameterState's per-element values
         ),
     ),
-    # The data's identity fields (lhm/carried.py, carry_basis) still assemble the same
-    # stiffness with numpy: add_fill_stiffness's differs from it by round-off (1e-16), which
-    # would change every carried fill of the data.
+    # the data's identity fields (lhm/carried.py, carry_basis) take the same stiffness
     "the fill's carry to a neutral skin": (
         "plugin/src/prepare/rest_physics.cpp",
         ("carry_fill", "add_fill_stiffness"),
-        ("carry_fill", "carried_vertices", "fill_stiffness"),
+        ("carry_fill", "carried_vertices", "fill_stiffness", "stiffness_matrix"),
     ),
 }
 # Modules using the contact rules' landmarks for another job, with that job.

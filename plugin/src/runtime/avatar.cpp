@@ -7,7 +7,7 @@
 
 namespace softdeca::runtime {
 
-// The avatar's state and staged inputs; prepare is avatar_prepare.cpp, the frames avatar_frame.cpp.
+// The avatar's state and staged inputs; prepare is avatar_prepare.cpp, the frames avatar_evaluate.cpp.
 
 Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
     : model_(std::move(model)),

@@ -39,21 +39,6 @@ from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
 
-def stiffness_matrix(vertices: np.ndarray, tets: np.ndarray) -> sp.csr_matrix:
-    """(n, n) sum over tets of vol * grad(phi_a) . grad(phi_b): the Dirichlet energy of a
-    piecewise-linear field is x^T K x per component."""
-    p = vertices[tets]
-    edges = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]], axis=2)
-    inv = np.linalg.inv(edges)  # row j: the gradient of barycentric coordinate j + 1
-    grads = np.concatenate([-inv.sum(axis=1, keepdims=True), inv], axis=1)  # (T, 4, 3)
-    vol = np.abs(np.linalg.det(edges)) / 6.0
-    local = vol[:, None, None] * np.einsum("tad,tbd->tab", grads, grads)
-    rows = np.repeat(tets, 4, axis=1).ravel()
-    cols = np.tile(tets, (1, 4)).ravel()
-    n = len(vertices)
-    return sp.csr_matrix((local.ravel(), (rows, cols)), shape=(n, n))
-
-
 def embedding_matrix(
     n_vertices: int, tets: np.ndarray, tet: np.ndarray, bary: np.ndarray, weight: np.ndarray
 ) -> sp.csr_matrix:
@@ -101,7 +86,10 @@ def carry_basis(template: Template, cfg: LhmConfig) -> CarryBasis:
         lhm.attachments["skin_lip_bone"], mesh.soft_lid_side, lhm.attachments["skin_lid_side"],
     )  # fmt: skip
     b = embedding_matrix(n, mesh.soft_tets, np.asarray(tet), bary, inside.astype(np.float64))
-    system = (b.T @ b + cfg.carry_smoothness * stiffness_matrix(mesh.vertices, tets)).tocsc()
+    # the fill's Dirichlet stiffness: the library's (prepare/rest_physics.cpp), as the runtime's
+    # carry of a fill assembles it
+    stiffness = sp.csc_matrix(native.fill_stiffness(mesh.vertices, tets))
+    system = (b.T @ b + cfg.carry_smoothness * stiffness).tocsc()
     modes = np.asarray(template.identity_modes[:, :N_SKIN], np.float64)  # (K, n_S, 3)
     k = len(modes)
     rhs = b.T @ modes.transpose(1, 0, 2).reshape(N_SKIN, 3 * k)

@@ -1,3 +1,5 @@
+// The core avatar's frames (avatar.h): SoftDECA from weights or a surface, SparseSoftDECA from
+// landmarks, the linear blend; each ends in the dynamics, the output and the normals.
 #include "runtime/avatar.h"
 
 #include <algorithm>
