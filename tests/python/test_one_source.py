@@ -340,6 +340,52 @@ def test_each_shared_algorithm_has_one_home() -> None:
     assert own_implementations(modules) == []
 
 
+# ---- Deliberate oracles -----------------------------------------------------------------------
+# The Python implementations kept on purpose as independent references, named here and nowhere
+# else: module (in the training package) -> (the library's home of the same job, the test that
+# compares the two). Each says so in its docstring ("Oracle:").
+ORACLES: dict[str, tuple[str, str]] = {
+    "models/reference.py": (
+        "plugin/src/runtime/avatar_evaluate.cpp",
+        "test_runtime_parity.py",
+    ),
+    "models/rest_physics.py": (
+        "plugin/src/prepare/rest_physics.cpp",
+        "test_runtime_parity.py",
+    ),
+    "runtime/fit_coverage.py": (
+        "plugin/src/fit/fit_quality.cpp",
+        "test_fit_avatars.py",
+    ),
+}
+
+
+def test_the_oracles_are_named_once_and_compared() -> None:
+    modules = package_modules()
+    declared = [
+        path
+        for path, tree in modules.items()
+        if (ast.get_docstring(tree) or "").count("\nOracle:")
+        or (ast.get_docstring(tree) or "").startswith("Oracle:")
+    ]
+    assert sorted(declared) == sorted(ORACLES), (
+        "an oracle is named here and in its docstring"
+    )
+    for module, (home, test) in ORACLES.items():
+        assert (ROOT / home).is_file(), home
+        text = (ROOT / "tests" / "python" / test).read_text(encoding="utf-8")
+        own = [
+            n.name
+            for n in modules[module].body
+            if isinstance(n, ast.FunctionDef | ast.ClassDef)
+            and not n.name.startswith("_")
+        ]
+        used = [name for name in own if re.search(rf"\b{name}\b", text)]
+        assert used, (
+            f"{test} uses nothing of {module}: it does not compare the library with it"
+        )
+
+
 def test_the_contact_landmarks_are_written_once() -> None:
     landmarks = contact_landmarks()
     assert landmarks["inner_lip"] == frozenset(range(60, 68))

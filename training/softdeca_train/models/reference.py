@@ -8,7 +8,11 @@ bundle has SoftDECA's vertex stage and sum_k c_k M[v, k] where it has the residu
 (c = f_r_w(w, f_r_ph(p)), M its modes). SparseSoftDECA: offsets of the
 retargeted landmarks from the avatar's neutral landmarks, z = f_l(offsets),
 X = neutral_skin + sum_k z_k L_v[v, k]. Then, if enabled, dynamics per skin vertex
-X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, the non-skin vertices, and normals."""
+X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, the non-skin vertices, and normals.
+
+Oracle: a deliberate second implementation of the runtime's frame (plugin/src/runtime/), the
+reference the parity tests hold the library to (tests/python/test_runtime_parity.py) and the
+evaluation runs bundles with."""
 
 from __future__ import annotations
 

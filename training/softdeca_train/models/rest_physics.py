@@ -19,7 +19,10 @@ defaults c = 0; a frame costs one add.
 The head is the bundle's (rest_head.py) carried to the avatar. Parameter maps reach the
 physics' elements as the data's regions do (template/regions.py, element_regions): a tet takes the
 values of the skin vertex nearest its centroid on the avatar, a skin triangle its face value,
-a skin point its vertex value."""
+a skin point its vertex value.
+
+Oracle: the reference's physics at prepare, a deliberate second implementation of
+plugin/src/prepare/rest_physics.cpp that tests/python/test_runtime_parity.py compares with."""
 
 from __future__ import annotations
 

@@ -7,7 +7,10 @@ lying on the avatar's surface leaves every face vertex within a millimetre or so
 
 `python -m softdeca_train.runtime.fit_coverage` fits each low-poly variant (avatars/config.py,
 LOW_POLY_VARIANTS) with the committed bundle and prints its coverage ($SOFTDECA_LIBRARY: another
-build of the library)."""
+build of the library).
+
+Oracle: an independent measure of what plugin/src/fit/fit_quality.cpp measures, from the test
+avatars' truth; tests/python/test_fit_avatars.py holds the two together."""
 
 from __future__ import annotations
 
