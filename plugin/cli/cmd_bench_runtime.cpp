@@ -419,6 +419,36 @@ std::pair<double, double> alternating_ms(const Bench& bench, const std::function
   return {median(a_ms), median(b_ms)};
 }
 
+// Several avatars of one bundle on one core, as crowds and collaborations run them: each frame
+// of the take evaluated on every avatar in turn (each its own memory, as separate hosts' avatars
+// are), so the figure pays for the caches they share. The per-avatar frame and how many avatars
+// one core keeps at 60 fps.
+constexpr std::size_t kCrowd = 16;
+constexpr double kFrame60HzMs = 1000.0 / 60.0;
+
+void measure_crowd(Bench& bench, Model& shipped, const std::string& how) {
+  std::vector<std::unique_ptr<Avatar>> crowd;
+  for (std::size_t i = 0; i < kCrowd; ++i) {
+    crowd.push_back(std::make_unique<Avatar>(shipped, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF));
+    check(softdeca_avatar_prepare(crowd.back()->handle), "prepare");
+  }
+  const Times t = median_ms(bench.frames, bench.warmup, [&](std::size_t f) {
+    for (const auto& a : crowd)
+      check(softdeca_avatar_evaluate_weights(a->handle, bench.take.weights[f].data(), 52, &bench.output), "crowd");
+  });
+  const double per_avatar = t.wall / static_cast<double>(kCrowd);
+  const std::string crowd_how = "; " + std::to_string(kCrowd) + " avatars of the shipped bundle on the template head, each frame "
+                                "evaluated on every one in turn (evaluate_weights, with normals), median frame over the " +
+                                std::to_string(kCrowd) + "; 1 thread" + how;
+  bench.figures.raw("runtime.crowd_softdeca_ms_per_avatar", figure(per_avatar, "ms", "wall-clock per avatar" + crowd_how));
+  bench.figures.raw("runtime.avatars_per_core_60fps",
+                    figure(std::floor(kFrame60HzMs / per_avatar), "avatars",
+                           "avatars one core keeps at 60 fps: floor(16.67 ms / crowd_softdeca_ms_per_avatar)" + crowd_how, 12.0,
+                           "higher"));
+  std::fprintf(stderr, "crowd of %zu: %.3f ms per avatar frame, %.0f avatars per core at 60 fps\n", kCrowd, per_avatar,
+               std::floor(kFrame60HzMs / per_avatar));
+}
+
 // The path users run: the shipped (trained) bundle, on the template and on a fitted avatar,
 // each against its own linear blend with frames alternating, and SparseSoftDECA (1 thread).
 void measure_shipped(Bench& bench, const std::string& bundle_path, const std::string& own_path) {
@@ -449,6 +479,7 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
                     figure(sparse / linear_again, "x", "sparse_shipped_ms over the linear blend's frames between them" + how));
   std::fprintf(stderr, "shipped bundle, template: softdeca %.3f ms, linear %.3f ms (x%.2f); sparse %.3f ms\n", softdeca, linear,
                softdeca / linear, sparse);
+  measure_crowd(bench, shipped, "; " + bench.how);
   if (own_path.empty()) return;
   const AvatarFile file = read_avatar_file(own_path);
   const softdeca_avatar_mesh mesh = file.abi_mesh();
