@@ -76,6 +76,71 @@ def test_with_a_rest_gate_the_residual_stage_is_zero_at_rest() -> None:
         assert (rest < 1e-5 * moving) == at_rest_is_zero, (tau, rest, moving)
 
 
+def _linear_ops(
+    module: torch.nn.Module, inputs: list[tuple[str, list]], out: list
+) -> int:
+    """How many matrix products the exported graph of `module` runs per call, and a check
+    that it computes what the module does."""
+    import onnx
+    import onnxruntime as ort
+    from softdeca_train.models.bundle import _export_onnx
+
+    spec = {
+        "inputs": [{"name": n, "shape": s} for n, s in inputs],
+        "outputs": [{"name": n, "shape": s} for n, s in out],
+    }
+    example = tuple(
+        torch.rand(*[1 if isinstance(d, str) else d for d in s]) for _, s in inputs
+    )
+    data = _export_onnx(module.eval(), spec, example)
+    session = ort.InferenceSession(data, providers=["CPUExecutionProvider"])
+    feed = {n: x.numpy() for (n, _), x in zip(inputs, example, strict=True)}
+    with torch.no_grad():
+        want = module(*example).numpy()
+    np.testing.assert_allclose(session.run(None, feed)[0], want, rtol=1e-4, atol=1e-6)
+    graph = onnx.load_from_string(data).graph
+    return sum(n.op_type in ("Gemm", "MatMul") for n in graph.node)
+
+
+def test_the_exported_frame_networks_hold_their_rest_terms_as_constants() -> None:
+    """With a rest gate, z(w) = net(w) - net(0) and the residual stage's c(w) - c(0): the
+    exported per-frame graphs run each network once, net(0) a constant of f_w's graph and
+    c(0) part of the condition made at prepare (models/residual.py condition_size)."""
+    from softdeca_train.models.parameters import load_parameter_specs
+    from softdeca_train.models.residual import (
+        ResidualCoefficients,
+        ResidualSizes,
+        ResidualStage,
+    )
+    from softdeca_train.models.synthetic import TEST_PARAMETERS
+
+    sizes = replace(TEST_SIZES, rest_gate=0.1)
+    enc = WeightEncoder(52, sizes, linear_skip=True, constant_slot=True)
+    layers = sum(isinstance(m, torch.nn.Linear) for m in enc.modules())
+    z = [("z", ["batch", sizes.latent])]
+    assert _linear_ops(enc, [("weights", ["batch", 52])], z) == layers
+
+    specs = load_parameter_specs(TEST_PARAMETERS)
+    labels = np.array([0, 0, 1, 1, 2, 2])
+    stage = ResidualStage(labels, specs, ResidualSizes(3, 8, 2, 0.0, rest_gate=0.1))
+    with torch.no_grad():
+        for prm in stage.parameters():
+            prm.normal_()
+    p = torch.tensor([[s.default for s in specs]] * len(labels))
+    condition = stage.condition(p)
+    # modes 3, hidden 8, members 2: the members' shares, then the 3 coefficients at rest
+    assert condition.shape == (1, stage.condition_size) == (1, 2 * 8 + 3)
+    assert torch.equal(
+        stage.coefficients(torch.zeros(1, 52), condition), torch.zeros(1, 4)
+    )
+    inputs = [("weights", ["batch", 52]), ("condition", [1, stage.condition_size])]
+    # per member: its first layer's share of w, then its two hidden layers
+    per_frame = _linear_ops(
+        ResidualCoefficients(stage), inputs, [("coefficients", ["batch", 4])]
+    )
+    assert per_frame == 3 * stage.sizes.members
+
+
 def test_local_features_carry_the_gravity_load_of_the_baselines(small) -> None:
     folder, _ = small
     run = Run(folder / "run-local", RunConfig(str(folder), "test", seed=3))

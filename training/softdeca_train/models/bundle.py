@@ -28,6 +28,7 @@ from softdeca_train.models.networks import (
     GAMMA_MAX,
     GAMMA_MIN,
     BundleNetworks,
+    freeze_rest_codes,
 )
 from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.reference import Model
@@ -118,7 +119,7 @@ def _network_specs(d: TemplateDefinition, nets: BundleNetworks) -> dict[str, dic
                 "parameter_columns": cols,
             }
         if (stage := nets.softdeca.f_r) is not None:
-            c, modes = stage.sizes.members * stage.sizes.hidden, stage.sizes.modes + 1
+            c, modes = stage.condition_size, stage.sizes.modes + 1
             specs["softdeca.f_r_ph"] = {
                 "inputs": [_tensor("parameters", [v, p])],
                 "outputs": [_tensor("condition", [1, c]), _tensor("modes", [v, modes, 3])],
@@ -188,6 +189,7 @@ def _example(spec: dict[str, Any]) -> tuple[torch.Tensor, ...]:
 def _export_onnx(
     module: nn.Module, spec: dict[str, Any], example: tuple[torch.Tensor, ...]
 ) -> bytes:
+    module = freeze_rest_codes(module)  # the rest terms as constants, not per-frame work
     buf = io.BytesIO()
     names_in = [t["name"] for t in spec["inputs"]]
     names_out = [t["name"] for t in spec["outputs"]]
@@ -541,7 +543,7 @@ def _residual_sizes(nets: BundleNetworks) -> dict[str, Any]:
     return {
         "residual_stage": {
             "modes": sizes.modes + 1,
-            "condition": sizes.members * sizes.hidden,
+            "condition": stage.condition_size,
             "regions": int(stage.regions.shape[0]),
         }
     }

@@ -14,6 +14,7 @@ inside f_ph, f_ph_v and f_dyn."""
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -99,16 +100,31 @@ class WeightEncoder(nn.Module):
         self.skip = nn.Linear(n_weights, free, bias=False) if linear_skip else None
         # not in the state: checkpoints and bundles written before it load as they are
         self.register_buffer("rest", torch.zeros(1, n_weights), persistent=False)
+        # net(0) as a constant (freeze_rest_codes, at export): the exported graph then holds
+        # it, and the frame does not run the MLP a second time
+        self.rest_code: torch.Tensor | None = None
 
     def forward(self, weights: torch.Tensor) -> torch.Tensor:
         z = self.net(weights)
         if self.rest_tau is not None:
-            z = z - self.net(self.rest)
+            z = z - (self.net(self.rest) if self.rest_code is None else self.rest_code)
         if self.skip is not None:
             z = z + self.skip(weights)
         if self.constant_slot:
             z = torch.cat([z, rest_gate(weights, self.rest_tau)], dim=1)
         return z
+
+
+def freeze_rest_codes(module: nn.Module) -> nn.Module:
+    """A copy of `module` whose weight encoders hold net(0) as a constant (WeightEncoder), as
+    the export writes them; the copy is for export and checks only: training on it would leave
+    the constant stale."""
+    out = copy.deepcopy(module)
+    for m in out.modules():
+        if isinstance(m, WeightEncoder) and m.rest_tau is not None:
+            with torch.no_grad():
+                m.rest_code = m.net(m.rest).detach().clone()
+    return out
 
 
 class LandmarkEncoder(nn.Module):

@@ -136,8 +136,16 @@ class ResidualStage(nn.Module):
         return torch.cat([weights, pf.expand(len(weights), -1)], dim=1)
 
     # ---- the two runtime halves -----------------------------------------------------------
+    @property
+    def condition_size(self) -> int:
+        """C: every member's first-layer share, then (with a rest gate) the coefficients at
+        rest, so that the per-frame half subtracts them instead of running the members twice."""
+        gated = self.sizes.rest_gate is not None
+        return self.sizes.members * self.sizes.hidden + (self.sizes.modes if gated else 0)
+
     def condition(self, parameters: torch.Tensor) -> torch.Tensor:
-        """(1, members x hidden): the parameters' share of every member's first layer."""
+        """(1, C): the parameters' share of every member's first layer, then with a rest gate
+        the members' mean at w = 0 (condition_size)."""
         n = N_WEIGHTS
         x = (self.parameter_features(parameters) - self.input_mean[n:]) / self.input_std[n:]
         parts = []
@@ -145,7 +153,11 @@ class ResidualStage(nn.Module):
             first = m[0]
             assert isinstance(first, nn.Linear)
             parts.append(x @ first.weight[:, n:].T + first.bias)
-        return torch.cat(parts, dim=1)
+        shares = torch.cat(parts, dim=1)
+        if self.sizes.rest_gate is None:
+            return shares
+        at_rest = self.members_mean(torch.zeros(1, n, dtype=shares.dtype), shares)
+        return torch.cat([shares, at_rest], dim=1)
 
     def members_mean(self, weights: torch.Tensor, condition: torch.Tensor) -> torch.Tensor:
         """(B, modes): the members' mean output for these weights and that condition."""
@@ -165,7 +177,7 @@ class ResidualStage(nn.Module):
         tau = self.sizes.rest_gate
         c = self.members_mean(weights, condition)
         if tau is not None:
-            c = c - self.members_mean(torch.zeros_like(weights[:1]), condition)
+            c = c - condition[:, self.sizes.members * self.sizes.hidden :]
         return torch.cat([c, rest_gate(weights, tau)], dim=1)
 
     def forward(self, weights: torch.Tensor, parameters: torch.Tensor) -> torch.Tensor:
