@@ -512,3 +512,48 @@ def test_at_rest_the_response_is_the_physics(setup):
         REASON_REST,
         what="mm",
     )
+
+
+def test_a_bundle_exact_at_rest_runs_as_its_reference(tmp_path):
+    """A bundle trained exact at rest (a rest gate: every network of w gives g(w) - g(0), the
+    residual stage's c(0) at the end of its condition, made at prepare): the native runtime
+    matches its reference, and at rest its frame is the linear blend (no rest physics at the
+    defaults), while a moving face is corrected."""
+    head = synthetic_head()
+    specs = load_parameter_specs(TEST_PARAMETERS)
+    nets = build_random(
+        head.definition,
+        specs,
+        replace(TEST_SIZES, rest_gate=0.1),
+        seed=9,
+        vertex_stage=True,
+        residual_stage=True,
+    )
+    export_bundle(tmp_path / "gated", head.definition, nets, BundleInfo(True, "gated"))
+    ref = ReferenceAvatar(
+        TorchNetworks(as_stored(nets)),
+        head.definition,
+        head.neutral,
+        head.head_triangles,
+        head.blendshapes,
+    )
+    nat = NativeAvatar(
+        NativeModel(tmp_path / "gated"),
+        head.neutral,
+        head.head_triangles,
+        head.blendshapes,
+        precision="float",
+    )
+    ref.prepare()
+    nat.prepare()
+    zero = np.zeros(52)
+    below(
+        err_mm(nat.evaluate_weights(zero)[0], nat.evaluate_linear(zero)[0]),
+        1e-5,
+        "float32 rounding of g(0) - g(0): exact at rest",
+        what="mm",
+    )
+    for w in frames(4, 5):
+        x = nat.evaluate_weights(w)[0]
+        below(err_mm(x, ref.evaluate_weights(w)[0]), BOUND_MM["float"], REASON["float"])
+        above(err_mm(x, nat.evaluate_linear(w)[0]), 0.05, "a moving face is corrected")
