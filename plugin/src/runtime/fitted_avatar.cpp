@@ -12,11 +12,11 @@
 namespace softdeca::runtime {
 
 fit::TemplateData fit_template(const Model& m) {
-  const TemplateHead* th = m.template_head();
+  const bundle::TemplateHead* th = m.template_head();
   expect(th != nullptr, [] {
     return std::string("the bundle has no template head (format version 5): fitting an avatar needs one");
   });
-  const Manifest& mf = m.manifest();
+  const bundle::Manifest& mf = m.manifest();
   fit::TemplateData t;
   t.head_neutral = th->neutral.data();
   t.head_vertices = static_cast<std::size_t>(mf.head_vertices);
@@ -27,7 +27,7 @@ fit::TemplateData fit_template(const Model& m) {
   t.identity_count = th->identity_count;
   t.skin_triangles = m.skin_triangles().data();
   t.skin_triangle_count = m.skin_triangles().size() / 3;
-  for (const LandmarkSpec& l : mf.landmarks) {
+  for (const bundle::LandmarkSpec& l : mf.landmarks) {
     t.landmark_triangle.push_back(l.triangle);
     t.landmark_bary.push_back({l.bary[0], l.bary[1], l.bary[2]});
   }
@@ -58,7 +58,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   core.triangles = t.skin_triangles;
   core.triangle_count = t.skin_triangle_count;
   core.blendshapes = shapes.data();
-  core.blendshape_count = kBlendshapeCount;
+  core.blendshape_count = bundle::kBlendshapeCount;
   core.threads = d.threads;
   core.precision = d.precision;
   // The identity code of the template identity closest to the avatar: the encoder reads a head
@@ -77,16 +77,16 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   to_avatar_ = f.placement.linear.inverse().cast<float>();
   // The avatar's own shapes; a shape its rig lacks is the template's, carried back onto the
   // avatar's face through the embedding, so a rig without some (or any) shapes animates fully.
-  std::vector<float> own(kBlendshapeCount * n_ * 3, 0.0f);
-  for (std::size_t k = 0; k < static_cast<std::size_t>(kBlendshapeCount); ++k) {
+  std::vector<float> own(bundle::kBlendshapeCount * n_ * 3, 0.0f);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(bundle::kBlendshapeCount); ++k) {
     if (a.deltas[k]) std::memcpy(own.data() + k * n_ * 3, a.deltas[k], n_ * 3 * sizeof(float));
     else if (f.origin[k] == fit::ShapeOrigin::Template) add_carried(shapes.data() + k * vh_ * 3, own.data() + k * n_ * 3);
   }
-  blendshapes_ = Blendshapes(own.data(), kBlendshapeCount, n_, 1);
+  blendshapes_ = Blendshapes(own.data(), bundle::kBlendshapeCount, n_, 1);
   source_ = f.source;
   head_out_.resize(vh_ * 3);
   field_.resize(vs_ * 3);
-  weights_.resize(kBlendshapeCount);
+  weights_.resize(bundle::kBlendshapeCount);
   normals_ = geometry::Normals(triangles_, n_);
 }
 
@@ -107,7 +107,7 @@ Output FittedAvatar::core_output() {
 }
 
 void FittedAvatar::own_blend(const float* weights, float* out) {
-  for (std::size_t i = 0; i < static_cast<std::size_t>(kBlendshapeCount); ++i) weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(bundle::kBlendshapeCount); ++i) weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
   blendshapes_.blend(weights_.data(), neutral_.data(), out, 0);
 }
 
