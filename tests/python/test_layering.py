@@ -131,6 +131,30 @@ def test_the_c_abi_has_one_avatar_whatever_its_mesh() -> None:
     assert on_kind == [], on_kind
 
 
+def test_every_avatar_runs_one_frame_path() -> None:
+    """FittedAvatar's frames and maps are one path for every mesh: each applies the avatar's
+    transfer (runtime/fit_transfer.h) and none asks which kind of mesh it has."""
+    text = (SRC / "runtime" / "fitted_avatar.cpp").read_text(encoding="utf-8")
+    # each definition from its first line to the closing brace at the start of a line
+    definitions = re.findall(
+        r"^[^\s/][^\n]*? FittedAvatar::(\w+)\((.*?)^\}", text, re.DOTALL | re.MULTILINE
+    )
+    per_call = {
+        name: body
+        for name, body in definitions
+        if name.startswith(("evaluate_", "set_parameter_"))
+    }
+    assert len(per_call) == 6, sorted(per_call)
+    deciding = [
+        name
+        for name, body in per_call.items()
+        if re.search(r"\b(if|while|switch)\s*\(| \? ", body)
+    ]
+    assert deciding == [], deciding
+    header = (SRC / "runtime" / "fitted_avatar.h").read_text(encoding="utf-8")
+    assert not re.search(r"\bbool\s+\w*identity", header), "a flag for the identity fit"
+
+
 def test_core_depends_on_nothing_but_the_public_header() -> None:
     core = sources("core")
     assert core
