@@ -37,7 +37,7 @@ AvatarView avatar_view(const AvatarFile& a, double metres_per_unit) {
 }
 
 double fit_metres_per_unit(const std::string& fit_report) {
-  const runtime::Json report = runtime::Json::parse(fit_report);
+  const bundle::Json report = bundle::Json::parse(fit_report);
   return report.at("metres_per_unit", "the fit's report").number("metres_per_unit");
 }
 

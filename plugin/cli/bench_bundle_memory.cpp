@@ -18,7 +18,7 @@
 namespace softdeca::cli {
 namespace {
 namespace fs = std::filesystem;
-using runtime::BundleFiles;
+using bundle::BundleFiles;
 using runtime::Model;
 using runtime::ModelOptions;
 
@@ -102,7 +102,7 @@ void write_file(const fs::path& p, const std::string& s) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out.write(s.data(), static_cast<std::streamsize>(s.size()));
 }
-std::string sha(const std::string& s) { return runtime::sha256_hex(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()); }
+std::string sha(const std::string& s) { return bundle::sha256_hex(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()); }
 
 // A copy of `bundle` whose identity encoder (loaded by every Model::load) also holds the
 // fragment: a second `graph` field merges into the first (protobuf rules), and the manifest's

@@ -34,15 +34,15 @@ std::string read_text(const fs::path& p) {
 
 // The attacks `softdeca fit` reads (not those only `replay` opens), paths resolved in `corpus`.
 std::vector<Entry> entries(const fs::path& corpus) {
-  const runtime::Json root = runtime::Json::parse(read_text(corpus / "corpus.json"));
+  const bundle::Json root = bundle::Json::parse(read_text(corpus / "corpus.json"));
   std::vector<Entry> out;
-  for (const runtime::Json& a : root.at("attacks", "corpus.json").array("attacks")) {
+  for (const bundle::Json& a : root.at("attacks", "corpus.json").array("attacks")) {
     if (a.at("command", "command").string("command") != "fit") continue;
     Entry e;
     e.name = a.at("name", "name").string("name");
     e.avatar = (corpus / a.at("avatar", "avatar").string("avatar")).string();
     e.input_bytes = static_cast<std::uint64_t>(a.at("input_bytes", "input_bytes").integer("input_bytes"));
-    const std::vector<runtime::Json>& args = a.at("args", "args").array("args");
+    const std::vector<bundle::Json>& args = a.at("args", "args").array("args");
     for (std::size_t i = 0; i + 1 < args.size(); ++i)
       if (args[i].string("args") == "--names") e.names = (corpus / args[i + 1].string("args")).string();
     out.push_back(std::move(e));

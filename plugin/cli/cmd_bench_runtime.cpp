@@ -1,7 +1,8 @@
 // softdeca bench-runtime: per-frame cost of the runtime on one avatar, measured on the frames of
 // a real take: plain linear blendshapes, SoftDECA static and dynamic, SparseSoftDECA, with one
 // and with two threads; prepare time, memory per avatar, and the error the compact hyper-tensor
-// storage adds (half and int8 against float, same frames). Writes the benchmark JSON of
+// storage adds (half and int8 against float, same frames), and what the C ABI's handle adds to
+// the template's frame over the core avatar it holds. Writes the benchmark JSON of
 // docs/ARCHITECTURE.md, Conventions ({figure: {value, unit, target, better, how}}).
 // Kept whole: every figure is measured in one run on the same inputs (take, avatars, bundles),
 // so their ratios hold; each figure's measurement is a function of its own.
@@ -17,11 +18,14 @@
 #include <thread>
 #include <utility>
 
-#include "imported_avatar.h"
 #include "bench_figures.h"
+#include "bundle/bundle_files.h"
 #include "command.h"
+#include "imported_avatar.h"
 #include "json.h"
 #include "options.h"
+#include "runtime/avatar.h"
+#include "runtime/model.h"
 #include "runtime_session.h"
 #include "take.h"
 
@@ -419,6 +423,41 @@ std::pair<double, double> alternating_ms(const Bench& bench, const std::function
   return {median(a_ms), median(b_ms)};
 }
 
+// The template path as hosts run it, through the C ABI's handle (whose avatar is the identity
+// fit: runtime/fitted_avatar.h runs one frame path for every mesh), against the core
+// runtime::Avatar of the same head on the same bundle evaluated directly, frames alternating
+// (1 thread): what the handle and the identity fit's transfer add to the template's frame.
+void measure_identity_fit(Bench& bench, const std::string& bundle_path) {
+  const std::shared_ptr<const runtime::Model> model = runtime::Model::load(bundle::BundleFiles::from_path(bundle_path), {});
+  const FaceRig& rig = bench.rig;
+  runtime::AvatarDesc desc;
+  desc.neutral = rig.neutral.vertices.data();
+  desc.vertex_count = rig.neutral.vertex_count();
+  desc.triangles = rig.neutral.triangles.data();
+  desc.triangle_count = rig.neutral.triangles.size() / 3;
+  desc.blendshapes = rig.deltas.empty() ? nullptr : rig.deltas.data();
+  desc.blendshape_count = rig.deltas.empty() ? 0 : 52;
+  runtime::Avatar core(model, desc);
+  core.prepare();
+  Avatar handle(bench.model, rig.neutral, rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  check(softdeca_avatar_prepare(handle.handle), "prepare");
+  const runtime::Output out{bench.vertices.data(), bench.vertices.size() / 3, bench.normals.data(), bench.normals.size() / 3};
+  const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
+  const auto [through_handle, direct] = alternating_ms(
+      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(handle.handle, w(f), 52, &bench.output), "handle"); },
+      [&](std::size_t f) { core.evaluate_weights(w(f), 52, out); });
+  char times[96];
+  std::snprintf(times, sizeof times, " (%.3f against %.3f ms)", through_handle, direct);
+  bench.figures.raw("runtime.identity_fit_overhead",
+                    figure(through_handle / direct, "x",
+                           std::string("the template head's evaluate_weights through the C ABI's handle (the identity fit) "
+                                       "over the core runtime::Avatar of the same head evaluated directly") +
+                               times + ", dynamics off, with normals, frames alternating, medians, wall-clock; 1 thread; " +
+                               bench.how,
+                           1.05));
+  std::fprintf(stderr, "identity fit: handle %.3f ms, core %.3f ms (x%.3f)\n", through_handle, direct, through_handle / direct);
+}
+
 // Several avatars of one bundle on one core, as crowds and collaborations run them: each frame
 // of the take evaluated on every avatar in turn (each its own memory, as separate hosts' avatars
 // are), so the figure pays for the caches they share. The per-avatar frame and how many avatars
@@ -542,6 +581,7 @@ int run_bench_runtime(const Args& args) {
   }
 
   for (const unsigned threads : {1u, 2u}) measure_with_threads(bench, threads);
+  measure_identity_fit(bench, o.text("--bundle"));
   for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) measure_storage(bench, precision);
   measure_storage_error(bench);
   measure_rest_physics(bench);

@@ -133,8 +133,8 @@ AvatarFile read_fitted_mesh(const std::string& dir, const ImportLimits& limits) 
   const std::string report = (fs::path(dir) / "fit.json").string();
   std::string recorded, from_fit, names_file, want;
   try {
-    const runtime::Json json = runtime::Json::parse(read_small_file(report));
-    const runtime::Json& source = json.at("source", "fit.json");
+    const bundle::Json json = bundle::Json::parse(read_small_file(report));
+    const bundle::Json& source = json.at("source", "fit.json");
     recorded = source.at("path", "source").string("source.path");
     from_fit = source.at("path_from_fit", "source").string("source.path_from_fit");
     names_file = source.at("names_file", "source").string("source.names_file");

@@ -7,8 +7,8 @@
 namespace softdeca::cli {
 
 Verdict read_verdict(const std::string& report) {
-  const runtime::Json r = runtime::Json::parse(report);
-  const runtime::Json& q = r.at("quality", "the fit's report");
+  const bundle::Json r = bundle::Json::parse(report);
+  const bundle::Json& q = r.at("quality", "the fit's report");
   const auto number = [&](const char* name) { return r.at(name, "the fit's report").number(name); };
   char scale[32] = "not measured";
   if (!r.at("template_scale", "the fit's report").is_null()) std::snprintf(scale, sizeof scale, "%.2f", number("template_scale"));

@@ -221,10 +221,10 @@ AvatarFile read_avatar_file(const std::string& path, const ShapeNames& names, co
 
 std::string avatar_mesh_sha256(const AvatarFile& avatar) {
   const auto digest = [](const auto& values) {
-    return runtime::sha256_hex(reinterpret_cast<const std::uint8_t*>(values.data()), values.size() * sizeof(values[0]));
+    return bundle::sha256_hex(reinterpret_cast<const std::uint8_t*>(values.data()), values.size() * sizeof(values[0]));
   };
   const std::string all = digest(avatar.neutral) + digest(avatar.triangles) + digest(avatar.blendshapes);
-  return runtime::sha256_hex(reinterpret_cast<const std::uint8_t*>(all.data()), all.size());
+  return bundle::sha256_hex(reinterpret_cast<const std::uint8_t*>(all.data()), all.size());
 }
 
 }  // namespace softdeca::avatar_import

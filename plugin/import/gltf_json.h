@@ -16,7 +16,7 @@
 
 namespace softdeca::avatar_import::gltf {
 
-using runtime::Json;
+using bundle::Json;
 
 // A problem at one place in the file; read_gltf puts the file's path in front.
 class Problem : public std::runtime_error {

@@ -61,7 +61,7 @@ SourceScene read(const std::string& path, const ImportLimits& limits) {
   const FileFormat format = agreed_format(path, bytes);
   if (format == FileFormat::fbx) throw Problem("", "an FBX file, not glTF");
   const Container container = split_container(bytes, format == FileFormat::gltf_binary, limits.max_json_bytes);
-  runtime::JsonLimits json_limits;
+  bundle::JsonLimits json_limits;
   json_limits.max_depth = limits.max_json_depth;
   json_limits.max_values = limits.max_json_values;
   Document doc(Json::parse(container.json, json_limits));

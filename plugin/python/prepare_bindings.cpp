@@ -57,7 +57,7 @@ std::vector<std::int32_t> triangle_list(const sim::Positions& skin, const sim::T
   return {tris.data(), tris.data() + tris.size()};
 }
 
-runtime::ContactRules rules_of(const sim::Positions& skin, const Indices& landmarks68, const Indices& lid_candidates,
+prepare::ContactRules rules_of(const sim::Positions& skin, const Indices& landmarks68, const Indices& lid_candidates,
                                double lip_radius, double lip_corner_radius, double lid_reach, double lid_corner_radius,
                                double eye_zone_share) {
   check_landmarks(skin, landmarks68);
@@ -69,7 +69,7 @@ runtime::ContactRules rules_of(const sim::Positions& skin, const Indices& landma
 // The rules' keyword arguments, after the function's own; defaults from contact_rules.json.
 template <class F, class... Extra>
 void def_with_rules(nb::module_& m, const char* name, F&& f, const char* doc, Extra&&... own) {
-  const runtime::ContactRules d;
+  const prepare::ContactRules d;
   m.def(name, std::forward<F>(f), std::forward<Extra>(own)..., nb::kw_only(), nb::arg("landmarks68"),
         nb::arg("lid_candidates") = Indices(), nb::arg("lip_radius") = d.lip_radius,
         nb::arg("lip_corner_radius") = d.lip_corner_radius, nb::arg("lid_reach") = d.lid_reach,
@@ -84,7 +84,7 @@ void bind_localisation(nb::module_& m) {
           throw nb::value_error("triangles name a vertex the vertex map has no value for");
         const std::vector<std::int32_t> t(triangles.data(), triangles.data() + triangles.size());
         Values out(triangles.rows());
-        runtime::faces_from_vertex_map(t, vertex_values.data(), out.data());
+        prepare::faces_from_vertex_map(t, vertex_values.data(), out.data());
         return out;
       },
       nb::arg("vertex_values"), nb::arg("triangles"), "A vertex map on the faces: the mean of each triangle's corners.");
@@ -98,7 +98,7 @@ void bind_localisation(nb::module_& m) {
         const std::vector<std::int32_t> t(triangles.data(), triangles.data() + triangles.size());
         const std::vector<double> area(face_area.data(), face_area.data() + face_area.size());
         Values out(n_vertices);
-        runtime::vertices_from_face_map(t, area, runtime::skin_vertex_areas(t, area, static_cast<std::size_t>(n_vertices)),
+        prepare::vertices_from_face_map(t, area, prepare::skin_vertex_areas(t, area, static_cast<std::size_t>(n_vertices)),
                                         face_values.data(), out.data());
         return out;
       },
@@ -117,7 +117,7 @@ void bind_carry(nb::module_& m) {
       [](const sim::Positions& vertices, const sim::TetIndices& tets) {
         check_tets(tets, vertices.rows(), "tets");
         std::vector<Eigen::Triplet<double>> k;
-        runtime::add_fill_stiffness(vertices, tets, 1.0, k);
+        prepare::add_fill_stiffness(vertices, tets, 1.0, k);
         Eigen::SparseMatrix<double> out(vertices.rows(), vertices.rows());
         out.setFromTriplets(k.begin(), k.end());
         return out;
@@ -136,14 +136,14 @@ void bind_carry(nb::module_& m) {
         check_tets(skin_vertex, vertices.rows(), "skin_vertex");
         if (skin_weight.rows() != skin_vertex.rows() || carry_weight.size() != skin_vertex.rows())
           throw nb::value_error("skin_vertex, skin_weight and carry_weight need one row per skin point");
-        runtime::RestHead head;
+        prepare::RestHead head;
         head.vertices = vertices;
         head.soft_tets = soft_tets;
         head.muscle_tets = muscle_tets;
         head.skin = {skin_vertex, skin_weight};
         head.carry_weight.assign(carry_weight.data(), carry_weight.data() + carry_weight.size());
         head.carry_smoothness = carry_smoothness;
-        return runtime::carry_fill(head, neutral_skin);
+        return prepare::carry_fill(head, neutral_skin);
       },
       nb::arg("vertices"), nb::arg("soft_tets"), nb::arg("muscle_tets"), nb::arg("skin_vertex"), nb::arg("skin_weight"),
       nb::arg("carry_weight"), nb::arg("carry_smoothness"), nb::arg("neutral_skin"),
@@ -158,15 +158,15 @@ void bind_prepare(nb::module_& m) {
       "lip_contact_zone",
       [](const sim::Positions& skin, const Indices& landmarks68, double radius) {
         check_landmarks(skin, landmarks68);
-        return to_flags(runtime::lip_contact_zone(skin, to_vector(landmarks68), radius));
+        return to_flags(prepare::lip_contact_zone(skin, to_vector(landmarks68), radius));
       },
-      nb::arg("skin"), nb::arg("landmarks68"), nb::arg("radius") = runtime::ContactRules{}.lip_radius,
+      nb::arg("skin"), nb::arg("landmarks68"), nb::arg("radius") = prepare::ContactRules{}.lip_radius,
       "Per skin point, 1 where it lies within `radius` of the inner lip contour, else 0.");
   def_with_rules(
       m, "lip_sets",
       [](const sim::Positions& skin, const sim::TriIndices& skin_triangles, const Indices& landmarks68,
          const Indices& lid_candidates, double lr, double lcr, double ldr, double ldcr, double ezs) {
-        const runtime::LipSets s = runtime::lip_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs),
+        const prepare::LipSets s = prepare::lip_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs),
                                                      skin, triangle_list(skin, skin_triangles));
         return nb::make_tuple(to_indices(s.zone), to_indices(s.upper), to_indices(s.lower), s.upper_triangles,
                               s.lower_triangles);
@@ -178,7 +178,7 @@ void bind_prepare(nb::module_& m) {
       [](const sim::Positions& skin, const Indices& landmarks68) {
         check_landmarks(skin, landmarks68);
         std::vector<Line> out;
-        for (const runtime::FissureLine& line : runtime::eye_fissures(skin, to_vector(landmarks68))) {
+        for (const prepare::FissureLine& line : prepare::eye_fissures(skin, to_vector(landmarks68))) {
           Line l;
           for (int k = 0; k < 4; ++k) l.row(k) = line[static_cast<std::size_t>(k)].transpose();
           out.push_back(l);
@@ -191,16 +191,16 @@ void bind_prepare(nb::module_& m) {
       "lid_sides",
       [](const sim::Positions& skin, const Indices& landmarks68, double eye_zone_share) {
         check_landmarks(skin, landmarks68);
-        return to_flags(runtime::lid_sides(skin, to_vector(landmarks68), eye_zone_share));
+        return to_flags(prepare::lid_sides(skin, to_vector(landmarks68), eye_zone_share));
       },
-      nb::arg("skin"), nb::arg("landmarks68"), nb::arg("eye_zone_share") = runtime::ContactRules{}.eye_zone_share,
+      nb::arg("skin"), nb::arg("landmarks68"), nb::arg("eye_zone_share") = prepare::ContactRules{}.eye_zone_share,
       "Per skin point: +1 on an upper lid's side of its eye's fissure, -1 on a lower lid's, 0 away from the eyes.");
   def_with_rules(
       m, "lid_sets",
       [](const sim::Positions& skin, const Indices& landmarks68, const Indices& lid_candidates, double lr, double lcr,
          double ldr, double ldcr, double ezs) {
-        const runtime::LidSets s =
-            runtime::lid_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs), skin);
+        const prepare::LidSets s =
+            prepare::lid_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs), skin);
         return nb::make_tuple(to_indices(s.upper), to_indices(s.lower));
       },
       "The lid sets: (upper, lower), skin point indices of both eyes.", nb::arg("skin"));
@@ -209,7 +209,7 @@ void bind_prepare(nb::module_& m) {
       [](const sim::Positions& skin, const sim::TriIndices& skin_triangles, const sim::TriIndices& upper_teeth,
          const sim::TriIndices& lower_teeth, const Indices& landmarks68, const Indices& lid_candidates, double lr,
          double lcr, double ldr, double ldcr, double ezs) {
-        return runtime::contact_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs), skin,
+        return prepare::contact_sets(rules_of(skin, landmarks68, lid_candidates, lr, lcr, ldr, ldcr, ezs), skin,
                                      triangle_list(skin, skin_triangles), upper_teeth, lower_teeth);
       },
       "A head's five collision sets (CollisionSet): the lips against each other and the teeth, the eyelids. "

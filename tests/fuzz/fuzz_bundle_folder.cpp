@@ -20,7 +20,7 @@
 #include "fuzz_files.h"
 
 namespace fs = std::filesystem;
-using namespace softdeca::runtime;
+using namespace softdeca::bundle;
 
 namespace {
 const std::string kSecret = "secret: never in a bundle";

@@ -10,7 +10,7 @@
 #include "bundle/onnx_model_scan.h"
 #include "fuzz_check.h"
 
-using namespace softdeca::runtime;
+using namespace softdeca::bundle;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

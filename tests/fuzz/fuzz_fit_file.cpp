@@ -22,7 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const fit::FitSizes sizes{6, 4, 2, 1};
   std::vector<uint8_t> bytes(data, data + size);
   if (bytes.size() >= fit::kFitHeaderBytes) {
-    const std::string sum = runtime::sha256_hex(bytes.data() + fit::kFitHeaderBytes, bytes.size() - fit::kFitHeaderBytes);
+    const std::string sum = bundle::sha256_hex(bytes.data() + fit::kFitHeaderBytes, bytes.size() - fit::kFitHeaderBytes);
     std::memcpy(bytes.data() + 12, sum.data(), sum.size());
   }
   try {

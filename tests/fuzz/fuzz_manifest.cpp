@@ -9,7 +9,7 @@
 #include "bundle/manifest.h"
 #include "fuzz_check.h"
 
-using namespace softdeca::runtime;
+using namespace softdeca::bundle;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -18,7 +18,7 @@
 #include "fuzz_check.h"
 #include "onnx_test_support.h"
 
-using namespace softdeca::runtime;
+using namespace softdeca::bundle;
 using namespace softdeca::test;
 
 namespace {

@@ -15,8 +15,8 @@
 
 namespace fs = std::filesystem;
 using softdeca::Error;
-using softdeca::runtime::BundleFiles;
-using softdeca::runtime::BundleLimits;
+using softdeca::bundle::BundleFiles;
+using softdeca::bundle::BundleLimits;
 
 namespace {
 
@@ -24,7 +24,7 @@ void write(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
-std::string text(const softdeca::runtime::Bytes& bytes) { return std::string(bytes.begin(), bytes.end()); }
+std::string text(const softdeca::bundle::Bytes& bytes) { return std::string(bytes.begin(), bytes.end()); }
 
 // The error `call` throws: its code and message.
 template <class Call>

@@ -25,6 +25,7 @@
 
 namespace fs = std::filesystem;
 using softdeca::Error;
+using namespace softdeca::bundle;
 using namespace softdeca::runtime;
 
 namespace {

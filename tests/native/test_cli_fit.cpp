@@ -128,7 +128,7 @@ TEST_F(CliFit, AFittedGltfReplaysAsItsHeadInTheTemplatesTopology) {
   EXPECT_NE(log("fit.log").find("left out  Body"), std::string::npos) << log("fit.log");
   for (const char* file : {"avatar.fit", "fit.json", "fit.png"}) EXPECT_TRUE(std::filesystem::exists(dir_.file("fit/") + file)) << file;
   const std::vector<char> json = rt::read_bytes(dir_.file("fit/fit.json"));
-  const softdeca::runtime::Json report = softdeca::runtime::Json::parse(std::string(json.begin(), json.end()));
+  const softdeca::bundle::Json report = softdeca::bundle::Json::parse(std::string(json.begin(), json.end()));
   EXPECT_EQ(report.at("parts", "").array("").size(), 1u);
   EXPECT_EQ(report.at("left_out", "").array("")[0].at("name", "").string(""), "Body");
   EXPECT_EQ(report.at("shapes", "").at("jawOpen", "").at("Head", "").string(""), "blendShape1.jawOpen");
@@ -186,9 +186,9 @@ TEST_F(CliFit, APoorFitIsRefusedWithItsReasonUnlessKept) {
   EXPECT_NE(log("kept.log").find("keeping a poor fit (face_coverage)"), std::string::npos) << log("kept.log");
   EXPECT_TRUE(std::filesystem::exists(dir_.file("kept/avatar.fit")));
   const std::vector<char> json = rt::read_bytes(dir_.file("kept/fit.json"));
-  const softdeca::runtime::Json report = softdeca::runtime::Json::parse(std::string(json.begin(), json.end()));
+  const softdeca::bundle::Json report = softdeca::bundle::Json::parse(std::string(json.begin(), json.end()));
   EXPECT_TRUE(report.at("poor_fit", "").boolean(""));
-  const softdeca::runtime::Json& quality = report.at("fit", "").at("quality", "");
+  const softdeca::bundle::Json& quality = report.at("fit", "").at("quality", "");
   EXPECT_FALSE(quality.at("passed", "").boolean(""));
   EXPECT_EQ(quality.at("failed_measure", "").string(""), "face_coverage");
   EXPECT_LT(report.at("fit", "").at("face_coverage", "").number(""), 0.7);

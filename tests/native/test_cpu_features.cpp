@@ -6,10 +6,10 @@
 
 #include "core/cpu_features.h"
 
-using softdeca::core::capped;
-using softdeca::core::CpuCap;
-using softdeca::core::CpuFeatures;
-using softdeca::core::parse_cpu_cap;
+using softdeca::capped;
+using softdeca::CpuCap;
+using softdeca::CpuFeatures;
+using softdeca::parse_cpu_cap;
 
 TEST(CpuFeatures, ParsesTheFamilyNamesInAnyCase) {
   CpuCap cap = CpuCap::Portable;
@@ -45,7 +45,7 @@ TEST(CpuFeatures, ACapRemovesFamiliesAndNeverAddsOne) {
 TEST(CpuFeatures, TheProcessFamilyHonoursTheEnvironment) {
   // make test-kernels runs this suite under SOFTDECA_CPU=avx2 and portable too.
   const char* env = std::getenv("SOFTDECA_CPU");
-  const std::string family = softdeca::core::cpu_family_name();
+  const std::string family = softdeca::cpu_family_name();
   const std::string asked = env != nullptr ? env : "";
   if (asked == "portable") {
     EXPECT_EQ(family, "portable");

@@ -184,7 +184,7 @@ TEST_F(FitApi, FitsSavesLoadsAndAnimatesTheUsersOwnMesh) {
   std::filesystem::remove(path);
 }
 
-double number(const softdeca::runtime::Json& report, const std::string& name) { return report.at(name, "report").number(name); }
+double number(const softdeca::bundle::Json& report, const std::string& name) { return report.at(name, "report").number(name); }
 
 // The user's avatar with a shell around its head: a copy 1.5 times its size, moved by the same
 // shapes (scaled alike). The template fits the head inside and lies on the avatar everywhere,
@@ -214,8 +214,8 @@ TEST_F(FitApi, TheReportJudgesTheFitFromBothSides) {
   UserAvatar user(head_);
   FitPtr good;
   ASSERT_EQ(fit(user.mesh, good), SOFTDECA_OK) << softdeca_last_error();
-  const auto g = softdeca::runtime::Json::parse(report(good));
-  const softdeca::runtime::Json& verdict = g.at("quality", "report");
+  const auto g = softdeca::bundle::Json::parse(report(good));
+  const softdeca::bundle::Json& verdict = g.at("quality", "report");
   EXPECT_TRUE(verdict.at("passed", "quality").boolean("passed")) << report(good);
   EXPECT_EQ(verdict.at("failed_measure", "quality").string("failed_measure"), "");
   EXPECT_EQ(verdict.at("reason", "quality").string("reason"), "");
@@ -232,9 +232,9 @@ TEST_F(FitApi, TheReportJudgesTheFitFromBothSides) {
   const UserAvatar shell = with_shell(user, head_.vertices());
   FitPtr poor;
   ASSERT_EQ(fit(shell.mesh, poor), SOFTDECA_OK) << softdeca_last_error();
-  const auto p = softdeca::runtime::Json::parse(report(poor));
+  const auto p = softdeca::bundle::Json::parse(report(poor));
   EXPECT_LT(number(p, "face_residual_mm_mean"), 0.5) << report(poor);
-  const softdeca::runtime::Json& refused = p.at("quality", "report");
+  const softdeca::bundle::Json& refused = p.at("quality", "report");
   EXPECT_FALSE(refused.at("passed", "quality").boolean("passed")) << report(poor);
   EXPECT_EQ(refused.at("failed_measure", "quality").string("failed_measure"), "face_coverage") << report(poor);
   const std::string reason = refused.at("reason", "quality").string("reason");
@@ -242,7 +242,7 @@ TEST_F(FitApi, TheReportJudgesTheFitFromBothSides) {
   EXPECT_NE(reason.find("at least 70 %"), std::string::npos) << reason;
   EXPECT_NE(reason.find("squeezed"), std::string::npos) << reason;
   EXPECT_NE(reason.find("0.01 m"), std::string::npos) << "names the unit the fit took: " << reason;
-  const softdeca::runtime::Json& bounds = refused.at("bounds", "quality");
+  const softdeca::bundle::Json& bounds = refused.at("bounds", "quality");
   EXPECT_EQ(bounds.at("face_coverage_min", "bounds").number("face_coverage_min"), 0.7);
   EXPECT_EQ(bounds.at("covered_mm", "bounds").number("covered_mm"), 3.0);
   EXPECT_LT(number(p, "face_coverage"), 0.7);

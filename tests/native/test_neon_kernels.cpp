@@ -15,19 +15,19 @@
 #include "kernels/hypertensor_neon.h"
 
 namespace {
-using namespace softdeca::runtime;
+using namespace softdeca::kernels;
 
 TEST(NeonKernels, AreChosenOnEveryAarch64UnlessCapped) {
 #ifdef SOFTDECA_NEON
-  const bool portable = softdeca::core::cpu_features().neon == false;
+  const bool portable = softdeca::cpu_features().neon == false;
   EXPECT_EQ(kernel_available(Kernel::Neon), !portable);
-  EXPECT_STREQ(softdeca::core::cpu_family_name(), portable ? "portable" : "neon");
+  EXPECT_STREQ(softdeca::cpu_family_name(), portable ? "portable" : "neon");
 #else
   EXPECT_FALSE(kernel_available(Kernel::Neon));
 #endif
-  EXPECT_FALSE(softdeca::core::capped({false, false, true}, softdeca::core::CpuCap::Portable).neon);
-  EXPECT_TRUE(softdeca::core::capped({false, false, true}, softdeca::core::CpuCap::Neon).neon);
-  EXPECT_FALSE(softdeca::core::capped({true, true, false}, softdeca::core::CpuCap::Neon).avx2);
+  EXPECT_FALSE(softdeca::capped({false, false, true}, softdeca::CpuCap::Portable).neon);
+  EXPECT_TRUE(softdeca::capped({false, false, true}, softdeca::CpuCap::Neon).neon);
+  EXPECT_FALSE(softdeca::capped({true, true, false}, softdeca::CpuCap::Neon).avx2);
 }
 
 // Faces of a strip over n vertices, in FaceBlocks form with random corners and coefficients.

@@ -18,7 +18,7 @@
 #include "core/error.h"
 #include "onnx_test_support.h"
 
-using namespace softdeca::runtime;
+using namespace softdeca::bundle;
 using namespace softdeca::test;
 
 namespace {

@@ -134,5 +134,5 @@ TEST(PngWriter, PythonsZlibDecodesIt) {
   ASSERT_TRUE(read);
   const std::string raw = filtered(rgb, w, h);
   EXPECT_EQ(std::string(line).substr(0, 64),
-            softdeca::runtime::sha256_hex(reinterpret_cast<const std::uint8_t*>(raw.data()), raw.size()));
+            softdeca::bundle::sha256_hex(reinterpret_cast<const std::uint8_t*>(raw.data()), raw.size()));
 }

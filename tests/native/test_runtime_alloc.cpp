@@ -69,7 +69,7 @@ TEST(RuntimeAllocations, FramesAllocateNothingBeyondOnnxRuntime) {
   REQUIRE_TEST_DATA();
   const Head head = Head::load();
   // ONNX Runtime alone: one run of each per-frame network over fixed buffers.
-  const auto files = softdeca::runtime::BundleFiles::from_path(data_dir() + "/bundle");
+  const auto files = softdeca::bundle::BundleFiles::from_path(data_dir() + "/bundle");
   const auto bare = softdeca::runtime::Model::load(files, {});
   std::vector<float> w(52, 0.2f), z(32), offsets(3 * bare->manifest().landmarks.size(), 0.001f);
   auto f_w = bare->encoder(false)->bind({w.data()}, {z.data()}, 1);

@@ -28,6 +28,9 @@
 #include "runtime/dynamics.h"
 
 namespace {
+using namespace softdeca::bundle;
+using namespace softdeca::kernels;
+using namespace softdeca::prepare;
 using namespace softdeca::runtime;
 using namespace softdeca::geometry;
 
@@ -387,7 +390,7 @@ TEST(Json, ParsesTheSubsetManifestsUse) {
 
 TEST(Json, BoundsItsNestingAndItsValues) {
   // Every value counts: the array, its members, an object's member values.
-  softdeca::runtime::JsonLimits limits;
+  softdeca::bundle::JsonLimits limits;
   limits.max_values = 4;
   EXPECT_NO_THROW(Json::parse("[1, 2, 3]", limits));
   EXPECT_THROW(Json::parse("[1, 2, 3, 4]", limits), softdeca::Error);

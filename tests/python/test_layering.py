@@ -80,7 +80,12 @@ CLI_MAY_INCLUDE = (
     "fit/limits.h",
     "geometry/surface_query.h",
 )
-CLI_BENCH_MAY_INCLUDE = ("runtime/model.h", "bundle/bundle_files.h", "bundle/sha256.h")
+CLI_BENCH_MAY_INCLUDE = (
+    "runtime/model.h",
+    "runtime/avatar.h",
+    "bundle/bundle_files.h",
+    "bundle/sha256.h",
+)
 
 
 def test_the_command_line_comes_in_by_its_documented_way() -> None:
@@ -131,6 +136,30 @@ def test_the_c_abi_has_one_avatar_whatever_its_mesh() -> None:
     assert on_kind == [], on_kind
 
 
+def test_every_avatar_runs_one_frame_path() -> None:
+    """FittedAvatar's frames and maps are one path for every mesh: each applies the avatar's
+    transfer (runtime/fit_transfer.h) and none asks which kind of mesh it has."""
+    text = (SRC / "runtime" / "fitted_avatar.cpp").read_text(encoding="utf-8")
+    # each definition from its first line to the closing brace at the start of a line
+    definitions = re.findall(
+        r"^[^\s/][^\n]*? FittedAvatar::(\w+)\((.*?)^\}", text, re.DOTALL | re.MULTILINE
+    )
+    per_call = {
+        name: body
+        for name, body in definitions
+        if name.startswith(("evaluate_", "set_parameter_"))
+    }
+    assert len(per_call) == 6, sorted(per_call)
+    deciding = [
+        name
+        for name, body in per_call.items()
+        if re.search(r"\b(if|while|switch)\s*\(| \? ", body)
+    ]
+    assert deciding == [], deciding
+    header = (SRC / "runtime" / "fitted_avatar.h").read_text(encoding="utf-8")
+    assert not re.search(r"\bbool\s+\w*identity", header), "a flag for the identity fit"
+
+
 def test_core_depends_on_nothing_but_the_public_header() -> None:
     core = sources("core")
     assert core
@@ -178,6 +207,85 @@ def test_native_areas_include_only_downwards() -> None:
         and layer[target] >= layer[area]
     ]
     assert offenders == [], "includes of an area of the same or a higher layer"
+
+
+# One namespace per area (docs/ARCHITECTURE.md, "Native code"): the code of plugin/src/<area>
+# opens only softdeca::<area> and namespaces nested in it, but for two documented exceptions
+# (AREA_NAMESPACE_EXCEPTIONS): core/ is `softdeca` itself, the vocabulary (Error, require, the
+# file helpers, the CPU's features) that every area finds unqualified from inside softdeca::;
+# api/'s exported functions are extern "C" at global scope, as the C header declares them, so its
+# files may keep their file-local helpers beside them in an anonymous namespace.
+AREA_NAMESPACE_EXCEPTIONS = {"core": ("softdeca",), "api": ("",)}
+_CPP_TOKEN = re.compile(
+    r"//[^\n]*|/\*.*?\*/|\"(?:\\.|[^\"\\\n])*\"|'(?:\\.|[^'\\\n])*'"
+    r"|\bnamespace\b\s*([\w:]*)\s*([{=])|[{}]",
+    re.DOTALL,
+)
+
+
+def opened_namespaces(text: str) -> list[tuple[str, int]]:
+    """The full name and line of every namespace a C++ file opens; an anonymous namespace is
+    named by the one it stands in ("" at global scope). Comments, strings and aliases
+    (`namespace x = y;`) are skipped."""
+    # per open brace: a namespace's full name, None for any other brace
+    stack: list[str | None] = []
+    out = []
+    for m in _CPP_TOKEN.finditer(text):
+        token = m.group(0)
+        if token[0] in "/\"'" or m.group(2) == "=":
+            continue
+        if token == "{":
+            stack.append(None)
+        elif token == "}":
+            stack.pop()
+        else:
+            outer = next((s for s in reversed(stack) if s is not None), "")
+            full = "::".join(x for x in (outer, m.group(1)) if x)
+            out.append((full, text.count("\n", 0, m.start()) + 1))
+            stack.append(full)
+    assert stack == [], "unbalanced braces: the scan is broken"
+    return out
+
+
+def namespace_offenders(area: str, name: str, text: str) -> list[str]:
+    own = f"softdeca::{area}"
+    allowed = AREA_NAMESPACE_EXCEPTIONS.get(area, ())
+    return [
+        f"{area}/{name}:{line} opens namespace {full or '(global anonymous)'}"
+        for full, line in opened_namespaces(text)
+        if full != own and not full.startswith(own + "::") and full not in allowed
+    ]
+
+
+def test_each_native_area_has_its_own_namespace() -> None:
+    files = sources()
+    opened = sum(len(opened_namespaces(p.read_text(encoding="utf-8"))) for p in files)
+    assert opened > 300, "few namespaces found: the scan is broken"
+    offenders = [
+        o
+        for p in files
+        for o in namespace_offenders(
+            p.relative_to(SRC).parts[0], p.name, p.read_text(encoding="utf-8")
+        )
+    ]
+    assert offenders == [], "\n".join(offenders)
+    # the check finds an area in another's namespace, and one nested in its own is fine
+    sample = (
+        "namespace softdeca::runtime {\nnamespace {\nint f() { return 1; }\n}\n}\n"
+        "// namespace softdeca::bundle {\nnamespace softdeca::bundle::onnx { }\n"
+        'const char* s = "namespace softdeca::prepare {";\nnamespace fs = std::filesystem;\n'
+    )
+    assert namespace_offenders("bundle", "x.h", sample) == [
+        "bundle/x.h:1 opens namespace softdeca::runtime",
+        "bundle/x.h:2 opens namespace softdeca::runtime",
+    ]
+    assert namespace_offenders("runtime", "x.h", sample) == [
+        "runtime/x.h:7 opens namespace softdeca::bundle::onnx"
+    ]
+    assert namespace_offenders("core", "x.h", "namespace softdeca { }") == []
+    assert namespace_offenders("stream", "x.h", "namespace softdeca { }") != []
+    assert namespace_offenders("api", "x.cpp", "namespace { }") == []
+    assert namespace_offenders("fit", "x.cpp", "namespace { }") != []
 
 
 # The Python package's layers, bottom up. An area (a sub-package, or a module at the package's

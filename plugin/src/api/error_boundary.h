@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "softdeca/softdeca.h"
 
-namespace softdeca {
+namespace softdeca::api {
 
 void set_last_error(const std::string& message);
 void clear_last_error();
@@ -58,4 +58,4 @@ void reset_struct(T* s) {
   s->struct_size = struct_size;
 }
 
-}  // namespace softdeca
+}  // namespace softdeca::api

@@ -16,12 +16,13 @@
 
 namespace {
 using namespace softdeca;
+using namespace softdeca::api;
 
 // A saved fit holds about 30 bytes per avatar vertex and 30 per template skin vertex.
 constexpr std::uint64_t kMaxFitFileBytes = std::uint64_t{1} << 30;
 
 fit::FitSizes fit_sizes(const runtime::Model& m) {
-  const runtime::Manifest& mf = m.manifest();
+  const bundle::Manifest& mf = m.manifest();
   fit::FitSizes s;
   s.head_vertices = static_cast<std::size_t>(mf.head_vertices);
   s.skin_vertices = static_cast<std::size_t>(mf.skin_vertices);
@@ -172,7 +173,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_fit_get_registered(const softdeca_a
 
 }  // extern "C"
 
-namespace softdeca {
+namespace softdeca::api {
 
 namespace {
 // A mesh in the template's topology, checked as the template path takes it (shapes optional).
@@ -189,11 +190,11 @@ runtime::AvatarDesc template_mesh(const softdeca_avatar_mesh* mesh, const runtim
   for (std::size_t i = 0; i < mesh->triangle_count * 3; ++i)
     require(mesh->triangles[i] >= 0 && static_cast<std::size_t>(mesh->triangles[i]) < vh,
             "desc->mesh->triangles[" + std::to_string(i) + "] = " + std::to_string(mesh->triangles[i]) + " is not a vertex index");
-  require(mesh->blendshape_count == 0 || mesh->blendshape_count == runtime::kBlendshapeCount,
+  require(mesh->blendshape_count == 0 || mesh->blendshape_count == bundle::kBlendshapeCount,
           "desc->mesh->blendshape_count must be 0 or 52");
   if (mesh->blendshape_count) {
     require_not_null(mesh->blendshapes, "desc->mesh->blendshapes");
-    require_finite(mesh->blendshapes, runtime::kBlendshapeCount * vh * 3, "desc->mesh->blendshapes");
+    require_finite(mesh->blendshapes, bundle::kBlendshapeCount * vh * 3, "desc->mesh->blendshapes");
   }
   runtime::AvatarDesc d;
   d.neutral = mesh->neutral;
@@ -208,7 +209,7 @@ runtime::AvatarDesc template_mesh(const softdeca_avatar_mesh* mesh, const runtim
 
 std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
                                                       const softdeca_avatar_fit* fit, std::size_t threads,
-                                                      runtime::Precision precision) {
+                                                      kernels::Precision precision) {
   const runtime::Model& m = model_of(model);
   if (!fit) {  // the identity fit
     runtime::AvatarDesc d = template_mesh(mesh, m);
@@ -227,4 +228,4 @@ std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* mode
   return std::make_unique<runtime::FittedAvatar>(model->model, d);
 }
 
-}  // namespace softdeca
+}  // namespace softdeca::api

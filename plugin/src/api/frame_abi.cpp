@@ -6,7 +6,7 @@
 
 #include "stream/rotation.h"
 
-namespace softdeca::abi {
+namespace softdeca::api {
 namespace {
 
 void pose_out(const stream::Pose& p, softdeca_pose& out) {
@@ -121,4 +121,4 @@ recording::Header header_from_abi(const softdeca_recording_header* h) {
   return out;
 }
 
-}  // namespace softdeca::abi
+}  // namespace softdeca::api

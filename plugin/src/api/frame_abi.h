@@ -13,7 +13,7 @@
 #include "stream/frame.h"
 #include "stream/wire_format.h"
 
-namespace softdeca::abi {
+namespace softdeca::api {
 
 void frame_to_abi(const stream::Frame& in, softdeca_frame* out);
 // Checks every field (finite, in range, unit rotations) before copying.
@@ -27,4 +27,4 @@ void neutral_to_abi(const std::vector<float>& xyz, float* out_xyz, uint32_t vert
 // A recording header from the ABI's (texts may be NULL).
 recording::Header header_from_abi(const softdeca_recording_header* header);
 
-}  // namespace softdeca::abi
+}  // namespace softdeca::api

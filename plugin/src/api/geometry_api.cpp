@@ -6,6 +6,7 @@
 
 namespace {
 using namespace softdeca;
+using namespace softdeca::api;
 using geometry::Points;
 using geometry::Tets;
 

@@ -7,7 +7,7 @@
 
 #include "api/error_boundary.h"
 
-namespace softdeca {
+namespace softdeca::api {
 
 // A new Handle filled by `fill` (which may throw: then nothing is handed out and *out is left
 // as it was), released into *out.
@@ -25,4 +25,4 @@ void destroy_handle(const char* function, Handle* handle) noexcept {
   guarded(function, [&] { delete handle; });
 }
 
-}  // namespace softdeca
+}  // namespace softdeca::api

@@ -7,7 +7,7 @@ SOFTDECA_API uint32_t softdeca_abi_version(void) { return SOFTDECA_ABI_VERSION; 
 
 SOFTDECA_API const char* softdeca_version(void) { return SOFTDECA_VERSION_STRING; }
 
-SOFTDECA_API const char* softdeca_last_error(void) { return softdeca::last_error_text(); }
+SOFTDECA_API const char* softdeca_last_error(void) { return softdeca::api::last_error_text(); }
 
 SOFTDECA_API const char* softdeca_status_name(softdeca_status status) {
   switch (status) {

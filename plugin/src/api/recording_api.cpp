@@ -22,6 +22,7 @@ struct softdeca_player {
 
 namespace {
 using namespace softdeca;
+using namespace softdeca::api;
 
 recording::RecordingWriter& recorder_of(softdeca_recorder* r) {
   require_not_null(r, "recorder");
@@ -72,7 +73,7 @@ SOFTDECA_API softdeca_status softdeca_recorder_create(const char* path, const so
   return guarded(__func__, [&] {
     require_not_null(path, "path");
     create_handle(out_recorder, "out_recorder", [&](softdeca_recorder& r) {
-      r.impl = std::make_unique<recording::RecordingWriter>(path, abi::header_from_abi(header));
+      r.impl = std::make_unique<recording::RecordingWriter>(path, header_from_abi(header));
     });
   });
 }
@@ -80,7 +81,7 @@ SOFTDECA_API softdeca_status softdeca_recorder_create(const char* path, const so
 SOFTDECA_API softdeca_status softdeca_recorder_write(softdeca_recorder* recorder, const softdeca_frame* frame) {
   return guarded(__func__, [&] {
     auto& r = recorder_of(recorder);
-    r.write(abi::frame_from_abi(frame));
+    r.write(frame_from_abi(frame));
   });
 }
 
@@ -159,7 +160,7 @@ SOFTDECA_API softdeca_status softdeca_player_get_frame(const softdeca_player* pl
     require_struct(out_frame, "out_frame");
     require(index < p.frame_count(), "index " + std::to_string(index) + " is not below the frame count " +
                                          std::to_string(p.frame_count()));
-    abi::frame_to_abi(p.frame(index), out_frame);
+    frame_to_abi(p.frame(index), out_frame);
   });
 }
 
@@ -169,7 +170,7 @@ SOFTDECA_API softdeca_status softdeca_player_get_frame_at(const softdeca_player*
     const auto& p = player_of(player);
     require_struct(out_frame, "out_frame");
     require(std::isfinite(time), "time is not finite", SOFTDECA_ERROR_NON_FINITE);
-    abi::frame_to_abi(p.frame_at(time), out_frame);
+    frame_to_abi(p.frame_at(time), out_frame);
   });
 }
 
@@ -192,7 +193,7 @@ SOFTDECA_API softdeca_status softdeca_player_advance(softdeca_player* player, do
     require_struct(out_frame, "out_frame");
     require(std::isfinite(dt) && dt >= 0, "dt must be finite and >= 0");
     const bool ended = p.advance(dt);
-    abi::frame_to_abi(p.frame_at(p.position()), out_frame);
+    frame_to_abi(p.frame_at(p.position()), out_frame);
     if (out_ended) *out_ended = ended ? 1 : 0;
   });
 }
@@ -209,14 +210,14 @@ SOFTDECA_API softdeca_status softdeca_player_get_profile(const softdeca_player* 
                                                      int32_t* out_indices, uint32_t capacity, uint32_t* out_count) {
   return guarded(__func__, [&] {
     const auto& profiles = player_of(player).recording().profiles;
-    abi::profile_to_abi(profiles.empty() ? nullptr : &profiles.back(), out_id, out_indices, capacity, out_count);
+    profile_to_abi(profiles.empty() ? nullptr : &profiles.back(), out_id, out_indices, capacity, out_count);
   });
 }
 
 SOFTDECA_API softdeca_status softdeca_player_get_neutral(const softdeca_player* player, float* out_xyz,
                                                      uint32_t vertex_capacity, uint32_t* out_vertex_count) {
   return guarded(__func__, [&] {
-    abi::neutral_to_abi(player_of(player).recording().neutral, out_xyz, vertex_capacity, out_vertex_count);
+    neutral_to_abi(player_of(player).recording().neutral, out_xyz, vertex_capacity, out_vertex_count);
   });
 }
 

@@ -11,6 +11,7 @@
 
 namespace {
 using namespace softdeca;
+using namespace softdeca::api;
 using runtime::Avatar;
 using runtime::Model;
 
@@ -62,7 +63,7 @@ SOFTDECA_API softdeca_status softdeca_model_load(const char* path, const softdec
     require_not_null(out_model, "out_model");
     const auto opts = model_options(options);
     create_handle(out_model, "out_model", [&](softdeca_model& h) {
-      h.model = Model::load(runtime::BundleFiles::from_path(path), opts);
+      h.model = Model::load(bundle::BundleFiles::from_path(path), opts);
     });
   });
 }
@@ -75,7 +76,7 @@ SOFTDECA_API softdeca_status softdeca_model_load_memory(const void* data, uint32
     require(byte_count > 0, "byte_count is 0");
     const auto opts = model_options(options);
     create_handle(out_model, "out_model", [&](softdeca_model& h) {
-      h.model = Model::load(runtime::BundleFiles::from_tar(static_cast<const std::uint8_t*>(data), byte_count), opts);
+      h.model = Model::load(bundle::BundleFiles::from_tar(static_cast<const std::uint8_t*>(data), byte_count), opts);
     });
   });
 }
@@ -94,7 +95,7 @@ SOFTDECA_API softdeca_status softdeca_model_get_info(const softdeca_model* model
     out_info->skin_triangle_count = static_cast<uint32_t>(m.skin_triangles);
     out_info->latent_size = static_cast<uint32_t>(m.latent);
     out_info->identity_size = static_cast<uint32_t>(m.identity);
-    out_info->blendshape_count = runtime::kBlendshapeCount;
+    out_info->blendshape_count = bundle::kBlendshapeCount;
     out_info->parameter_count = static_cast<uint32_t>(m.parameters.size());
     out_info->landmark_count = static_cast<uint32_t>(m.landmarks.size());
     out_info->arkit_vertex_count = static_cast<uint32_t>(m.arkit_vertex_count);
@@ -193,7 +194,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
     require_not_null(out_avatar, "out_avatar");
     require(desc->threads <= kMaxThreads, "desc->threads must be at most " + std::to_string(kMaxThreads));
     const std::size_t threads = desc->threads == 0 ? 1 : desc->threads;
-    const runtime::Precision precision = precision_of(desc->precision, "desc->precision");
+    const kernels::Precision precision = precision_of(desc->precision, "desc->precision");
     create_handle(out_avatar, "out_avatar",
                   [&](softdeca_avatar& h) { h.avatar = avatar_on_mesh(model, desc->mesh, desc->fit, threads, precision); });
   });

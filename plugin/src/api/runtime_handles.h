@@ -26,7 +26,7 @@ struct softdeca_avatar_fit {
   std::string bundle_sha256;
 };
 
-namespace softdeca {
+namespace softdeca::api {
 
 inline const runtime::Model& model_of(const softdeca_model* m) {
   require_not_null(m, "model");
@@ -34,18 +34,18 @@ inline const runtime::Model& model_of(const softdeca_model* m) {
 }
 
 // A softdeca_precision value, checked.
-inline runtime::Precision precision_of(int32_t precision, const char* name) {
+inline kernels::Precision precision_of(int32_t precision, const char* name) {
   require(precision >= SOFTDECA_PRECISION_HALF && precision <= SOFTDECA_PRECISION_INT8,
           std::string(name) + " is not a softdeca_precision");
-  return precision == SOFTDECA_PRECISION_FLOAT  ? runtime::Precision::Float
-         : precision == SOFTDECA_PRECISION_INT8 ? runtime::Precision::Int8
-                                                : runtime::Precision::Half;
+  return precision == SOFTDECA_PRECISION_FLOAT  ? kernels::Precision::Float
+         : precision == SOFTDECA_PRECISION_INT8 ? kernels::Precision::Int8
+                                                : kernels::Precision::Half;
 }
 
 // The avatar on `mesh` (fit_api.cpp): through `fit`, its bundle and the mesh checked; without
 // one, the mesh in the template's topology as the identity fit. softdeca_avatar_create's one way.
 std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
                                                       const softdeca_avatar_fit* fit, std::size_t threads,
-                                                      runtime::Precision precision);
+                                                      kernels::Precision precision);
 
-}  // namespace softdeca
+}  // namespace softdeca::api

@@ -16,6 +16,7 @@ struct softdeca_sim {
 
 namespace {
 using namespace softdeca;
+using namespace softdeca::api;
 using namespace softdeca::sim;
 
 constexpr std::size_t kMaxCount = std::size_t{1} << 30;

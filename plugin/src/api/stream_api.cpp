@@ -15,6 +15,7 @@ struct softdeca_receiver {
 
 namespace {
 using namespace softdeca;
+using namespace softdeca::api;
 
 const live::Receiver& receiver_of(const softdeca_receiver* r) {
   require_not_null(r, "receiver");
@@ -27,7 +28,7 @@ live::Receiver& receiver_of(softdeca_receiver* r) {
 
 void frame_out(softdeca_frame* out, softdeca_bool* out_received, bool got, const stream::Frame& f) {
   *out_received = got ? 1 : 0;
-  if (got) abi::frame_to_abi(f, out);
+  if (got) frame_to_abi(f, out);
 }
 }  // namespace
 
@@ -163,7 +164,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_profile(const softdeca_receiv
   return guarded(__func__, [&] {
     stream::wire::Profile p;
     const bool have = receiver_of(receiver).profile(p);
-    abi::profile_to_abi(have ? &p : nullptr, out_id, out_indices, capacity, out_count);
+    profile_to_abi(have ? &p : nullptr, out_id, out_indices, capacity, out_count);
   });
 }
 
@@ -172,7 +173,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_get_neutral(const softdeca_receiv
   return guarded(__func__, [&] {
     std::vector<float> xyz;
     receiver_of(receiver).neutral(xyz);
-    abi::neutral_to_abi(xyz, out_xyz, vertex_capacity, out_vertex_count);
+    neutral_to_abi(xyz, out_xyz, vertex_capacity, out_vertex_count);
   });
 }
 
@@ -189,7 +190,7 @@ SOFTDECA_API softdeca_status softdeca_receiver_start_recording(softdeca_receiver
   return guarded(__func__, [&] {
     auto& r = receiver_of(receiver);
     require_not_null(path, "path");
-    r.start_recording(path, abi::header_from_abi(header));
+    r.start_recording(path, header_from_abi(header));
   });
 }
 

@@ -5,7 +5,7 @@
 #include "bundle/bundle_folder_io.h"
 #include "core/error.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 namespace {
 std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
@@ -183,4 +183,4 @@ const Bytes& BundleFiles::get(const std::string& name) const {
   return it->second;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 using Bytes = std::vector<std::uint8_t>;
 
@@ -43,4 +43,4 @@ class BundleFiles {
   mutable std::uint64_t bytes_read_ = 0;
 };
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 enum class EntryKind { missing, regular, link, folder, fifo, device, socket, other };
 
@@ -43,4 +43,4 @@ class ReadOnlyFile {
   std::intptr_t handle_ = kClosed;  // a file descriptor, or a Windows HANDLE
 };
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

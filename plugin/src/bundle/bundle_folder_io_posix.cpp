@@ -8,7 +8,7 @@
 
 #include "bundle/bundle_folder_io.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 namespace {
 EntryKind kind_of(const struct stat& st) {
@@ -73,4 +73,4 @@ bool ReadOnlyFile::read(std::uint8_t* data, std::size_t n) {
   return true;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

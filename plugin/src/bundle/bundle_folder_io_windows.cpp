@@ -14,7 +14,7 @@
 #include "bundle/bundle_folder_io.h"
 #include "core/wide_path.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 namespace {
 std::string narrow(const wchar_t* text, std::size_t size) {
@@ -130,4 +130,4 @@ bool ReadOnlyFile::read(std::uint8_t* data, std::size_t n) {
   return true;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

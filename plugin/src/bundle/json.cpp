@@ -5,7 +5,7 @@
 
 #include "core/error.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, message); }
@@ -252,4 +252,4 @@ const Json& Json::at(const std::string& key, const std::string& what) const {
   fail(what + " has no member \"" + key + "\"");
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 struct JsonLimits {
   int max_depth = 64;                                              // how deep a value lies (the document: 0)
@@ -55,4 +55,4 @@ class Json {
   friend class JsonParser;
 };
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

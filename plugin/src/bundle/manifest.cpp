@@ -6,7 +6,7 @@
 #include "bundle/json.h"
 #include "core/error.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, "manifest: " + message); }
@@ -417,4 +417,4 @@ Manifest parse_manifest(const std::string& text) {
   return m;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -9,7 +9,7 @@
 
 #include "stream/arkit_names.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 // Versions this runtime reads: 1, 2 (adds SoftDECA's optional vertex stage), 3 (adds its
 // optional residual stage), 4 (adds the optional physics at prepare, `rest_physics`) and 5
@@ -101,4 +101,4 @@ Manifest parse_manifest(const std::string& json_text);
 // The shapes the runtime requires of each network, given the manifest's sizes.
 NetworkSpec expected_network(const Manifest& m, const std::string& key, int parameter_count);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -2,7 +2,7 @@
 
 #include <limits>
 
-namespace softdeca::runtime::onnx {
+namespace softdeca::bundle::onnx {
 
 namespace {
 constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
@@ -63,4 +63,4 @@ std::string Node::label() const {
   return printable(op) + " node '" + printable(id) + "'";
 }
 
-}  // namespace softdeca::runtime::onnx
+}  // namespace softdeca::bundle::onnx

@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-namespace softdeca::runtime::onnx {
+namespace softdeca::bundle::onnx {
 
 // Integer tensors of at most this many elements carry their values.
 constexpr std::size_t kMaxValues = 64;
@@ -82,4 +82,4 @@ std::string printable(const std::string& name);
 std::uint64_t add_sat(std::uint64_t a, std::uint64_t b);
 std::uint64_t mul_sat(std::uint64_t a, std::uint64_t b);
 
-}  // namespace softdeca::runtime::onnx
+}  // namespace softdeca::bundle::onnx

@@ -8,7 +8,7 @@
 #include "bundle/onnx_static_sizes.h"
 #include "core/error.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 namespace {
 
 using namespace onnx;
@@ -387,4 +387,4 @@ OnnxModelScan scan_onnx_model(const std::uint8_t* data, std::size_t size, const 
   return scan;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -16,7 +16,7 @@
 
 #include "bundle/manifest.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 // The batch the runtime feeds every network with (a contract's free dimension).
 constexpr std::int64_t kFedBatch = 1;
@@ -36,4 +36,4 @@ struct OnnxModelScan {
 // (naming it), and for a tensor without a static shape.
 OnnxModelScan scan_onnx_model(const std::uint8_t* data, std::size_t size, const std::vector<TensorSpec>& inputs);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

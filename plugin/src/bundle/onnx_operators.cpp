@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 
-namespace softdeca::runtime::onnx {
+namespace softdeca::bundle::onnx {
 namespace {
 
 using Dims = std::vector<std::uint64_t>;
@@ -608,4 +608,4 @@ Tensor infer_output(const Node& node, const std::vector<const Tensor*>& inputs) 
   return out;
 }
 
-}  // namespace softdeca::runtime::onnx
+}  // namespace softdeca::bundle::onnx

@@ -11,7 +11,7 @@
 
 #include "bundle/onnx_graph.h"
 
-namespace softdeca::runtime::onnx {
+namespace softdeca::bundle::onnx {
 
 // The version of the default domain the rules follow (the exporter's; docs/bundle.md).
 constexpr std::int64_t kOpsetVersion = 17;
@@ -25,4 +25,4 @@ std::vector<std::string> allowed_operators();  // in the table's (alphabetical) 
 // decides a shape (Reshape's shape, Slice's bounds, ...) whose values are not known at load.
 Tensor infer_output(const Node& node, const std::vector<const Tensor*>& inputs);
 
-}  // namespace softdeca::runtime::onnx
+}  // namespace softdeca::bundle::onnx

@@ -5,7 +5,7 @@
 #include "bundle/onnx_operators.h"
 #include "core/error.h"
 
-namespace softdeca::runtime::onnx {
+namespace softdeca::bundle::onnx {
 namespace {
 
 [[noreturn]] void refuse(const std::string& why) { throw Error(SOFTDECA_ERROR_FORMAT, why); }
@@ -95,4 +95,4 @@ StaticSizes static_sizes(const Graph& graph, const std::map<std::string, std::ve
   return sizes.result;
 }
 
-}  // namespace softdeca::runtime::onnx
+}  // namespace softdeca::bundle::onnx

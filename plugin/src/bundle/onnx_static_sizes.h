@@ -13,7 +13,7 @@
 
 #include "bundle/onnx_graph.h"
 
-namespace softdeca::runtime::onnx {
+namespace softdeca::bundle::onnx {
 
 struct StaticSizes {
   std::uint64_t bytes = 0;  // all tensors (saturating)
@@ -27,4 +27,4 @@ struct StaticSizes {
 // or nowhere, a cycle, or a node whose output has no static shape (onnx_operators.h).
 StaticSizes static_sizes(const Graph& graph, const std::map<std::string, std::vector<std::uint64_t>>& fed);
 
-}  // namespace softdeca::runtime::onnx
+}  // namespace softdeca::bundle::onnx

@@ -2,7 +2,7 @@
 
 #include <array>
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 namespace {
 constexpr std::array<std::uint32_t, 64> kRound = {
     0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
@@ -64,4 +64,4 @@ std::string sha256_hex(const std::uint8_t* data, std::size_t size) {
   return out;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <string>
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 // Lower-case hex digest of `size` bytes.
 std::string sha256_hex(const std::uint8_t* data, std::size_t size);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

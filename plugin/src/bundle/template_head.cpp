@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "kernels/half.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 TemplateHead parse_template_head(const Manifest& m, const Bytes& data) {
   const std::string& f = m.template_head_file;
@@ -20,10 +20,10 @@ TemplateHead parse_template_head(const Manifest& m, const Bytes& data) {
   const auto modes = in.vector<std::uint16_t>(t.identity_count * vs * 3, "the identity modes");
   in.finish();
   t.shapes.resize(half.size());
-  for (std::size_t i = 0; i < half.size(); ++i) t.shapes[i] = half_to_float(half[i]);
+  for (std::size_t i = 0; i < half.size(); ++i) t.shapes[i] = kernels::half_to_float(half[i]);
   t.identity_modes.resize(modes.size());
   for (std::size_t i = 0; i < modes.size(); ++i) {
-    t.identity_modes[i] = half_to_float(modes[i]);
+    t.identity_modes[i] = kernels::half_to_float(modes[i]);
     if (!std::isfinite(t.identity_modes[i])) throw Error(SOFTDECA_ERROR_FORMAT, f + ": an identity mode holds a non-finite value");
   }
   for (const float v : t.neutral)
@@ -38,4 +38,4 @@ TemplateHead parse_template_head(const Manifest& m, const Bytes& data) {
   return t;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

@@ -10,7 +10,7 @@
 #include "bundle/bundle_files.h"
 #include "bundle/manifest.h"
 
-namespace softdeca::runtime {
+namespace softdeca::bundle {
 
 struct TemplateHead {
   std::vector<float> neutral;  // head_vertices x 3, metres
@@ -27,4 +27,4 @@ struct TemplateHead {
 // non-finite value.
 TemplateHead parse_template_head(const Manifest& manifest, const Bytes& data);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::bundle

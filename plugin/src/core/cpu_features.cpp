@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <string>
 
-namespace softdeca::core {
+namespace softdeca {
 
 namespace {
 
@@ -57,4 +57,4 @@ const char* cpu_family_name() {
   return f.avx512_vnni ? "avx512" : f.avx2 ? "avx2" : f.neon ? "neon" : "portable";
 }
 
-}  // namespace softdeca::core
+}  // namespace softdeca

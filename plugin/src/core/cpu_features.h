@@ -10,7 +10,7 @@
 // would choose (tests, docs/platforms.md); it never enables what the CPU lacks.
 #pragma once
 
-namespace softdeca::core {
+namespace softdeca {
 
 struct CpuFeatures {
   bool avx2 = false;         // AVX2 + FMA + F16C
@@ -37,4 +37,4 @@ const CpuFeatures& cpu_features();
 // "portable", "neon", "avx2" or "avx512": the family cpu_features() allows (benchmarks, `softdeca info`).
 const char* cpu_family_name();
 
-}  // namespace softdeca::core
+}  // namespace softdeca

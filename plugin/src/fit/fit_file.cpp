@@ -183,7 +183,7 @@ std::vector<std::uint8_t> encode_fit(const AvatarFit& f, const std::string& bund
   w.put(f.embedding.offset.data(), f.embedding.size());
   w.put(f.embedding.weight.data(), f.embedding.size());
   w.text(f.report);
-  const std::string sum = runtime::sha256_hex(w.out.data() + kFitHeaderBytes, w.out.size() - kFitHeaderBytes);
+  const std::string sum = bundle::sha256_hex(w.out.data() + kFitHeaderBytes, w.out.size() - kFitHeaderBytes);
   std::memcpy(w.out.data() + 12, sum.data(), kHashHex);
   return std::move(w.out);
 }
@@ -199,7 +199,7 @@ AvatarFit decode_fit(const std::uint8_t* data, std::size_t size, const std::stri
   if (version != kFitFileVersion)
     fail(name + " is fit file version " + std::to_string(version) + "; this library reads version " +
          std::to_string(kFitFileVersion) + ": fit the avatar again");
-  if (runtime::sha256_hex(data + kFitHeaderBytes, size - kFitHeaderBytes) !=
+  if (bundle::sha256_hex(data + kFitHeaderBytes, size - kFitHeaderBytes) !=
       std::string(reinterpret_cast<const char*>(data) + 12, kHashHex))
     fail(damaged(name, "its checksum does not match"));
 

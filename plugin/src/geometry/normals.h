@@ -24,7 +24,7 @@ class Normals {
  private:
   std::vector<std::int32_t> triangles_;
   std::vector<std::int32_t> vertex_ptr_, vertex_faces_;  // CSR: vertex -> incident triangles
-  runtime::AlignedArray<float> face_normals_;                     // scratch, 3 per triangle
+  kernels::AlignedArray<float> face_normals_;                     // scratch, 3 per triangle
   std::size_t n_vertices_ = 0;
 };
 

@@ -194,7 +194,7 @@ __attribute__((target("avx2,fma"))) void scatter_avx2(const std::int32_t* cols, 
   }
 }
 
-bool cpu_has_avx2_fma() { return core::cpu_features().avx2; }
+bool cpu_has_avx2_fma() { return cpu_features().avx2; }
 #endif
 
 template <class Index>
@@ -207,7 +207,7 @@ void substitute(const std::vector<std::int32_t>& rows, const std::vector<std::in
   }
 #endif
 #ifdef SOFTDECA_LDLT_NEON
-  if (core::cpu_features().neon) {
+  if (cpu_features().neon) {
     neon::substitute(rows.data(), rows.size(), ptr.data(), idx, values, y);
     return;
   }
@@ -230,7 +230,7 @@ void scatter(const std::vector<std::int32_t>& cols, const std::vector<std::int32
   }
 #endif
 #ifdef SOFTDECA_LDLT_NEON
-  if (core::cpu_features().neon) {
+  if (cpu_features().neon) {
     neon::scatter(cols.data(), cols.size(), ptr.data(), idx, values, y);
     return;
   }

@@ -62,7 +62,7 @@ class SparseLdlt {
   // Strict lower L, column-major ([0, nnz)) and, with several parts, row-major ([nnz, 2 nnz));
   // one array so that it is one huge-page stream (aligned.h).
   bool rows_copy_ = false;
-  runtime::AlignedArray<float> values_;
+  kernels::AlignedArray<float> values_;
   std::vector<std::vector<std::int32_t>> bins_, bins_down_;  // rows of independent subtrees, up and down
   std::vector<std::int32_t> top_, top_down_;                 // the top part, up and down
   double serial_fraction_ = 0;

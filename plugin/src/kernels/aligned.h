@@ -12,7 +12,7 @@
 
 #include "kernels/aligned_memory.h"
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 
@@ -66,4 +66,4 @@ class AlignedArray {
   std::size_t size_ = 0, allocated_ = 0;
 };
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

@@ -5,7 +5,7 @@
 
 #include <cstddef>
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 // `bytes` a multiple of `alignment` (a power of two); nullptr when out of memory.
 void* aligned_allocate(std::size_t alignment, std::size_t bytes);
@@ -14,4 +14,4 @@ void aligned_release(void* p);
 // Asks for transparent huge pages over [p, p + bytes); advice only, ignored where unsupported.
 void advise_huge_pages(void* p, std::size_t bytes);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

@@ -4,7 +4,7 @@
 
 #include "kernels/aligned_memory.h"
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 // posix_memalign rather than aligned_alloc: Android has aligned_alloc from API 28 only, macOS from
 // 10.15.
@@ -21,4 +21,4 @@ void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t by
 #endif
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

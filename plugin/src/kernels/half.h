@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <cstring>
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 inline std::uint16_t float_to_half(float f) {
   std::uint32_t x;
@@ -50,4 +50,4 @@ inline float half_to_float(std::uint16_t h) {
   return f;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

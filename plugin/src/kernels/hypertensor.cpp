@@ -13,7 +13,7 @@
 #define SOFTDECA_X86 1
 #endif
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision)
     : n_(n), latent_(latent), width_(width), precision_(precision) {
@@ -366,8 +366,8 @@ __attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"), flatten)) vo
   vertex_offsets_blocks<Precision::Int8, PairsVnni>(L, z, base_pos, b0, b1, out);
 }
 
-bool cpu_has_avx2() { return core::cpu_features().avx2; }
-bool cpu_has_vnni() { return core::cpu_features().avx512_vnni; }
+bool cpu_has_avx2() { return cpu_features().avx2; }
+bool cpu_has_vnni() { return cpu_features().avx512_vnni; }
 #endif
 
 // The kernel that runs: the one asked for, or (Best) the fastest this CPU has for L.
@@ -397,7 +397,7 @@ bool kernel_available(Kernel k) {
     case Kernel::Avx512Vnni: return false;
 #endif
 #ifdef SOFTDECA_NEON
-    case Kernel::Neon: return core::cpu_features().neon;
+    case Kernel::Neon: return cpu_features().neon;
 #else
     case Kernel::Neon: return false;
 #endif
@@ -445,4 +445,4 @@ void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std
   }
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

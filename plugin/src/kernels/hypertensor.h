@@ -13,7 +13,7 @@
 
 #include "kernels/aligned.h"
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 enum class Precision { Half, Float, Int8 };
 constexpr std::size_t kLanes = 8;
@@ -96,4 +96,4 @@ inline void add_block_offsets(const float (&lanes)[3][kLanes], const HyperTensor
 void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out,
                     Kernel kernel = Kernel::Best);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cstdint>
 
-namespace softdeca::runtime::neon {
+namespace softdeca::kernels::neon {
 
 namespace {
 
@@ -212,6 +212,6 @@ void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std
   }
 }
 
-}  // namespace softdeca::runtime::neon
+}  // namespace softdeca::kernels::neon
 
 #endif  // SOFTDECA_NEON

@@ -12,7 +12,7 @@
 #if defined(__aarch64__) && defined(__ARM_NEON)
 #define SOFTDECA_NEON 1
 
-namespace softdeca::runtime::neon {
+namespace softdeca::kernels::neon {
 
 // The most latents the int8 kernel takes (its int32 sums stay exact); more run the portable one.
 constexpr int kMaxInt8Latent = 256;
@@ -21,6 +21,6 @@ void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const
             std::size_t b1, float* rhs);
 void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out);
 
-}  // namespace softdeca::runtime::neon
+}  // namespace softdeca::kernels::neon
 
 #endif

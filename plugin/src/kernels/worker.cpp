@@ -9,7 +9,7 @@
 #define SOFTDECA_PAUSE() std::this_thread::yield()
 #endif
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 namespace {
 constexpr int kSpinsBeforeSleep = 20000;  // ~0.5 ms of pause instructions
@@ -81,4 +81,4 @@ void Worker::loop() {
   }
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

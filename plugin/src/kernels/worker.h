@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-namespace softdeca::runtime {
+namespace softdeca::kernels {
 
 class Worker {
  public:
@@ -54,4 +54,4 @@ class Worker {
   void* ctx_ = nullptr;
 };
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::kernels

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 namespace {
 using Vec = Eigen::Vector3d;
@@ -148,4 +148,4 @@ std::vector<sim::CollisionSet> contact_sets(const ContactRules& r, const sim::Po
   return sets;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

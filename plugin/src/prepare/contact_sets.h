@@ -12,7 +12,7 @@
 #include "prepare/contact_rules_table.h"  // generated from plugin/data/contact_rules.json
 #include "sim/mesh.h"
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 struct ContactRules {
   std::vector<std::int32_t> landmarks68;     // skin vertex indices of the 68 Multi-PIE landmarks
@@ -63,4 +63,4 @@ std::vector<sim::CollisionSet> contact_sets(const ContactRules& rules, const sim
                                             const std::vector<std::int32_t>& skin_triangles,
                                             const sim::TriIndices& upper_teeth, const sim::TriIndices& lower_teeth);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

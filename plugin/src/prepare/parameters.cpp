@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 std::vector<double> skin_vertex_areas(const std::vector<std::int32_t>& triangles, const std::vector<double>& face_area,
                                       std::size_t n_vertices) {
@@ -30,7 +30,7 @@ void vertices_from_face_map(const std::vector<std::int32_t>& t, const std::vecto
   for (std::size_t i = 0; i < vertex_area.size(); ++i) out[i] /= std::max(vertex_area[i], 1e-300);
 }
 
-ParameterState::ParameterState(const Manifest& manifest, const std::vector<std::int32_t>& triangles,
+ParameterState::ParameterState(const bundle::Manifest& manifest, const std::vector<std::int32_t>& triangles,
                                const std::vector<double>& face_area)
     : specs_(&manifest.parameters),
       triangles_(&triangles),
@@ -80,7 +80,7 @@ void ParameterState::check_index(int index) const {
 void ParameterState::check_values(int index, const float* values, std::size_t count, std::size_t expected,
                                   const char* what) const {
   check_index(index);
-  const ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
+  const bundle::ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
   require(s.localisable, s.name + " is a global parameter: it cannot vary over the face");
   require_not_null(values, "values");
   require(count == expected, s.name + ": " + std::to_string(count) + " values given, the skin has " +
@@ -94,7 +94,7 @@ void ParameterState::check_values(int index, const float* values, std::size_t co
 
 void ParameterState::set_global(int index, double value) {
   check_index(index);
-  const ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
+  const bundle::ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
   if (!std::isfinite(value)) throw Error(SOFTDECA_ERROR_NON_FINITE, s.name + ": value is not finite");
   require(value >= s.min && value <= s.max, s.name + " = " + std::to_string(value) + " is outside [" +
                                                 std::to_string(s.min) + ", " + std::to_string(s.max) + "]");
@@ -149,4 +149,4 @@ void ParameterState::matrix(const std::vector<int>& columns, bool faces, float* 
   }
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

@@ -11,7 +11,7 @@
 
 #include "bundle/manifest.h"
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 // The localisation rules over a skin's triangles (3 indices each). vertex_values: one per
 // vertex; face_values and face_area: one per triangle; vertex_area: skin_vertex_areas'.
@@ -28,7 +28,8 @@ class ParameterState {
  public:
   enum class Kind { Global, Faces, Vertices };
 
-  ParameterState(const Manifest& manifest, const std::vector<std::int32_t>& triangles, const std::vector<double>& face_area);
+  ParameterState(const bundle::Manifest& manifest, const std::vector<std::int32_t>& triangles,
+                 const std::vector<double>& face_area);
 
   // Throw Error(INVALID_ARGUMENT / NON_FINITE) for a bad index, count or value.
   void set_global(int index, double value);
@@ -61,11 +62,11 @@ class ParameterState {
   // [rows][columns.size()] row-major, one row per face (faces) or vertex.
   void matrix(const std::vector<int>& columns, bool faces, float* out) const;
 
-  const std::vector<ParameterSpec>* specs_;
+  const std::vector<bundle::ParameterSpec>* specs_;
   const std::vector<std::int32_t>* triangles_;
   std::vector<double> face_area_, vertex_area_;
   std::size_t n_faces_, n_vertices_;
   std::vector<Value> values_;
 };
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

@@ -7,7 +7,7 @@
 #include "core/binary_reader.h"
 #include "core/error.h"
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, message); }
@@ -34,8 +34,8 @@ std::size_t RestHead::bytes() const {
   return b;
 }
 
-RestHead parse_rest_head(const Manifest& m, const Bytes& data) {
-  const RestPhysicsSpec& s = m.rest_physics;
+RestHead parse_rest_head(const bundle::Manifest& m, const bundle::Bytes& data) {
+  const bundle::RestPhysicsSpec& s = m.rest_physics;
   const std::string& f = s.file;
   BinaryReader in(data.data(), data.size(), f);
   RestHead h;
@@ -105,4 +105,4 @@ RestHead parse_rest_head(const Manifest& m, const Bytes& data) {
   return h;
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

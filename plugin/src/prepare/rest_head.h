@@ -14,7 +14,7 @@
 #include "sim/mesh.h"
 #include "sim/parameters.h"
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 struct RestHead {
   sim::Positions vertices;  // the fill's vertices on the template (metres)
@@ -43,6 +43,6 @@ struct RestHead {
 // Throws Error(FORMAT) naming the first problem: a size that does not match the manifest,
 // an index out of range, a non-finite value, embedding weights that do not sum to one, an
 // embedding tet with a repeated corner.
-RestHead parse_rest_head(const Manifest& manifest, const Bytes& data);
+RestHead parse_rest_head(const bundle::Manifest& manifest, const bundle::Bytes& data);
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

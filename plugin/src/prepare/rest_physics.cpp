@@ -10,7 +10,7 @@
 #include "prepare/contact_sets.h"
 #include "sim/parameters.h"
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 namespace {
 using Triplets = std::vector<Eigen::Triplet<double>>;
@@ -94,7 +94,7 @@ sim::Positions carry_fill(const RestHead& head, const sim::Positions& neutral_sk
   return out;
 }
 
-RestPhysics::RestPhysics(const RestHead& head, const Manifest& m, const float* neutral,
+RestPhysics::RestPhysics(const RestHead& head, const bundle::Manifest& m, const float* neutral,
                          const std::vector<std::int32_t>& skin_triangles, int threads)
     : head_(head), m_(m) {
   const auto ns = static_cast<Eigen::Index>(m.skin_vertices);
@@ -171,4 +171,4 @@ sim::Positions RestPhysics::solve(const ParameterState& params) {
   return std::move(r.skin);
 }
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

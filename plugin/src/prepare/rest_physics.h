@@ -22,7 +22,7 @@
 #include "prepare/rest_head.h"
 #include "sim/simulator.h"
 
-namespace softdeca::runtime {
+namespace softdeca::prepare {
 
 // The fill's vertices carried to a neutral skin (skin_vertices x 3, metres).
 sim::Positions carry_fill(const RestHead& head, const sim::Positions& neutral_skin);
@@ -38,8 +38,8 @@ class RestPhysics {
   // neutral: the avatar's whole head (head_vertices x 3). Throws Error(INVALID_ARGUMENT) when
   // the carried head is not a valid simulation mesh (an inverted tet: a neutral too far from
   // the template's proportions for the fill to follow).
-  RestPhysics(const RestHead& head, const Manifest& manifest, const float* neutral, const std::vector<std::int32_t>& skin_triangles,
-              int threads);
+  RestPhysics(const RestHead& head, const bundle::Manifest& manifest, const float* neutral,
+              const std::vector<std::int32_t>& skin_triangles, int threads);
 
   // The simulated skin at rest (skin_vertices x 3) under the avatar's parameters.
   sim::Positions solve(const ParameterState& params);
@@ -47,11 +47,11 @@ class RestPhysics {
 
  private:
   const RestHead& head_;
-  const Manifest& m_;
+  const bundle::Manifest& m_;
   sim::Positions targets_;
   std::vector<std::int32_t> soft_tet_vertex_, muscle_tet_vertex_;  // per tet: its skin vertex
   std::unique_ptr<sim::Simulator> sim_;
   int iterations_ = 0;
 };
 
-}  // namespace softdeca::runtime
+}  // namespace softdeca::prepare

@@ -22,7 +22,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       blendshapes_(d.blendshapes ? Blendshapes(d.blendshapes, d.blendshape_count, vh_, d.threads) : Blendshapes()),
       worker_(d.threads),
       params_(m_, model_->skin_triangles(), geometry_.face_area),
-      weights_(kBlendshapeCount),
+      weights_(bundle::kBlendshapeCount),
       z_(static_cast<std::size_t>(m_.latent)),
       offsets_(3 * m_.landmarks.size()),
       head_(vh_ * 3),
@@ -38,7 +38,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
   }
   // Landmarks on the avatar's neutral skin.
   const auto& tri = model_->skin_triangles();
-  for (const LandmarkSpec& l : m_.landmarks) {
+  for (const bundle::LandmarkSpec& l : m_.landmarks) {
     landmark_arkit_.push_back(l.arkit_vertex);
     for (int c = 0; c < 3; ++c) {
       double p = 0;
@@ -87,7 +87,7 @@ void Avatar::get_parameter(int index, double* value, bool* localised) const {
   std::lock_guard<std::mutex> lock(params_mutex_);
   require(index >= 0 && static_cast<std::size_t>(index) < m_.parameters.size(), "parameter index out of range");
   if (value) *value = params_.global(index);
-  if (localised) *localised = params_.kind(index) != ParameterState::Kind::Global;
+  if (localised) *localised = params_.kind(index) != prepare::ParameterState::Kind::Global;
 }
 
 void Avatar::set_identity(const float* values, std::size_t count) {

@@ -39,7 +39,7 @@ struct AvatarDesc {
   const float* blendshapes = nullptr;  // 52 x head_vertices x 3 deltas, or null
   std::size_t blendshape_count = 0;
   std::size_t threads = 1;
-  Precision precision = Precision::Half;
+  kernels::Precision precision = kernels::Precision::Half;
 };
 
 struct Output {
@@ -68,12 +68,12 @@ struct Preparation {
   std::uint64_t generation = 0;
   std::shared_ptr<const DeformationTransfer> dt;
   std::vector<float> identity;
-  HyperTensor face_l, vertex_l;       // SoftDECA: [F][latent][9]; sparse: [Vs][latent][3]
-  HyperTensor softdeca_vertex_l;      // SoftDECA's vertex stage, [Vs][latent][3] (empty: none)
+  kernels::HyperTensor face_l, vertex_l;       // SoftDECA: [F][latent][9]; sparse: [Vs][latent][3]
+  kernels::HyperTensor softdeca_vertex_l;      // SoftDECA's vertex stage, [Vs][latent][3] (empty: none)
   // SoftDECA's residual stage: the condition its frame half reads, and its modes
   // [Vs][modes][3] (empty: none)
   std::vector<float> residual_condition;
-  HyperTensor residual_modes;
+  kernels::HyperTensor residual_modes;
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
   // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)], p_inert being
@@ -120,7 +120,7 @@ class Avatar {
 
  private:
   std::shared_ptr<const Preparation> current() const;
-  HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
+  kernels::HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                            const std::vector<float>& identity, std::size_t n, std::size_t width) const;
   void read_weights(const float* weights, std::size_t count);
   const float* select_landmarks(const float* points, std::size_t count, const char* what) const;
@@ -128,29 +128,30 @@ class Avatar {
   void finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
               AvatarStats& st);
   void softdeca_frame(const Preparation& prep, AvatarStats& st);
-  void add_vertex_offsets(const HyperTensor& modes, const float* coefficients);  // static_ += c . modes
+  void add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients);  // static_ += c . modes
   // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.
   void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since);
-  void prepare_residual(const ParameterState& params, Preparation& prep) const;
+  void prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
   // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep`.
-  void prepare_softdeca_stages(const ParameterState& params, const std::vector<float>& identity, Preparation& prep) const;
+  void prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
+                               Preparation& prep) const;
   // The networks' part of a preparation for these parameters and identity.
-  std::shared_ptr<Preparation> prepare_networks(const ParameterState& params, const std::vector<float>& identity) const;
+  std::shared_ptr<Preparation> prepare_networks(const prepare::ParameterState& params, const std::vector<float>& identity) const;
   // SoftDECA's static frame at rest (zero weights on the neutral) for a preparation, without
   // touching the frame thread's buffers (prepare runs beside frames).
   std::vector<float> softdeca_rest(const Preparation& prep) const;
-  std::vector<float> softdeca_rest(const ParameterState& params, const std::vector<float>& identity) const;
+  std::vector<float> softdeca_rest(const prepare::ParameterState& params, const std::vector<float>& identity) const;
   // c(p) of Preparation::rest_offset (prepare_mutex_ held); iterations: of the physics' solve.
-  std::vector<float> rest_offset(const ParameterState& params, const Preparation& prep, const std::vector<float>& identity,
-                                 int& iterations);
+  std::vector<float> rest_offset(const prepare::ParameterState& params, const Preparation& prep,
+                                 const std::vector<float>& identity, int& iterations);
   void write_rigid_non_skin(const float* skin, float* head) const;
   void compute_normals(const float* head, float* normals);
   void record(AvatarStats st);  // a frame's timings, keeping the counters
 
   std::shared_ptr<const Model> model_;
-  const Manifest& m_;
+  const bundle::Manifest& m_;
   std::size_t vh_, vs_, nf_;
-  Precision precision_;
+  kernels::Precision precision_;
   std::vector<float> neutral_;  // Vh x 3
   std::vector<std::int32_t> triangles_;
   SkinGeometry geometry_;
@@ -158,11 +159,11 @@ class Avatar {
   std::vector<int> landmark_arkit_;        // K ARKit vertex indices
   std::vector<int> jaw_vertices_, cranium_vertices_;
   Blendshapes blendshapes_;
-  Worker worker_;
+  kernels::Worker worker_;
 
   // Staged inputs of prepare (any thread).
   mutable std::mutex params_mutex_;
-  ParameterState params_;
+  prepare::ParameterState params_;
   std::vector<float> identity_;
 
   std::mutex prepare_mutex_;
@@ -170,7 +171,7 @@ class Avatar {
   // The physics at prepare (bundles with a rest head): the avatar's head, built by the first
   // prepare away from the defaults, and P_rest(p0) and M_rest(p0) (for the identity they were
   // computed with); all under prepare_mutex_.
-  std::unique_ptr<RestPhysics> rest_physics_;
+  std::unique_ptr<prepare::RestPhysics> rest_physics_;
   sim::Positions rest_physics0_;
   std::vector<float> rest_model0_, rest_model0_identity_;
   std::uint64_t generation_ = 0;
@@ -180,11 +181,11 @@ class Avatar {
   // Frame-thread state.
   std::atomic<bool> busy_{false};
   std::atomic<bool> dynamics_enabled_{false}, reset_requested_{false};
-  AlignedArray<float> weights_, z_, offsets_, head_, static_;
-  AlignedArray<float> residual_condition_, residual_coefficients_;  // the residual stage's frame half
-  std::vector<AlignedArray<float>> rhs_;  // one right-hand side per thread
+  kernels::AlignedArray<float> weights_, z_, offsets_, head_, static_;
+  kernels::AlignedArray<float> residual_condition_, residual_coefficients_;  // the residual stage's frame half
+  std::vector<kernels::AlignedArray<float>> rhs_;  // one right-hand side per thread
   std::vector<const float*> rhs_parts_;
-  AlignedArray<double> solve_work_;
+  kernels::AlignedArray<double> solve_work_;
   OnnxNetwork::Binding f_w_, f_l_, f_r_w_;
   DynamicsState dynamics_;
   geometry::Normals normals_;

@@ -35,7 +35,7 @@ void check_output_capacity(const Output& out, std::size_t vertices) {
 
 void Avatar::read_weights(const float* weights, std::size_t count) {
   require_not_null(weights, "weights");
-  expect(count == kBlendshapeCount,
+  expect(count == bundle::kBlendshapeCount,
          [&] { return "expected 52 blendshape weights (canonical ARKit order), got " + std::to_string(count); });
   require_finite(weights, count, "weights");
   for (std::size_t i = 0; i < count; ++i) {
@@ -63,8 +63,8 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   auto pass = [&](std::size_t part, std::size_t n_parts) {
     float* rhs = rhs_[part].data();
     std::memset(rhs, 0, vs_ * 3 * sizeof(float));
-    dg_rhs(prep.face_l, prep.dt->faces(), z_.data(), head_.data(), blocks * part / n_parts, blocks * (part + 1) / n_parts,
-           rhs);
+    kernels::dg_rhs(prep.face_l, prep.dt->faces(), z_.data(), head_.data(), blocks * part / n_parts,
+                    blocks * (part + 1) / n_parts, rhs);
   };
   worker_.run(pass);
   auto t2 = Clock::now();
@@ -100,10 +100,10 @@ void Avatar::add_vertex_stages(const Preparation& prep, AvatarStats& st, Clock::
   st.hyper_ms += ms(since, Clock::now());
 }
 
-void Avatar::add_vertex_offsets(const HyperTensor& modes, const float* coefficients) {
+void Avatar::add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients) {
   const std::size_t blocks = modes.blocks();
   auto pass = [&](std::size_t part, std::size_t parts) {
-    vertex_offsets(modes, coefficients, static_.data(), blocks * part / parts, blocks * (part + 1) / parts,
+    kernels::vertex_offsets(modes, coefficients, static_.data(), blocks * part / parts, blocks * (part + 1) / parts,
                    static_.data());
   };
   worker_.run(pass);
@@ -281,7 +281,7 @@ void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Ou
   st.encoder_ms = ms(t1, t2);
   const std::size_t blocks = prep->vertex_l.blocks();
   auto pass = [&](std::size_t part, std::size_t parts) {
-    vertex_offsets(prep->vertex_l, z_.data(), neutral_.data(), blocks * part / parts, blocks * (part + 1) / parts,
+    kernels::vertex_offsets(prep->vertex_l, z_.data(), neutral_.data(), blocks * part / parts, blocks * (part + 1) / parts,
                    static_.data());
   };
   worker_.run(pass);

@@ -14,13 +14,13 @@ namespace softdeca::runtime {
 using namespace avatar_detail;
 
 // A hypernetwork's L(p, h) for n elements of the given width, checked and stored.
-HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
+kernels::HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                                  const std::vector<float>& identity, std::size_t n, std::size_t width) const {
   std::vector<float> l(n * static_cast<std::size_t>(m_.latent) * width);
   net.run({parameters.data(), identity.data()}, {l.data()}, 1);
   if (!all_finite(l.data(), l.size()))
     throw Error(SOFTDECA_ERROR_FORMAT, net.spec().key + " produced non-finite values for these parameters");
-  return HyperTensor(l.data(), n, m_.latent, static_cast<int>(width), precision_);
+  return kernels::HyperTensor(l.data(), n, m_.latent, static_cast<int>(width), precision_);
 }
 
 std::size_t Preparation::bytes() const {
@@ -33,10 +33,10 @@ void Avatar::prepare() {
   std::lock_guard<std::mutex> prepare_lock(prepare_mutex_);
   const auto t0 = Clock::now();
   std::vector<float> identity;
-  std::unique_ptr<ParameterState> params;
+  std::unique_ptr<prepare::ParameterState> params;
   {
     std::lock_guard<std::mutex> lock(params_mutex_);
-    params = std::make_unique<ParameterState>(params_);
+    params = std::make_unique<prepare::ParameterState>(params_);
     identity = identity_;
   }
   double factorisation_ms = 0;
@@ -73,7 +73,7 @@ void Avatar::prepare() {
 
 // SoftDECA's stages for these parameters: its per-face hyper-tensor, its vertex stage and the
 // residual stage's prepare half (what softdeca_rest reads).
-void Avatar::prepare_softdeca_stages(const ParameterState& params, const std::vector<float>& identity,
+void Avatar::prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
                                      Preparation& prep) const {
   const OnnxNetwork& hyper = *model_->hyper(false);
   const auto& cols = hyper.spec().parameter_columns;
@@ -89,7 +89,7 @@ void Avatar::prepare_softdeca_stages(const ParameterState& params, const std::ve
 }
 
 // The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
-std::shared_ptr<Preparation> Avatar::prepare_networks(const ParameterState& params,
+std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterState& params,
                                                       const std::vector<float>& identity) const {
   auto prep = std::make_shared<Preparation>();
   prep->dt = dt_;
@@ -122,7 +122,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const ParameterState& para
 
 // SoftDECA's static frame at rest for other parameters than the preparation's: its stages
 // alone (no dynamics, no sparse model).
-std::vector<float> Avatar::softdeca_rest(const ParameterState& params, const std::vector<float>& identity) const {
+std::vector<float> Avatar::softdeca_rest(const prepare::ParameterState& params, const std::vector<float>& identity) const {
   Preparation stages;
   stages.dt = dt_;
   prepare_softdeca_stages(params, identity, stages);
@@ -130,48 +130,48 @@ std::vector<float> Avatar::softdeca_rest(const ParameterState& params, const std
 }
 
 std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
-  const std::vector<float> weights(kBlendshapeCount, 0.0f);
+  const std::vector<float> weights(bundle::kBlendshapeCount, 0.0f);
   std::vector<float> z(static_cast<std::size_t>(m_.latent)), out(vs_ * 3);
   model_->encoder(false)->run({weights.data()}, {z.data()}, 1);
   if (prep.face_l.zero()) {
     std::copy(neutral_.begin(), neutral_.begin() + static_cast<std::ptrdiff_t>(vs_ * 3), out.begin());
   } else {
     std::vector<float> rhs(vs_ * 3, 0.0f);
-    dg_rhs(prep.face_l, prep.dt->faces(), z.data(), neutral_.data(), 0, prep.face_l.blocks(), rhs.data());
+    kernels::dg_rhs(prep.face_l, prep.dt->faces(), z.data(), neutral_.data(), 0, prep.face_l.blocks(), rhs.data());
     std::vector<double> work(prep.dt->work_size());
     const float* parts[] = {rhs.data()};
     prep.dt->solve(parts, 1, neutral_.data(), work.data(), out.data());
   }
   if (!prep.softdeca_vertex_l.empty())
-    vertex_offsets(prep.softdeca_vertex_l, z.data(), out.data(), 0, prep.softdeca_vertex_l.blocks(), out.data());
+    kernels::vertex_offsets(prep.softdeca_vertex_l, z.data(), out.data(), 0, prep.softdeca_vertex_l.blocks(), out.data());
   if (!prep.residual_modes.empty()) {
     std::vector<float> c(static_cast<std::size_t>(m_.residual_modes));
     model_->residual_coefficients()->run({weights.data(), prep.residual_condition.data()}, {c.data()}, 1);
-    vertex_offsets(prep.residual_modes, c.data(), out.data(), 0, prep.residual_modes.blocks(), out.data());
+    kernels::vertex_offsets(prep.residual_modes, c.data(), out.data(), 0, prep.residual_modes.blocks(), out.data());
   }
   return out;
 }
 
-std::vector<float> Avatar::rest_offset(const ParameterState& params, const Preparation& prep,
+std::vector<float> Avatar::rest_offset(const prepare::ParameterState& params, const Preparation& prep,
                                        const std::vector<float>& identity, int& iterations) {
   if (!rest_physics_) {  // kept only once its defaults' solve succeeded
-    auto physics = std::make_unique<RestPhysics>(*model_->rest_head(), m_, neutral_.data(), model_->skin_triangles(),
+    auto physics = std::make_unique<prepare::RestPhysics>(*model_->rest_head(), m_, neutral_.data(), model_->skin_triangles(),
                                                  static_cast<int>(worker_.parts()));
-    rest_physics0_ = physics->solve(ParameterState(m_, model_->skin_triangles(), geometry_.face_area));
+    rest_physics0_ = physics->solve(prepare::ParameterState(m_, model_->skin_triangles(), geometry_.face_area));
     rest_physics_ = std::move(physics);
   }
   // Each distinct parameter set runs the networks once: p's own stages are the preparation's,
   // the defaults' are kept per identity, and p's rest-inert part is p itself when every
   // parameter p moves is rest-inert.
   if (rest_model0_.empty() || rest_model0_identity_ != identity) {
-    rest_model0_ = softdeca_rest(ParameterState(m_, model_->skin_triangles(), geometry_.face_area), identity);
+    rest_model0_ = softdeca_rest(prepare::ParameterState(m_, model_->skin_triangles(), geometry_.face_area), identity);
     rest_model0_identity_ = identity;
   }
   const sim::Positions physics = rest_physics_->solve(params);
   iterations = rest_physics_->iterations();
   // The networks' own rest response to p, less their response to p's rest-inert parameters
   // alone: the physics says nothing about those at rest, so that part stays the networks'.
-  const ParameterState inert_only = params.only(m_.rest_physics.inert_parameters);
+  const prepare::ParameterState inert_only = params.only(m_.rest_physics.inert_parameters);
   const std::vector<float> model = softdeca_rest(prep);
   std::optional<std::vector<float>> inert_rest;
   const std::vector<float>& model_inert = inert_only.at_defaults() ? rest_model0_
@@ -190,7 +190,7 @@ std::vector<float> Avatar::rest_offset(const ParameterState& params, const Prepa
 }
 
 // The residual stage's prepare half: its condition and modes for these parameters.
-void Avatar::prepare_residual(const ParameterState& params, Preparation& prep) const {
+void Avatar::prepare_residual(const prepare::ParameterState& params, Preparation& prep) const {
   const OnnxNetwork* net = model_->residual_condition();
   if (!net) return;
   const auto& cols = net->spec().parameter_columns;
@@ -202,7 +202,7 @@ void Avatar::prepare_residual(const ParameterState& params, Preparation& prep) c
   if (!all_finite(condition.data(), condition.size()) || !all_finite(modes.data(), modes.size()))
     throw Error(SOFTDECA_ERROR_FORMAT, net->spec().key + " produced non-finite values for these parameters");
   prep.residual_condition = std::move(condition);
-  prep.residual_modes = HyperTensor(modes.data(), vs_, m_.residual_modes, 3, precision_);
+  prep.residual_modes = kernels::HyperTensor(modes.data(), vs_, m_.residual_modes, 3, precision_);
 }
 
 }  // namespace softdeca::runtime

@@ -37,7 +37,7 @@ class Blendshapes {
     std::vector<std::size_t> part_begin;  // first run of each part, plus the end
   };
   std::vector<Shape> shapes_;
-  AlignedArray<float> deltas_;  // every shape's runs, one after the other (one huge-page stream)
+  kernels::AlignedArray<float> deltas_;  // every shape's runs, one after the other (one huge-page stream)
   std::vector<std::size_t> part_vertex_;  // vertex range bounds, parts + 1
 };
 

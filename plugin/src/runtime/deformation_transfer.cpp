@@ -47,17 +47,17 @@ Eigen::SparseMatrix<double> assemble(const SkinGeometry& g, std::size_t n, const
   return K;
 }
 
-FaceBlocks face_blocks(const SkinGeometry& g, const std::vector<std::int32_t>& t) {
-  FaceBlocks fb;
+kernels::FaceBlocks face_blocks(const SkinGeometry& g, const std::vector<std::int32_t>& t) {
+  kernels::FaceBlocks fb;
   const std::size_t nf = t.size() / 3;
-  fb.blocks = (nf + kLanes - 1) / kLanes;
-  fb.corners.resize(fb.blocks * 3 * kLanes);
-  fb.coeff.resize(fb.blocks * 3 * kLanes);
+  fb.blocks = (nf + kernels::kLanes - 1) / kernels::kLanes;
+  fb.corners.resize(fb.blocks * 3 * kernels::kLanes);
+  fb.coeff.resize(fb.blocks * 3 * kernels::kLanes);
   for (std::size_t f = 0; f < nf; ++f) {
-    const std::size_t base = (f / kLanes) * 3 * kLanes, lane = f % kLanes;
+    const std::size_t base = (f / kernels::kLanes) * 3 * kernels::kLanes, lane = f % kernels::kLanes;
     for (std::size_t c = 0; c < 3; ++c) {
-      fb.corners[base + c * kLanes + lane] = t[3 * f + c];
-      fb.coeff[base + c * kLanes + lane] = static_cast<float>(g.metric[3 * f + c]);
+      fb.corners[base + c * kernels::kLanes + lane] = t[3 * f + c];
+      fb.coeff[base + c * kernels::kLanes + lane] = static_cast<float>(g.metric[3 * f + c]);
     }
   }
   return fb;

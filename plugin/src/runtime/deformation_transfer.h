@@ -31,7 +31,7 @@ class DeformationTransfer {
   DeformationTransfer(const SkinGeometry& geometry, std::size_t n_vertices, const std::vector<std::int32_t>& triangles,
                       double regularisation, std::size_t parts = 1);
 
-  const FaceBlocks& faces() const { return faces_; }
+  const kernels::FaceBlocks& faces() const { return faces_; }
   std::size_t vertices() const { return ldlt_.size(); }
   std::size_t bytes() const { return ldlt_.bytes() + faces_.corners.bytes() + faces_.coeff.bytes(); }
   std::size_t factor_nonzeros() const { return ldlt_.factor_nonzeros(); }
@@ -48,7 +48,7 @@ class DeformationTransfer {
   double serial_fraction() const { return ldlt_.serial_fraction(); }
 
  private:
-  FaceBlocks faces_;
+  kernels::FaceBlocks faces_;
   geometry::SparseLdlt ldlt_;
 };
 

@@ -8,7 +8,7 @@
 
 namespace softdeca::runtime {
 
-void DynamicsCoefficients::check(const Manifest& m, const char* network) const {
+void DynamicsCoefficients::check(const bundle::Manifest& m, const char* network) const {
   constexpr double kTol = 1e-5;
   for (std::size_t v = 0; v < alpha.size(); ++v) {
     const double a = alpha[v], b = beta[v], g = gamma[v];

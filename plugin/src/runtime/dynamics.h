@@ -12,12 +12,12 @@
 namespace softdeca::runtime {
 
 struct DynamicsCoefficients {
-  AlignedArray<float> alpha, beta, gamma;
+  kernels::AlignedArray<float> alpha, beta, gamma;
   bool empty() const { return alpha.size() == 0; }
   std::size_t bytes() const { return alpha.bytes() + beta.bytes() + gamma.bytes(); }
   // Takes the network's outputs; throws Error(FORMAT) naming the network when a coefficient is
   // non-finite or outside the stable, equilibrium-preserving set the manifest declares.
-  void check(const Manifest& m, const char* network) const;
+  void check(const bundle::Manifest& m, const char* network) const;
 };
 
 class DynamicsState {
@@ -36,7 +36,7 @@ class DynamicsState {
   void commit(int model);
 
  private:
-  AlignedArray<float> buffer_[3];
+  kernels::AlignedArray<float> buffer_[3];
   std::size_t head_ = 0;  // buffer_[head_] = x_{t-1}, buffer_[(head_+1)%3] = x_{t-2}
   bool valid_ = false;
   int model_ = -1;

@@ -6,17 +6,17 @@
 //
 // A mesh in the template's topology is the identity fit: the registered template is the mesh
 // itself and the embedding the identity, so the core's frame is the avatar's, with nothing to
-// carry (the template path, at the core's own cost). The C ABI's handle holds one of these
-// whatever the mesh, and calls it alike.
+// carry (the template path, at the core's own cost). Both run one frame path, which applies the
+// avatar's FitTransfer (runtime/fit_transfer.h) step by step; the C ABI's handle holds one of
+// these whatever the mesh, and calls it alike.
 #pragma once
 
-#include <Eigen/Core>
 #include <atomic>
 #include <memory>
-#include <vector>
 
 #include "fit/avatar_fit.h"
 #include "runtime/avatar.h"
+#include "runtime/fit_transfer.h"
 
 namespace softdeca::runtime {
 
@@ -27,7 +27,7 @@ struct FittedAvatarDesc {
   const fit::AvatarFit* fit = nullptr;
   const fit::AvatarMesh* mesh = nullptr;  // the mesh the fit was made for (checked by its hash)
   std::size_t threads = 1;
-  Precision precision = Precision::Half;
+  kernels::Precision precision = kernels::Precision::Half;
 };
 
 class FittedAvatar {
@@ -40,8 +40,6 @@ class FittedAvatar {
   // The registered template's avatar: parameters, identity, prepare, dynamics, calibration.
   Avatar& core() { return *core_; }
   const Avatar& core() const { return *core_; }
-  std::size_t vertex_count() const { return n_; }
-  std::size_t triangle_count() const { return triangles_.size() / 3; }
 
   // Maps over the avatar's own triangles or vertices, carried to the template's skin vertices.
   void set_parameter_faces(int index, const float* values, std::size_t count);
@@ -55,31 +53,12 @@ class FittedAvatar {
   void evaluate_surface(const float* weights, std::size_t count, const float* surface, std::size_t vertices, const Output& out);
 
   // What the avatar holds besides its core (nothing for the identity fit).
-  std::size_t bytes() const;
+  std::size_t bytes() const { return transfer_->bytes(); }
 
  private:
-  Output core_output();                             // the registered template's frame buffer
-  void own_blend(const float* weights, float* out);  // the avatar's own linear blend
-  // out[v] += weight * A^-1 (sum of bary * field[corner]) over the embedding; field: skin x 3.
-  void add_carried(const float* field, float* out) const;
-  void finish(const Output& out);
-
   std::unique_ptr<Avatar> core_;
-  bool identity_ = false;  // the template's own topology: the core's frame is the avatar's
-  std::size_t n_ = 0, vs_ = 0, vh_ = 0;
-  std::vector<float> neutral_;  // the avatar's own, n x 3
-  std::vector<std::int32_t> triangles_;
-  Blendshapes blendshapes_;     // the avatar's own shapes
-  std::vector<float> registered_skin_;  // vs x 3
-  fit::Embedding embedding_;
-  std::vector<std::int32_t> skin_triangles_;
-  Eigen::Matrix3f to_avatar_;  // the placement's inverse linear part (template vectors to the avatar's)
-  fit::ShapeSource source_;
-  std::vector<float> template_skin_weight_;  // per template skin vertex: sum of its source weights (for maps)
-
-  std::atomic<bool> busy_{false};
-  std::vector<float> head_out_, field_, weights_;
-  geometry::Normals normals_;
+  std::unique_ptr<FitTransfer> transfer_;
+  std::atomic<bool> busy_{false};  // one frame thread at a time (the transfer's buffers)
 };
 
 }  // namespace softdeca::runtime

@@ -25,46 +25,46 @@ const char* const kNetworkKeys[] = {"identity_encoder", "softdeca.f_w",    "soft
 std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
 
 // The file's bytes, once their sha256 matches the manifest's.
-const Bytes& verified(const BundleFiles& files, const std::string& name, const std::string& sha256) {
-  const Bytes& bytes = files.get(name);
-  if (sha256_hex(bytes.data(), bytes.size()) != sha256)
+const bundle::Bytes& verified(const bundle::BundleFiles& files, const std::string& name, const std::string& sha256) {
+  const bundle::Bytes& bytes = files.get(name);
+  if (bundle::sha256_hex(bytes.data(), bytes.size()) != sha256)
     fail(name + ": sha256 does not match the manifest (the file was changed or damaged)");
   return bytes;
 }
 
 // Refuses external data and graphs outside the exporter's operators or without static shapes,
 // and adds what the network may allocate to the estimate.
-void scan_network(const Bytes& bytes, const NetworkSpec& spec, MemoryEstimate& estimate) {
-  const OnnxModelScan scan = [&] {
+void scan_network(const bundle::Bytes& bytes, const bundle::NetworkSpec& spec, MemoryEstimate& estimate) {
+  const bundle::OnnxModelScan scan = [&] {
     try {
-      return scan_onnx_model(bytes.data(), bytes.size(), spec.inputs);
+      return bundle::scan_onnx_model(bytes.data(), bytes.size(), spec.inputs);
     } catch (const Error& e) {
       fail(spec.file + ": " + e.what());
     }
   }();
   if (!scan.external_tensors.empty())
-    fail(spec.file + ": tensor '" + onnx::printable(scan.external_tensors.front()) +
+    fail(spec.file + ": tensor '" + bundle::onnx::printable(scan.external_tensors.front()) +
          "' keeps its data in another file (ONNX external data); a bundle's networks must hold all their data");
   std::uint64_t contract = 0;
   for (const auto* side : {&spec.inputs, &spec.outputs})
-    for (const TensorSpec& t : *side)
-      contract = onnx::add_sat(contract, OnnxNetwork::element_count(t, kFedBatch) * sizeof(float));
-  estimate.bytes = onnx::add_sat(estimate.bytes, onnx::add_sat(scan.bytes, contract));
+    for (const bundle::TensorSpec& t : *side)
+      contract = bundle::onnx::add_sat(contract, OnnxNetwork::element_count(t, bundle::kFedBatch) * sizeof(float));
+  estimate.bytes = bundle::onnx::add_sat(estimate.bytes, bundle::onnx::add_sat(scan.bytes, contract));
   if (scan.largest_bytes > estimate.largest_bytes) {
     estimate.largest_bytes = scan.largest_bytes;
-    estimate.largest = spec.file + " tensor '" + onnx::printable(scan.largest_tensor) + "'";
+    estimate.largest = spec.file + " tensor '" + bundle::onnx::printable(scan.largest_tensor) + "'";
   }
 }
 }  // namespace
 
-std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOptions& options) {
+std::shared_ptr<const Model> Model::load(const bundle::BundleFiles& files, const ModelOptions& options) {
   std::shared_ptr<Model> m(new Model());
-  const Bytes& manifest_bytes = files.get("manifest.json");
-  m->manifest_ = parse_manifest(std::string(manifest_bytes.begin(), manifest_bytes.end()));
-  m->manifest_sha256_ = sha256_hex(manifest_bytes.data(), manifest_bytes.size());
-  const Manifest& mf = m->manifest_;
+  const bundle::Bytes& manifest_bytes = files.get("manifest.json");
+  m->manifest_ = bundle::parse_manifest(std::string(manifest_bytes.begin(), manifest_bytes.end()));
+  m->manifest_sha256_ = bundle::sha256_hex(manifest_bytes.data(), manifest_bytes.size());
+  const bundle::Manifest& mf = m->manifest_;
 
-  const Bytes& tri = verified(files, mf.skin_triangles_file, mf.skin_triangles_sha256);
+  const bundle::Bytes& tri = verified(files, mf.skin_triangles_file, mf.skin_triangles_sha256);
   const std::size_t n_idx = static_cast<std::size_t>(mf.skin_triangles) * 3;
   if (tri.size() != n_idx * sizeof(std::int32_t))
     fail(mf.skin_triangles_file + ": " + std::to_string(tri.size()) + " bytes, expected " +
@@ -87,7 +87,7 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
     if (!used[v]) fail(mf.skin_triangles_file + ": skin vertex " + std::to_string(v) + " is in no triangle");
 
   const std::size_t non_skin = static_cast<std::size_t>(mf.head_vertices - mf.skin_vertices);
-  const Bytes& bones = verified(files, mf.non_skin_bones_file, mf.non_skin_bones_sha256);
+  const bundle::Bytes& bones = verified(files, mf.non_skin_bones_file, mf.non_skin_bones_sha256);
   if (bones.size() != non_skin)
     fail(mf.non_skin_bones_file + ": " + std::to_string(bones.size()) + " bytes, expected " + std::to_string(non_skin));
   bool any_jaw = false;
@@ -101,7 +101,7 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
   if (mf.has_rest_physics) {
     // Every parameter must be one the physics knows, over a range it accepts.
     std::vector<sim::Param> ids;
-    for (const ParameterSpec& p : mf.parameters) {
+    for (const bundle::ParameterSpec& p : mf.parameters) {
       const auto& table = sim::parameter_table();
       const auto it = std::find_if(table.begin(), table.end(), [&](const sim::ParameterInfo& i) { return p.name == i.name; });
       if (it == table.end()) fail("rest_physics: parameter " + p.name + " is not one of the physics' parameters");
@@ -109,20 +109,20 @@ std::shared_ptr<const Model> Model::load(const BundleFiles& files, const ModelOp
         fail("rest_physics: parameter " + p.name + "'s range is wider than the physics accepts");
       ids.push_back(static_cast<sim::Param>(it - table.begin()));  // the table is in Param's order
     }
-    const Bytes& data = verified(files, mf.rest_physics.file, mf.rest_physics.sha256);
-    RestHead head = parse_rest_head(mf, data);
+    const bundle::Bytes& data = verified(files, mf.rest_physics.file, mf.rest_physics.sha256);
+    prepare::RestHead head = prepare::parse_rest_head(mf, data);
     head.parameter_ids = std::move(ids);
-    m->rest_head_ = std::make_unique<const RestHead>(std::move(head));
+    m->rest_head_ = std::make_unique<const prepare::RestHead>(std::move(head));
   }
 
   if (mf.has_template_head)
-    m->template_head_ = std::make_unique<const TemplateHead>(
-        parse_template_head(mf, verified(files, mf.template_head_file, mf.template_head_sha256)));
+    m->template_head_ = std::make_unique<const bundle::TemplateHead>(
+        bundle::parse_template_head(mf, verified(files, mf.template_head_file, mf.template_head_sha256)));
 
   // Every network is verified and scanned before the first session exists: nothing a bundle
   // declares is allocated until the whole bundle fits the budget.
   MemoryEstimate estimate;
-  std::vector<const Bytes*> network_bytes;
+  std::vector<const bundle::Bytes*> network_bytes;
   for (const char* key : kNetworkKeys) {
     const auto it = mf.networks.find(key);
     if (it == mf.networks.end()) {

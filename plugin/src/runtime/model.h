@@ -39,9 +39,9 @@ class Model {
  public:
   // Checks every file's sha256 against the manifest, refuses ONNX files with external data
   // and bundles over the memory budget, all before creating a session. Throws Error(FORMAT).
-  static std::shared_ptr<const Model> load(const BundleFiles& files, const ModelOptions& options);
+  static std::shared_ptr<const Model> load(const bundle::BundleFiles& files, const ModelOptions& options);
 
-  const Manifest& manifest() const { return manifest_; }
+  const bundle::Manifest& manifest() const { return manifest_; }
   const std::vector<std::int32_t>& skin_triangles() const { return skin_triangles_; }  // F*3
   const std::vector<std::uint8_t>& non_skin_bones() const { return non_skin_bones_; }  // Vh-Vs, 0 cranium 1 jaw
 
@@ -61,19 +61,19 @@ class Model {
   const OnnxNetwork* residual_condition() const { return networks_.at(8).get(); }
   const OnnxNetwork* residual_coefficients() const { return networks_.at(9).get(); }
   // The physics at prepare's head (format version 4), or null.
-  const RestHead* rest_head() const { return rest_head_.get(); }
+  const prepare::RestHead* rest_head() const { return rest_head_.get(); }
   // The template head for fitting users' avatars (format version 5), or null.
-  const TemplateHead* template_head() const { return template_head_.get(); }
+  const bundle::TemplateHead* template_head() const { return template_head_.get(); }
   // SHA-256 of the manifest as loaded: a saved fit names the bundle it was made for.
   const std::string& manifest_sha256() const { return manifest_sha256_; }
 
  private:
   Model() = default;
-  Manifest manifest_;
+  bundle::Manifest manifest_;
   std::vector<std::int32_t> skin_triangles_;
   std::vector<std::uint8_t> non_skin_bones_;
-  std::unique_ptr<const RestHead> rest_head_;
-  std::unique_ptr<const TemplateHead> template_head_;
+  std::unique_ptr<const prepare::RestHead> rest_head_;
+  std::unique_ptr<const bundle::TemplateHead> template_head_;
   std::string manifest_sha256_;
   std::unique_ptr<Ort::Env> env_;  // before the sessions: they must go first
   std::vector<std::unique_ptr<OnnxNetwork>> networks_;

@@ -22,14 +22,15 @@ bool dims_match(const std::vector<std::int64_t>& model, const std::vector<std::i
   return true;
 }
 
-void check_side(Ort::Session& session, bool inputs, const std::vector<TensorSpec>& want, const NetworkSpec& spec) {
+void check_side(Ort::Session& session, bool inputs, const std::vector<bundle::TensorSpec>& want,
+                const bundle::NetworkSpec& spec) {
   const std::size_t n = inputs ? session.GetInputCount() : session.GetOutputCount();
   const char* side = inputs ? "input" : "output";
   if (n != want.size())
     throw Error(SOFTDECA_ERROR_FORMAT, spec.file + ": the model has " + std::to_string(n) + " " + side + "s, the contract " +
                                            std::to_string(want.size()));
   Ort::AllocatorWithDefaultOptions alloc;
-  for (const TensorSpec& t : want) {
+  for (const bundle::TensorSpec& t : want) {
     bool found = false;
     for (std::size_t i = 0; i < n && !found; ++i) {
       auto name = inputs ? session.GetInputNameAllocated(i, alloc) : session.GetOutputNameAllocated(i, alloc);
@@ -51,7 +52,7 @@ void check_side(Ort::Session& session, bool inputs, const std::vector<TensorSpec
 }
 }  // namespace
 
-OnnxNetwork::OnnxNetwork(Ort::Env& env, const Bytes& model, const NetworkSpec& spec, int threads)
+OnnxNetwork::OnnxNetwork(Ort::Env& env, const bundle::Bytes& model, const bundle::NetworkSpec& spec, int threads)
     : spec_(spec), memory_(Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault)) {
   try {
     Ort::SessionOptions opts;
@@ -79,7 +80,7 @@ OnnxNetwork::OnnxNetwork(Ort::Env& env, const Bytes& model, const NetworkSpec& s
   for (const auto& t : spec_.outputs) output_names_.push_back(t.name.c_str());
 }
 
-std::size_t OnnxNetwork::element_count(const TensorSpec& t, std::int64_t batch) {
+std::size_t OnnxNetwork::element_count(const bundle::TensorSpec& t, std::int64_t batch) {
   std::size_t n = 1;
   for (const std::int64_t d : t.shape) n *= static_cast<std::size_t>(d < 0 ? batch : d);
   return n;
@@ -90,7 +91,7 @@ OnnxNetwork::Binding OnnxNetwork::bind(const std::vector<const float*>& inputs, 
   if (inputs.size() != spec_.inputs.size() || outputs.size() != spec_.outputs.size())
     throw Error(SOFTDECA_ERROR_INTERNAL, spec_.key + ": wrong number of buffers");
   Binding b;
-  const auto make = [&](const TensorSpec& t, float* data) {
+  const auto make = [&](const bundle::TensorSpec& t, float* data) {
     std::vector<std::int64_t> shape = t.shape;
     for (auto& d : shape)
       if (d < 0) d = batch;

@@ -19,9 +19,9 @@ class OnnxNetwork {
   // `threads`: intra-op threads of this session (1 for per-frame networks: the runtime
   // parallelises around them). Throws Error(FORMAT) for bytes ONNX Runtime cannot load or a
   // model whose inputs/outputs differ from `spec`.
-  OnnxNetwork(Ort::Env& env, const Bytes& model, const NetworkSpec& spec, int threads);
+  OnnxNetwork(Ort::Env& env, const bundle::Bytes& model, const bundle::NetworkSpec& spec, int threads);
 
-  const NetworkSpec& spec() const { return spec_; }
+  const bundle::NetworkSpec& spec() const { return spec_; }
 
   // Tensors over caller memory, created once and reused every frame (no allocation by us).
   // `batch` resolves the free dimension. Buffers must outlive the binding.
@@ -40,10 +40,10 @@ class OnnxNetwork {
   // One-off evaluation (prepare): same as bind + run.
   void run(const std::vector<const float*>& inputs, const std::vector<float*>& outputs, std::int64_t batch) const;
 
-  static std::size_t element_count(const TensorSpec& t, std::int64_t batch);
+  static std::size_t element_count(const bundle::TensorSpec& t, std::int64_t batch);
 
  private:
-  NetworkSpec spec_;
+  bundle::NetworkSpec spec_;
   std::unique_ptr<Ort::Session> session_;
   Ort::MemoryInfo memory_;
   std::vector<const char*> input_names_, output_names_;

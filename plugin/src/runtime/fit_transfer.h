@@ -1,0 +1,59 @@
+// How a frame of the registered template (the core Avatar of a FittedAvatar) becomes a frame of
+// the avatar's own mesh, one step at a time, so that every avatar runs the same frame path:
+//
+//   core frame into core_output(out); blend(weights) or rest(); carry(base); finish()
+//
+// Through a fit (embedding_transfer) the avatar's own rig gives the linear part, and the core's
+// correction, its frame minus `base`, is carried through the fit's embedding. A mesh in the
+// template's topology is the identity fit (identity_transfer): the core writes straight into the
+// caller's output and every step leaves it as it is, so the template path costs what the core
+// costs. The steps are per frame (a virtual call each); their loops over vertices are inside.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "fit/avatar_fit.h"
+#include "runtime/avatar.h"
+
+namespace softdeca::runtime {
+
+class FitTransfer {
+ public:
+  virtual ~FitTransfer() = default;
+
+  // Where the core writes a frame for `out`: `out` itself, or the registered template's buffer
+  // once `out` is checked to hold the avatar's vertices (Error(BUFFER_TOO_SMALL) otherwise).
+  virtual Output core_output(const Output& out) = 0;
+  // Where the core writes a frame of a surface in the template's topology: the identity fit's
+  // `out`; Error(INVALID_ARGUMENT) through a fit, whose correction comes from weights or landmarks.
+  virtual Output surface_output(const Output& out) = 0;
+
+  // out = the avatar's own linear blend of the 52 weights (clamped to [0, 1]).
+  virtual void blend(const float* weights, const Output& out) = 0;
+  // out = the avatar's own neutral.
+  virtual void rest(const Output& out) = 0;
+  // out += the core's last frame minus `base` (the registered template's skin vertices x 3),
+  // carried onto the avatar's vertices.
+  virtual void carry(const float* base, const Output& out) = 0;
+  // The normals of out's vertices, when it asks for them.
+  virtual void finish(const Output& out) = 0;
+
+  // A parameter's map over the avatar's own triangles or vertices, given to the core over the
+  // registered template's skin vertices.
+  virtual void set_parameter_faces(Avatar& core, int index, const float* values, std::size_t count) = 0;
+  virtual void set_parameter_vertices(Avatar& core, int index, const float* values, std::size_t count) = 0;
+
+  // What the transfer holds (nothing for the identity fit).
+  virtual std::size_t bytes() const = 0;
+};
+
+// The identity fit: the core's frames and maps are the avatar's.
+std::unique_ptr<FitTransfer> identity_transfer();
+
+// The avatar `mesh` through its fit `f` to the template `t`; `core_shapes` are the registered
+// template's 52 shapes (fit::carried_shapes), which give the shapes the avatar's rig lacks.
+std::unique_ptr<FitTransfer> embedding_transfer(const fit::TemplateData& t, const fit::AvatarMesh& mesh,
+                                                const fit::AvatarFit& f, const float* core_shapes);
+
+}  // namespace softdeca::runtime
