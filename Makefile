@@ -139,7 +139,7 @@ bench: build bench-runtime bench-unity bench-stress ## every benchmark -> build/
 	@$(BUILD)/plugin/cli/softdeca bench-reliability --out build/bench/reliability.json --bundle build/bench/runtime_test_data/bundle \
 	  --import-corpus build/bench/hostile_avatars \
 	  --avatar build/bench/runtime_test_data/avatar --avatar-unit 1
-	@$(BUILD)/plugin/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
+	@$(BUILD)/plugin/bench/bench_physics --levels 3,4,5 --default 4 --frames 6 --repeats 2 --out build/bench/physics.json
 	@$(PY) -m softdeca_train bench-physics --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench --ict "$(SOFTDECA_ICT)" --out build/bench
 	@$(PY) -m softdeca_train bench-datagen --ict "$(SOFTDECA_ICT)" --out build/bench

@@ -113,6 +113,16 @@ TEST(OnnxStaticSizes, InputsAreFedAtTheContractsShapesWithBatchOne) {
             std::string::npos);
 }
 
+TEST(OnnxStaticSizes, WeightsAreTheStoredConstants) {
+  // Initializers (float, float16) and Constant nodes' values count; a tensor computed from a
+  // constant (ConstantOfShape's zeros) and the inputs do not.
+  const std::vector<TensorSpec> contract{{"weights", {-1, 52}}};
+  const std::string g = graph_input("weights") + initializer(tensor("w", kFloat, {52, 1000})) +
+                        initializer(tensor("table", 10, {8, 3})) + node("MatMul", {"weights", "w"}, "h") +
+                        vector_constant("dims", {4, 5}) + node("ConstantOfShape", {"dims"}, "zeros");
+  EXPECT_EQ(scan(g, contract).weight_bytes, 4 * 52000 + 2 * 24 + 8 * 2u);
+}
+
 TEST(OnnxStaticSizes, ShapesFromRunTimeValuesAreRefused) {
   // A Reshape to a shape read from an input's values: unknown until it runs.
   const std::vector<TensorSpec> contract{{"x", {4}}};

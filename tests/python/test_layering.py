@@ -1,7 +1,8 @@
 """The native library's layers (NATIVE_LAYERS): core/ below everything, the C ABI (api/) on
 top, nothing below api/ including it, and every area including only areas of lower layers.
 The import layer (plugin/import) below every host; the command line in by its documented way
-(CLI_MAY_INCLUDE). The training package's layers (PYTHON_LAYERS): no import cycle, areas
+(CLI_MAY_INCLUDE), its benchmarks (plugin/bench) by the same way and a few internals they
+measure (BENCH_MAY_INCLUDE). The training package's layers (PYTHON_LAYERS): no import cycle, areas
 importing only downwards, and imports at module top but for a few explained ones."""
 
 from __future__ import annotations
@@ -38,6 +39,13 @@ def test_nothing_below_the_c_abi_includes_it() -> None:
 
 IMPORT = SRC.parent / "import"
 CLI = SRC.parent / "cli"
+BENCH = SRC.parent / "bench"
+
+
+def files_of(folder: Path) -> list[Path]:
+    return [p for p in folder.iterdir() if p.suffix in (".h", ".cpp")]
+
+
 # What the import layer (plugin/import) may include: the library's lower areas it reads with
 # (core's file opening and errors, the bundle's JSON parser and hash, the one rule for an
 # avatar's values that the fit applies too), the public header for the names rule, and its own
@@ -52,9 +60,8 @@ IMPORT_MAY_INCLUDE = (
 
 
 def test_the_import_layer_includes_no_host() -> None:
-    own = {p.name for p in IMPORT.iterdir() if p.suffix in (".h", ".cpp")}
-    cli = {p.name for p in CLI.iterdir() if p.suffix in (".h", ".cpp")}
-    files = [p for p in IMPORT.iterdir() if p.suffix in (".h", ".cpp")]
+    files = files_of(IMPORT)
+    own = {p.name for p in files}
     assert files
     offenders = [
         f"{p.name} includes {inc}"
@@ -63,12 +70,23 @@ def test_the_import_layer_includes_no_host() -> None:
         if inc not in own and not inc.startswith(IMPORT_MAY_INCLUDE)
     ]
     assert offenders == []
-    assert not own & cli, f"files in both plugin/import and plugin/cli: {own & cli}"
+
+
+def test_the_hosts_folders_share_no_file_name() -> None:
+    """The import layer, the command line and its benchmarks include each other's headers by
+    name alone (flat include folders), so a name must say which file it is."""
+    folders = (IMPORT, CLI, BENCH)
+    names = [{p.name for p in files_of(f)} for f in folders]
+    assert all(names)
+    for i, a in enumerate(folders):
+        for j in range(i + 1, len(folders)):
+            both = names[i] & names[j]
+            assert not both, f"files in both {a.name} and {folders[j].name}: {both}"
 
 
 # The command line's way into the library (docs/ARCHITECTURE.md, "Ways into the native
 # library"): the C ABI for models, avatars and fits; the file and stream areas it is the tool
-# for; the import layer; and the few internals its benchmarks measure and its pictures use.
+# for; the import layer; and the few internals its pictures use.
 CLI_MAY_INCLUDE = (
     "softdeca/softdeca.h",
     "core/",
@@ -80,29 +98,38 @@ CLI_MAY_INCLUDE = (
     "fit/limits.h",
     "geometry/surface_query.h",
 )
-CLI_BENCH_MAY_INCLUDE = (
+# The bench-* commands (plugin/bench) come in as the command line does, built on its shared
+# parts, and measure a few internals by name: a bundle's load and memory, and the core avatar
+# the handle's template path is timed against. The physics' micro-benchmark
+# (bench_physics.cpp) times the simulator itself.
+BENCH_MAY_INCLUDE = (
     "runtime/model.h",
     "runtime/avatar.h",
     "bundle/bundle_files.h",
     "bundle/sha256.h",
 )
+PHYSICS_BENCH = "bench_physics.cpp"
+PHYSICS_BENCH_MAY_INCLUDE = ("sim/",)
+
+
+def include_offenders(
+    files: list[Path], headers: set[str], allowed: tuple[str, ...]
+) -> list[str]:
+    return [
+        f"{p.name} includes {inc}"
+        for p in files
+        for inc in local_includes(p)
+        if inc not in headers and not inc.startswith(allowed)
+    ]
 
 
 def test_the_command_line_comes_in_by_its_documented_way() -> None:
-    own = {p.name for p in CLI.iterdir() if p.suffix in (".h", ".cpp")}
+    own = {p.name for p in files_of(CLI)}
     imported = {p.name for p in IMPORT.iterdir() if p.suffix == ".h"}
-    files = [p for p in CLI.iterdir() if p.suffix in (".h", ".cpp")]
+    files = files_of(CLI)
     assert len(files) > 20
-    offenders = []
-    for p in files:
-        bench = p.name.startswith(("bench_", "cmd_bench_"))
-        allowed = CLI_MAY_INCLUDE + (CLI_BENCH_MAY_INCLUDE if bench else ())
-        offenders += [
-            f"{p.name} includes {inc}"
-            for inc in local_includes(p)
-            if inc not in own and inc not in imported and not inc.startswith(allowed)
-        ]
-    assert offenders == []
+    # never a benchmark's header: the command line lists the bench-* commands by their run_*
+    assert include_offenders(files, own | imported, CLI_MAY_INCLUDE) == []
     # fitting and evaluating avatars: the C ABI's calls, never the runtime's classes
     for name in (
         "cmd_fit.cpp",
@@ -112,6 +139,21 @@ def test_the_command_line_comes_in_by_its_documented_way() -> None:
     ):
         text = (CLI / name).read_text(encoding="utf-8")
         assert "runtime::" not in text and "fit::" not in text, name
+
+
+def test_the_benchmarks_come_in_by_the_command_lines_way() -> None:
+    files = files_of(BENCH)
+    commands = [p for p in files if p.name != PHYSICS_BENCH]
+    assert len(commands) > 10 and len(commands) < len(files)
+    headers = {p.name for p in files_of(BENCH) + files_of(CLI)}
+    headers |= {p.name for p in IMPORT.iterdir() if p.suffix == ".h"}
+    allowed = CLI_MAY_INCLUDE + BENCH_MAY_INCLUDE
+    assert include_offenders(commands, headers, allowed) == []
+    physics = [p for p in files if p.name == PHYSICS_BENCH]
+    assert include_offenders(physics, set(), PHYSICS_BENCH_MAY_INCLUDE) == []
+    # bench-runtime times avatars as hosts make them: through the C ABI only
+    text = (BENCH / "cmd_bench_runtime.cpp").read_text(encoding="utf-8")
+    assert "runtime::" not in text and "fit::" not in text
 
 
 def test_the_c_abi_has_one_avatar_whatever_its_mesh() -> None:

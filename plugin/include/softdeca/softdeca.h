@@ -87,7 +87,7 @@ typedef enum softdeca_status {
 } softdeca_status;
 
 /* The version of the ABI convention and signatures in this header; see softdeca_abi_version. */
-#define SOFTDECA_ABI_VERSION 3u
+#define SOFTDECA_ABI_VERSION 4u
 
 /* softdeca_bool: 0 false, 1 true (inputs: non-zero is true). */
 typedef int32_t softdeca_bool;
@@ -355,6 +355,11 @@ typedef struct softdeca_stats {
   double prepare_physics_ms;  /* its physics at rest (bundles with rest physics; 0 at the defaults) */
   uint32_t physics_iterations; /* solver iterations of that solve (0: none ran) */
   uint32_t reserved;
+  uint64_t frame_bytes;       /* the least bytes the last frame read and wrote in memory: the
+                                 tables its stages read at their stored size (blendshape deltas
+                                 of the moved shapes, hyper-tensors, correction bases, the DT
+                                 factor, the per-frame networks' weights, normals topology), its
+                                 input vertices and its output, each once (docs/runtime.md) */
 } softdeca_stats;
 
 SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* avatar, softdeca_stats* out_stats);

@@ -320,6 +320,7 @@ SOFTDECA_API softdeca_status softdeca_avatar_get_stats(const softdeca_avatar* av
     out_stats->prepare_physics_ms = s.prepare_physics_ms;
     out_stats->physics_iterations = static_cast<uint32_t>(s.physics_iterations);
     out_stats->reserved = 0;
+    out_stats->frame_bytes = s.frame_bytes.total();
   });
 }
 

@@ -375,6 +375,10 @@ OnnxModelScan scan_onnx_model(const std::uint8_t* data, std::size_t size, const 
     std::vector<std::uint64_t>& dims = fed[t.name];
     for (const std::int64_t d : t.shape) dims.push_back(static_cast<std::uint64_t>(d < 0 ? kFedBatch : d));
   }
+  for (const Initializer& i : r.graph.initializers) scan.weight_bytes = add_sat(scan.weight_bytes, i.tensor.bytes());
+  for (const Node& node : r.graph.nodes)
+    for (const auto& [name, a] : node.attributes)
+      if (a.kind == Attribute::kTensor) scan.weight_bytes = add_sat(scan.weight_bytes, a.t.bytes());
   try {
     const StaticSizes s = static_sizes(r.graph, fed);
     scan.bytes = s.bytes;

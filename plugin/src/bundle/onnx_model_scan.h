@@ -25,6 +25,8 @@ struct OnnxModelScan {
   std::vector<std::string> external_tensors;  // names of tensors with external data; when any,
                                               // nothing else is checked or counted
   std::uint64_t bytes = 0;                    // every tensor at its static size (saturating)
+  std::uint64_t weight_bytes = 0;             // the stored constants (initializers and Constant
+                                              // nodes' values): what one run reads of its weights
   std::string largest_tensor;                 // the largest of them, for messages
   std::uint64_t largest_bytes = 0;
   std::size_t tensors = 0;

@@ -19,7 +19,11 @@ Normals::Normals(const std::vector<std::int32_t>& triangles, std::size_t n_verti
 }
 
 std::size_t Normals::bytes() const {
-  return (triangles_.size() + vertex_ptr_.size() + vertex_faces_.size()) * 4 + face_normals_.bytes();
+  return topology_bytes() + face_normals_.bytes();
+}
+
+std::size_t Normals::topology_bytes() const {
+  return (triangles_.size() + vertex_ptr_.size() + vertex_faces_.size()) * sizeof(std::int32_t);
 }
 
 void Normals::faces(const float* v, std::size_t part, std::size_t parts) {

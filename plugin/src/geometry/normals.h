@@ -17,6 +17,8 @@ class Normals {
   Normals(const std::vector<std::int32_t>& triangles, std::size_t n_vertices);
 
   std::size_t bytes() const;
+  // What both passes read besides the vertices: the triangles and the vertex-to-triangle lists.
+  std::size_t topology_bytes() const;
   // Pass 1 for triangles of range `part` of `parts`; pass 2 for vertices of that range.
   void faces(const float* vertices, std::size_t part, std::size_t parts);
   void vertices(float* normals, std::size_t part, std::size_t parts) const;

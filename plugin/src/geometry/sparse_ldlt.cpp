@@ -121,10 +121,14 @@ void SparseLdlt::schedule(std::size_t parts) {
   serial_fraction_ = total > 0 ? top_weight / total : 0.0;
 }
 
+std::size_t SparseLdlt::solve_bytes() const {
+  // The row-major copy (values, row_ptr_, row_cols) only exists, or is read, with several parts.
+  return (gather_.size() + col_ptr_.size() + (rows_copy_ ? row_ptr_.size() : 0)) * 4 + inv_d_.size() * 8 +
+         (row_cols16_.size() + col_rows16_.size()) * 2 + (row_cols32_.size() + col_rows32_.size()) * 4 + values_.bytes();
+}
+
 std::size_t SparseLdlt::bytes() const {
-  return (gather_.size() + row_ptr_.size() + col_ptr_.size()) * 4 + inv_d_.size() * 8 +
-         (row_cols16_.size() + col_rows16_.size()) * 2 + (row_cols32_.size() + col_rows32_.size()) * 4 +
-         values_.allocated_bytes();
+  return solve_bytes() + (rows_copy_ ? 0 : row_ptr_.size() * 4) + values_.allocated_bytes() - values_.bytes();
 }
 
 namespace {

@@ -30,6 +30,7 @@ class SparseLdlt {
   std::size_t size() const { return n_; }
   std::size_t factor_nonzeros() const { return nnz_; }
   std::size_t bytes() const;  // the factor and the schedule
+  std::size_t solve_bytes() const;  // what a solve reads: the factor's values, indices and diagonal
 
   // x = K^-1 (b[0] + ... + b[count-1]), xyz interleaved (n x 3); the right-hand side comes in
   // parts (one per thread). `work`: work_size() doubles. Single-threaded.

@@ -47,6 +47,8 @@ class HyperTensor {
   std::size_t bytes() const {
     return half_.allocated_bytes() + float_.allocated_bytes() + int8_.allocated_bytes() + scales_.allocated_bytes();
   }
+  // What one product z . L reads: the stored entries (padding lanes included) and the scales.
+  std::size_t stored_bytes() const { return half_.bytes() + float_.bytes() + int8_.bytes() + scales_.bytes(); }
   // Element e, latent k, component c (for tests and the error measurement).
   float at(std::size_t e, int k, int c) const;
 

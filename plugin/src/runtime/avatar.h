@@ -53,6 +53,20 @@ struct Output {
 // it has normals); Error(INVALID_ARGUMENT) without vertices.
 void check_output_capacity(const Output& out, std::size_t vertices);
 
+// The least bytes one frame moves between memory and the core, by stage as AvatarStats times
+// them (avatar_frame_bytes.cpp): every table a stage reads (the moved shapes' blendshape deltas,
+// the hyper-tensors and the vertex and residual stages' tables at their stored precision, DT's
+// face blocks and factor, the per-frame networks' weights, the dynamics coefficients and state,
+// the normals' topology) counted once at its stored size, the frame's input vertices read once
+// and its output (vertices, normals) written once. The avatar's scratch that a frame writes and
+// reads back (S_t, right-hand sides, the static result, face normals) and inputs of a few
+// hundred bytes (weights, landmarks) are not counted: what a frame must move when nothing of the
+// previous one is left in cache and its stages hand over through the cache.
+struct FrameBytes {
+  std::uint64_t blend = 0, encoder = 0, hyper = 0, solve = 0, dynamics = 0, output = 0, normals = 0;
+  std::uint64_t total() const { return blend + encoder + hyper + solve + dynamics + output + normals; }
+};
+
 struct AvatarStats {
   std::size_t threads = 1;
   std::uint64_t frames = 0, preparations = 0, generation = 0;
@@ -61,6 +75,7 @@ struct AvatarStats {
   double prepare_ms = 0, prepare_networks_ms = 0, factorisation_ms = 0, prepare_physics_ms = 0;
   int physics_iterations = 0;
   std::uint64_t memory_bytes = 0;
+  FrameBytes frame_bytes;  // of the last frame
 };
 
 // Everything a frame needs that prepare computes; immutable once published.
@@ -124,9 +139,20 @@ class Avatar {
                            const std::vector<float>& identity, std::size_t n, std::size_t width) const;
   void read_weights(const float* weights, std::size_t count);
   const float* select_landmarks(const float* points, std::size_t count, const char* what) const;
-  // The shared tail of a frame: dynamics, checks, output of the head and normals.
-  void finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
+  // The shared tail of a frame: dynamics, checks, output of the head and normals. Returns
+  // whether the dynamics ran.
+  bool finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
               AvatarStats& st);
+  // FrameBytes of each kind of frame (avatar_frame_bytes.cpp), after it ran: `surface`, the
+  // vertices of a caller's surface (0: blended from the weights read); `dynamics`, what finish
+  // returned; `normals`, whether the output has normals.
+  FrameBytes softdeca_bytes(const Preparation& prep, std::size_t surface, bool dynamics, bool normals) const;
+  FrameBytes sparse_bytes(const Preparation& prep, bool dynamics, bool normals) const;
+  FrameBytes linear_bytes(bool normals) const;
+  // The tail's (finish): dynamics, the head written (and the neutral's non-skin vertices read
+  // where they follow the bones), normals.
+  void add_tail_bytes(const Preparation& prep, int model, bool dynamics, bool rigid_non_skin, bool normals,
+                      FrameBytes& b) const;
   void softdeca_frame(const Preparation& prep, AvatarStats& st);
   void add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients);  // static_ += c . modes
   // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.

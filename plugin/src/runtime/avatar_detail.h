@@ -1,5 +1,6 @@
 // What the avatar's source files share (avatar.cpp: state and inputs; avatar_prepare.cpp:
-// prepare; avatar_evaluate.cpp: frames): timing, the models' indices, the finiteness check.
+// prepare; avatar_evaluate.cpp: frames; avatar_frame_bytes.cpp: their bytes): timing, the
+// models' indices, the finiteness check.
 #pragma once
 
 #include <chrono>

@@ -129,12 +129,13 @@ void Avatar::compute_normals(const float* head, float* normals) {
   worker_.run(vertices);
 }
 
-void Avatar::finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
+bool Avatar::finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
                     AvatarStats& st) {
   auto t = Clock::now();
   if (reset_requested_.exchange(false)) dynamics_.invalidate();
   const float* result = skin;
-  if (dynamics_enabled_.load()) {
+  const bool dynamics = dynamics_enabled_.load();
+  if (dynamics) {
     const DynamicsCoefficients& c = prep.dynamics[model];
     auto pass = [&](std::size_t part, std::size_t parts) {
       dynamics_.step(c, model, skin, vs_ * part / parts, vs_ * (part + 1) / parts);
@@ -144,7 +145,7 @@ void Avatar::finish(const Preparation& prep, int model, const float* skin, const
   }
   if (!all_finite(result, vs_ * 3))
     throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
-  if (dynamics_enabled_.load()) dynamics_.commit(model);
+  if (dynamics) dynamics_.commit(model);
   else dynamics_.invalidate();
   auto t1 = Clock::now();
   st.dynamics_ms = ms(t, t1);
@@ -157,6 +158,7 @@ void Avatar::finish(const Preparation& prep, int model, const float* skin, const
   if (out.normals) compute_normals(head, out.normals);
   st.normals_ms = ms(t2, Clock::now());
   st.generation = prep.generation;
+  return dynamics;
 }
 
 namespace {
@@ -183,8 +185,9 @@ void Avatar::evaluate_weights(const float* weights, std::size_t count, const Out
   worker_.run(blend);
   st.blend_ms = ms(t0, Clock::now());
   softdeca_frame(*prep, st);
-  finish(*prep, kSoftDeca, static_.data(), head_.data() + vs_ * 3, out, st);
+  const bool dynamics = finish(*prep, kSoftDeca, static_.data(), head_.data() + vs_ * 3, out, st);
   st.frame_ms = ms(t0, Clock::now());
+  st.frame_bytes = softdeca_bytes(*prep, 0, dynamics, out.normals != nullptr);
   record(st);
 }
 
@@ -206,8 +209,9 @@ void Avatar::evaluate_surface(const float* weights, std::size_t count, const flo
   AvatarStats st;
   st.blend_ms = ms(t0, Clock::now());
   softdeca_frame(*prep, st);
-  finish(*prep, kSoftDeca, static_.data(), vertices == vh_ ? head_.data() + vs_ * 3 : nullptr, out, st);
+  const bool dynamics = finish(*prep, kSoftDeca, static_.data(), vertices == vh_ ? head_.data() + vs_ * 3 : nullptr, out, st);
   st.frame_ms = ms(t0, Clock::now());
+  st.frame_bytes = softdeca_bytes(*prep, vertices, dynamics, out.normals != nullptr);
   record(st);
 }
 
@@ -286,8 +290,9 @@ void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Ou
   };
   worker_.run(pass);
   st.hyper_ms = ms(t2, Clock::now());
-  finish(*prep, kSparse, static_.data(), nullptr, out, st);
+  const bool dynamics = finish(*prep, kSparse, static_.data(), nullptr, out, st);
   st.frame_ms = ms(t0, Clock::now());
+  st.frame_bytes = sparse_bytes(*prep, dynamics, out.normals != nullptr);
   record(st);
 }
 
@@ -305,6 +310,7 @@ void Avatar::evaluate_linear(const float* weights, std::size_t count, const Outp
   if (out.normals) compute_normals(out.vertices, out.normals);
   st.normals_ms = ms(t1, Clock::now());
   st.frame_ms = ms(t0, Clock::now());
+  st.frame_bytes = linear_bytes(out.normals != nullptr);
   record(st);
 }
 

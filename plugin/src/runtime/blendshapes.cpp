@@ -36,6 +36,7 @@ Blendshapes::Blendshapes(const float* deltas, std::size_t n_shapes, std::size_t 
       }
       sh.part_begin.push_back(sh.runs.size());
     }
+    for (const Run& run : sh.runs) sh.stored_bytes += sizeof(Run) + 3 * std::size_t{run.count} * sizeof(float);
   }
   deltas_.resize(deltas_stored.size());
   std::copy(deltas_stored.begin(), deltas_stored.end(), deltas_.data());
@@ -49,6 +50,13 @@ std::size_t Blendshapes::bytes() const {
 
 std::size_t Blendshapes::stored_vertices() const {
   return deltas_.size() / 3;
+}
+
+std::size_t Blendshapes::bytes_read(const float* weights) const {
+  std::size_t b = 0;
+  for (std::size_t s = 0; s < shapes_.size(); ++s)
+    if (weights[s] != 0.0f) b += shapes_[s].stored_bytes;
+  return b;
 }
 
 void Blendshapes::blend(const float* weights, const float* neutral, float* out, std::size_t part) const {

@@ -24,6 +24,9 @@ class Blendshapes {
   bool empty() const { return shapes_.empty(); }
   std::size_t bytes() const;
   std::size_t stored_vertices() const;  // vertices stored over all shapes (zeros in gaps included)
+  // What blend() reads of the basis for these weights: the runs and deltas of the shapes with a
+  // non-zero weight.
+  std::size_t bytes_read(const float* weights) const;
 
   // out[v] = neutral[v] + sum_i w_i B_i[v] for the vertices of range `part`.
   void blend(const float* weights, const float* neutral, float* out, std::size_t part) const;
@@ -35,6 +38,7 @@ class Blendshapes {
   struct Shape {
     std::vector<Run> runs;
     std::vector<std::size_t> part_begin;  // first run of each part, plus the end
+    std::size_t stored_bytes = 0;         // its runs and their deltas
   };
   std::vector<Shape> shapes_;
   kernels::AlignedArray<float> deltas_;  // every shape's runs, one after the other (one huge-page stream)

@@ -35,6 +35,9 @@ class DeformationTransfer {
   std::size_t vertices() const { return ldlt_.size(); }
   std::size_t bytes() const { return ldlt_.bytes() + faces_.corners.bytes() + faces_.coeff.bytes(); }
   std::size_t factor_nonzeros() const { return ldlt_.factor_nonzeros(); }
+  // What a frame reads: the right-hand side's face blocks, and the factor in the solve.
+  std::size_t face_bytes() const { return faces_.corners.bytes() + faces_.coeff.bytes(); }
+  std::size_t solve_bytes() const { return ldlt_.solve_bytes(); }
 
   // out = skin + K^-1 (r[0] + ... + r[count-1]). `work`: work_size() doubles.
   std::size_t work_size() const { return ldlt_.work_size(); }

@@ -33,8 +33,8 @@ const bundle::Bytes& verified(const bundle::BundleFiles& files, const std::strin
 }
 
 // Refuses external data and graphs outside the exporter's operators or without static shapes,
-// and adds what the network may allocate to the estimate.
-void scan_network(const bundle::Bytes& bytes, const bundle::NetworkSpec& spec, MemoryEstimate& estimate) {
+// and adds what the network may allocate to the estimate; returns its weights' bytes.
+std::uint64_t scan_network(const bundle::Bytes& bytes, const bundle::NetworkSpec& spec, MemoryEstimate& estimate) {
   const bundle::OnnxModelScan scan = [&] {
     try {
       return bundle::scan_onnx_model(bytes.data(), bytes.size(), spec.inputs);
@@ -54,6 +54,7 @@ void scan_network(const bundle::Bytes& bytes, const bundle::NetworkSpec& spec, M
     estimate.largest_bytes = scan.largest_bytes;
     estimate.largest = spec.file + " tensor '" + bundle::onnx::printable(scan.largest_tensor) + "'";
   }
+  return scan.weight_bytes;
 }
 }  // namespace
 
@@ -123,14 +124,16 @@ std::shared_ptr<const Model> Model::load(const bundle::BundleFiles& files, const
   // declares is allocated until the whole bundle fits the budget.
   MemoryEstimate estimate;
   std::vector<const bundle::Bytes*> network_bytes;
+  std::vector<std::uint64_t> weight_bytes;
   for (const char* key : kNetworkKeys) {
     const auto it = mf.networks.find(key);
     if (it == mf.networks.end()) {
       network_bytes.push_back(nullptr);
+      weight_bytes.push_back(0);
       continue;
     }
     network_bytes.push_back(&verified(files, it->second.file, it->second.sha256));
-    scan_network(*network_bytes.back(), it->second, estimate);
+    weight_bytes.push_back(scan_network(*network_bytes.back(), it->second, estimate));
   }
   const std::uint64_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : kDefaultMemoryBudget;
   if (estimate.bytes > budget)
@@ -153,7 +156,7 @@ std::shared_ptr<const Model> Model::load(const bundle::BundleFiles& files, const
     const bool per_frame = std::strcmp(key, "softdeca.f_w") == 0 || std::strcmp(key, "sparse.f_l") == 0 ||
                            std::strcmp(key, "softdeca.f_r_w") == 0;
     m->networks_.push_back(std::make_unique<OnnxNetwork>(*m->env_, *network_bytes[k], it->second,
-                                                         per_frame ? 1 : options.prepare_threads));
+                                                         per_frame ? 1 : options.prepare_threads, weight_bytes[k]));
   }
   return m;
 }

@@ -52,8 +52,9 @@ void check_side(Ort::Session& session, bool inputs, const std::vector<bundle::Te
 }
 }  // namespace
 
-OnnxNetwork::OnnxNetwork(Ort::Env& env, const bundle::Bytes& model, const bundle::NetworkSpec& spec, int threads)
-    : spec_(spec), memory_(Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault)) {
+OnnxNetwork::OnnxNetwork(Ort::Env& env, const bundle::Bytes& model, const bundle::NetworkSpec& spec, int threads,
+                         std::uint64_t weight_bytes)
+    : spec_(spec), weight_bytes_(weight_bytes), memory_(Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault)) {
   try {
     Ort::SessionOptions opts;
     opts.SetIntraOpNumThreads(threads < 1 ? 1 : threads);

@@ -17,11 +17,14 @@ namespace softdeca::runtime {
 class OnnxNetwork {
  public:
   // `threads`: intra-op threads of this session (1 for per-frame networks: the runtime
-  // parallelises around them). Throws Error(FORMAT) for bytes ONNX Runtime cannot load or a
-  // model whose inputs/outputs differ from `spec`.
-  OnnxNetwork(Ort::Env& env, const bundle::Bytes& model, const bundle::NetworkSpec& spec, int threads);
+  // parallelises around them). `weight_bytes`: its stored constants, as the bundle scan counted
+  // them (bundle::OnnxModelScan). Throws Error(FORMAT) for bytes ONNX Runtime cannot load or a model
+  // whose inputs/outputs differ from `spec`.
+  OnnxNetwork(Ort::Env& env, const bundle::Bytes& model, const bundle::NetworkSpec& spec, int threads, std::uint64_t weight_bytes);
 
   const bundle::NetworkSpec& spec() const { return spec_; }
+  // What one run reads of the network's weights, at their stored precision.
+  std::uint64_t weight_bytes() const { return weight_bytes_; }
 
   // Tensors over caller memory, created once and reused every frame (no allocation by us).
   // `batch` resolves the free dimension. Buffers must outlive the binding.
@@ -44,6 +47,7 @@ class OnnxNetwork {
 
  private:
   bundle::NetworkSpec spec_;
+  std::uint64_t weight_bytes_ = 0;
   std::unique_ptr<Ort::Session> session_;
   Ort::MemoryInfo memory_;
   std::vector<const char*> input_names_, output_names_;

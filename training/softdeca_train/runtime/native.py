@@ -17,7 +17,7 @@ import numpy as np
 from softdeca_train.paths import REPO_ROOT
 
 SOFTDECA_OK = 0
-ABI_VERSION = 3  # SOFTDECA_ABI_VERSION of the header these structs mirror
+ABI_VERSION = 4  # SOFTDECA_ABI_VERSION of the header these structs mirror
 PRECISIONS = {"half": 0, "float": 1, "int8": 2}  # softdeca_precision
 STATUS_NAMES = {
     0: "ok",
@@ -154,6 +154,7 @@ class Stats(C.Structure):
         ("prepare_physics_ms", C.c_double),
         ("physics_iterations", C.c_uint32),
         ("reserved", C.c_uint32),
+        ("frame_bytes", C.c_uint64),
     ]
 
 

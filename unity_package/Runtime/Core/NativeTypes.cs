@@ -161,6 +161,7 @@ namespace SoftDeca
         public double PreparePhysicsMs;
         public uint PhysicsIterations;
         public uint Reserved;
+        public ulong FrameBytes;
 
         public static AvatarStats Create()
         {

@@ -1,8 +1,9 @@
 // softdeca bench-runtime: per-frame cost of the runtime on one avatar, measured on the frames of
 // a real take: plain linear blendshapes, SoftDECA static and dynamic, SparseSoftDECA, with one
 // and with two threads; prepare time, memory per avatar, and the error the compact hyper-tensor
-// storage adds (half and int8 against float, same frames), and what the C ABI's handle adds to
-// the template's frame over the core avatar it holds. Writes the benchmark JSON of
+// storage adds (half and int8 against float, same frames), what the C ABI's handle adds to the
+// template's frame over the core avatar it holds, and the shipped bundle's frames against the
+// machine's memory bandwidth. Writes the benchmark JSON of
 // docs/ARCHITECTURE.md, Conventions ({figure: {value, unit, target, better, how}}).
 // Kept whole: every figure is measured in one run on the same inputs (take, avatars, bundles),
 // so their ratios hold; each figure's measurement is a function of its own.
@@ -18,6 +19,7 @@
 #include <thread>
 #include <utility>
 
+#include "bench_bandwidth.h"
 #include "bench_figures.h"
 #include "bundle/bundle_files.h"
 #include "command.h"
@@ -488,6 +490,51 @@ void measure_crowd(Bench& bench, Model& shipped, const std::string& how) {
                std::floor(kFrame60HzMs / per_avatar));
 }
 
+// The least bytes of a kind of frame (softdeca_stats.frame_bytes) over the take's frames, median
+// (only the blend's share changes from frame to frame: the shapes the weights move).
+double median_frame_bytes(const Bench& bench, const Avatar& a, const std::function<void(std::size_t)>& frame) {
+  std::vector<double> bytes;
+  for (std::size_t f = 0; f < bench.frames; ++f) {
+    frame(f);
+    bytes.push_back(static_cast<double>(a.stats().frame_bytes));
+  }
+  return median(bytes);
+}
+
+// The frames' times against the memory-bandwidth limit: the machine's streaming read bandwidth
+// on one thread, the least bytes each kind of frame moves, and the share of its measured time
+// that moving them at that bandwidth takes ((bytes / bandwidth) / time: 1 is a frame bound by
+// memory alone).
+struct FrameKind {
+  const char* name;   // the figures' prefix
+  const char* timed;  // the figure of its time
+  double ms;
+  std::function<void(std::size_t)> frame;
+};
+
+void measure_bandwidth_share(Bench& bench, const Avatar& a, const std::vector<FrameKind>& kinds, const std::string& how) {
+  const double gb_s = streaming_read_gb_s();
+  const std::string bandwidth_how = "a sum of 64-bit words over " + std::to_string(kBandwidthBufferBytes >> 20) +
+                                    " MiB written beforehand, best of " + std::to_string(kBandwidthPasses) +
+                                    " passes, 1 thread, measured in the same run right after the shipped bundle's frames; " +
+                                    bench.how;
+  bench.figures.raw("runtime.copy_read_gb_s", figure(gb_s, "GB/s", "streaming read bandwidth: " + bandwidth_how, NAN, "higher"));
+  std::fprintf(stderr, "streaming read bandwidth %.2f GB/s;", gb_s);
+  for (const FrameKind& k : kinds) {
+    const double bytes = median_frame_bytes(bench, a, k.frame);
+    const double limit_ms = bytes / (gb_s * 1e9) * 1e3;
+    const std::string name = k.name;
+    bench.figures.raw("runtime." + name + "_bytes_per_frame",
+                      figure(bytes, "bytes/frame", "softdeca_stats.frame_bytes (the least bytes the frame reads and writes "
+                                                   "in memory, docs/runtime.md), median over the take's frames" + how));
+    bench.figures.raw("runtime." + name + "_bandwidth_share",
+                      figure(limit_ms / k.ms, "ratio", name + "_bytes_per_frame / copy_read_gb_s (" + std::to_string(limit_ms) +
+                                                           " ms) over " + k.timed + how, NAN, "higher"));
+    std::fprintf(stderr, " %s %.0f bytes, %.3f ms at that rate of %.3f ms (%.2f);", k.name, bytes, limit_ms, k.ms, limit_ms / k.ms);
+  }
+  std::fprintf(stderr, "\n");
+}
+
 // The path users run: the shipped (trained) bundle, on the template and on a fitted avatar,
 // each against its own linear blend with frames alternating, and SparseSoftDECA (1 thread).
 void measure_shipped(Bench& bench, const std::string& bundle_path, const std::string& own_path) {
@@ -518,6 +565,17 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
                     figure(sparse / linear_again, "x", "sparse_shipped_ms over the linear blend's frames between them" + how));
   std::fprintf(stderr, "shipped bundle, template: softdeca %.3f ms, linear %.3f ms (x%.2f); sparse %.3f ms\n", softdeca, linear,
                softdeca / linear, sparse);
+  measure_bandwidth_share(
+      bench, head,
+      {{"softdeca", "shipped_softdeca_ms", softdeca,
+        [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(head.handle, w(f), 52, out), "softdeca"); }},
+       {"sparse", "sparse_shipped_ms", sparse,
+        [&](std::size_t f) {
+          check(softdeca_avatar_evaluate_landmarks(head.handle, input.points[f].data(), input.point_count, out), "sparse");
+        }},
+       {"linear", "shipped_linear_ms", linear,
+        [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); }}},
+      how);
   measure_crowd(bench, shipped, "; " + bench.how);
   if (own_path.empty()) return;
   const AvatarFile file = read_avatar_file(own_path);
