@@ -20,14 +20,12 @@
 #include <utility>
 
 #include "bench_bandwidth.h"
+#include "bench_core_avatar.h"
 #include "bench_figures.h"
-#include "bundle/bundle_files.h"
 #include "command.h"
 #include "imported_avatar.h"
 #include "json.h"
 #include "options.h"
-#include "runtime/avatar.h"
-#include "runtime/model.h"
 #include "runtime_session.h"
 #include "take.h"
 
@@ -426,34 +424,25 @@ std::pair<double, double> alternating_ms(const Bench& bench, const std::function
 }
 
 // The template path as hosts run it, through the C ABI's handle (whose avatar is the identity
-// fit: runtime/fitted_avatar.h runs one frame path for every mesh), against the core
-// runtime::Avatar of the same head on the same bundle evaluated directly, frames alternating
+// fit: runtime/fitted_avatar.h runs one frame path for every mesh), against the core avatar of
+// the same head on the same bundle evaluated directly (bench_core_avatar.h), frames alternating
 // (1 thread): what the handle and the identity fit's transfer add to the template's frame.
 void measure_identity_fit(Bench& bench, const std::string& bundle_path) {
-  const std::shared_ptr<const runtime::Model> model = runtime::Model::load(bundle::BundleFiles::from_path(bundle_path), {});
   const FaceRig& rig = bench.rig;
-  runtime::AvatarDesc desc;
-  desc.neutral = rig.neutral.vertices.data();
-  desc.vertex_count = rig.neutral.vertex_count();
-  desc.triangles = rig.neutral.triangles.data();
-  desc.triangle_count = rig.neutral.triangles.size() / 3;
-  desc.blendshapes = rig.deltas.empty() ? nullptr : rig.deltas.data();
-  desc.blendshape_count = rig.deltas.empty() ? 0 : 52;
-  runtime::Avatar core(model, desc);
-  core.prepare();
+  CoreAvatar core(bundle_path, rig.neutral.vertices, rig.neutral.triangles, rig.deltas);
   Avatar handle(bench.model, rig.neutral, rig.deltas, 1, SOFTDECA_PRECISION_HALF);
   check(softdeca_avatar_prepare(handle.handle), "prepare");
-  const runtime::Output out{bench.vertices.data(), bench.vertices.size() / 3, bench.normals.data(), bench.normals.size() / 3};
+  const std::size_t capacity = bench.vertices.size() / 3;
   const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
   const auto [through_handle, direct] = alternating_ms(
       bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(handle.handle, w(f), 52, &bench.output), "handle"); },
-      [&](std::size_t f) { core.evaluate_weights(w(f), 52, out); });
+      [&](std::size_t f) { core.evaluate_weights(w(f), bench.vertices.data(), bench.normals.data(), capacity); });
   char times[96];
   std::snprintf(times, sizeof times, " (%.3f against %.3f ms)", through_handle, direct);
   bench.figures.raw("runtime.identity_fit_overhead",
                     figure(through_handle / direct, "x",
                            std::string("the template head's evaluate_weights through the C ABI's handle (the identity fit) "
-                                       "over the core runtime::Avatar of the same head evaluated directly") +
+                                       "over the core avatar of the same head evaluated directly") +
                                times + ", dynamics off, with normals, frames alternating, medians, wall-clock; 1 thread; " +
                                bench.how,
                            1.05));

@@ -17,6 +17,7 @@
 namespace {
 using namespace rt;
 using namespace softdeca::runtime;
+using namespace softdeca::bundle;
 
 constexpr std::uint64_t kVertex = 12;  // xyz float
 constexpr std::uint64_t kRun = 12;     // a blendshape run's first vertex, count and offset (uint32 each)
