@@ -92,7 +92,7 @@ std::size_t apply(const Model& model, ReplayAvatar& target, const std::vector<Ch
       softdeca_parameter_info info{};
       info.struct_size = sizeof info;
       check(softdeca_model_get_parameter_info(model.handle, static_cast<uint32_t>(index), &info), "parameter " + c.name);
-      c.value = static_cast<float>(c.bound == "min" ? info.lo : c.bound == "max" ? info.hi : info.default_value);
+      c.value = static_cast<float>(c.bound == "min" ? info.minimum : c.bound == "max" ? info.maximum : info.default_value);
       std::fprintf(stderr, "%s=%s: %g\n", c.name.c_str(), c.bound.c_str(), static_cast<double>(c.value));
     }
     if (!c.region) {

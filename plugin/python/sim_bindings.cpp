@@ -158,22 +158,24 @@ void bind_parameters(nb::module_& m) {
 
   m.def("parameter_table", [] {
     nb::list out;
-    for (const ParameterInfo& p : parameter_table()) {
-      nb::dict d;
+    const auto& table = parameter_table();
+    for (std::size_t i = 0; i < table.size(); ++i) {
+      const softdeca::ParameterSpec& p = table[i];
+      nb::dict d;  // keyed as parameters.json's entries
       d["name"] = p.name;
       d["symbol"] = p.symbol;
       d["default"] = p.default_value;
-      d["lo"] = p.lo;
-      d["hi"] = p.hi;
-      d["scale"] = p.scale == Scale::kLog ? "log" : "linear";
+      d["lo"] = p.minimum;
+      d["hi"] = p.maximum;
+      d["scale"] = p.log_scale ? "log" : "linear";
       d["unit"] = p.unit;
-      d["domain"] = domain_name(p.domain);
-      d["refactor"] = p.refactor;
+      d["domain"] = p.domain;
+      d["refactor"] = parameter_refactors(static_cast<Param>(i));
       d["description"] = p.description;
       out.append(d);
     }
     return out;
-  }, "The material parameters p as compiled in from plugin/data/parameters.json.");
+  }, "The material parameters p as compiled in from plugin/data/parameters.json, keyed as its entries.");
   m.def("parameters_json", [] { return std::string(parameters_json()); },
         "plugin/data/parameters.json verbatim, as compiled in.");
 }
@@ -332,7 +334,7 @@ void bind_simulator(nb::module_& m) {
       .def("parameters", [](const Simulator& s) {
              nb::dict d;
              for (std::size_t i = 0; i < parameter_table().size(); ++i)
-               d[parameter_table()[i].name] = s.parameters().global(static_cast<Param>(i));
+               d[parameter_table()[i].name.c_str()] = s.parameters().global(static_cast<Param>(i));
              return d;
            }, "Global values of all parameters.")
       .def(

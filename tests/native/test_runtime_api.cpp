@@ -55,8 +55,8 @@ TEST_F(Runtime, ModelInfoDescribesTheBundle) {
   EXPECT_STREQ(p.name, "w_skin_strain");
   EXPECT_EQ(p.log_scale, 1);
   EXPECT_STREQ(p.domain, "skin_triangle");
-  EXPECT_DOUBLE_EQ(p.lo, 0.001);
-  EXPECT_DOUBLE_EQ(p.hi, 100.0);
+  EXPECT_DOUBLE_EQ(p.minimum, 0.001);
+  EXPECT_DOUBLE_EQ(p.maximum, 100.0);
   uint32_t gravity = 0;
   ASSERT_EQ(softdeca_model_find_parameter(model.p, "gravity_strength", &gravity), SOFTDECA_OK);
   ASSERT_EQ(softdeca_model_get_parameter_info(model.p, gravity, &p), SOFTDECA_OK);

@@ -452,10 +452,10 @@ TEST(ParameterState, ComparesKindsValuesAndMaps) {
   Manifest m;
   m.skin_vertices = 3;
   for (const char* name : {"a", "b"}) {
-    ParameterSpec p;
+    softdeca::ParameterSpec p;
     p.name = name;
     p.default_value = 0.5;
-    p.max = 1;
+    p.maximum = 1;
     p.localisable = true;
     m.parameters.push_back(p);
   }

@@ -10,14 +10,14 @@
 using namespace sim_test;
 
 TEST(SimDynamics, StoredParameterisationIsStableAndEquilibriumPreserving) {
-  const auto& g = parameter_info(Param::dyn_gamma);
-  const auto& b = parameter_info(Param::dyn_beta);
+  const auto& g = parameter_spec(Param::dyn_gamma);
+  const auto& b = parameter_spec(Param::dyn_beta);
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> ug(g.lo, g.hi), ub(b.lo, b.hi);
+  std::uniform_real_distribution<double> ug(g.minimum, g.maximum), ub(b.minimum, b.maximum);
   for (int i = 0; i < 10000; ++i) {
     // Every point of the sampling box, corners included.
-    const double gamma = i < 4 ? (i & 1 ? g.hi : g.lo) : ug(rng);
-    const double beta = i < 4 ? (i & 2 ? b.hi : b.lo) : ub(rng);
+    const double gamma = i < 4 ? (i & 1 ? g.maximum : g.minimum) : ug(rng);
+    const double beta = i < 4 ? (i & 2 ? b.maximum : b.minimum) : ub(rng);
     const double alpha = dynamics_alpha(gamma, beta);
     EXPECT_NEAR(gamma + 2 * alpha - beta, 1.0, 1e-15);
     EXPECT_GE(alpha, 0);

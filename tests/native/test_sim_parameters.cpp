@@ -26,13 +26,13 @@ TEST(SimParameters, TableIsConsistent) {
   std::set<std::string> names;
   for (const auto& p : t) {
     EXPECT_TRUE(names.insert(p.name).second) << "duplicate " << p.name;
-    EXPECT_LT(p.lo, p.hi) << p.name;
-    EXPECT_GE(p.default_value, p.lo) << p.name;
-    EXPECT_LE(p.default_value, p.hi) << p.name;
-    if (p.scale == Scale::kLog) {
-      EXPECT_GT(p.lo, 0) << p.name;
+    EXPECT_LT(p.minimum, p.maximum) << p.name;
+    EXPECT_GE(p.default_value, p.minimum) << p.name;
+    EXPECT_LE(p.default_value, p.maximum) << p.name;
+    if (p.log_scale) {
+      EXPECT_GT(p.minimum, 0) << p.name;
     }
-    EXPECT_GT(std::string(p.description).size(), 10u) << p.name;
+    EXPECT_GT(p.description.size(), 10u) << p.name;
     // The compiled-in JSON is the same file the table came from.
     EXPECT_NE(std::string(parameters_json()).find(std::string("\"name\": \"") + p.name + "\""), std::string::npos)
         << p.name;
@@ -47,23 +47,23 @@ TEST(SimParameters, CoversAppendixA) {
     EXPECT_NO_THROW(find_parameter(n)) << n;
   for (const char* bone : {"cranium", "jaw"})
     for (const char* axis : {"x", "y", "z"}) {
-      const auto& info = parameter_info(find_parameter(std::string(bone) + "_scale_" + axis));
-      EXPECT_EQ(info.lo, 0.5);
-      EXPECT_EQ(info.hi, 1.5);
+      const auto& spec = parameter_spec(find_parameter(std::string(bone) + "_scale_" + axis));
+      EXPECT_EQ(spec.minimum, 0.5);
+      EXPECT_EQ(spec.maximum, 1.5);
     }
   int weights = 0;
   for (const auto& p : parameter_table())
-    if (p.name[0] == 'w' && p.name[1] == '_') {
+    if (p.name.rfind("w_", 0) == 0) {
       ++weights;
-      EXPECT_EQ(p.lo, 0.001) << p.name;
-      EXPECT_EQ(p.hi, 100.0) << p.name;
-      EXPECT_EQ(p.scale, Scale::kLog) << p.name;
-      EXPECT_TRUE(p.refactor) << p.name;
+      EXPECT_EQ(p.minimum, 0.001) << p.name;
+      EXPECT_EQ(p.maximum, 100.0) << p.name;
+      EXPECT_TRUE(p.log_scale) << p.name;
+      EXPECT_TRUE(parameter_refactors(find_parameter(p.name))) << p.name;
     }
   EXPECT_GE(weights, 12);
-  EXPECT_EQ(parameter_info(Param::target_volume).lo, 0.5);
-  EXPECT_EQ(parameter_info(Param::max_strain).hi, 1.3);
-  EXPECT_EQ(parameter_info(Param::gravity_strength).hi, 2.0);
+  EXPECT_EQ(parameter_spec(Param::target_volume).minimum, 0.5);
+  EXPECT_EQ(parameter_spec(Param::max_strain).maximum, 1.3);
+  EXPECT_EQ(parameter_spec(Param::gravity_strength).maximum, 2.0);
 }
 
 TEST(SimParameters, PhysicalConstantsComeFromTheFile) {
@@ -94,7 +94,7 @@ TEST(SimParameters, OutOfRangeValuesAreRefusedWithNameAndRange) {
     EXPECT_EQ(e.status(), SOFTDECA_ERROR_NON_FINITE);
   }
   EXPECT_THROW(p.set("no_such_parameter", 1.0), Error);
-  EXPECT_EQ(p.global(Param::w_soft_volume), parameter_info(Param::w_soft_volume).default_value);
+  EXPECT_EQ(p.global(Param::w_soft_volume), parameter_spec(Param::w_soft_volume).default_value);
 }
 
 TEST(SimParameters, FieldsOverrideTheGlobalPerElement) {

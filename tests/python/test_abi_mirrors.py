@@ -263,8 +263,8 @@ def test_the_header_parses_into_every_mirrored_struct() -> None:
     assert Field("head", "struct:softdeca_pose") in structs["softdeca_frame"]
     assert [f.name for f in structs["softdeca_parameter_info"]][5:8] == [
         "default_value",
-        "lo",
-        "hi",
+        "minimum",
+        "maximum",
     ]
 
 

@@ -151,7 +151,8 @@ def test_controls_come_from_the_parameter_definition() -> None:
         assert dead in physics.names and dead not in controls.names
     for s in controls.specs:
         full = physics.specs[physics.names.index(s.name)]
-        assert full.lo <= s.lo < s.hi <= full.hi and s.lo <= s.default <= s.hi
+        assert full.minimum <= s.minimum < s.maximum <= full.maximum
+        assert s.minimum <= s.default_value <= s.maximum
     names = [c.name for c in global_controls(controls)]
     assert "gravity_strength" in names and "dyn_gamma" not in names  # static gallery
     azimuth = next(c for c in global_controls(controls) if c.name == "gravity_azimuth")

@@ -368,7 +368,7 @@ def test_parameters_are_sampled_in_the_range_profile(small) -> None:
         params.validate(p)  # inside the narrowed ranges, not only the physics' own
     lo, hi = profile_ranges(load_parameters(), DEFAULT_PROFILE)["w_target"]
     k = params.names.index("w_target")
-    assert params.specs[k].lo == lo and params.specs[k].hi == hi
+    assert params.specs[k].minimum == lo and params.specs[k].maximum == hi
     # datasets written before range profiles sampled the physics' ranges
     legacy = {k: v for k, v in SMALL.as_dict().items() if k != "ranges"}
     assert GenerateConfig.from_dict(legacy).ranges == "appendix-a"
@@ -378,8 +378,9 @@ def test_parameters_are_sampled_in_the_range_profile(small) -> None:
     physics = {s.name: s for s in load_parameters().specs}
     for profile in (*PROFILES, *FROM_DEFINITION):
         for s in sampling_parameters(load_parameters(), profile).specs:
-            assert physics[s.name].lo <= s.lo <= s.default <= s.hi <= physics[s.name].hi
-            assert s.default == physics[s.name].default, (profile, s.name)
+            lo, hi = physics[s.name].minimum, physics[s.name].maximum
+            assert lo <= s.minimum <= s.default_value <= s.maximum <= hi
+            assert s.default_value == physics[s.name].default_value, (profile, s.name)
 
 
 def test_a_sample_at_the_top_of_a_log_range_stays_inside_it() -> None:
@@ -391,7 +392,9 @@ def test_a_sample_at_the_top_of_a_log_range_stays_inside_it() -> None:
 
     # exp(log(100)) is 100 + 4e-14 in float64: without the clip a value leaves its range
     assert np.exp(np.log(100.0)) > 100.0
-    spec = replace(load_parameters().specs[0], lo=0.001, hi=100.0, scale="log")
+    spec = replace(
+        load_parameters().specs[0], minimum=0.001, maximum=100.0, log_scale=True
+    )
     assert spec.sample(Top()) == 100.0  # type: ignore[arg-type]
     assert (spec.sample(Top(), 3) == 100.0).all()  # type: ignore[arg-type]
 

@@ -36,7 +36,8 @@ def _ranges() -> list[dict]:
     """What a manifest records: the ranges its profile sampled."""
     params = sampling_parameters(load_parameters(), GenerateConfig().ranges)
     return [
-        {"name": s.name, "lo": s.lo, "hi": s.hi, "scale": s.scale} for s in params.specs
+        {"name": s.name, "lo": s.minimum, "hi": s.maximum, "scale": s.scale}
+        for s in params.specs
     ]
 
 
@@ -49,11 +50,13 @@ def test_parameters_normalise_to_the_dataset_ranges() -> None:
     specs = sc.params.specs
     # the dataset's ranges are the control ranges where a parameter is a control
     controls = {s.name: s.control for s in load_parameters().specs if s.control}
-    assert all((s.lo, s.hi) == controls[s.name] for s in specs if s.name in controls)
-    lo = np.array([s.lo for s in specs])
-    hi = np.array([s.hi for s in specs])
+    assert all(
+        (s.minimum, s.maximum) == controls[s.name] for s in specs if s.name in controls
+    )
+    lo = np.array([s.minimum for s in specs])
+    hi = np.array([s.maximum for s in specs])
     assert np.allclose(sc.normalise(lo), 0.0) and np.allclose(sc.normalise(hi), 1.0)
-    k = next(i for i, s in enumerate(specs) if s.scale == "log")
+    k = next(i for i, s in enumerate(specs) if s.log_scale)
     mid = lo.copy()
     mid[k] = np.sqrt(lo[k] * hi[k])  # the geometric middle of a log-scaled range
     assert sc.normalise(mid)[k] == pytest.approx(0.5)
@@ -62,7 +65,7 @@ def test_parameters_normalise_to_the_dataset_ranges() -> None:
 def test_gravity_load_is_zero_at_the_capture_load() -> None:
     sc = _scaling()
     names = load_parameters().names
-    p = np.array([s.default for s in load_parameters().specs])
+    p = np.array([s.default_value for s in load_parameters().specs])
     assert np.allclose(
         sc.gravity_load(p), 0.0
     )  # 1 g straight down: what the neutral carries
@@ -114,14 +117,14 @@ def _planted_dataset(folder: Path, rng: np.random.Generator) -> None:
     specs = sc.params.specs
     a_w = 1e-3 * rng.normal(size=(52, VERTICES * 3))
     a_p = 1e-3 * rng.normal(size=(len(specs), VERTICES * 3))
-    lo = np.array([s.lo for s in specs])
-    hi = np.array([s.hi for s in specs])
+    lo = np.array([s.minimum for s in specs])
+    hi = np.array([s.maximum for s in specs])
     shards = []
     for index, split in enumerate((0, 0, 0, 0, 1)):
         n = 40
         w = rng.uniform(0, 1, size=(n, 52)).astype(np.float32)
         p = lo + (hi - lo) * rng.uniform(size=(n, len(specs)))
-        log = np.array([s.scale == "log" for s in specs])
+        log = np.array([s.log_scale for s in specs])
         p[:, log] = np.exp(
             np.log(lo[log])
             + (np.log(hi[log]) - np.log(lo[log])) * rng.uniform(size=(n, log.sum()))

@@ -27,7 +27,7 @@ from softdeca_train.train.local_fit import (
 
 def _scaling() -> ParameterScaling:
     params = sampling_parameters(load_parameters(), GenerateConfig().ranges)
-    ranges = [{"name": s.name, "lo": s.lo, "hi": s.hi} for s in params.specs]
+    ranges = [{"name": s.name, "lo": s.minimum, "hi": s.maximum} for s in params.specs]
     return ParameterScaling.of({"dataset": {"parameters": ranges}})
 
 
@@ -61,7 +61,7 @@ def test_averaged_features_carry_a_local_change_to_the_neighbours_only() -> None
     # a constant field averages to itself
     assert np.allclose(base[:, 0, n_own:], base[0, 0, n_own:])
     column = sc.params.names.index("target_volume")
-    p[:3, column] = sc.params.specs[column].hi  # a change at one end of the row
+    p[:3, column] = sc.params.specs[column].maximum  # a change at one end of the row
     changed = averaged_features(local_features(w, p, sc), p, sc, smoothing).numpy()
     delta = np.abs(changed - base)[:, 0, n_own:].sum(axis=1)
     assert delta[5] > 0 and delta[5] > delta[20] and delta[-1] < 1e-2 * delta[0]

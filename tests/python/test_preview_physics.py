@@ -113,9 +113,11 @@ def test_a_ball_change_reaches_the_tets_under_it(template: Template) -> None:
     assert isinstance(field, np.ndarray) and field.shape == (len(hs.mesh.soft_tets),)
     # inside: the top of the range; at the ball's rim a vertex's faces are partly in (its
     # area-weighted mean); elsewhere the default
-    assert (field > spec.default - 1e-9).all() and (field < spec.max + 1e-9).all()
-    changed = field > spec.default + 1e-9
-    assert np.isclose(field, spec.max).any() and changed.mean() < 0.1
+    assert (field > spec.default_value - 1e-9).all() and (
+        field < spec.maximum + 1e-9
+    ).all()
+    changed = field > spec.default_value + 1e-9
+    assert np.isclose(field, spec.maximum).any() and changed.mean() < 0.1
     rest = np.asarray(hs.mesh.rest)
     centroids = rest[np.asarray(hs.mesh.soft_tets)].mean(axis=1)
     # every changed tet lies under the ball (its nearest skin vertex is in or near it)
@@ -125,7 +127,7 @@ def test_a_ball_change_reaches_the_tets_under_it(template: Template) -> None:
         parameter_fields(hs, specs, [Change("target_volume", "max", far)])[
             "target_volume"
         ]
-        == spec.default
+        == spec.default_value
     )
 
 

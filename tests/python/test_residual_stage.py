@@ -24,7 +24,9 @@ def stage(modes: int = 3, members: int = 2, dropout: float = 0.3) -> ResidualSta
 
 
 def defaults(n: int = V) -> torch.Tensor:
-    return torch.tensor([[s.default for s in SPECS]], dtype=torch.float32).repeat(n, 1)
+    return torch.tensor([[s.default_value for s in SPECS]], dtype=torch.float32).repeat(
+        n, 1
+    )
 
 
 def test_region_means_average_each_region_and_skip_empty_ones():
@@ -177,8 +179,8 @@ def test_pairs_teach_a_response_that_differences_between_heads_hide():
     head = torch.from_numpy(np.repeat(rng.normal(size=(groups, 2)), 2, axis=0)).float()
     big = torch.from_numpy(rng.normal(size=(2, V, 3))).float() * 1e-3
     response = torch.from_numpy(rng.normal(size=(V, 3))).float() * 1e-4
-    values = torch.from_numpy(rng.uniform(spec.min, spec.max, n)).float()
-    t = (values - spec.min) / (spec.max - spec.min)
+    values = torch.from_numpy(rng.uniform(spec.minimum, spec.maximum, n)).float()
+    t = (values - spec.minimum) / (spec.maximum - spec.minimum)
     residual = torch.einsum("nk,kvc->nvc", head, big) + t[:, None, None] * response
     p = defaults(1).repeat(n, 1)
     p[:, col] = values
@@ -193,7 +195,7 @@ def test_pairs_teach_a_response_that_differences_between_heads_hide():
         s.fit(w, features, residual, cfg, False, pairs if with_pairs else None)
         s.eval()
         lo, hi = defaults(), defaults()
-        lo[:, col], hi[:, col] = spec.min, spec.max
+        lo[:, col], hi[:, col] = spec.minimum, spec.maximum
         with torch.no_grad():
             got = s(w[:8], hi) - s(w[:8], lo)
         return float((got - response).norm() / (response.norm() * 8**0.5))

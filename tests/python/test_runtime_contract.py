@@ -108,8 +108,8 @@ def test_dynamics_networks_stay_in_the_stable_equilibrium_set(bundle, head):
     onnx = OnnxNetworks(folder)
     rng = np.random.default_rng(0)
     specs = onnx.specs
-    lo = np.array([s.min for s in specs])
-    hi = np.array([s.max for s in specs])
+    lo = np.array([s.minimum for s in specs])
+    hi = np.array([s.maximum for s in specs])
     p = lo + (hi - lo) * rng.uniform(size=(head.definition.skin_vertices, len(specs)))
     for model in ("softdeca", "sparse"):
         a, b, g = onnx.f_dyn(model, p, rng.normal(size=TEST_SIZES.identity) * 3)

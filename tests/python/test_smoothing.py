@@ -61,7 +61,9 @@ def test_smoothed_inputs_widen_the_vertex_stage_table(rest: np.ndarray) -> None:
     assert plain.local is not None and wide.local is not None
     extra = wide.local.table.shape[1] - plain.local.table.shape[1]
     assert extra == localisable * len(s.scales)
-    p = torch.tensor([[sp.default for sp in specs]] * len(rest), dtype=torch.float32)
+    p = torch.tensor(
+        [[sp.default_value for sp in specs]] * len(rest), dtype=torch.float32
+    )
     f = wide.local.features(p)
     # at a constant field the smoothed columns equal the vertex's own normalised values
     own = f[:, 1 : 1 + len(specs)][

@@ -69,7 +69,7 @@ def test_with_a_rest_gate_the_residual_stage_is_zero_at_rest() -> None:
         with torch.no_grad():
             stage.table.normal_()
         stage.eval()
-        p = torch.tensor([[s.default for s in specs]] * len(labels))
+        p = torch.tensor([[s.default_value for s in specs]] * len(labels))
         with torch.no_grad():
             rest = stage(torch.zeros(1, 52), p).abs().max().item()
             moving = stage(torch.rand(1, 52), p).abs().max().item()
@@ -146,7 +146,7 @@ def test_local_features_carry_the_gravity_load_of_the_baselines(small) -> None:
     run = Run(folder / "run-local", RunConfig(str(folder), "test", seed=3))
     local = LocalLinear(3, run.specs, 3)
     names = [s.name for s in run.specs]
-    p = np.tile(np.array([s.default for s in run.specs], np.float32), (3, 1))
+    p = np.tile(np.array([s.default_value for s in run.specs], np.float32), (3, 1))
     p[1, names.index("gravity_strength")] = 2.0
     p[2, names.index("gravity_tilt")] = 30.0
     x = local.features(torch.from_numpy(p)).numpy()
@@ -168,14 +168,16 @@ def test_region_means_are_inputs_of_every_vertex() -> None:
     plain = LocalLinear(6, specs, 3)
     local = LocalLinear(6, specs, 3, regions=labels)
     assert local.table.shape[1] - plain.table.shape[1] == 3 * len(loc)
-    p = torch.tensor([[s.default for s in specs]] * 6)
+    p = torch.tensor([[s.default_value for s in specs]] * 6)
     f = local.features(p)
     # every vertex sees each region's mean; at a constant field that is the own value
     own = f[:, 1 : 1 + len(specs)][:, loc]
     np.testing.assert_allclose(f[:, -3 * len(loc) :].numpy(), own.repeat(1, 3).numpy())
     q = p.clone()
     s0 = specs[loc[0]]
-    q[4:, loc[0]] = s0.min if s0.default != s0.min else s0.max  # region 2 only
+    q[4:, loc[0]] = (
+        s0.minimum if s0.default_value != s0.minimum else s0.maximum
+    )  # region 2 only
     g = local.features(q)
     assert torch.equal(g[:, 1 : 1 + len(specs)][:4], f[:, 1 : 1 + len(specs)][:4])
     assert (g[:4, -3 * len(loc) :] != f[:4, -3 * len(loc) :]).any(dim=1).all()
@@ -189,7 +191,7 @@ def test_region_means_are_inputs_of_every_vertex() -> None:
     assert some.table.shape[1] == 1 + 2 + 3 + 2 * 2
     q = p.clone()
     q[4:, loc[0]] = (
-        s0.min if s0.default != s0.min else s0.max
+        s0.minimum if s0.default_value != s0.minimum else s0.maximum
     )  # the unnumbered region only
     h = some.features(q) - some.features(p)
     assert torch.equal(h[:4], torch.zeros_like(h[:4])) and (h[4:, 1] != 0).all()
@@ -213,13 +215,13 @@ def test_only_the_tissues_weights_reach_the_expression_slots(small) -> None:
         local.slot_table.normal_()
         hyper.body.rest[-1][-1].weight.zero_()  # the MLP's share off, as at the start
         hyper.body.rest[-1][-1].bias.zero_()
-    p = torch.tensor([[s.default for s in run.specs]] * 3)
+    p = torch.tensor([[s.default_value for s in run.specs]] * 3)
     h = torch.zeros(1, run.sizes.identity)
     base = hyper(p, h)
     for name in ("gravity_strength", "target_volume", "w_soft_strain"):
         q = p.clone()
         s = run.specs[names.index(name)]
-        q[:, names.index(name)] = s.max
+        q[:, names.index(name)] = s.maximum
         change = (hyper(q, h) - base).abs().amax(dim=(0, 2))  # per latent slot
         # the expression slots move with the tissues' weights only; the other slots of z
         # (beyond the constant one and those two) never move with a local parameter change
@@ -288,7 +290,9 @@ def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
         for name in held:
             spec = run.specs[names.index(name)]
             q = b.p.clone()
-            q[:, names.index(name)] = spec.max if spec.default != spec.max else spec.min
+            q[:, names.index(name)] = (
+                spec.maximum if spec.default_value != spec.maximum else spec.minimum
+            )
             moved = replace(b, p=q, p_faces=None, p_vertices=None)
             if b.p_vertices is not None:
                 moved = replace(

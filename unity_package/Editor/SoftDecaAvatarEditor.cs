@@ -217,7 +217,7 @@ namespace SoftDeca.Editor
             float current = at >= 0 ? avatar.parameters[at].value : (float)p.DefaultValue;
             string label = string.IsNullOrEmpty(p.Unit) ? p.Name : p.Name + " (" + p.Unit + ")";
             EditorGUILayout.BeginHorizontal();
-            float value = EditorGUILayout.Slider(new GUIContent(label, p.Description), current, (float)p.Min, (float)p.Max);
+            float value = EditorGUILayout.Slider(new GUIContent(label, p.Description), current, (float)p.Minimum, (float)p.Maximum);
             bool reset = GUILayout.Button("Default", GUILayout.Width(60));
             EditorGUILayout.EndHorizontal();
             if (reset)

@@ -30,7 +30,10 @@
  *      lookup by name (softdeca_sim_find_parameter for the simulator's, softdeca_model_find_parameter
  *      for a bundle's). Every function that reads or writes a parameter takes its uint32_t
  *      index, so any parameter is addressable by index directly and by name through the lookup.
- *      Scalar parameter values are double; per-element maps are float arrays.
+ *      Scalar parameter values are double; per-element maps are float arrays. A parameter's
+ *      description has the same field names in every language: name, unit, domain,
+ *      description, default_value, minimum, maximum, log_scale (C#: the same words in
+ *      PascalCase); never min/max (macros of <windows.h>) nor lo/hi.
  *   7. Every array argument comes with its element count; null pointers, wrong sizes and
  *      non-finite values are rejected with a status, never with a crash or an exception.
  *   8. No callbacks into the caller; strings are NUL-terminated UTF-8, owned by the library when
@@ -471,8 +474,8 @@ typedef struct softdeca_parameter_info {
                               "muscle_tet", "connecting_tet", "skin_triangle", "skull_triangle",
                               "vertex", "skin_point", "landmark" */
   const char* description;
-  double default_value, lo, hi; /* closed range */
-  softdeca_bool log_scale;      /* sample uniformly in log space */
+  double default_value, minimum, maximum; /* the closed range [minimum, maximum] */
+  softdeca_bool log_scale;                /* sample uniformly in log space */
 } softdeca_parameter_info;
 
 SOFTDECA_API softdeca_status softdeca_sim_get_parameter_count(uint32_t* out_count);

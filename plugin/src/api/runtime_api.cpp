@@ -117,8 +117,8 @@ SOFTDECA_API softdeca_status softdeca_model_get_parameter_info(const softdeca_mo
     out_info->domain = p.localisable ? p.domain.c_str() : "global";
     out_info->description = p.description.c_str();
     out_info->default_value = p.default_value;
-    out_info->lo = p.min;
-    out_info->hi = p.max;
+    out_info->minimum = p.minimum;
+    out_info->maximum = p.maximum;
     out_info->log_scale = p.log_scale ? 1 : 0;
   });
 }

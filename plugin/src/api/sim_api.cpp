@@ -222,15 +222,15 @@ SOFTDECA_API softdeca_status softdeca_sim_get_parameter_count(uint32_t* out_coun
 SOFTDECA_API softdeca_status softdeca_sim_get_parameter_info(uint32_t index, softdeca_parameter_info* out) {
   return guarded(__func__, [&] {
     require_struct(out, "out_info");
-    const ParameterInfo& p = parameter_info(parameter(index));
-    out->name = p.name;
-    out->unit = p.unit;
-    out->domain = domain_name(p.domain);
-    out->description = p.description;
+    const ParameterSpec& p = parameter_spec(parameter(index));
+    out->name = p.name.c_str();
+    out->unit = p.unit.c_str();
+    out->domain = p.domain.c_str();
+    out->description = p.description.c_str();
     out->default_value = p.default_value;
-    out->lo = p.lo;
-    out->hi = p.hi;
-    out->log_scale = p.scale == Scale::kLog ? SOFTDECA_TRUE : SOFTDECA_FALSE;
+    out->minimum = p.minimum;
+    out->maximum = p.maximum;
+    out->log_scale = p.log_scale ? SOFTDECA_TRUE : SOFTDECA_FALSE;
   });
 }
 

@@ -175,8 +175,8 @@ ParameterSpec parse_parameter(const Json& p, std::set<std::string>& seen) {
   const std::string what = "parameter " + s.name;
   check(!s.name.empty() && seen.insert(s.name).second, what + ": names must be unique and non-empty");
   s.default_value = finite(p.at("default", what), what + ".default");
-  s.min = finite(p.at("min", what), what + ".min");
-  s.max = finite(p.at("max", what), what + ".max");
+  s.minimum = finite(p.at("min", what), what + ".min");
+  s.maximum = finite(p.at("max", what), what + ".max");
   const std::string scale = p.at("scale", what).string(what + ".scale");
   check(scale == "linear" || scale == "log", what + ": scale must be linear or log");
   s.log_scale = scale == "log";
@@ -185,8 +185,9 @@ ParameterSpec parse_parameter(const Json& p, std::set<std::string>& seen) {
   if (p.has("symbol")) s.symbol = p.at("symbol", what).string(what + ".symbol");
   if (p.has("domain")) s.domain = p.at("domain", what).string(what + ".domain");
   if (p.has("description")) s.description = p.at("description", what).string(what + ".description");
-  check(s.min < s.max && s.default_value >= s.min && s.default_value <= s.max, what + ": needs min < max and default in range");
-  check(!s.log_scale || s.min > 0, what + ": log scale needs min > 0");
+  check(s.minimum < s.maximum && s.default_value >= s.minimum && s.default_value <= s.maximum,
+        what + ": needs min < max and default in range");
+  check(!s.log_scale || s.minimum > 0, what + ": log scale needs min > 0");
   return s;
 }
 

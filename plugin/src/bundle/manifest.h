@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/parameter_spec.h"
 #include "stream/arkit_names.h"
 
 namespace softdeca::bundle {
@@ -31,12 +32,6 @@ struct NetworkSpec {
   std::string sha256;  // lower-case hex, checked before the file is used
   std::vector<TensorSpec> inputs, outputs;
   std::vector<int> parameter_columns;  // indices into Manifest::parameters
-};
-
-struct ParameterSpec {
-  std::string name, symbol, unit, domain, description;
-  double default_value = 0, min = 0, max = 0;
-  bool log_scale = false, localisable = false;
 };
 
 struct LandmarkSpec {
@@ -67,7 +62,7 @@ struct Manifest {
   std::string description, template_name;
   int head_vertices = 0, skin_vertices = 0, skin_triangles = 0;
   int latent = 0, identity = 0;
-  std::vector<ParameterSpec> parameters;
+  std::vector<ParameterSpec> parameters;  // the manifest's "min"/"max" as minimum/maximum
   int arkit_vertex_count = 0;
   std::vector<LandmarkSpec> landmarks;
   std::vector<int> jaw_anchors;

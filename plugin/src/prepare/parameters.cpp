@@ -87,17 +87,17 @@ void ParameterState::check_values(int index, const float* values, std::size_t co
                                  std::to_string(expected) + " " + what);
   require_finite(values, count, "values");
   for (std::size_t i = 0; i < count; ++i)
-    require(values[i] >= s.min && values[i] <= s.max, s.name + ": values[" + std::to_string(i) + "] = " +
-                                                           std::to_string(values[i]) + " is outside [" +
-                                                           std::to_string(s.min) + ", " + std::to_string(s.max) + "]");
+    require(values[i] >= s.minimum && values[i] <= s.maximum,
+            s.name + ": values[" + std::to_string(i) + "] = " + std::to_string(values[i]) + " is outside [" +
+                std::to_string(s.minimum) + ", " + std::to_string(s.maximum) + "]");
 }
 
 void ParameterState::set_global(int index, double value) {
   check_index(index);
   const bundle::ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
   if (!std::isfinite(value)) throw Error(SOFTDECA_ERROR_NON_FINITE, s.name + ": value is not finite");
-  require(value >= s.min && value <= s.max, s.name + " = " + std::to_string(value) + " is outside [" +
-                                                std::to_string(s.min) + ", " + std::to_string(s.max) + "]");
+  require(value >= s.minimum && value <= s.maximum, s.name + " = " + std::to_string(value) + " is outside [" +
+                                                        std::to_string(s.minimum) + ", " + std::to_string(s.maximum) + "]");
   Value& v = values_[static_cast<std::size_t>(index)];
   v.kind = Kind::Global;
   v.global = value;

@@ -160,7 +160,7 @@ sim::Positions RestPhysics::solve(const ParameterState& params) {
       continue;
     }
     const Eigen::VectorXd field =
-        field_of(sim::parameter_info(id).domain, params, index, nf, nv, soft_tet_vertex_, muscle_tet_vertex_);
+        field_of(sim::parameter_domain(id), params, index, nf, nv, soft_tet_vertex_, muscle_tet_vertex_);
     if (field.size() == 0) p.set(id, params.global(index));  // no per-element values there
     else p.set_field(id, field);
   }

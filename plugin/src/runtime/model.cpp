@@ -104,9 +104,9 @@ std::shared_ptr<const Model> Model::load(const bundle::BundleFiles& files, const
     std::vector<sim::Param> ids;
     for (const bundle::ParameterSpec& p : mf.parameters) {
       const auto& table = sim::parameter_table();
-      const auto it = std::find_if(table.begin(), table.end(), [&](const sim::ParameterInfo& i) { return p.name == i.name; });
+      const auto it = std::find_if(table.begin(), table.end(), [&](const ParameterSpec& s) { return p.name == s.name; });
       if (it == table.end()) fail("rest_physics: parameter " + p.name + " is not one of the physics' parameters");
-      if (p.min < it->lo || p.max > it->hi)
+      if (p.minimum < it->minimum || p.maximum > it->maximum)
         fail("rest_physics: parameter " + p.name + "'s range is wider than the physics accepts");
       ids.push_back(static_cast<sim::Param>(it - table.begin()));  // the table is in Param's order
     }

@@ -7,8 +7,9 @@
 
 namespace softdeca::sim {
 namespace {
-constexpr Scale linear = Scale::kLinear;
-constexpr Scale log = Scale::kLog;
+// The generated table names scales and domains as bare words.
+constexpr bool linear = false;
+constexpr bool log = true;
 constexpr Domain global = Domain::kGlobal;
 constexpr Domain soft_tet = Domain::kSoftTet;
 constexpr Domain muscle_tet = Domain::kMuscleTet;
@@ -19,6 +20,19 @@ constexpr Domain vertex = Domain::kVertex;
 constexpr Domain skin_point = Domain::kSkinPoint;
 constexpr Domain landmark = Domain::kLandmark;
 
+#define SOFTDECA_PARAMETER_DOMAIN(id, name, symbol, def, minimum, maximum, log_scale, unit, domain, refactor, \
+                                  description)                                                                \
+  domain,
+constexpr Domain kDomains[] = {SOFTDECA_PARAMETER_TABLE(SOFTDECA_PARAMETER_DOMAIN)};
+#undef SOFTDECA_PARAMETER_DOMAIN
+#define SOFTDECA_PARAMETER_REFACTOR(id, name, symbol, def, minimum, maximum, log_scale, unit, domain, refactor, \
+                                    description)                                                                \
+  refactor,
+constexpr bool kRefactors[] = {SOFTDECA_PARAMETER_TABLE(SOFTDECA_PARAMETER_REFACTOR)};
+#undef SOFTDECA_PARAMETER_REFACTOR
+
+std::size_t row(Param p) { return static_cast<std::size_t>(p); }
+
 std::string format_number(double v) {
   std::ostringstream s;
   s << v;
@@ -26,18 +40,20 @@ std::string format_number(double v) {
 }
 }  // namespace
 
-const std::vector<ParameterInfo>& parameter_table() {
-#define SOFTDECA_PARAMETER_ROW(id, name, symbol, def, lo, hi, scale, unit, domain, refactor, \
-                               description)                                                \
-  ParameterInfo{name, symbol, def, lo, hi, scale, unit, domain, refactor, description},
-  static const std::vector<ParameterInfo> table = {SOFTDECA_PARAMETER_TABLE(SOFTDECA_PARAMETER_ROW)};
+const std::vector<ParameterSpec>& parameter_table() {
+#define SOFTDECA_PARAMETER_ROW(id, name, symbol, def, minimum, maximum, log_scale, unit, domain, refactor, \
+                               description)                                                                \
+  ParameterSpec{name, symbol, unit, domain_name(domain), description, def, minimum, maximum, log_scale, domain != global},
+  static const std::vector<ParameterSpec> table = {SOFTDECA_PARAMETER_TABLE(SOFTDECA_PARAMETER_ROW)};
 #undef SOFTDECA_PARAMETER_ROW
   return table;
 }
 
-const ParameterInfo& parameter_info(Param p) {
-  return parameter_table()[static_cast<std::size_t>(p)];
-}
+const ParameterSpec& parameter_spec(Param p) { return parameter_table()[row(p)]; }
+
+Domain parameter_domain(Param p) { return kDomains[row(p)]; }
+
+bool parameter_refactors(Param p) { return kRefactors[row(p)]; }
 
 const PhysicalConstants& physical_constants() {
   static const PhysicalConstants c = [] {
@@ -88,15 +104,13 @@ Param find_parameter(std::string_view name) {
 }
 
 void check_parameter_value(Param p, double value, const std::string& where) {
-  const auto& info = parameter_info(p);
+  const ParameterSpec& spec = parameter_spec(p);
   if (!std::isfinite(value))
-    throw Error(SOFTDECA_ERROR_NON_FINITE,
-                std::string("parameter '") + info.name + "'" + where + " is not finite");
-  if (value < info.lo || value > info.hi)
+    throw Error(SOFTDECA_ERROR_NON_FINITE, "parameter '" + spec.name + "'" + where + " is not finite");
+  if (value < spec.minimum || value > spec.maximum)
     throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT,
-                std::string("parameter '") + info.name + "'" + where + " = " +
-                    format_number(value) + " is outside its range [" + format_number(info.lo) +
-                    ", " + format_number(info.hi) + "]");
+                "parameter '" + spec.name + "'" + where + " = " + format_number(value) + " is outside its range [" +
+                    format_number(spec.minimum) + ", " + format_number(spec.maximum) + "]");
 }
 
 ParameterSet::ParameterSet(const DomainSizes& sizes) : sizes_(sizes) {
@@ -118,7 +132,7 @@ void ParameterSet::reset_to_defaults() {
 
 void ParameterSet::touched(Param p) {
   ++revision_;
-  if (parameter_info(p).refactor) ++matrix_revision_;
+  if (parameter_refactors(p)) ++matrix_revision_;
 }
 
 void ParameterSet::set(Param p, double value) {
@@ -129,14 +143,13 @@ void ParameterSet::set(Param p, double value) {
 }
 
 void ParameterSet::set_field(Param p, const Eigen::VectorXd& values) {
-  const auto& info = parameter_info(p);
-  require(info.domain != Domain::kGlobal,
-          std::string("parameter '") + info.name + "' is global and has no per-element values");
-  const std::size_t n = domain_size(info.domain);
+  const ParameterSpec& spec = parameter_spec(p);
+  const Domain domain = parameter_domain(p);
+  require(domain != Domain::kGlobal, "parameter '" + spec.name + "' is global and has no per-element values");
+  const std::size_t n = domain_size(domain);
   require(static_cast<std::size_t>(values.size()) == n,
-          std::string("parameter '") + info.name + "': " + std::to_string(values.size()) +
-              " values given, but its domain " + domain_name(info.domain) + " has " +
-              std::to_string(n) + " elements");
+          "parameter '" + spec.name + "': " + std::to_string(values.size()) + " values given, but its domain " +
+              spec.domain + " has " + std::to_string(n) + " elements");
   for (Eigen::Index i = 0; i < values.size(); ++i)
     check_parameter_value(p, values[i], "[" + std::to_string(i) + "]");
   field_[index(p)] = values;

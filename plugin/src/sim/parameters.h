@@ -1,7 +1,9 @@
 // The material and simulation parameter vector p (paper section 3.3.3, Appendix A).
 // The list itself lives in plugin/data/parameters.json, compiled into the library; this file
-// gives it a C++ face: an immutable table, and ParameterSet, the values one simulator uses,
-// global or per element ("localised", paper section 3.5.2).
+// gives it a C++ face: an immutable table of ParameterSpecs (core/parameter_spec.h), the
+// simulator's own facts per parameter (its element kind, whether it changes the system matrix),
+// and ParameterSet, the values one simulator uses, global or per element ("localised", paper
+// section 3.5.2).
 #pragma once
 
 #include <Eigen/Core>
@@ -12,11 +14,10 @@
 #include <string_view>
 #include <vector>
 
+#include "core/parameter_spec.h"
 #include "sim/parameter_table.h"  // generated from plugin/data/parameters.json
 
 namespace softdeca::sim {
-
-enum class Scale { kLinear, kLog };
 
 // Where per-element values of a parameter live. The element counts come from the mesh.
 enum class Domain {
@@ -31,18 +32,6 @@ enum class Domain {
   kLandmark,
 };
 constexpr int kDomainCount = 9;
-
-struct ParameterInfo {
-  const char* name;
-  const char* symbol;  // the paper's symbol
-  double default_value;
-  double lo, hi;  // closed range
-  Scale scale;
-  const char* unit;
-  Domain domain;
-  bool refactor;  // a change alters the system matrix
-  const char* description;
-};
 
 // Compile-time handles, in the order of parameters.json.
 #define SOFTDECA_PARAMETER_ID(id, ...) id,
@@ -60,8 +49,13 @@ struct PhysicalConstants {
   double target_layer_thickness_m;
 };
 
-const std::vector<ParameterInfo>& parameter_table();
-const ParameterInfo& parameter_info(Param p);
+// The list in Param's order; static, built once.
+const std::vector<ParameterSpec>& parameter_table();
+const ParameterSpec& parameter_spec(Param p);
+// The element kind per-element values of p are given for (its spec's domain, as an enum).
+Domain parameter_domain(Param p);
+// Whether a change of p alters the system matrix ("refactor" in parameters.json).
+bool parameter_refactors(Param p);
 const PhysicalConstants& physical_constants();
 // The JSON file verbatim, as compiled in.
 const char* parameters_json();
@@ -70,7 +64,7 @@ const char* domain_name(Domain d);
 // Index of a parameter by name; throws Error (invalid argument) naming the known ones.
 Param find_parameter(std::string_view name);
 
-// Throws Error when value is not finite or outside [lo, hi]; the message names the parameter,
+// Throws Error when value is not finite or outside [minimum, maximum]; the message names the parameter,
 // the value and the range.
 void check_parameter_value(Param p, double value, const std::string& where = "");
 
@@ -104,7 +98,7 @@ class ParameterSet {
   void reset_to_defaults();
 
   std::size_t domain_size(Domain d) const { return sizes_[static_cast<std::size_t>(d)]; }
-  // Incremented on every change / on changes of parameters whose `refactor` flag is set.
+  // Incremented on every change / on changes of parameters that alter the system matrix.
   std::uint64_t revision() const { return revision_; }
   std::uint64_t matrix_revision() const { return matrix_revision_; }
 

@@ -127,7 +127,7 @@ class ModelCase:
 
     def _value(self, name: str, value: float) -> float:
         s = self.specs[name]
-        v = min(max(value, s.min), s.max)
+        v = min(max(value, s.minimum), s.maximum)
         if v != value:
             self.clamped.add(name)
         return v
@@ -141,7 +141,7 @@ class ModelCase:
     def solve(self, setting: Setting) -> np.ndarray:
         params = self.avatar.params
         for s in self.nets.specs:
-            params.set_global(s.name, s.default)
+            params.set_global(s.name, s.default_value)
         for name, value in setting.globals.items():
             if name in self.specs:
                 params.set_global(name, self._value(name, value))

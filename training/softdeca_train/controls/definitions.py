@@ -59,9 +59,9 @@ def global_controls(params: ParameterSet, names: list[str] | None = None) -> lis
         if s.name in NOT_STATIC or (names is not None and s.name not in names):
             continue
         fixed: tuple[tuple[str, float], ...] = ()
-        lo, hi = s.lo, s.hi
+        lo, hi = s.minimum, s.maximum
         if s.name == "gravity_azimuth" and "gravity_tilt" in spec:
-            fixed = (("gravity_tilt", min(spec["gravity_tilt"].hi, 90.0)),)
+            fixed = (("gravity_tilt", min(spec["gravity_tilt"].maximum, 90.0)),)
             lo, hi = (lo / 2, hi / 2) if hi - lo >= 360.0 else (lo, hi)
         out.append(Control(s.name, s.name, lo, hi, s.unit, None, fixed))
     return out
@@ -83,5 +83,5 @@ def region_controls(
         for r in regions:
             if r not in REGIONS:
                 raise ValueError(f"unknown region {r!r}; known: {', '.join(REGIONS)}")
-            out.append(Control(f"{name}@{r}", name, s.lo, s.hi, s.unit, r))
+            out.append(Control(f"{name}@{r}", name, s.minimum, s.maximum, s.unit, r))
     return out

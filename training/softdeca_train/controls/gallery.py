@@ -68,8 +68,8 @@ def controls_of(cfg: GalleryConfig) -> tuple[list[Control], dict[str, float]]:
     """The controls to measure and the default value of every physics parameter."""
     physics = load_parameters()
     params: ParameterSet = physics.controls() if cfg.ranges == "control" else physics
-    defaults = {s.name: s.default for s in physics.specs}
-    defaults.update({s.name: s.default for s in params.specs})
+    defaults = {s.name: s.default_value for s in physics.specs}
+    defaults.update({s.name: s.default_value for s in params.specs})
     out = global_controls(params) + region_controls(params, cfg.region_parameters)
     if cfg.only:
         unknown = set(cfg.only) - {c.name for c in out}

@@ -82,8 +82,8 @@ class _Judge:
 
     def __init__(self, nets: OnnxNetworks, first: PhysicsCase, cache: PhysicsCache) -> None:
         physics = load_parameters()
-        self.defaults = {s.name: s.default for s in physics.specs}
-        self.defaults.update({s.name: s.default for s in physics.controls().specs})
+        self.defaults = {s.name: s.default_value for s in physics.specs}
+        self.defaults.update({s.name: s.default_value for s in physics.controls().specs})
         self.domains = {s.name: s.domain for s in physics.specs}
         self.first, self.model, self.cache = first, ModelCase(nets, first), cache
 

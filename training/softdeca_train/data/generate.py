@@ -95,7 +95,13 @@ def describe_plan(cfg: GenerateConfig, plan: list[ShardSpec], takes: list[Take])
         "kinds": per_kind,
         "splits": splits,
         "parameters": [
-            {"name": s.name, "lo": s.lo, "hi": s.hi, "default": s.default, "scale": s.scale}
+            {
+                "name": s.name,
+                "lo": s.minimum,
+                "hi": s.maximum,
+                "default": s.default_value,
+                "scale": s.scale,
+            }
             for s in params.specs
         ],
         "expressions": {

@@ -24,8 +24,6 @@ no controls (they act on nothing in the head model) at their defaults."""
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from softdeca_train.parameters import ParameterSet, load_parameters
 
 
@@ -109,8 +107,10 @@ def sampling_parameters(params: ParameterSet, profile: str) -> ParameterSet:
     for s in params.specs:
         if s.name in narrowed:
             lo, hi = narrowed[s.name]
-            if not s.lo <= lo < hi <= s.hi:
-                raise ValueError(f"{profile}: {s.name} range [{lo}, {hi}] outside [{s.lo}, {s.hi}]")
-            s = replace(s, lo=lo, hi=hi, default=min(max(s.default, lo), hi))
+            if not s.minimum <= lo < hi <= s.maximum:
+                raise ValueError(
+                    f"{profile}: {s.name} range [{lo}, {hi}] outside [{s.minimum}, {s.maximum}]"
+                )
+            s = s.narrowed(lo, hi)
         specs.append(s)
     return ParameterSet(tuple(specs))

@@ -121,7 +121,8 @@ def _plot_parameters(p_norm: dict[str, np.ndarray], manifest: dict, path: Path) 
         ax.axhline(1.0, color="k", ls="--", lw=1, label="target (uniform)")
         fixed_in = [kind for kind in p_norm if spec.name in fixed[kind]]
         note = f"\nfixed in {', '.join(fixed_in)}" if fixed_in else ""
-        ax.set_title(f"{spec.name} [{spec.lo:g}, {spec.hi:g}] {spec.scale}{note}", fontsize=8)
+        title = f"{spec.name} [{spec.minimum:g}, {spec.maximum:g}] {spec.scale}{note}"
+        ax.set_title(title, fontsize=8)
         ax.tick_params(labelsize=7)
     axes[0, 2].legend(fontsize=7)
     fig.suptitle("parameters p, normalised on their sampling scale (density)")

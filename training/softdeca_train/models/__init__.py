@@ -20,7 +20,7 @@ from softdeca_train.models.networks import (
     NetworkSizes,
     build_random,
 )
-from softdeca_train.models.parameters import ParameterSpec, ParameterState, load_parameter_specs
+from softdeca_train.models.parameters import ParameterState, load_parameter_specs
 from softdeca_train.models.reference import ReferenceAvatar, TorchNetworks
 from softdeca_train.models.topology import LandmarkSet, TemplateDefinition
 
@@ -35,7 +35,6 @@ __all__ = [
     "LandmarkSet",
     "NetworkSizes",
     "OnnxNetworks",
-    "ParameterSpec",
     "ParameterState",
     "ReferenceAvatar",
     "TemplateDefinition",

@@ -11,7 +11,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.parameters import ParameterSpec
 
 
 @dataclass(frozen=True)
@@ -56,9 +56,9 @@ class Normalise(nn.Module):
 
     def __init__(self, specs: Sequence[ParameterSpec]) -> None:
         super().__init__()
-        log = torch.tensor([s.scale == "log" for s in specs])
-        lo = torch.tensor([np.log(s.min) if s.scale == "log" else s.min for s in specs])
-        hi = torch.tensor([np.log(s.max) if s.scale == "log" else s.max for s in specs])
+        log = torch.tensor([s.log_scale for s in specs])
+        lo = torch.tensor([np.log(s.minimum) if s.log_scale else s.minimum for s in specs])
+        hi = torch.tensor([np.log(s.maximum) if s.log_scale else s.maximum for s in specs])
         self.register_buffer("log", log)
         self.register_buffer("lo", lo.float())
         self.register_buffer("span", (hi - lo).float())

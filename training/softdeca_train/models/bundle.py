@@ -30,7 +30,6 @@ from softdeca_train.models.networks import (
     BundleNetworks,
     freeze_rest_codes,
 )
-from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.reference import Model
 from softdeca_train.models.residual import ResidualCoefficients, ResidualCondition
 from softdeca_train.models.rest_head import (
@@ -44,6 +43,7 @@ from softdeca_train.models.template_head import (
     template_head_file,
 )
 from softdeca_train.models.topology import LandmarkSet, TemplateDefinition
+from softdeca_train.parameters import ParameterSpec
 
 FORMAT = "softdeca-bundle"
 # Version 2 adds SoftDECA's optional vertex stage (softdeca.f_ph_v), version 3 its optional
@@ -282,7 +282,7 @@ def as_stored(nets: BundleNetworks) -> BundleNetworks:
 
 
 def _default_parameters(specs: tuple[ParameterSpec, ...], n: int) -> torch.Tensor:
-    return torch.tensor([[s.default for s in specs]], dtype=torch.float32).repeat(n, 1)
+    return torch.tensor([[s.default_value for s in specs]], dtype=torch.float32).repeat(n, 1)
 
 
 def export_bundle(

@@ -30,10 +30,10 @@ from softdeca_train.models.blocks import (
     region_means,
     rest_gate,
 )
-from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.residual import ResidualSizes, ResidualStage
 from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
+from softdeca_train.parameters import ParameterSpec
 
 # The stable, equilibrium-preserving dynamics set (eq. 21 with gamma + 2 alpha - beta = 1):
 # beta in [0, BETA_MAX], gamma in [GAMMA_MIN, GAMMA_MAX] keep both roots of

@@ -1,8 +1,8 @@
-"""Material parameter specs as the model bundle carries them, and each avatar's parameter
-state: a global value, a per-face map or a per-vertex map per parameter, turned into the
-per-element inputs of the hypernetworks by the localisation rules of docs/bundle.md. The rules
-are the native library's (plugin/src/prepare/parameters.h), called through softdeca_native
-where a map reaches the other kind of element."""
+"""The parameter specs a model takes (softdeca_train.parameters.ParameterSpec, from a list or a
+file), and each avatar's parameter state: a global value, a per-face map or a per-vertex map per
+parameter, turned into the per-element inputs of the hypernetworks by the localisation rules of
+docs/bundle.md. The rules are the native library's (plugin/src/prepare/parameters.h), called
+through softdeca_native where a map reaches the other kind of element."""
 
 from __future__ import annotations
 
@@ -18,73 +18,7 @@ from typing import Any, Literal
 import numpy as np
 
 from softdeca_train.models.synthetic import TEST_PARAMETERS
-from softdeca_train.paths import REPO_ROOT
-
-# The one list of parameters (the physics'). The exporter reads it when present.
-PARAMETERS_JSON = REPO_ROOT / "plugin" / "data" / "parameters.json"
-
-Scale = Literal["linear", "log"]
-
-
-@dataclass(frozen=True)
-class ParameterSpec:
-    """One material parameter: its range, default and whether it may vary over the face."""
-
-    name: str
-    default: float
-    min: float
-    max: float
-    scale: Scale = "linear"
-    unit: str = ""
-    domain: str = "global"  # the physics' element kind ("global", "soft_tet", "skin_point", ...)
-    symbol: str = ""
-    description: str = ""
-
-    def __post_init__(self) -> None:
-        if not (np.isfinite([self.min, self.max, self.default]).all() and self.min < self.max):
-            raise ValueError(f"parameter {self.name}: need finite min < max")
-        if not self.min <= self.default <= self.max:
-            raise ValueError(f"parameter {self.name}: default outside [min, max]")
-        if self.scale not in ("linear", "log"):
-            raise ValueError(f"parameter {self.name}: scale must be linear or log")
-        if self.scale == "log" and self.min <= 0:
-            raise ValueError(f"parameter {self.name}: log scale needs min > 0")
-
-    @property
-    def localisable(self) -> bool:
-        """Per-region values are allowed for everything the physics defines per element."""
-        return self.domain != "global"
-
-    def manifest(self) -> dict[str, Any]:
-        return {
-            "name": self.name,
-            "symbol": self.symbol,
-            "unit": self.unit,
-            "default": self.default,
-            "min": self.min,
-            "max": self.max,
-            "scale": self.scale,
-            "domain": self.domain,
-            "localisable": self.localisable,
-            "description": self.description,
-        }
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> ParameterSpec:
-        """Accepts the physics' parameters.json entries (lo/hi) and manifest entries (min/max)."""
-        lo = d["min"] if "min" in d else d["lo"]
-        hi = d["max"] if "max" in d else d["hi"]
-        return cls(
-            name=str(d["name"]),
-            default=float(d["default"]),
-            min=float(lo),
-            max=float(hi),
-            scale=d.get("scale", "linear"),
-            unit=str(d.get("unit", "")),
-            domain=str(d.get("domain", "global")),
-            symbol=str(d.get("symbol", "")),
-            description=str(d.get("description", "")),
-        )
+from softdeca_train.parameters import DEFINITION, ParameterSpec
 
 
 def load_parameter_specs(
@@ -95,11 +29,11 @@ def load_parameter_specs(
     repository's plugin/data/parameters.json. `controls_only`: leave out the entries marked as
     no control (`"control": null`: they act on nothing in the head model)."""
     if source is None:
-        if not PARAMETERS_JSON.is_file():
+        if not DEFINITION.is_file():
             raise FileNotFoundError(
-                f"{PARAMETERS_JSON} does not exist; pass a parameter list or a file in its format"
+                f"{DEFINITION} does not exist; pass a parameter list or a file in its format"
             )
-        source = PARAMETERS_JSON
+        source = DEFINITION
     if isinstance(source, (str, os.PathLike)):
         doc = json.loads(Path(source).read_text())
         entries = doc["parameters"] if isinstance(doc, dict) else doc
@@ -119,10 +53,8 @@ def load_parameter_specs(
 def specs_or_test_list(source: str | None) -> tuple[ParameterSpec, ...]:
     """For tools that must run before the physics' list exists: `source`, else the controls
     of plugin/data/parameters.json, else (with a note on stderr) the 5-parameter test list."""
-    if source is None and not PARAMETERS_JSON.is_file():
-        print(
-            f"note: {PARAMETERS_JSON} is missing: using the 5-parameter test list", file=sys.stderr
-        )
+    if source is None and not DEFINITION.is_file():
+        print(f"note: {DEFINITION} is missing: using the 5-parameter test list", file=sys.stderr)
         return load_parameter_specs(TEST_PARAMETERS)
     return load_parameter_specs(source, controls_only=True)
 
@@ -147,7 +79,7 @@ class ParameterState:
         self.triangles = np.asarray(triangles, dtype=np.int64)
         self.n_vertices = int(self.triangles.max()) + 1 if len(self.triangles) else 0
         self.face_areas = np.asarray(face_areas, dtype=np.float64)
-        self._values = [_Value("global", s.default) for s in self.specs]
+        self._values = [_Value("global", s.default_value) for s in self.specs]
 
     def index(self, name: str) -> int:
         for i, s in enumerate(self.specs):
@@ -159,8 +91,8 @@ class ParameterState:
         s = self.specs[i]
         if not np.isfinite(values).all():
             raise ValueError(f"{s.name}: values must be finite")
-        if (values < s.min).any() or (values > s.max).any():
-            raise ValueError(f"{s.name}: values outside [{s.min}, {s.max}]")
+        if (values < s.minimum).any() or (values > s.maximum).any():
+            raise ValueError(f"{s.name}: values outside [{s.minimum}, {s.maximum}]")
 
     def set_global(self, name: str, value: float) -> None:
         i = self.index(name)
@@ -206,7 +138,7 @@ class ParameterState:
         """A copy with the named parameters (default: all) back at their global defaults."""
         out = copy.copy(self)
         out._values = [
-            _Value("global", s.default) if names is None or s.name in names else v
+            _Value("global", s.default_value) if names is None or s.name in names else v
             for v, s in zip(self._values, self.specs, strict=True)
         ]
         return out
@@ -214,7 +146,7 @@ class ParameterState:
     def at_defaults(self) -> bool:
         """Every parameter a global value at its default."""
         return all(
-            v.kind == "global" and float(v.data) == s.default  # type: ignore[arg-type]
+            v.kind == "global" and float(v.data) == s.default_value  # type: ignore[arg-type]
             for v, s in zip(self._values, self.specs, strict=True)
         )
 

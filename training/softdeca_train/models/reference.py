@@ -25,10 +25,11 @@ import torch
 from softdeca_train.geometry import Similarity, umeyama
 from softdeca_train.models.dt import DtSystem, deformation_transfer, dt_system
 from softdeca_train.models.networks import BundleNetworks
-from softdeca_train.models.parameters import ParameterSpec, ParameterState
+from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_head import RestHead
 from softdeca_train.models.rest_physics import RestSolver
 from softdeca_train.models.topology import JAW, TemplateDefinition
+from softdeca_train.parameters import ParameterSpec
 
 Model = Literal["softdeca", "sparse"]
 

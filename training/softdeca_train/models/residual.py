@@ -32,7 +32,7 @@ from softdeca_train.models.blocks import (
     region_means,
     rest_gate,
 )
-from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.parameters import ParameterSpec
 
 N_WEIGHTS = 52
 

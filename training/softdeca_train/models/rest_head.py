@@ -290,10 +290,10 @@ def inert_parameters(
         if s.domain == "global":
             continue
         moved = 0.0
-        for value in (s.min, s.max):
+        for value in (s.minimum, s.maximum):
             sim.set_parameter(s.name, float(value))
             moved = max(moved, float(np.abs(rest() - base).max()))
-        sim.set_parameter(s.name, float(s.default))
+        sim.set_parameter(s.name, float(s.default_value))
         if moved < 1e-7:
             inert.append(s.name)
     return tuple(inert)

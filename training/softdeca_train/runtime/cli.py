@@ -73,8 +73,8 @@ def _rest_physics_args(p: argparse.ArgumentParser) -> None:
 def _rest_physics_run(args: argparse.Namespace) -> int:
     from softdeca_train.lhm import LhmConfig
     from softdeca_train.models.bundle import add_rest_physics, read_manifest
-    from softdeca_train.models.parameters import ParameterSpec
     from softdeca_train.models.rest_head import rest_head_for_bundle
+    from softdeca_train.parameters import ParameterSpec
     from softdeca_train.template import Template
 
     folder = Path(args.bundle)

@@ -78,8 +78,8 @@ class ParameterInfo(C.Structure):
         ("domain", C.c_char_p),
         ("description", C.c_char_p),
         ("default_value", C.c_double),
-        ("lo", C.c_double),
-        ("hi", C.c_double),
+        ("minimum", C.c_double),
+        ("maximum", C.c_double),
         ("log_scale", C.c_int32),
     ]
 

@@ -22,7 +22,7 @@ import numpy as np
 from softdeca_train.controls.metrics import response_error
 from softdeca_train.mesh_files import read_obj, read_pc2
 from softdeca_train.models.bundle import read_manifest
-from softdeca_train.models.parameters import ParameterSpec
+from softdeca_train.parameters import ParameterSpec
 from softdeca_train.render import Focus, MeshLayer, RenderSettings, TileSettings, render, tile
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN

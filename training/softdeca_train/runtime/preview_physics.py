@@ -25,8 +25,9 @@ import numpy as np
 
 from softdeca_train.lhm import LhmConfig
 from softdeca_train.models.dt import face_geometry
-from softdeca_train.models.parameters import ParameterSpec, ParameterState
+from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_physics import element_values
+from softdeca_train.parameters import ParameterSpec
 from softdeca_train.sim import sanity
 from softdeca_train.sim.head import build_head_simulation
 from softdeca_train.sim.run import simulate_frames
@@ -74,7 +75,7 @@ def parse_changes(text: str) -> list[Change]:
 
 
 def _resolved(spec: ParameterSpec, value: str) -> float:
-    bounds = {"min": spec.min, "max": spec.max, "default": spec.default}
+    bounds = {"min": spec.minimum, "max": spec.maximum, "default": spec.default_value}
     return float(bounds[value]) if value in bounds else float(value)
 
 

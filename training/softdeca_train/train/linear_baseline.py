@@ -17,7 +17,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterator, Sequence
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +64,7 @@ class ParameterScaling:
         sampled = {q["name"]: q for q in manifest["dataset"]["parameters"]}
         params = ParameterSet(
             tuple(
-                replace(s, lo=sampled[s.name]["lo"], hi=sampled[s.name]["hi"])
+                s.narrowed(sampled[s.name]["lo"], sampled[s.name]["hi"])
                 for s in load_parameters().specs
             )
         )

@@ -96,7 +96,7 @@ def localisation_figure(
     names = [s.name for s in run.specs]
     k = names.index(change.name)
     if change.value is None:  # the networks are only valid inside the trained range
-        change = replace(change, value=float(run.specs[k].min))
+        change = replace(change, value=float(run.specs[k].minimum))
     assert change.value is not None
     neutral = batch.neutral.double().numpy()
     tris = run.template.skin_triangles

@@ -33,10 +33,10 @@ from softdeca_train.models.networks import (
     WeightEncoder,
     mlp,
 )
-from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.residual import ResidualFit, ResidualSizes, ResidualStage
 from softdeca_train.models.smoothing import FieldSmoothing
 from softdeca_train.models.topology import TemplateDefinition
+from softdeca_train.parameters import ParameterSpec
 from softdeca_train.template.regions import CONTROL_REGIONS, REGIONS
 from softdeca_train.train.batches import Batch, Dataset
 from softdeca_train.train.gradients import GRADIENT_CLAMP, frame_gradients

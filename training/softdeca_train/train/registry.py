@@ -5,13 +5,12 @@ A training run (a folder) holds one checkpoint per name."""
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from softdeca_train.data.ranges import fixed_outside_profile, sampling_parameters
 from softdeca_train.models.networks import NetworkSizes
-from softdeca_train.models.parameters import ParameterSpec, load_parameter_specs
 from softdeca_train.models.topology import TemplateDefinition
-from softdeca_train.parameters import load_parameters
+from softdeca_train.parameters import ParameterSpec, load_parameters
 from softdeca_train.train import models as m
 
 Build = Callable[
@@ -129,10 +128,6 @@ def dataset_specs(range_profile: str) -> tuple[ParameterSpec, ...]:
     network is only valid there, so the runtime refuses values outside them). Parameters the
     profile keeps at their defaults because they are no controls are not model inputs."""
     physics = load_parameters()
-    sampled = {s.name: s for s in sampling_parameters(physics, range_profile).specs}
     fixed = set(fixed_outside_profile(physics, range_profile))
-    return tuple(
-        replace(s, min=sampled[s.name].lo, max=sampled[s.name].hi, default=sampled[s.name].default)
-        for s in load_parameter_specs()
-        if s.name not in fixed
-    )
+    sampled = sampling_parameters(physics, range_profile).specs
+    return tuple(s for s in sampled if s.name not in fixed)

@@ -14,8 +14,8 @@ import torch
 
 from softdeca_train.data.config import GenerateConfig
 from softdeca_train.models.networks import FULL_SIZES, TEST_SIZES, IdentityEncoder, NetworkSizes
-from softdeca_train.models.parameters import ParameterSpec
 from softdeca_train.models.topology import TemplateDefinition, from_template
+from softdeca_train.parameters import ParameterSpec
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.batches import Dataset

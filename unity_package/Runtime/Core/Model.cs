@@ -2,7 +2,10 @@ using System;
 
 namespace SoftDeca
 {
-    /// <summary>A material parameter of a bundle (softdeca_parameter_info).</summary>
+    /// <summary>
+    /// A material parameter of a bundle (softdeca_parameter_info, with the same fields under the
+    /// same names): its default and closed range [Minimum, Maximum].
+    /// </summary>
     public struct ParameterInfo
     {
         public int Index;
@@ -12,8 +15,8 @@ namespace SoftDeca
         public string Domain;
         public string Description;
         public double DefaultValue;
-        public double Min;
-        public double Max;
+        public double Minimum;
+        public double Maximum;
         public bool LogScale;
 
         public bool Localisable { get { return Domain != "global"; } }
@@ -51,8 +54,8 @@ namespace SoftDeca
                     Domain = Utf8.FromNative(p.Domain),
                     Description = Utf8.FromNative(p.Description),
                     DefaultValue = p.DefaultValue,
-                    Min = p.Lo,
-                    Max = p.Hi,
+                    Minimum = p.Minimum,
+                    Maximum = p.Maximum,
                     LogScale = p.LogScale != 0,
                 };
             }

@@ -97,8 +97,8 @@ namespace SoftDeca
         public IntPtr Domain;
         public IntPtr Description;
         public double DefaultValue;
-        public double Lo;
-        public double Hi;
+        public double Minimum;
+        public double Maximum;
         public int LogScale;
 
         public static NativeParameterInfo Create()

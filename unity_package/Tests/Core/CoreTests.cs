@@ -285,8 +285,8 @@ namespace SoftDeca.Tests
                     Assert.AreEqual(p.Index, avatar.ParameterIndex(p.Name), p.Name);
                     Assert.AreEqual(p.DefaultValue, avatar.GetParameter(p.Name), 1e-9, p.Name);
                 }
-                ParameterInfo strain = Array.Find(ps, p => p.Localisable && p.Max > p.DefaultValue);
-                double value = (strain.DefaultValue + strain.Max) / 2;
+                ParameterInfo strain = Array.Find(ps, p => p.Localisable && p.Maximum > p.DefaultValue);
+                double value = (strain.DefaultValue + strain.Maximum) / 2;
                 avatar.SetParameter(strain.Name, value);
                 Assert.AreEqual(value, avatar.GetParameter(strain.Index), 1e-12);
                 Assert.IsFalse(avatar.IsLocalised(strain.Index));
@@ -300,7 +300,7 @@ namespace SoftDeca.Tests
                 var e = Assert.Throws<SoftDecaException>(() => avatar.SetParameter("no_such_parameter", 1));
                 Assert.AreEqual(Status.InvalidArgument, e.Status);
                 StringAssert.Contains("no_such_parameter", e.Message);
-                e = Assert.Throws<SoftDecaException>(() => avatar.SetParameter(strain.Name, strain.Max * 10 + 1));
+                e = Assert.Throws<SoftDecaException>(() => avatar.SetParameter(strain.Name, strain.Maximum * 10 + 1));
                 StringAssert.Contains(strain.Name, e.Message);
                 e = Assert.Throws<SoftDecaException>(() => avatar.SetParameter(ps.Length, 1));
                 StringAssert.Contains("parameter index", e.Message);
