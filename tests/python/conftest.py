@@ -11,8 +11,8 @@ import bounds
 import pytest
 from softdeca_train.data.config import GenerateConfig, RunSettings
 from softdeca_train.data.generate import generate
-from softdeca_train.runtime.fit_check import DEFAULT_BUNDLE
-from softdeca_train.runtime.native import NativeModel
+from softdeca_train.host.fit_check import DEFAULT_BUNDLE
+from softdeca_train.host.native import NativeModel
 from softdeca_train.template import Template
 
 # The small dataset of the data generation and training tests: LHM level 2 (162 vertices per

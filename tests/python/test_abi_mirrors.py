@@ -1,5 +1,5 @@
 """The C ABI's structs are written once, in plugin/include/softdeca/softdeca.h; Unity's C#
-(unity_package/Runtime/Core/NativeTypes.cs) and the Python binding (softdeca_train/runtime/
+(unity_package/Runtime/Core/NativeTypes.cs) and the Python binding (softdeca_train/host/
 native.py) mirror them by hand. These tests parse the header and hold every mirror to it: the
 same fields in the same order with the same types (and names, up to the languages' spelling),
 the same ABI version, and C#'s P/Invoke declarations (NativeMethods.cs) the header's
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from softdeca_train.runtime import native
+from softdeca_train.host import native
 
 ROOT = Path(__file__).resolve().parents[2]
 HEADER = ROOT / "plugin" / "include" / "softdeca" / "softdeca.h"
@@ -292,7 +292,7 @@ def test_python_mirrors_match_the_header() -> None:
         and v.__module__ == native.__name__
     }
     assert sorted(mirrors) == sorted(py for _, py in MIRRORS.values() if py), (
-        "every ctypes structure of runtime/native.py mirrors one of the header (MIRRORS)"
+        "every ctypes structure of host/native.py mirrors one of the header (MIRRORS)"
     )
     problems = {
         c: d
@@ -305,7 +305,7 @@ def test_python_mirrors_match_the_header() -> None:
 def test_mirrors_name_the_headers_abi_version() -> None:
     _, version = header_structs()
     assert csharp_abi_version() == version, "NativeMethods.AbiVersion"
-    assert native.ABI_VERSION == version, "softdeca_train.runtime.native.ABI_VERSION"
+    assert native.ABI_VERSION == version, "softdeca_train.host.native.ABI_VERSION"
 
 
 # ---- functions: C#'s P/Invoke declarations against the header's prototypes -------------------

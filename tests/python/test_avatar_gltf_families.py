@@ -1,7 +1,7 @@
 """glTF avatars written as Ready Player Me and VRoid (through gltfpack) write them
-(avatars/gltf_families.py), through the command line as a user runs it: `softdeca fit` reads
+(sample_avatars/gltf_families.py), through the command line as a user runs it: `softdeca fit` reads
 the file and passes its own quality verdict; the independent check (the avatar's moving face
-vertices to the registered template, runtime/fit_coverage.py) puts the face a median under
+vertices to the registered template, host/fit_coverage.py) puts the face a median under
 1 mm from it with at least 70 % within 3 mm; and `softdeca replay` of a real take moves no
 vertex more than 20 mm from the avatar's own linear blend."""
 
@@ -17,19 +17,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 from bounds import above, below
-from softdeca_train.avatars.build import make_avatar
-from softdeca_train.avatars.config import AvatarConfig, low_poly
-from softdeca_train.avatars.gltf_families import (
+from softdeca_train.host.fit_check import DEFAULT_BUNDLE
+from softdeca_train.host.fit_coverage import face_coverage
+from softdeca_train.host.native import NativeFit, NativeModel
+from softdeca_train.mesh_files import read_pc2
+from softdeca_train.paths import default_takes_path
+from softdeca_train.sample_avatars.build import make_avatar
+from softdeca_train.sample_avatars.config import AvatarConfig, low_poly
+from softdeca_train.sample_avatars.gltf_families import (
     VROID_PRIMITIVES,
     VROID_TARGETS,
     write_ready_player_me,
     write_vroid,
 )
-from softdeca_train.mesh_files import read_pc2
-from softdeca_train.paths import default_takes_path
-from softdeca_train.runtime.fit_check import DEFAULT_BUNDLE
-from softdeca_train.runtime.fit_coverage import face_coverage
-from softdeca_train.runtime.native import NativeFit, NativeModel
 from softdeca_train.template import Template
 from streaming_cli import CLI
 

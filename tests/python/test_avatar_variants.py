@@ -1,4 +1,4 @@
-"""Test avatars (softdeca_train.avatars, `python -m softdeca_train avatar`): the template
+"""Test avatars (softdeca_train.sample_avatars, `python -m softdeca_train avatar`): the template
 moved into the conventions users' avatars come in, and the truth that takes each back to the
 template: the remesh stays on the surface, carried shapes are the template's at the same
 surface points, unit, axes and mirror invert exactly, rig names read back under the library's
@@ -16,7 +16,11 @@ import scipy.sparse as sp
 import softdeca_native as native
 from bounds import below
 from scipy.spatial import cKDTree
-from softdeca_train.avatars import (
+from softdeca_train.cli import STAGES
+from softdeca_train.data.plan import derived_seed
+from softdeca_train.face_names import ARKIT_BLENDSHAPES
+from softdeca_train.landmarks import ArkitFace
+from softdeca_train.sample_avatars import (
     HELD_OUT_IDENTITIES,
     NAME_STYLES,
     UNITS,
@@ -27,14 +31,10 @@ from softdeca_train.avatars import (
     rig_name,
     write_avatar,
 )
-from softdeca_train.avatars.cli import COMMANDS, config_from_args
-from softdeca_train.avatars.config import low_poly
-from softdeca_train.avatars.mesh import PARTS
-from softdeca_train.avatars.remesh import remesh
-from softdeca_train.cli import STAGES
-from softdeca_train.data.plan import derived_seed
-from softdeca_train.face_names import ARKIT_BLENDSHAPES
-from softdeca_train.landmarks import ArkitFace
+from softdeca_train.sample_avatars.cli import COMMANDS, config_from_args
+from softdeca_train.sample_avatars.config import low_poly
+from softdeca_train.sample_avatars.mesh import PARTS
+from softdeca_train.sample_avatars.remesh import remesh
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 
@@ -437,7 +437,7 @@ def test_keep_and_drop_shapes(face) -> None:
 
 def test_the_command_line(tmp_path) -> None:
     command = COMMANDS[0]
-    assert command.name == "avatar" and "softdeca_train.avatars.cli" in STAGES
+    assert command.name == "avatar" and "softdeca_train.sample_avatars.cli" in STAGES
     p = argparse.ArgumentParser()
     command.add_arguments(p)
     out = tmp_path / "face"

@@ -11,7 +11,7 @@ import subprocess
 from pathlib import Path
 
 from softdeca_train.face_names import ARKIT_BLENDSHAPES, DEFINITION, LIVELINKFACE_VALUES
-from softdeca_train.runtime.native import blendshape_index
+from softdeca_train.host.native import blendshape_index
 from softdeca_train.streaming.livelinkface import CANONICAL, VALUE_NAMES
 
 ROOT = Path(__file__).resolve().parents[2]

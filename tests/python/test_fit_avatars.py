@@ -11,25 +11,25 @@ import numpy as np
 import pytest
 from bounds import above, below
 from scipy.spatial import cKDTree
-from softdeca_train.avatars.build import make_avatar
-from softdeca_train.avatars.config import LOW_POLY_VARIANTS, AvatarConfig
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
-from softdeca_train.landmarks.arkit_reference import ArkitFace
-from softdeca_train.paths import default_takes_path
-from softdeca_train.runtime.fit_check import (
+from softdeca_train.host.fit_check import (
     FitCheckConfig,
     avatar_arrays,
     check_identity,
     template_head,
 )
-from softdeca_train.runtime.fit_coverage import face_coverage
-from softdeca_train.runtime.native import (
+from softdeca_train.host.fit_coverage import face_coverage
+from softdeca_train.host.native import (
     AvatarArrays,
     NativeAvatar,
     NativeError,
     NativeFit,
     NativeModel,
 )
+from softdeca_train.landmarks.arkit_reference import ArkitFace
+from softdeca_train.paths import default_takes_path
+from softdeca_train.sample_avatars.build import make_avatar
+from softdeca_train.sample_avatars.config import LOW_POLY_VARIANTS, AvatarConfig
 from softdeca_train.sim.take import read_take
 
 LIMIT_RATIO = (

@@ -1,5 +1,5 @@
 """Hostile avatars through the `softdeca` command line (docs/security.md, "Avatars and fits"):
-every attack of softdeca_train.runtime.hostile_avatars given to `softdeca fit` and `softdeca
+every attack of softdeca_train.host.hostile_avatars given to `softdeca fit` and `softdeca
 replay --avatar`, each in a process of its own under a wall-clock limit and an address-space
 cap. An attack is refused with a message that says why (never a C++ exception's text), the
 process is never killed by a signal, its peak memory stays within 4 x its input + 500 MB, and
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from softdeca_train.runtime.hostile_avatars import (
+from softdeca_train.host.hostile_avatars import (
     BASE_ARGS,
     SECRET,
     Attack,

@@ -21,7 +21,7 @@ CSHARP_INFO = ROOT / "unity_package" / "Runtime" / "Core" / "Model.cs"
 # The one description per language (and the C ABI's mirrors, which must exist beside them).
 PYTHON = {
     ("softdeca_train/parameters.py", "ParameterSpec"),
-    ("softdeca_train/runtime/native.py", "ParameterInfo"),  # the ctypes mirror
+    ("softdeca_train/host/native.py", "ParameterInfo"),  # the ctypes mirror
 }
 NATIVE = {
     ("src/core/parameter_spec.h", "ParameterSpec"),

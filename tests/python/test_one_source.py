@@ -354,7 +354,7 @@ ORACLES: dict[str, tuple[str, str]] = {
         "plugin/src/prepare/rest_physics.cpp",
         "test_runtime_parity.py",
     ),
-    "runtime/fit_coverage.py": (
+    "host/fit_coverage.py": (
         "plugin/src/fit/fit_quality.cpp",
         "test_fit_avatars.py",
     ),

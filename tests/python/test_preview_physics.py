@@ -6,9 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from softdeca_train.models.parameters import load_parameter_specs
-from softdeca_train.runtime.preview import _with_physics, localised_response
-from softdeca_train.runtime.preview_physics import (
+from softdeca_train.host.preview import _with_physics, localised_response
+from softdeca_train.host.preview_physics import (
     Change,
     lip_openings_mm,
     parameter_fields,
@@ -16,6 +15,7 @@ from softdeca_train.runtime.preview_physics import (
     simulate_column,
     widest_open_frame,
 )
+from softdeca_train.models.parameters import load_parameter_specs
 from softdeca_train.sim.head import build_head_simulation
 from softdeca_train.sim.take import read_take
 from softdeca_train.template import Template

@@ -5,7 +5,7 @@ coordinates (any unit, any up axis) mapped to metres in the subject's frame by t
 from __future__ import annotations
 
 import numpy as np
-from softdeca_train.runtime.preview import face_focus, to_view
+from softdeca_train.host.preview import face_focus, to_view
 
 
 def _summary(to_view_rows: list[list[float]], count: int) -> dict:

@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from bounds import above, below
+from softdeca_train.host.native import NativeAvatar, NativeError, NativeModel
 from softdeca_train.models import (
     TEST_SIZES,
     BundleInfo,
@@ -35,7 +36,6 @@ from softdeca_train.models.synthetic import (
     synthetic_head,
     synthetic_rest_head,
 )
-from softdeca_train.runtime.native import NativeAvatar, NativeError, NativeModel
 
 BOUND_MM = {"float": 1e-4, "half": 1e-3, "int8": 0.02}
 REASON = {

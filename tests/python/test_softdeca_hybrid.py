@@ -1,4 +1,4 @@
-"""SoftDECA with a vertex stage (train/models.py SoftDecaHybrid): the constant slot of z, the
+"""SoftDECA with a vertex stage (train/trainable.py SoftDecaHybrid): the constant slot of z, the
 per-vertex local map of the parameters, and the closed-form start at the per-vertex ridge
 fit, checked against an independent fit on the small generated dataset."""
 
@@ -15,8 +15,8 @@ from bounds import below
 from softdeca_train.data.plan import FIXED
 from softdeca_train.models.networks import TEST_SIZES, LocalLinear, WeightEncoder
 from softdeca_train.train.linear_baseline import ParameterScaling
-from softdeca_train.train.models import CM, SoftDecaHybrid
 from softdeca_train.train.run import Run, RunConfig
+from softdeca_train.train.trainable import CM, SoftDecaHybrid
 
 
 def test_the_constant_slot_is_one_and_the_skip_is_linear() -> None:

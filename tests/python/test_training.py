@@ -18,10 +18,10 @@ from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.networks import BETA_MAX
 from softdeca_train.parameters import load_parameters
 from softdeca_train.paths import REPO_ROOT
-from softdeca_train.train.bundle import BundleBudget, stage_config, train_bundle
+from softdeca_train.train.bundle_stages import BundleBudget, stage_config, train_bundle
 from softdeca_train.train.loop import LoopConfig, train
-from softdeca_train.train.models import vertex_error
 from softdeca_train.train.run import Run, RunConfig
+from softdeca_train.train.trainable import vertex_error
 
 COMMITTED = REPO_ROOT / "models" / "softdeca-default"
 
@@ -343,7 +343,7 @@ def test_identity_encoder_recovers_identities_exactly(template) -> None:
 
 
 def test_contrast_pairs_join_each_frame_to_its_base() -> None:
-    from softdeca_train.train.models import contrast_pairs
+    from softdeca_train.train.trainable import contrast_pairs
 
     a, b = b"a", b"b"
     keys = [
@@ -369,7 +369,7 @@ def test_a_retrained_sparsesoftdeca_replaces_the_bundles_own(
     torch, SoftDECA's files are untouched, and the manifest says what trained the new ones."""
     from softdeca_train.models.bundle import replace_networks
     from softdeca_train.models.networks import LandmarkEncoder
-    from softdeca_train.train.bundle import replace_sparse
+    from softdeca_train.train.bundle_stages import replace_sparse
 
     bundle = train_bundle(
         run, tmp_path / "bundle", BundleBudget(steps=4), "test", False

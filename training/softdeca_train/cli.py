@@ -20,8 +20,8 @@ STAGES = (
     "softdeca_train.data.cli",
     "softdeca_train.train.cli",
     "softdeca_train.controls.cli",
-    "softdeca_train.runtime.cli",
-    "softdeca_train.avatars.cli",
+    "softdeca_train.host.cli",
+    "softdeca_train.sample_avatars.cli",
     "softdeca_train.streaming.cli",
 )
 

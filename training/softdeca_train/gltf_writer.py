@@ -1,6 +1,6 @@
 """glTF 2.0 files built accessor by accessor, for the import's tests: the test avatars written
-as exporters write them (avatars/gltf_families.py) and the hostile corpus
-(runtime/hostile_avatars.py), whose files are this writer's output edited to attack a reader.
+as exporters write them (sample_avatars/gltf_families.py) and the hostile corpus
+(host/hostile_avatars.py), whose files are this writer's output edited to attack a reader.
 The first buffer is the binary chunk of a .glb, or a file beside a .gltf."""
 
 from __future__ import annotations

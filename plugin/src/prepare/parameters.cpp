@@ -80,7 +80,7 @@ void ParameterState::check_index(int index) const {
 void ParameterState::check_values(int index, const float* values, std::size_t count, std::size_t expected,
                                   const char* what) const {
   check_index(index);
-  const bundle::ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
+  const ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
   require(s.localisable, s.name + " is a global parameter: it cannot vary over the face");
   require_not_null(values, "values");
   require(count == expected, s.name + ": " + std::to_string(count) + " values given, the skin has " +
@@ -94,7 +94,7 @@ void ParameterState::check_values(int index, const float* values, std::size_t co
 
 void ParameterState::set_global(int index, double value) {
   check_index(index);
-  const bundle::ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
+  const ParameterSpec& s = (*specs_)[static_cast<std::size_t>(index)];
   if (!std::isfinite(value)) throw Error(SOFTDECA_ERROR_NON_FINITE, s.name + ": value is not finite");
   require(value >= s.minimum && value <= s.maximum, s.name + " = " + std::to_string(value) + " is outside [" +
                                                         std::to_string(s.minimum) + ", " + std::to_string(s.maximum) + "]");

@@ -62,7 +62,7 @@ class ParameterState {
   // [rows][columns.size()] row-major, one row per face (faces) or vertex.
   void matrix(const std::vector<int>& columns, bool faces, float* out) const;
 
-  const std::vector<bundle::ParameterSpec>* specs_;
+  const std::vector<ParameterSpec>* specs_;
   const std::vector<std::int32_t>* triangles_;
   std::vector<double> face_area_, vertex_area_;
   std::size_t n_faces_, n_vertices_;

@@ -102,7 +102,7 @@ std::shared_ptr<const Model> Model::load(const bundle::BundleFiles& files, const
   if (mf.has_rest_physics) {
     // Every parameter must be one the physics knows, over a range it accepts.
     std::vector<sim::Param> ids;
-    for (const bundle::ParameterSpec& p : mf.parameters) {
+    for (const ParameterSpec& p : mf.parameters) {
       const auto& table = sim::parameter_table();
       const auto it = std::find_if(table.begin(), table.end(), [&](const ParameterSpec& s) { return p.name == s.name; });
       if (it == table.end()) fail("rest_physics: parameter " + p.name + " is not one of the physics' parameters");

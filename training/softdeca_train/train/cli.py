@@ -102,7 +102,7 @@ def add_bundle_args(p: argparse.ArgumentParser) -> None:
 
 
 def run_bundle(args: argparse.Namespace) -> int:
-    from softdeca_train.train.bundle import BundleBudget, default_command, train_bundle
+    from softdeca_train.train.bundle_stages import BundleBudget, default_command, train_bundle
 
     run = _open_run(args)
     budget = BundleBudget(
@@ -131,7 +131,7 @@ def add_replace_sparse_args(p: argparse.ArgumentParser) -> None:
 
 
 def run_replace_sparse(args: argparse.Namespace) -> int:
-    from softdeca_train.train.bundle import default_command, replace_sparse
+    from softdeca_train.train.bundle_stages import default_command, replace_sparse
 
     run = _open_run(args)
     deviations = replace_sparse(

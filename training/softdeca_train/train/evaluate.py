@@ -18,7 +18,8 @@ from softdeca_train.data.config import GenerateConfig
 from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.models.dt import deformation_transfer
 from softdeca_train.train.batches import EVERY_FRAME, Batch
-from softdeca_train.train.models import (
+from softdeca_train.train.run import Run
+from softdeca_train.train.trainable import (
     Dynamics,
     FaceMlp,
     GlobalMlp,
@@ -32,7 +33,6 @@ from softdeca_train.train.models import (
     expand,
     vertex_error,
 )
-from softdeca_train.train.run import Run
 
 # SparseSoftDECA inputs for Table 2: the simulated head's own landmarks (on its S_t), another
 # head's expression personalised to it (clean), the same with the augmentation's noise, and

@@ -1,5 +1,5 @@
 """Per-face deformation gradients of training frames (Sumner and Popovic), the targets a
-model's gradient stage is started from (train/models.py, train/local_fit.py)."""
+model's gradient stage is started from (train/trainable.py, train/local_fit.py)."""
 
 from __future__ import annotations
 

@@ -16,8 +16,8 @@ from softdeca_train.data.config import GenerateConfig
 from softdeca_train.render import MeshLayer, RenderSettings, render, tile
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.batches import Batch
-from softdeca_train.train.models import Trainable
 from softdeca_train.train.run import Run
+from softdeca_train.train.trainable import Trainable
 
 
 @dataclass(frozen=True)

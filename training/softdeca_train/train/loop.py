@@ -16,7 +16,7 @@ import torch
 from tqdm import tqdm
 
 from softdeca_train.train.batches import Batch, Dataset
-from softdeca_train.train.models import Trainable
+from softdeca_train.train.trainable import Trainable
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from softdeca_train.data.ranges import fixed_outside_profile, sampling_parameter
 from softdeca_train.models.networks import NetworkSizes
 from softdeca_train.models.topology import TemplateDefinition
 from softdeca_train.parameters import ParameterSpec, load_parameters
-from softdeca_train.train import models as m
+from softdeca_train.train import trainable as m
 
 Build = Callable[
     [TemplateDefinition, Sequence[ParameterSpec], NetworkSizes, m.Trainable | None], m.Trainable

@@ -36,14 +36,14 @@ from softdeca_train.train.evaluate import (
     time_per_frame,
 )
 from softdeca_train.train.localisation import localisation_figure
-from softdeca_train.train.models import (
+from softdeca_train.train.registry import MODELS
+from softdeca_train.train.run import Run
+from softdeca_train.train.trainable import (
     NoCorrection,
     SparseSoftDeca,
     Trainable,
     vertex_error,
 )
-from softdeca_train.train.registry import MODELS
-from softdeca_train.train.run import Run
 
 TABLE1 = (
     ("no correction (S_t)", "no-correction"),

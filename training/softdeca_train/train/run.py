@@ -21,8 +21,8 @@ from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.batches import Dataset
 from softdeca_train.train.identity import IdentityConfig, train_identity_encoder
 from softdeca_train.train.loop import LoopConfig, train
-from softdeca_train.train.models import Trainable
 from softdeca_train.train.registry import MODELS, dataset_specs
+from softdeca_train.train.trainable import Trainable
 
 # "test": the tiny networks of the tests, with the template's identity size (the data's h)
 # and an encoder wide enough for its exact least-squares start (train/identity.py).

@@ -208,7 +208,7 @@ def _add_physics(
     """The physics column, the widest-open mouth among the rows (it replaces the row of its
     segment), preview.json with every column's lip opening, and the sheet's notes."""
     # the physics needs the compiled softdeca_native; the sheet without it does not
-    from softdeca_train.runtime.preview_physics import (
+    from softdeca_train.host.preview_physics import (
         lip_openings_mm,
         parse_changes,
         simulate_column,

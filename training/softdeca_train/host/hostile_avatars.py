@@ -24,9 +24,9 @@ from pathlib import Path
 import numpy as np
 
 from softdeca_train.gltf_writer import GltfWriter
+from softdeca_train.host.files import write_rig
 from softdeca_train.mesh_files import write_obj
 from softdeca_train.models.synthetic import synthetic_head
-from softdeca_train.runtime.files import write_rig
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 
 # Bytes no output may ever hold: every secret file starts with them.

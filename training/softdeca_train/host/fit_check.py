@@ -1,7 +1,7 @@
 """The fit against the truth: a held-out ICT identity made into a user's avatar (remeshed to
 another topology, shuffled, in centimetres, Z-up) is fitted, and on the frames of recorded
 takes what the fitted avatar gets is compared with what the same identity gets on the template
-path, at the same surface points (the avatar's truth, avatars/mesh.py):
+path, at the same surface points (the avatar's truth, sample_avatars/mesh.py):
 
 - SoftDECA: the correction (SoftDECA - linear blend), per frame the mean distance between the
   two over the face, over the template path's mean magnitude there;
@@ -23,12 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
-from softdeca_train.avatars.build import make_avatar
-from softdeca_train.avatars.config import HELD_OUT_IDENTITIES, AvatarConfig
-from softdeca_train.avatars.mesh import AvatarMesh
+from softdeca_train.host.native import AvatarArrays, NativeAvatar, NativeFit, NativeModel
 from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.paths import REPO_ROOT, default_recordings_path
-from softdeca_train.runtime.native import AvatarArrays, NativeAvatar, NativeFit, NativeModel
+from softdeca_train.sample_avatars.build import make_avatar
+from softdeca_train.sample_avatars.config import HELD_OUT_IDENTITIES, AvatarConfig
+from softdeca_train.sample_avatars.mesh import AvatarMesh
 from softdeca_train.sim.take import read_take
 from softdeca_train.streaming.takes import take_paths
 from softdeca_train.template import Template

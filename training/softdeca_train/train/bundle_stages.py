@@ -22,9 +22,9 @@ from softdeca_train.train.batches import Dataset
 from softdeca_train.train.evaluate import SPARSE_INPUTS, measure, test_errors
 from softdeca_train.train.identity import IdentityConfig
 from softdeca_train.train.loop import LoopConfig
-from softdeca_train.train.models import Dynamics, SoftDecaHybrid, SparseSoftDeca
 from softdeca_train.train.registry import BUNDLE_STAGES
 from softdeca_train.train.run import Run
+from softdeca_train.train.trainable import Dynamics, SoftDecaHybrid, SparseSoftDeca
 
 
 @dataclass(frozen=True)
@@ -37,7 +37,7 @@ class BundleBudget:
     sparse_dynamics: float = 8.0
     identity_steps: int = 0  # the encoder starts exact (train/identity.py)
     steps: int | None = None  # a step budget per stage instead of the minutes (tests)
-    # SoftDECA's own step budget; 0 keeps its closed-form start (train/models.py), which on
+    # SoftDECA's own step budget; 0 keeps its closed-form start (train/trainable.py), which on
     # unseen identities measured better than the steps after it (docs/training.md).
     softdeca_steps: int | None = None
 

@@ -5,7 +5,7 @@ and anything no such shape moves left out) to the registered template skin
 triangles. A template squeezed onto part of the face leaves most of the face far from it; one
 lying on the avatar's surface leaves every face vertex within a millimetre or so.
 
-`python -m softdeca_train.runtime.fit_coverage` fits each low-poly variant (avatars/config.py,
+`python -m softdeca_train.host.fit_coverage` fits each low-poly variant (sample_avatars/config.py,
 LOW_POLY_VARIANTS) with the committed bundle and prints its coverage ($SOFTDECA_LIBRARY: another
 build of the library).
 
@@ -20,13 +20,13 @@ from dataclasses import dataclass
 import igl
 import numpy as np
 
-from softdeca_train.avatars.build import make_avatar
-from softdeca_train.avatars.config import LOW_POLY_VARIANTS
-from softdeca_train.avatars.mesh import AvatarMesh
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
+from softdeca_train.host.fit_check import DEFAULT_BUNDLE, avatar_arrays
+from softdeca_train.host.native import NativeFit, NativeModel
 from softdeca_train.landmarks.arkit_reference import ArkitFace
-from softdeca_train.runtime.fit_check import DEFAULT_BUNDLE, avatar_arrays
-from softdeca_train.runtime.native import NativeFit, NativeModel
+from softdeca_train.sample_avatars.build import make_avatar
+from softdeca_train.sample_avatars.config import LOW_POLY_VARIANTS
+from softdeca_train.sample_avatars.mesh import AvatarMesh
 from softdeca_train.template import Template
 
 # The shapes that move skin only on every rig (plugin/src/fit/avatar_fit.cpp, kSkinShapes).

@@ -7,7 +7,8 @@ import argparse
 import time
 from pathlib import Path
 
-from softdeca_train.avatars.config import (
+from softdeca_train.commands import Command, add_ict_argument
+from softdeca_train.sample_avatars.config import (
     DEFAULT_BODY_VERTICES,
     DEFAULT_IDENTITY,
     HELD_OUT_IDENTITIES,
@@ -18,7 +19,6 @@ from softdeca_train.avatars.config import (
     AvatarConfig,
     low_poly,
 )
-from softdeca_train.commands import Command, add_ict_argument
 
 # What real heads carry and how they are exported: on/off options of `avatar`.
 LOOK_FLAGS = (
@@ -172,9 +172,9 @@ def config_from_args(args: argparse.Namespace) -> AvatarConfig:
 
 
 def _avatar_run(args: argparse.Namespace) -> int:
-    from softdeca_train.avatars.build import make_avatar
-    from softdeca_train.avatars.files import write_avatar
     from softdeca_train.landmarks import ArkitFace
+    from softdeca_train.sample_avatars.build import make_avatar
+    from softdeca_train.sample_avatars.files import write_avatar
     from softdeca_train.template import Template
 
     start = time.perf_counter()

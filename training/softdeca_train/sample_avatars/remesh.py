@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import igl
 import numpy as np
 
-from softdeca_train.avatars.config import REMESH_STYLES
 from softdeca_train.landmarks.topology import face_normals, vertex_normals
+from softdeca_train.sample_avatars.config import REMESH_STYLES
 
 
 @dataclass(frozen=True)

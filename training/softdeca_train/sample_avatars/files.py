@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from softdeca_train.avatars.mesh import AvatarMesh, AvatarTruth
 from softdeca_train.mesh_files import read_obj, read_obj_groups, write_obj
+from softdeca_train.sample_avatars.mesh import AvatarMesh, AvatarTruth
 
 TRUTH_FILE = "truth.npz"
 

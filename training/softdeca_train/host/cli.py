@@ -126,7 +126,7 @@ def _replay_preview_args(p: argparse.ArgumentParser) -> None:
 
 
 def _replay_preview_run(args: argparse.Namespace) -> int:
-    from softdeca_train.runtime.preview import render_preview
+    from softdeca_train.host.preview import render_preview
 
     out = render_preview(args.replay, args.frames, physics_seed=args.physics_seed, ict=args.ict)
     print(f"wrote {out}")
@@ -138,7 +138,7 @@ def _runtime_test_data_args(p: argparse.ArgumentParser) -> None:
 
 
 def _runtime_test_data_run(args: argparse.Namespace) -> int:
-    from softdeca_train.runtime.testdata import write_test_data
+    from softdeca_train.host.testdata import write_test_data
 
     print(f"wrote {write_test_data(Path(args.out))}")
     return 0
@@ -156,7 +156,7 @@ def _hostile_avatars_args(p: argparse.ArgumentParser) -> None:
 
 
 def _hostile_avatars_run(args: argparse.Namespace) -> int:
-    from softdeca_train.runtime.hostile_avatars import write_corpus
+    from softdeca_train.host.hostile_avatars import write_corpus
 
     attacks = write_corpus(Path(args.out), args.fan_mib, args.bomb_mib)
     print(f"wrote {len(attacks)} hostile avatars and {Path(args.out) / 'corpus.json'}")
@@ -172,7 +172,7 @@ def _runtime_bench_args(p: argparse.ArgumentParser) -> None:
 
 
 def _runtime_bench_run(args: argparse.Namespace) -> int:
-    from softdeca_train.runtime.bench import DEFAULT_TAKE, bench_runtime
+    from softdeca_train.host.bench import DEFAULT_TAKE, bench_runtime
 
     take = Path(args.take) if args.take else DEFAULT_TAKE
     print(f"wrote {bench_runtime(Path(args.out), args.ict, take, args.frames, args.parameters)}")
@@ -180,7 +180,7 @@ def _runtime_bench_run(args: argparse.Namespace) -> int:
 
 
 def _fit_check_args(p: argparse.ArgumentParser) -> None:
-    from softdeca_train.avatars.config import HELD_OUT_IDENTITIES as held_out
+    from softdeca_train.sample_avatars.config import HELD_OUT_IDENTITIES as held_out
 
     p.add_argument("--out", default="build/fit-check/fit_check.json", help="the report (JSON)")
     p.add_argument(
@@ -197,8 +197,8 @@ def _fit_check_args(p: argparse.ArgumentParser) -> None:
 
 
 def _fit_check_run(args: argparse.Namespace) -> int:
-    from softdeca_train.avatars.config import HELD_OUT_IDENTITIES as held_out
-    from softdeca_train.runtime.fit_check import FitCheckConfig, run_fit_check, write_report
+    from softdeca_train.host.fit_check import FitCheckConfig, run_fit_check, write_report
+    from softdeca_train.sample_avatars.config import HELD_OUT_IDENTITIES as held_out
 
     config = FitCheckConfig(
         identities=tuple(args.identity or held_out),

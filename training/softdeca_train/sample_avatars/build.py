@@ -19,14 +19,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from softdeca_train.avatars.body import synthetic_body, synthetic_bust
-from softdeca_train.avatars.config import AvatarConfig
-from softdeca_train.avatars.extras import eyebrow_fins, hair_cards
-from softdeca_train.avatars.mesh import PARTS, AvatarMesh, AvatarTruth
-from softdeca_train.avatars.names import _side, rig_name
-from softdeca_train.avatars.remesh import SurfacePoints, remesh
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
 from softdeca_train.landmarks import ArkitFace
+from softdeca_train.sample_avatars.body import synthetic_body, synthetic_bust
+from softdeca_train.sample_avatars.config import AvatarConfig
+from softdeca_train.sample_avatars.extras import eyebrow_fins, hair_cards
+from softdeca_train.sample_avatars.mesh import PARTS, AvatarMesh, AvatarTruth
+from softdeca_train.sample_avatars.names import _side, rig_name
+from softdeca_train.sample_avatars.remesh import SurfacePoints, remesh
 from softdeca_train.template import Template
 from softdeca_train.template.components import COMPONENTS, SKIN_COMPONENTS
 from softdeca_train.template.identities import identity_coefficients

@@ -12,13 +12,13 @@ import subprocess
 import sys
 from pathlib import Path
 
-from softdeca_train.avatars import AvatarConfig, make_avatar, write_avatar
 from softdeca_train.models import FULL_SIZES, BundleInfo, build_random, export_bundle
 from softdeca_train.models.parameters import specs_or_test_list
 from softdeca_train.models.rest_head import rest_head_for_bundle
 from softdeca_train.models.template_head import template_head_from
 from softdeca_train.models.topology import from_template
 from softdeca_train.paths import REPO_ROOT, default_takes_path
+from softdeca_train.sample_avatars import AvatarConfig, make_avatar, write_avatar
 from softdeca_train.template import Template
 
 DEFAULT_TAKE = default_takes_path() / "S07-001.csv"

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from softdeca_train.host.files import write_rig
 from softdeca_train.mesh_files import write_obj
 from softdeca_train.models import (
     TEST_SIZES,
@@ -20,7 +21,6 @@ from softdeca_train.models import (
 )
 from softdeca_train.models.synthetic import TEST_PARAMETERS, synthetic_head, synthetic_rest_head
 from softdeca_train.models.template_head import template_head_of
-from softdeca_train.runtime.files import write_rig
 from softdeca_train.streaming.livelinkface import CSV_ORDER, VALUE_NAMES
 from softdeca_train.template.arkit import ARKIT_BLENDSHAPES
 

@@ -11,7 +11,7 @@ the import and the fit on what users bring (tests/python/test_avatar_gltf_famili
   `EXT_meshopt_compression` with a fallback buffer and `KHR_mesh_quantization`.
 
 Positions are the avatar's own, in metres with +Y up as glTF defines them, so a fit of the
-file and the avatar's truth (avatars/mesh.py) share one frame."""
+file and the avatar's truth (sample_avatars/mesh.py) share one frame."""
 
 from __future__ import annotations
 
@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from softdeca_train.avatars.mesh import PARTS, AvatarMesh
 from softdeca_train.face_names import ARKIT_BLENDSHAPES
 from softdeca_train.gltf_writer import GltfWriter
+from softdeca_train.sample_avatars.mesh import PARTS, AvatarMesh
 
 READY_PLAYER_ME_NAMES = {
     "skin": "Wolf3D_Head",
