@@ -154,9 +154,11 @@ class Avatar {
   void add_tail_bytes(const Preparation& prep, int model, bool dynamics, bool rigid_non_skin, bool normals,
                       FrameBytes& b) const;
   void softdeca_frame(const Preparation& prep, AvatarStats& st);
-  void add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients);  // static_ += c . modes
+  // static_ = base + c . modes (base may be static_ itself)
+  void add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients, const float* base);
   // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.
-  void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since);
+  void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since,
+                         const float* base);
   void prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
   // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep`.
   void prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,

@@ -54,9 +54,9 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   st.encoder_ms = ms(t, t1);
   if (prep.face_l.zero()) {
     // Every G_f is I: DT(S_t, I) = S_t + K^-1 0 = S_t exactly, so neither the right-hand side
-    // nor the solve is needed (a model started in closed form has no DT correction yet).
-    std::memcpy(static_.data(), head_.data(), vs_ * 3 * sizeof(float));
-    add_vertex_stages(prep, st, Clock::now());
+    // nor the solve is needed (a model started in closed form has no DT correction yet): the
+    // vertex stages start from the blend itself.
+    add_vertex_stages(prep, st, Clock::now(), head_.data());
     return;
   }
   const std::size_t blocks = prep.face_l.blocks();
@@ -79,19 +79,25 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   }
   auto t3 = Clock::now();
   st.solve_ms = ms(t2, t3);
-  add_vertex_stages(prep, st, t3);
+  add_vertex_stages(prep, st, t3, static_.data());
 }
 
-void Avatar::add_vertex_stages(const Preparation& prep, AvatarStats& st, Clock::time_point since) {
-  // The vertex stage on top of DT's result, in place: static_ += z . L_v.
-  if (!prep.softdeca_vertex_l.empty()) add_vertex_offsets(prep.softdeca_vertex_l, z_.data());
-  // The residual stage: its coefficients from w and the preparation's condition, then
-  // static_ += c . modes.
+void Avatar::add_vertex_stages(const Preparation& prep, AvatarStats& st, Clock::time_point since, const float* base) {
+  // static_ = base + z . L_v + c . modes (+ the physics at prepare): the first stage reads
+  // `base` (the blend, or DT's result already in static_), each later one works in place.
+  const float* from = base;
+  if (!prep.softdeca_vertex_l.empty()) {
+    add_vertex_offsets(prep.softdeca_vertex_l, z_.data(), from);
+    from = static_.data();
+  }
+  // The residual stage: its coefficients from w and the preparation's condition.
   if (!prep.residual_modes.empty()) {
     std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
     model_->residual_coefficients()->run(f_r_w_);
-    add_vertex_offsets(prep.residual_modes, residual_coefficients_.data());
+    add_vertex_offsets(prep.residual_modes, residual_coefficients_.data(), from);
+    from = static_.data();
   }
+  if (from != static_.data()) std::memcpy(static_.data(), from, vs_ * 3 * sizeof(float));
   // The physics at prepare's correction (empty at the defaults).
   if (!prep.rest_offset.empty()) {
     float* x = static_.data();
@@ -100,11 +106,10 @@ void Avatar::add_vertex_stages(const Preparation& prep, AvatarStats& st, Clock::
   st.hyper_ms += ms(since, Clock::now());
 }
 
-void Avatar::add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients) {
+void Avatar::add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients, const float* base) {
   const std::size_t blocks = modes.blocks();
   auto pass = [&](std::size_t part, std::size_t parts) {
-    kernels::vertex_offsets(modes, coefficients, static_.data(), blocks * part / parts, blocks * (part + 1) / parts,
-                   static_.data());
+    vertex_offsets(modes, coefficients, base, blocks * part / parts, blocks * (part + 1) / parts, static_.data());
   };
   worker_.run(pass);
 }
