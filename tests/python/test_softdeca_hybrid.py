@@ -126,7 +126,7 @@ def test_the_exported_frame_networks_hold_their_rest_terms_as_constants() -> Non
     with torch.no_grad():
         for prm in stage.parameters():
             prm.normal_()
-    p = torch.tensor([[s.default for s in specs]] * len(labels))
+    p = torch.tensor([[s.default_value for s in specs]] * len(labels))
     condition = stage.condition(p)
     # modes 3, hidden 8, members 2: the members' shares, then the 3 coefficients at rest
     assert condition.shape == (1, stage.condition_size) == (1, 2 * 8 + 3)
