@@ -130,6 +130,9 @@ class Avatar {
   // S_t of the last evaluate_weights (skin_vertices x 3): the linear blend the model corrected.
   // Frame thread only, valid until its next frame.
   const float* linear_skin() const { return head_.data(); }
+  // The 52 weights of the last evaluate_weights or evaluate_linear, checked and clamped to
+  // [0, 1] (read_weights). Frame thread only, valid until its next frame.
+  const float* weights() const { return weights_.data(); }
   // The avatar's neutral head (head_vertices x 3).
   const std::vector<float>& neutral() const { return neutral_; }
 

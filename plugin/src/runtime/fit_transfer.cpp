@@ -2,7 +2,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
-#include <algorithm>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -53,7 +52,6 @@ class EmbeddingTransfer final : public FitTransfer {
     blendshapes_ = Blendshapes(own.data(), bundle::kBlendshapeCount, n_, 1);
     head_out_.resize(vh_ * 3);
     field_.resize(vs_ * 3);
-    weights_.resize(bundle::kBlendshapeCount);
     normals_ = geometry::Normals(triangles_, n_);
   }
 
@@ -72,8 +70,7 @@ class EmbeddingTransfer final : public FitTransfer {
   }
 
   void blend(const float* weights, const Output& out) override {
-    for (std::size_t i = 0; i < weights_.size(); ++i) weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
-    blendshapes_.blend(weights_.data(), neutral_.data(), out.vertices, 0);
+    blendshapes_.blend(weights, neutral_.data(), out.vertices, 0);
   }
 
   void rest(const Output& out) override { std::memcpy(out.vertices, neutral_.data(), n_ * 3 * sizeof(float)); }
@@ -161,7 +158,7 @@ class EmbeddingTransfer final : public FitTransfer {
   Eigen::Matrix3f to_avatar_;  // the placement's inverse linear part (template vectors to the avatar's)
   fit::ShapeSource source_;
   // frame buffers
-  std::vector<float> head_out_, field_, weights_;
+  std::vector<float> head_out_, field_;
 };
 
 }  // namespace

@@ -29,7 +29,8 @@ class FitTransfer {
   // `out`; Error(INVALID_ARGUMENT) through a fit, whose correction comes from weights or landmarks.
   virtual Output surface_output(const Output& out) = 0;
 
-  // out = the avatar's own linear blend of the 52 weights (clamped to [0, 1]).
+  // out = the avatar's own linear blend of the 52 weights, as the core read them (checked and
+  // clamped: Avatar::weights).
   virtual void blend(const float* weights, const Output& out) = 0;
   // out = the avatar's own neutral.
   virtual void rest(const Output& out) = 0;

@@ -74,7 +74,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const AvatarDesc&
 void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
   core_->evaluate_weights(weights, count, transfer_->core_output(out));  // checks the weights
-  transfer_->blend(weights, out);
+  transfer_->blend(core_->weights(), out);
   transfer_->carry(core_->linear_skin(), out);  // the models' correction of the core's linear blend
   transfer_->finish(out);
 }
@@ -90,7 +90,7 @@ void FittedAvatar::evaluate_landmarks(const float* points, std::size_t count, co
 void FittedAvatar::evaluate_linear(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
   core_->evaluate_linear(weights, count, transfer_->core_output(out));  // checks the weights, counts the frame
-  transfer_->blend(weights, out);
+  transfer_->blend(core_->weights(), out);
   transfer_->finish(out);
 }
 
