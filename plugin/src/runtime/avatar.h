@@ -119,6 +119,9 @@ class Avatar {
                         const Output& out);
   void evaluate_landmarks(const float* points, std::size_t count, const Output& out);
   void evaluate_linear(const float* weights, std::size_t count, const Output& out);
+  // A linear frame blended outside the core (a fitted avatar's own rig): the weights checked and
+  // clamped (weights()) and the frame counted; its timings are the caller's.
+  void read_frame_weights(const float* weights, std::size_t count);
   void calibrate_landmarks(const float* points, std::size_t count);
   void clear_calibration();
 

@@ -301,6 +301,12 @@ void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Ou
   record(st);
 }
 
+void Avatar::read_frame_weights(const float* weights, std::size_t count) {
+  FrameGuard guard(busy_);
+  read_weights(weights, count);
+  record(AvatarStats{});
+}
+
 void Avatar::evaluate_linear(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();

@@ -18,6 +18,9 @@ class IdentityTransfer final : public FitTransfer {
   Output core_output(const Output& out) override { return out; }
   Output surface_output(const Output& out) override { return out; }
   void blend(const float*, const Output&) override {}
+  void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
+    core.evaluate_linear(weights, count, out);
+  }
   void rest(const Output&) override {}
   void carry(const float*, const Output&) override {}
   void finish(const Output&) override {}  // the core wrote the normals
@@ -71,6 +74,12 @@ class EmbeddingTransfer final : public FitTransfer {
 
   void blend(const float* weights, const Output& out) override {
     blendshapes_.blend(weights, neutral_.data(), out.vertices, 0);
+  }
+
+  void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
+    check_output_capacity(out, n_);
+    core.read_frame_weights(weights, count);
+    blend(core.weights(), out);
   }
 
   void rest(const Output& out) override { std::memcpy(out.vertices, neutral_.data(), n_ * 3 * sizeof(float)); }

@@ -32,6 +32,10 @@ class FitTransfer {
   // out = the avatar's own linear blend of the 52 weights, as the core read them (checked and
   // clamped: Avatar::weights).
   virtual void blend(const float* weights, const Output& out) = 0;
+  // A frame of the linear blend alone: the core checks the weights and counts the frame, and
+  // blends only where its head is the avatar's (the identity fit); through a fit the avatar's
+  // own rig blends them, so the registered template is not blended for nothing.
+  virtual void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) = 0;
   // out = the avatar's own neutral.
   virtual void rest(const Output& out) = 0;
   // out += the core's last frame minus `base` (the registered template's skin vertices x 3),

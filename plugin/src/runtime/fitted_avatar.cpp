@@ -89,8 +89,7 @@ void FittedAvatar::evaluate_landmarks(const float* points, std::size_t count, co
 
 void FittedAvatar::evaluate_linear(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
-  core_->evaluate_linear(weights, count, transfer_->core_output(out));  // checks the weights, counts the frame
-  transfer_->blend(core_->weights(), out);
+  transfer_->linear(*core_, weights, count, out);
   transfer_->finish(out);
 }
 
