@@ -303,16 +303,17 @@ void measure_storage(Bench& bench, unsigned precision) {
                name, lin.wall, st.wall, dy.wall, st.wall / lin.wall, lin.cpu, st.cpu, st.cpu / lin.cpu);
 }
 
-// Error of the compact storage: the same frames with float, half and int8 hyper-tensors.
-void measure_storage_error(Bench& bench) {
-  const Model& model = bench.model;
+// Error of the compact storage: the same frames with float, half and int8 hyper-tensors, on
+// `model` (keys `runtime.<prefix>half_added_error_max_mm`, ...; `networks` says whose
+// corrections set the figures).
+void measure_storage_error(Bench& bench, const Model& model, const std::string& prefix, const std::string& networks) {
   const std::size_t n = std::min<std::size_t>(bench.frames, 100);
   double worst[2] = {0, 0}, mean[2] = {0, 0}, worst_sp[2] = {0, 0};
   const unsigned precisions[3] = {SOFTDECA_PRECISION_FLOAT, SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_INT8};
   std::vector<std::vector<float>> ref_sd, ref_sp;
   const std::vector<float>& vertices = bench.vertices;
   for (int p = 0; p < 3; ++p) {
-    Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, precisions[p]);
+    Avatar a(model, bench.rig.neutral, bench.rig.deltas, 1, precisions[p]);
     check(softdeca_avatar_prepare(a.handle), "prepare");
     if (!bench.user.empty())
       check(softdeca_avatar_calibrate_landmarks(a.handle, bench.user.neutral.vertices.data(), bench.user.neutral.vertex_count()),
@@ -343,15 +344,14 @@ void measure_storage_error(Bench& bench) {
   const char* names[2] = {"half", "int8"};
   for (int p = 0; p < 2; ++p) {
     const std::string what = std::string(" storage of the hyper-tensors against float, over ") + std::to_string(n) +
-                             " frames of the take, all skin vertices (untrained networks: the size of their corrections sets this)";
-    bench.figures.raw(std::string("runtime.") + names[p] + "_added_error_max_mm",
-                      figure(worst[p], "mm", std::string("SoftDECA: max |x - x_float|, ") + names[p] + what));
-    bench.figures.raw(std::string("runtime.") + names[p] + "_added_error_mean_mm",
-                      figure(mean[p], "mm", std::string("SoftDECA: mean |x - x_float|, ") + names[p] + what));
-    bench.figures.raw(std::string("runtime.") + names[p] + "_added_error_sparse_max_mm",
+                             " frames of the take, all skin vertices (" + networks + ")";
+    const std::string key = "runtime." + prefix + names[p];
+    bench.figures.raw(key + "_added_error_max_mm", figure(worst[p], "mm", std::string("SoftDECA: max |x - x_float|, ") + names[p] + what));
+    bench.figures.raw(key + "_added_error_mean_mm", figure(mean[p], "mm", std::string("SoftDECA: mean |x - x_float|, ") + names[p] + what));
+    bench.figures.raw(key + "_added_error_sparse_max_mm",
                       figure(worst_sp[p], "mm", std::string("SparseSoftDECA: max |x - x_float|, ") + names[p] + what));
-    std::fprintf(stderr, "%s storage: SoftDECA max %.5f mm, mean %.6f mm; sparse max %.5f mm\n", names[p], worst[p], mean[p],
-                 worst_sp[p]);
+    std::fprintf(stderr, "%s%s storage: SoftDECA max %.5f mm, mean %.6f mm; sparse max %.5f mm\n", prefix.c_str(), names[p], worst[p],
+                 mean[p], worst_sp[p]);
   }
 }
 // A user's own avatar (a whole body, another topology): the fit, loading it, and its frames
@@ -565,6 +565,19 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
        {"linear", "shipped_linear_ms", linear,
         [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); }}},
       how);
+  // The same head with int8 hyper-tensors (a quarter of float's bytes), against its own linear
+  // blend in the same way, and what each compact storage adds to the trained networks' output.
+  Avatar head_int8(shipped, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_INT8);
+  check(softdeca_avatar_prepare(head_int8.handle), "prepare");
+  const auto [softdeca_int8, linear_int8] = alternating_ms(
+      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(head_int8.handle, w(f), 52, out), "softdeca"); },
+      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head_int8.handle, w(f), 52, out), "linear"); });
+  bench.figures.raw("runtime.shipped_softdeca_ms_int8", figure(softdeca_int8, "ms", "evaluate_weights, int8 hyper-tensors" + how));
+  bench.figures.raw("runtime.shipped_softdeca_over_linear_int8",
+                    figure(softdeca_int8 / linear_int8, "x", "shipped_softdeca_ms_int8 over the linear blend's frames between them" + how, 1.5));
+  std::fprintf(stderr, "shipped bundle, template, int8: softdeca %.3f ms, linear %.3f ms (x%.2f)\n", softdeca_int8, linear_int8,
+               softdeca_int8 / linear_int8);
+  measure_storage_error(bench, shipped, "shipped_", "the shipped bundle's trained networks, the template head");
   measure_crowd(bench, shipped, "; " + bench.how);
   if (own_path.empty()) return;
   const AvatarFile file = read_avatar_file(own_path);
@@ -630,7 +643,7 @@ int run_bench_runtime(const Args& args) {
   for (const unsigned threads : {1u, 2u}) measure_with_threads(bench, threads);
   measure_identity_fit(bench, o.text("--bundle"));
   for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) measure_storage(bench, precision);
-  measure_storage_error(bench);
+  measure_storage_error(bench, bench.model, "", "untrained networks: the size of their corrections sets this");
   measure_rest_physics(bench);
   if (o.given("--own-avatar")) measure_own_avatar(bench, o.text("--own-avatar"));
   if (o.given("--shipped-bundle")) measure_shipped(bench, o.text("--shipped-bundle"), o.given("--own-avatar") ? o.text("--own-avatar") : "");
