@@ -30,6 +30,7 @@ from softdeca_train.controls.real_takes import (
     RecordedTake,
     readme_lines,
     recorded_takes,
+    reduced,
     summarise,
     trained_on,
     trained_take_names,
@@ -236,6 +237,49 @@ def test_calm_frames_are_reported_and_a_take_worse_there_is_named() -> None:
         t.pop("calm")
     validate_real_takes(older)
     assert "calm ratio" in "".join(readme_lines(older))
+
+
+def test_unseen_takes_at_a_reduced_amplitude_are_pooled_apart() -> None:
+    """A reduced copy is the take's motion made calmly: reported per take with its amplitude,
+    pooled in `unseen_reduced`, and never in the recorded takes' `unseen` figure."""
+    seen = RecordedTake("source-a/seen", "0" * 64, np.full((3, 52), 0.5, np.float32))
+    unseen = RecordedTake(
+        "source-b/unseen", "1" * 64, np.full((3, 52), 0.5, np.float32)
+    )
+    calm = reduced(unseen, 0.3)
+    assert (calm.name, calm.amplitude) == (unseen.name, 0.3)
+    assert np.allclose(calm.weights, 0.15)
+    with pytest.raises(ValueError, match="amplitude"):
+        reduced(unseen, 1.0)
+    d = FrameDistances(
+        take=np.repeat([0, 1, 2], 3),
+        softdeca_mm=np.array([0.1, 0.1, 0.1, 0.2, 0.2, 0.2, 0.05, 0.03, 0.04]),
+        linear_mm=np.array([0.2, 0.2, 0.2, 0.4, 0.4, 0.4, 0.04, 0.04, 0.06]),
+    )
+    real = summarise(
+        [seen, unseen, calm], [True, False, False], d, every=10, identities=1
+    )
+    validate_real_takes(real)
+    assert real["unseen"]["frames"] == 3 and real["unseen"]["ratio"] == pytest.approx(
+        0.5
+    )
+    assert real["unseen_reduced"]["frames"] == 3 and real["reduced_amplitude"] == 0.3
+    assert real["unseen_reduced"]["ratio"] == pytest.approx(0.12 / 0.14)
+    row = real["takes"][2]
+    assert row["amplitude"] == 0.3 and row["calm"]["ratio"] == pytest.approx(
+        0.08 / 0.08
+    )
+    row["calm"]["ratio"] = 1.2
+    assert worse_when_calm(real) == ["source-b/unseen x0.3"]
+    assert any("unseen takes x0.3, pooled" in line for line in readme_lines(real))
+    with pytest.raises(ValueError, match="one reduced amplitude"):
+        summarise(
+            [seen, unseen, calm, reduced(unseen, 0.5)],
+            [True, False, False, False],
+            FrameDistances(np.repeat([0, 1, 2, 3], 1), *np.ones((2, 4))),
+            every=10,
+            identities=1,
+        )
 
 
 def test_the_takes_a_bundle_trained_on_come_from_its_training_record() -> None:

@@ -18,6 +18,7 @@ from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.networks import BETA_MAX
 from softdeca_train.parameters import load_parameters
 from softdeca_train.paths import REPO_ROOT
+from softdeca_train.train.batches import index_ranges
 from softdeca_train.train.bundle_stages import BundleBudget, stage_config, train_bundle
 from softdeca_train.train.loop import LoopConfig, train
 from softdeca_train.train.run import Run, RunConfig
@@ -273,6 +274,28 @@ def test_bundle_pipeline_exports_a_bundle_onnxruntime_agrees_with(
     assert names == set(load_parameters().controls().names)
     nets = OnnxNetworks(bundle)
     assert nets.has("softdeca") and nets.has("sparse")
+    _check_take_frames(run, m["training"]["dataset"]["train_take_frames"])
+
+
+def _check_take_frames(run: Run, record: dict) -> None:
+    """The training record names every take frame the kept train instances came from."""
+    names = [t["name"] for t in run.data.manifest["header"]["takes"]]
+    want: dict[str, set[int]] = {}
+    for kind in run.data.manifest["dataset"]["kinds"]:
+        for b in run.data.batches(kind, "train"):
+            for t, i in zip(b.source_take, b.source_index, strict=True):
+                if t >= 0:
+                    want.setdefault(names[int(t)], set()).add(int(i))
+    assert want, "the small dataset draws frames from the takes"
+    got = {}
+    for name, entry in record.items():
+        frames: set[int] = set()
+        for r in entry["frames"].split(","):
+            lo, _, hi = r.partition("-")
+            frames.update(range(int(lo), int(hi or lo) + 1))
+        got[name] = frames
+    assert got == want
+    assert index_ranges([0, 1, 2, 4, 7, 8]) == "0-2,4,7-8" and index_ranges([]) == ""
 
 
 def test_bundle_at_softdecas_start_is_exported_and_evaluated(small, tmp_path) -> None:

@@ -152,6 +152,13 @@ def add_report_arguments(p: argparse.ArgumentParser, standalone: bool = True) ->
     )
     p.add_argument("--real-every", type=int, default=10, help="every n-th frame (default 10)")
     p.add_argument("--real-identities", type=int, default=3, help="identities, 1-3 (default 3)")
+    p.add_argument(
+        "--real-reduced",
+        type=float,
+        default=0.3,
+        help="also judge every unseen take with its weights scaled by this, a calm face of the "
+        "same motion (default 0.3; 0: as recorded only)",
+    )
     p.add_argument("--no-real-takes", action="store_true", help="leave `real_takes` as it is")
     add_physics_cache_argument(p)
 
@@ -174,6 +181,7 @@ def report_parts(args: argparse.Namespace, bundle: Path) -> tuple[list[dict], di
             args.recordings,
             args.real_identities,
             args.real_every,
+            reduced_amplitude=args.real_reduced or None,
             physics_cache=physics_cache_of(args),
         )
         real = real_takes(cfg, bundle)

@@ -7,7 +7,10 @@ apart from those it never saw, and the report leads with the unseen ones. Mild f
 linear blend within MILD_MM of the physics: speech, small co-activations) are summarised apart
 from strong ones, since a pooled mean is mostly the many mild frames. Calm frames (the linear
 blend within CALM_MM: a face near rest, as in most live talking) are summarised too: there the
-linear blend is nearly the physics already, and SoftDECA must not be further from it."""
+linear blend is nearly the physics already, and SoftDECA must not be further from it. Recorded
+takes are mostly expressive, so every unseen take is also judged at a reduced amplitude (each
+frame's weights scaled alike): the same motion as a calm face makes it, where calm frames are
+many."""
 
 from __future__ import annotations
 
@@ -23,11 +26,23 @@ from softdeca_train.streaming.takes import TAKE_SUFFIXES, read_take, take_paths
 MILD_MM = 0.1  # a frame is mild when the linear blend is this close to the physics (mean, mm)
 CALM_MM = 0.05  # and calm when it is this close
 GROUP_KEYS = ("frames", "softdeca_mm", "linear_mm", "ratio")
-TAKE_KEYS = ("take", "trained_on", *GROUP_KEYS, "mild", "strong", "calm")
-KEYS = ("every", "identities", "mild_mm", "calm_mm", "takes", "unseen", "seen", "rest")
-# Reports made before the calm figure existed lack these; they are read all the same.
-LATER_TAKE_KEYS = ("calm",)
-LATER_KEYS = ("calm_mm",)
+TAKE_KEYS = ("take", "trained_on", "amplitude", *GROUP_KEYS, "mild", "strong", "calm")
+KEYS = (
+    "every",
+    "identities",
+    "mild_mm",
+    "calm_mm",
+    "reduced_amplitude",
+    "takes",
+    "unseen",
+    "unseen_reduced",
+    "seen",
+    "rest",
+)
+# Reports made before the calm figure and the reduced takes existed lack these; they are read
+# all the same.
+LATER_TAKE_KEYS = ("calm", "amplitude")
+LATER_KEYS = ("calm_mm", "reduced_amplitude", "unseen_reduced")
 REST_KEYS = ("softdeca_mm", "linear_mm")
 
 
@@ -36,6 +51,18 @@ class RecordedTake:
     name: str  # "<source folder>/<take>" relative to the recordings folder
     sha256: str
     weights: np.ndarray  # (n, 52) every n-th tracked frame, canonical ARKit order
+    amplitude: float = 1.0  # the recorded weights scaled by this (1: as recorded)
+
+    def label(self) -> str:
+        return self.name if self.amplitude == 1.0 else f"{self.name} x{self.amplitude:g}"
+
+
+def reduced(take: RecordedTake, amplitude: float) -> RecordedTake:
+    """`take` at a reduced amplitude: every weight of every frame scaled by `amplitude` (the
+    expression's shape kept, as the data's reduced draws, data/expressions.py)."""
+    if not 0.0 < amplitude < 1.0:
+        raise ValueError(f"a reduced amplitude is in (0, 1), got {amplitude}")
+    return RecordedTake(take.name, take.sha256, take.weights * np.float32(amplitude), amplitude)
 
 
 def recorded_takes(recordings: Path, every: int) -> list[RecordedTake]:
@@ -132,24 +159,34 @@ def summarise(
     rest: tuple[float, float] | None = None,
 ) -> dict:
     """The `real_takes` section: per take, pooled over the unseen takes and over the seen ones
-    (those a training frame came from); ratio: SoftDECA's distance to the physics over the
-    linear blend's, pooled over frames. `rest`: the mean distances (SoftDECA, linear) of the
-    neutral face (every weight 0), where a calm take's frames lie."""
+    (those a training frame came from) as recorded, and over the unseen takes at a reduced
+    amplitude (`unseen_reduced`); ratio: SoftDECA's distance to the physics over the linear
+    blend's, pooled over frames. `rest`: the mean distances (SoftDECA, linear) of the neutral
+    face (every weight 0), where a calm take's frames lie."""
     per_take = []
     for i, take in enumerate(takes):
         rows = d.take == i
         group = _with_mild_and_strong(d.softdeca_mm[rows], d.linear_mm[rows])
         if group is None:
-            raise ValueError(f"take {take.name}: no frame evaluated")
-        per_take.append({"take": take.name, "trained_on": seen[i], **group})
+            raise ValueError(f"take {take.label()}: no frame evaluated")
+        per_take.append(
+            {"take": take.name, "trained_on": seen[i], "amplitude": take.amplitude, **group}
+        )
+    amplitudes = sorted({t.amplitude for t in takes if t.amplitude != 1.0})
+    if len(amplitudes) > 1:
+        raise ValueError(f"one reduced amplitude per report, got {amplitudes}")
+    whole = [i for i, t in enumerate(takes) if t.amplitude == 1.0]
+    calm = [i for i, t in enumerate(takes) if t.amplitude != 1.0 and not seen[i]]
     return {
         "every": every,
         "identities": identities,
         "mild_mm": MILD_MM,
         "calm_mm": CALM_MM,
+        "reduced_amplitude": amplitudes[0] if amplitudes else None,
         "takes": per_take,
-        "unseen": _pooled(d, [i for i in range(len(takes)) if not seen[i]], per_take),
-        "seen": _pooled(d, [i for i in range(len(takes)) if seen[i]], per_take),
+        "unseen": _pooled(d, [i for i in whole if not seen[i]], per_take),
+        "unseen_reduced": _pooled(d, calm, per_take),
+        "seen": _pooled(d, [i for i in whole if seen[i]], per_take),
         "rest": None if rest is None else dict(zip(REST_KEYS, rest, strict=True)),
     }
 
@@ -184,8 +221,8 @@ def validate_real_takes(real: object) -> None:
             _check_group(f"{t['take']}.{part}", t.get(part), optional=True)
     if real["unseen"] is None and real["seen"] is None:
         raise ValueError("report: real_takes has neither unseen nor seen takes")
-    for part in ("unseen", "seen"):
-        _check_group(part, real[part], optional=True)
+    for part in ("unseen", "seen", "unseen_reduced"):
+        _check_group(part, real.get(part), optional=True)
     rest = real["rest"]
     if rest is not None and not (
         isinstance(rest, dict)
@@ -199,10 +236,15 @@ def worse_when_calm(real: dict) -> list[str]:
     """The takes on whose calm frames SoftDECA is further from the physics than the linear
     blend (calm ratio above 1): what a user streaming calm talking would see."""
     return [
-        t["take"]
+        _take_label(t)
         for t in real["takes"]
         if (t.get("calm") or {}).get("ratio") is not None and t["calm"]["ratio"] > 1.0
     ]
+
+
+def _take_label(t: dict) -> str:
+    a = t.get("amplitude", 1.0)
+    return t["take"] if a == 1.0 else f"{t['take']} x{a:g}"
 
 
 def _cell(g: dict | None, key: str) -> str:
@@ -218,7 +260,13 @@ def readme_lines(real: dict) -> list[str]:
         "trained on, default parameters): mean distance to the physics over the skin (mm) and "
         "SoftDECA's share of the linear blend's (ratio; below 1 is closer to the physics). "
         f"Mild frames: the linear blend within {real['mild_mm']} mm of the physics"
-        + (f"; calm frames: within {real['calm_mm']} mm." if "calm_mm" in real else "."),
+        + (f"; calm frames: within {real['calm_mm']} mm." if "calm_mm" in real else ".")
+        + (
+            f" Takes marked x{real['reduced_amplitude']:g} are an unseen take with every weight "
+            "scaled by that: the same motion made calmly."
+            if real.get("reduced_amplitude")
+            else ""
+        ),
         "",
         *(
             [
@@ -242,9 +290,13 @@ def readme_lines(real: dict) -> list[str]:
         "| strong ratio |",
         "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
-    rows = sorted(real["takes"], key=lambda t: (t["trained_on"], t["take"]))
-    for label, g in [(t["take"], t) for t in rows] + [
+    rows = sorted(
+        real["takes"], key=lambda t: (t["trained_on"], t["take"], -t.get("amplitude", 1.0))
+    )
+    reduced_label = f"unseen takes x{real.get('reduced_amplitude') or 0:g}, pooled"
+    for label, g in [(_take_label(t), t) for t in rows] + [
         ("**unseen takes, pooled**", real["unseen"]),
+        (f"**{reduced_label}**", real.get("unseen_reduced")),
         ("in-distribution takes, pooled", real["seen"]),
     ]:
         if g is None:

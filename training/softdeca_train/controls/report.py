@@ -25,6 +25,7 @@ from softdeca_train.controls.real_takes import (
     FrameDistances,
     readme_lines,
     recorded_takes,
+    reduced,
     summarise,
     trained_on,
     trained_take_names,
@@ -71,6 +72,9 @@ class RealTakes:
     recordings: Path  # every *.csv below it is a take
     identities: int = 3
     every: int = 10
+    # every unseen take is also judged with its weights scaled by this (a calm face of the
+    # same motion; controls/real_takes.py); None: as recorded only
+    reduced_amplitude: float | None = 0.3
     level: int = 3
     chunk: int = 32  # frames solved per batch (memory)
     # solves reused across runs (controls/physics_cache.py); None: always solve
@@ -107,6 +111,10 @@ def real_takes(cfg: RealTakes, bundle: Path, progress: bool = True) -> dict:
         raise ValueError(f"identities must be in 1..{len(IDENTITY_SEEDS)}, every >= 1")
     takes = recorded_takes(cfg.recordings, cfg.every)
     trained = trained_take_names(json.loads((Path(bundle) / "manifest.json").read_text()))
+    if cfg.reduced_amplitude is not None:
+        takes += [
+            reduced(t, cfg.reduced_amplitude) for t in list(takes) if not trained_on(t, trained)
+        ]
     template = Template.load()
     nets = OnnxNetworks(bundle)
     cache = open_cache(cfg.physics_cache)

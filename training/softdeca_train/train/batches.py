@@ -42,6 +42,20 @@ def training_mask(arrays: dict[str, np.ndarray], limit: float) -> tuple[np.ndarr
     return solved, sane
 
 
+def index_ranges(indices: list[int]) -> str:
+    """Sorted distinct integers as ranges: [0, 1, 2, 4, 7, 8] -> "0-2,4,7-8"."""
+    runs: list[str] = []
+    start = prev = None
+    for i in [*indices, None]:
+        if start is not None and (i is None or i != prev + 1):
+            runs.append(str(start) if start == prev else f"{start}-{prev}")
+            start = None
+        if i is not None and start is None:
+            start = i
+        prev = i
+    return ",".join(runs)
+
+
 @dataclass
 class Batch:
     """One group of frames. Shapes: B frames (static/sparse) or L sequence frames (dynamic);
@@ -63,6 +77,7 @@ class Batch:
     prev_T: torch.Tensor | None = None
     prev_weights: torch.Tensor | None = None  # dynamic: (2, 52)
     source_take: np.ndarray | None = None  # (B,) take index or -1 (coverage)
+    source_index: np.ndarray | None = None  # (B,) frame of that take, or coverage draw
     # static/sparse: (len(REGIONS), P) the group's values per region of S (template/regions.py),
     # p in every region without a regional pattern; None in datasets written without them
     p_regions: torch.Tensor | None = None
@@ -162,6 +177,46 @@ class Dataset:
             failed += int((solved & ~sane).sum())
         return {"kept": kept, "left_out": left, "failed_bounds": failed, "max_error": limit}  # type: ignore[dict-item]
 
+    def take_frames(self, split: str = "train") -> dict[str, dict]:
+        """Which frames of which recorded takes the kept instances of `split` came from (every
+        kind; coverage draws are no take's): per take name, the instances per kind and the frame
+        indices as ranges ("0-4,9"), for a training record that says what a model saw."""
+        names = [t["name"] for t in self.manifest["header"].get("takes", [])]
+        limit = 3 * self.tolerance
+        seen: dict[str, dict] = {}
+        for kind in self.manifest["dataset"]["kinds"]:
+            for f in self.shards(kind, split):
+                with np.load(self.folder / f) as z:
+                    arrays = {
+                        k: z[k]
+                        for k in (
+                            "instance_id",
+                            "estimated_error",
+                            "failures",
+                            "source_take",
+                            "source_index",
+                        )
+                        if k in z
+                    }
+                if "source_take" not in arrays:
+                    continue
+                solved, sane = training_mask(arrays, limit)
+                keep = solved & sane
+                takes = arrays["source_take"][keep].reshape(-1)
+                index = arrays["source_index"][keep].reshape(-1)
+                for t in np.unique(takes[takes >= 0]):
+                    entry = seen.setdefault(names[int(t)], {"instances": {}, "frames": set()})
+                    entry["instances"][kind] = entry["instances"].get(kind, 0) + int(
+                        (arrays["source_take"][keep].reshape(int(keep.sum()), -1) == t)
+                        .any(axis=1)
+                        .sum()
+                    )
+                    entry["frames"].update(int(i) for i in index[takes == t])
+        return {
+            name: {"instances": e["instances"], "frames": index_ranges(sorted(e["frames"]))}
+            for name, e in sorted(seen.items())
+        }
+
     def batches(
         self,
         kind: str,
@@ -213,6 +268,7 @@ class Dataset:
             T=f32(t),
             dt=system,
             source_take=a["source_take"][idx].reshape(-1),
+            source_index=a["source_index"][idx].reshape(-1),
         )
         if "p_regions" in a:
             pr = a["p_regions"][i0][:, self.columns]

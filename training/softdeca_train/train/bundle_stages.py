@@ -143,6 +143,7 @@ def _dataset_summary(data: Dataset | None) -> dict | None:
             k: {"identities": len(v["identities"]), "takes": v["takes"]}
             for k, v in m["dataset"]["splits"].items()
         },
+        "train_take_frames": data.take_frames("train"),
     }
 
 
