@@ -2,6 +2,7 @@
 // the avatar's own mesh, one step at a time, so that every avatar runs the same frame path:
 //
 //   core frame into core_output(out); blend(weights) or rest(); carry(base); finish()
+//   a linear frame alone: linear(core, weights); finish()
 //
 // Through a fit (embedding_transfer) the avatar's own rig gives the linear part, and the core's
 // correction, its frame minus `base`, is carried through the fit's embedding. A mesh in the

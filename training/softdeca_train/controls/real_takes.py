@@ -54,7 +54,12 @@ class RecordedTake:
     amplitude: float = 1.0  # the recorded weights scaled by this (1: as recorded)
 
     def label(self) -> str:
-        return self.name if self.amplitude == 1.0 else f"{self.name} x{self.amplitude:g}"
+        return take_label(self.name, self.amplitude)
+
+
+def take_label(name: str, amplitude: float) -> str:
+    """How the report names a take: its name, and its amplitude where it is reduced."""
+    return name if amplitude == 1.0 else f"{name} x{amplitude:g}"
 
 
 def reduced(take: RecordedTake, amplitude: float) -> RecordedTake:
@@ -243,8 +248,7 @@ def worse_when_calm(real: dict) -> list[str]:
 
 
 def _take_label(t: dict) -> str:
-    a = t.get("amplitude", 1.0)
-    return t["take"] if a == 1.0 else f"{t['take']} x{a:g}"
+    return take_label(t["take"], t.get("amplitude", 1.0))
 
 
 def _cell(g: dict | None, key: str) -> str:

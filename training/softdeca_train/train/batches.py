@@ -56,6 +56,9 @@ def index_ranges(indices: list[int]) -> str:
     return ",".join(runs)
 
 
+SOURCES = ("source_take", "source_index")  # where an instance's expression came from
+
+
 @dataclass
 class Batch:
     """One group of frames. Shapes: B frames (static/sparse) or L sequence frames (dynamic);
@@ -168,10 +171,7 @@ class Dataset:
         failed sanity bound (`failed_bounds`, sim/sanity.py): reported, never silent."""
         limit = 3 * self.tolerance if max_error is None else max_error
         kept = left = failed = 0
-        for f in self.shards(kind, split):
-            with np.load(self.folder / f) as z:
-                arrays = {k: z[k] for k in ("instance_id", "estimated_error", "failures") if k in z}
-            solved, sane = training_mask(arrays, limit)
+        for _, solved, sane in self._judged(kind, split, limit):
             kept += int((solved & sane).sum())
             left += int((~solved).sum())
             failed += int((solved & ~sane).sum())
@@ -182,40 +182,35 @@ class Dataset:
         kind; coverage draws are no take's): per take name, the instances per kind and the frame
         indices as ranges ("0-4,9"), for a training record that says what a model saw."""
         names = [t["name"] for t in self.manifest["header"].get("takes", [])]
-        limit = 3 * self.tolerance
         seen: dict[str, dict] = {}
         for kind in self.manifest["dataset"]["kinds"]:
-            for f in self.shards(kind, split):
-                with np.load(self.folder / f) as z:
-                    arrays = {
-                        k: z[k]
-                        for k in (
-                            "instance_id",
-                            "estimated_error",
-                            "failures",
-                            "source_take",
-                            "source_index",
-                        )
-                        if k in z
-                    }
+            for arrays, solved, sane in self._judged(kind, split, 3 * self.tolerance, SOURCES):
                 if "source_take" not in arrays:
                     continue
-                solved, sane = training_mask(arrays, limit)
                 keep = solved & sane
-                takes = arrays["source_take"][keep].reshape(-1)
-                index = arrays["source_index"][keep].reshape(-1)
+                # dynamic instances are sequences: one take per sequence, a frame per step
+                takes = arrays["source_take"][keep].reshape(int(keep.sum()), -1)
+                index = arrays["source_index"][keep].reshape(takes.shape)
                 for t in np.unique(takes[takes >= 0]):
                     entry = seen.setdefault(names[int(t)], {"instances": {}, "frames": set()})
-                    entry["instances"][kind] = entry["instances"].get(kind, 0) + int(
-                        (arrays["source_take"][keep].reshape(int(keep.sum()), -1) == t)
-                        .any(axis=1)
-                        .sum()
-                    )
+                    count = int((takes == t).any(axis=1).sum())
+                    entry["instances"][kind] = entry["instances"].get(kind, 0) + count
                     entry["frames"].update(int(i) for i in index[takes == t])
         return {
             name: {"instances": e["instances"], "frames": index_ranges(sorted(e["frames"]))}
             for name, e in sorted(seen.items())
         }
+
+    def _judged(
+        self, kind: str, split: str, limit: float, more: tuple[str, ...] = ()
+    ) -> Iterator[tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]]:
+        """Per shard of one kind and split: its arrays (the solver and sanity columns and
+        `more`) and training_mask's verdicts at `limit`."""
+        for f in self.shards(kind, split):
+            with np.load(self.folder / f) as z:
+                keys = ("instance_id", "estimated_error", "failures", *more)
+                arrays = {k: z[k] for k in keys if k in z}
+            yield (arrays, *training_mask(arrays, limit))
 
     def batches(
         self,
