@@ -1,5 +1,6 @@
 """Command lines of the training: `train-bundle` (every bundle network, then the bundle),
-`bundle-sparse` (a retrained SparseSoftDECA into a bundle), `train-model` (one model of the
+`bundle-sparse` (a retrained SparseSoftDECA into a bundle), `bundle-carry` (one model's
+networks as they are from another bundle), `train-model` (one model of the
 registry, e.g. a baseline), `evaluate` (the report), `linear-baseline` (closed-form linear
 fits of the data)."""
 
@@ -146,6 +147,27 @@ def run_replace_sparse(args: argparse.Namespace) -> int:
             run, Path(args.bundle), Path(args.report), args.model, not args.no_progress
         )
         print(f"{path}: SparseSoftDECA's rows re-measured")
+    return 0
+
+
+def add_carry_args(p: argparse.ArgumentParser) -> None:
+    from softdeca_train.models.bundle_carry import MODELS as CARRIED
+
+    p.add_argument("--from", dest="source", required=True, help="bundle folder to copy from")
+    p.add_argument(
+        "--bundle", default=DEFAULT_BUNDLE, help=f"bundle to change in place ({DEFAULT_BUNDLE})"
+    )
+    p.add_argument(
+        "--model", choices=sorted(CARRIED), default="sparse", help="whose networks (sparse)"
+    )
+
+
+def run_carry(args: argparse.Namespace) -> int:
+    from softdeca_train.models.bundle_carry import carry_model
+    from softdeca_train.train.bundle_stages import default_command
+
+    names = carry_model(args.source, args.bundle, args.model, default_command())
+    print(f"{args.bundle}: {', '.join(names)} carried from {args.source}")
     return 0
 
 
@@ -309,6 +331,14 @@ COMMANDS = [
         "a run's trained one, with its test errors and training record in the manifest.",
         add_replace_sparse_args,
         run_replace_sparse,
+    ),
+    Command(
+        "bundle-carry",
+        "Copy one model's networks (e.g. SparseSoftDECA) as they are from another bundle that "
+        "reads the same template, landmarks, parameters and identity code, with their test "
+        "errors and origin in the manifest.",
+        add_carry_args,
+        run_carry,
     ),
     Command(
         "train-model",
