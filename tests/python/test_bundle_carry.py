@@ -79,6 +79,11 @@ def test_carried_networks_are_the_sources_and_nothing_else_changes(bundles) -> N
         "dest"
     )
     assert not list(dest.glob("*.partial"))
+    # the evaluation report names the carried networks (they are not its run's)
+    from softdeca_train.train.report import _carried
+
+    assert _carried(dest) == dict.fromkeys(SPARSE, "unknown")
+    assert _carried(source) == {}
 
 
 def test_bundles_that_read_other_inputs_are_refused_and_left_as_they_were(

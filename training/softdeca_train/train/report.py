@@ -20,7 +20,7 @@ from tqdm import tqdm
 
 from softdeca_train.bench import write_area
 from softdeca_train.data.config import GenerateConfig
-from softdeca_train.models.bundle import OnnxNetworks
+from softdeca_train.models.bundle import OnnxNetworks, read_manifest
 from softdeca_train.models.reference import ReferenceAvatar
 from softdeca_train.render import MeshLayer, RenderSettings, render, tile
 from softdeca_train.template.model import N_SKIN
@@ -350,7 +350,9 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
                 f"| {label} | {_row(e[k])} | {_row(e[k], 'real_take_mm')} | "
                 f"{_row(e[k], 'coverage_mm')} | {_training(run, key)} |"
             )
-    lines += sparse_section(run, e, r["bundle"].get("sparse") if r["bundle"] else None)
+    lines += sparse_section(
+        run, e, r["bundle"].get("sparse") if r["bundle"] else None, _carried(bundle)
+    )
     loc = r["localisation"]
     lines += [
         "",
@@ -386,8 +388,27 @@ SPARSE_ROWS = (
 SPARSE_HEADING = "## Table 2 analogue: SparseSoftDECA"
 
 
-def sparse_section(run: Run, e: dict, bundle_sparse: dict | None) -> list[str]:
-    """The report's Table 2: SparseSoftDECA's models of the run on its test split."""
+def _carried(bundle: Path) -> dict[str, str]:
+    """The bundle's SparseSoftDECA networks that another bundle made (bundle-carry), with
+    the dataset each was trained on; empty when the bundle's own training made them."""
+    if not (bundle / "manifest.json").is_file():
+        return {}
+    out: dict[str, str] = {}
+    for r in (read_manifest(bundle).get("training") or {}).get("replaced", []):
+        for name in r["networks"]:
+            if name.startswith("sparse."):
+                if "carried_from" in r:
+                    out[name] = r.get("origins", {}).get(name, "another bundle")
+                else:
+                    out.pop(name, None)
+    return out
+
+
+def sparse_section(
+    run: Run, e: dict, bundle_sparse: dict | None, carried: dict[str, str] | None = None
+) -> list[str]:
+    """The report's Table 2: SparseSoftDECA's models of the run on its test split; with
+    `carried` (_carried), a note that the bundle's networks are not the run's."""
     cfg = run.data.manifest["header"]["config"]
     lines = [
         "",
@@ -411,6 +432,14 @@ def sparse_section(run: Run, e: dict, bundle_sparse: dict | None) -> list[str]:
         lines.append(
             f"| the bundle end to end (ONNX, encoder's h) | – | – | {_row(bundle_sparse)} | – | – |"
         )
+    if carried:
+        origins = ", ".join(f"`{k}` ({v})" for k, v in sorted(carried.items()))
+        lines += [
+            "",
+            "The bundle's SparseSoftDECA is not this run's: its networks were carried as they "
+            f"are from another bundle (`bundle-carry`; trained on: {origins}; the manifest's "
+            "training.replaced). The bundle row measures them on this run's test split.",
+        ]
     return lines
 
 
