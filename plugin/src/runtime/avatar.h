@@ -84,16 +84,17 @@ struct Preparation {
   std::shared_ptr<const DeformationTransfer> dt;
   std::vector<float> identity;
   kernels::HyperTensor face_l, vertex_l;       // SoftDECA: [F][latent][9]; sparse: [Vs][latent][3]
-  kernels::HyperTensor softdeca_vertex_l;      // SoftDECA's vertex stage, [Vs][latent][3] (empty: none)
-  // SoftDECA's residual stage: the condition its frame half reads, and its modes
-  // [Vs][modes][3] (empty: none)
-  std::vector<float> residual_condition;
-  kernels::HyperTensor residual_modes;
+  // SoftDECA's vertex and residual stages as one table [Vs][latent + modes][3] (empty: neither):
+  // the vertex stage's L_v(p, h), weighed by z, then the residual stage's modes, weighed by its
+  // coefficients c(w, condition), so that one contraction with (z, c) adds both in one pass.
+  kernels::HyperTensor vertex_stages;
+  std::vector<float> residual_condition;  // what the residual stage's frame half reads with w
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
   // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)], p_inert being
   // p's rest-inert parameters alone, the others at their defaults (prepare/rest_physics.h).
   std::vector<float> rest_offset;
+  float rest_offset_peak = 0;  // its largest magnitude
   std::size_t bytes() const;
 };
 
@@ -130,9 +131,14 @@ class Avatar {
 
   AvatarStats stats() const;
 
-  // S_t of the last evaluate_weights (skin_vertices x 3): the linear blend the model corrected.
-  // Frame thread only, valid until its next frame.
-  const float* linear_skin() const { return head_.data(); }
+  // SoftDECA's correction of the linear blend S_t for 52 weights (checked and clamped as
+  // evaluate_weights does) into `correction` (skin_vertices x 3): the frame's skin minus S_t,
+  // the dynamics included when they are on. A fitted avatar carries it onto its own mesh. With
+  // the DT stage at identity and the dynamics off it is the vertex and residual stages' offsets
+  // alone (and the physics at prepare's), so the template is not blended at all. On
+  // Error(NON_FINITE) `correction` holds no valid frame: it is the caller's scratch, which only
+  // a frame that succeeds carries into an output.
+  void evaluate_correction(const float* weights, std::size_t count, float* correction);
   // The 52 weights of the last evaluate_weights or evaluate_linear, checked and clamped to
   // [0, 1] (read_weights). Frame thread only, valid until its next frame.
   const float* weights() const { return weights_.data(); }
@@ -143,29 +149,47 @@ class Avatar {
   std::shared_ptr<const Preparation> current() const;
   kernels::HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                            const std::vector<float>& identity, std::size_t n, std::size_t width) const;
+  // The same network's values, checked, before they are stored ([n][latent][width]).
+  std::vector<float> hyper_values(const OnnxNetwork& net, const std::vector<float>& parameters,
+                                  const std::vector<float>& identity, std::size_t n, std::size_t width) const;
   void read_weights(const float* weights, std::size_t count);
   const float* select_landmarks(const float* points, std::size_t count, const char* what) const;
-  // The shared tail of a frame: dynamics, checks, output of the head and normals. Returns
-  // whether the dynamics ran.
-  bool finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
-              AvatarStats& st);
+  // The shared tail of a frame: settle, then the head written to `out` (the skin, and the
+  // non-skin vertices from `non_skin` or following the bones) and its normals.
+  void finish(const Preparation& prep, int model, const float* skin, const float* non_skin, bool dynamics,
+              const Output& out, AvatarStats& st);
+  // The dynamics on `skin` (when on) and the check that the result is finite (Error(NON_FINITE)
+  // otherwise, before anything is written); returns the frame's final skin.
+  const float* settle(const Preparation& prep, int model, const float* skin, bool dynamics, AvatarStats& st);
+  // A frame without dynamics forgets their past (a later frame with them starts at rest).
+  void settle_static();
   // FrameBytes of each kind of frame (avatar_frame_bytes.cpp), after it ran: `surface`, the
   // vertices of a caller's surface (0: blended from the weights read); `dynamics`, what finish
   // returned; `normals`, whether the output has normals.
   FrameBytes softdeca_bytes(const Preparation& prep, std::size_t surface, bool dynamics, bool normals) const;
+  // evaluate_correction's: `blended`, whether it blended the template (the dynamics or DT ran).
+  FrameBytes correction_bytes(const Preparation& prep, bool blended, bool dynamics) const;
   FrameBytes sparse_bytes(const Preparation& prep, bool dynamics, bool normals) const;
   FrameBytes linear_bytes(bool normals) const;
   // The tail's (finish): dynamics, the head written (and the neutral's non-skin vertices read
   // where they follow the bones), normals.
   void add_tail_bytes(const Preparation& prep, int model, bool dynamics, bool rigid_non_skin, bool normals,
                       FrameBytes& b) const;
+  // f_w's z and the vertex stages' coefficients (z, c) of the weights read.
+  void encode_weights(const Preparation& prep, AvatarStats& st);
+  // SoftDECA's static skin from the linear skin in head_ into static_: DT (unless every G_f is
+  // I), then the vertex stages.
   void softdeca_frame(const Preparation& prep, AvatarStats& st);
-  // static_ = base + c . modes (base may be static_ itself)
-  void add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients, const float* base);
-  // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.
-  void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since,
-                         const float* base);
-  void prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
+  // out = base + the vertex and residual stages' offsets + the physics at prepare's (skin x 3;
+  // base may be out itself, or null for the offsets alone); their time joins hyper_ms.
+  void add_vertex_stages(const Preparation& prep, const float* base, float* out, AvatarStats& st);
+  // Whether the frame of the weights read may be written straight into the caller's output:
+  // no dynamics, DT at identity, and every sum it forms provably finite (so it needs no check
+  // afterwards that would have to leave the previous output untouched).
+  bool in_place(const Preparation& prep, bool dynamics) const;
+  // The residual stage's prepare half for these parameters: its condition into `prep`; returns
+  // its modes [Vs][modes][3] (empty: no residual stage).
+  std::vector<float> prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
   // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep`.
   void prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
                                Preparation& prep) const;
@@ -187,6 +211,7 @@ class Avatar {
   std::size_t vh_, vs_, nf_;
   kernels::Precision precision_;
   std::vector<float> neutral_;  // Vh x 3
+  float neutral_peak_;          // its largest magnitude (infinite if one is not finite)
   std::vector<std::int32_t> triangles_;
   SkinGeometry geometry_;
   std::vector<double> neutral_landmarks_;  // K x 3, on the avatar's neutral skin
@@ -216,7 +241,10 @@ class Avatar {
   std::atomic<bool> busy_{false};
   std::atomic<bool> dynamics_enabled_{false}, reset_requested_{false};
   kernels::AlignedArray<float> weights_, z_, offsets_, head_, static_;
-  kernels::AlignedArray<float> residual_condition_, residual_coefficients_;  // the residual stage's frame half
+  // The vertex stages' coefficients (z, c): z's copy for the vertex stage (stage_latents_ of
+  // them), then the residual stage's frame half's output; and that half's condition input.
+  std::size_t stage_latents_, residual_modes_;
+  kernels::AlignedArray<float> stage_coefficients_, residual_condition_;
   std::vector<kernels::AlignedArray<float>> rhs_;  // one right-hand side per thread
   std::vector<const float*> rhs_parts_;
   kernels::AlignedArray<double> solve_work_;

@@ -29,11 +29,18 @@ FrameBytes Avatar::softdeca_bytes(const Preparation& prep, std::size_t surface, 
     b.hyper = prep.face_l.stored_bytes() + prep.dt->face_bytes();
     b.solve = prep.dt->solve_bytes();
   }
-  b.hyper += prep.softdeca_vertex_l.stored_bytes();
-  if (!prep.residual_modes.empty())
-    b.hyper += weight_bytes(model_->residual_coefficients()) + prep.residual_modes.stored_bytes();
-  b.hyper += prep.rest_offset.size() * sizeof(float);
+  b.hyper += prep.vertex_stages.stored_bytes() + weight_bytes(model_->residual_coefficients()) +
+             prep.rest_offset.size() * sizeof(float);
   add_tail_bytes(prep, kSoftDeca, dynamics, surface == vs_, normals, b);
+  return b;
+}
+
+FrameBytes Avatar::correction_bytes(const Preparation& prep, bool blended, bool dynamics) const {
+  // The frame's stages; the template's blend only where it ran; the correction written instead
+  // of the head, and no normals.
+  FrameBytes b = softdeca_bytes(prep, 0, dynamics, false);
+  if (!blended) b.blend = 0;
+  b.output = vs_ * kVertexBytes;
   return b;
 }
 

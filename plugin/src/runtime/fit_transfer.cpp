@@ -17,7 +17,9 @@ class IdentityTransfer final : public FitTransfer {
  public:
   Output core_output(const Output& out) override { return out; }
   Output surface_output(const Output& out) override { return out; }
-  void blend(const float*, const Output&) override {}
+  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
+    core.evaluate_weights(weights, count, out);
+  }
   void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
     core.evaluate_linear(weights, count, out);
   }
@@ -72,14 +74,17 @@ class EmbeddingTransfer final : public FitTransfer {
                 "landmarks");
   }
 
-  void blend(const float* weights, const Output& out) override {
-    blendshapes_.blend(weights, neutral_.data(), out.vertices, 0);
+  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
+    check_output_capacity(out, n_);
+    core.evaluate_correction(weights, count, field_.data());  // checks the weights; out untouched on error
+    blendshapes_.blend(core.weights(), neutral_.data(), out.vertices, 0);
+    add_carried(field_.data(), out.vertices);
   }
 
   void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
     check_output_capacity(out, n_);
     core.read_frame_weights(weights, count);
-    blend(core.weights(), out);
+    blendshapes_.blend(core.weights(), neutral_.data(), out.vertices, 0);
   }
 
   void rest(const Output& out) override { std::memcpy(out.vertices, neutral_.data(), n_ * 3 * sizeof(float)); }

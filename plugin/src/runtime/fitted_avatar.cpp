@@ -73,9 +73,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const AvatarDesc&
 // One frame path for every avatar: the core's frame, then the transfer's steps onto the mesh.
 void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
-  core_->evaluate_weights(weights, count, transfer_->core_output(out));  // checks the weights
-  transfer_->blend(core_->weights(), out);
-  transfer_->carry(core_->linear_skin(), out);  // the models' correction of the core's linear blend
+  transfer_->softdeca(*core_, weights, count, out);
   transfer_->finish(out);
 }
 
