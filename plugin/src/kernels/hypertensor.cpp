@@ -168,17 +168,39 @@ __attribute__((target("avx2,fma,f16c"))) inline __m256 load8(const HyperTensor& 
     return _mm256_loadu_ps(L.float_data() + at);
 }
 
-// out[c] (8 lanes) = sum_k z_k L[b, k, c] for c < W, half or float storage.
+// out[c] (8 lanes) = sum_k z_k L[b, k, c] for c < W, half or float storage. Each sum is a
+// chain of fused multiply-adds, each waiting on the one before (4 cycles); a width-3 table
+// (vertex offsets) would keep only three chains in flight, a third of what two FMA units take,
+// so its latents are dealt round-robin to S sets of accumulators (S W >= 8 chains), added up
+// at the end.
 template <Precision P, int W>
 __attribute__((target("avx2,fma,f16c"))) inline void contract(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  constexpr int S = W >= 8 ? 1 : (8 + W - 1) / W;
   const int K = L.latent();
   const std::size_t base = b * L.block_stride();
-  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
-  for (int k = 0; k < K; ++k) {
+  __m256 acc[S][W];
+  for (int s = 0; s < S; ++s)
+    for (int c = 0; c < W; ++c) acc[s][c] = _mm256_setzero_ps();
+  int k = 0;
+  for (; k + S <= K; k += S) {
+#pragma GCC unroll 3
+    for (int s = 0; s < S; ++s) {
+      const __m256 zk = _mm256_set1_ps(z[k + s]);
+      const std::size_t at = base + static_cast<std::size_t>(k + s) * W * kLanes;
+#pragma GCC unroll 9
+      for (int c = 0; c < W; ++c)
+        acc[s][c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), acc[s][c]);
+    }
+  }
+  for (; k < K; ++k) {
     const __m256 zk = _mm256_set1_ps(z[k]);
     const std::size_t at = base + static_cast<std::size_t>(k) * W * kLanes;
 #pragma GCC unroll 9
-    for (int c = 0; c < W; ++c) out[c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), out[c]);
+    for (int c = 0; c < W; ++c) acc[0][c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), acc[0][c]);
+  }
+  for (int c = 0; c < W; ++c) {
+    out[c] = acc[0][c];
+    for (int s = 1; s < S; ++s) out[c] = _mm256_add_ps(out[c], acc[s][c]);
   }
 }
 
