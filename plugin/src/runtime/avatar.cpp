@@ -23,6 +23,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       geometry_(SkinGeometry::measure(neutral_.data(), vs_, model_->skin_triangles())),
       blendshapes_(d.blendshapes ? Blendshapes(d.blendshapes, d.blendshape_count, vh_, d.threads) : Blendshapes()),
       worker_(d.threads),
+      carry_(d.carry),
       params_(m_, model_->skin_triangles(), geometry_.face_area),
       weights_(bundle::kBlendshapeCount),
       z_(static_cast<std::size_t>(m_.latent)),

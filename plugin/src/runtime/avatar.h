@@ -24,6 +24,7 @@
 #include "prepare/parameters.h"
 #include "prepare/rest_physics.h"
 #include "runtime/blendshapes.h"
+#include "runtime/carry_map.h"
 #include "runtime/deformation_transfer.h"
 #include "runtime/dynamics.h"
 #include "runtime/model.h"
@@ -40,6 +41,9 @@ struct AvatarDesc {
   std::size_t blendshape_count = 0;
   std::size_t threads = 1;
   kernels::Precision precision = kernels::Precision::Half;
+  // A fitted avatar's carry map (the avatar is its registered template): prepare also carries
+  // the vertex stages onto the map's vertices, for evaluate_carried. Null for other avatars.
+  std::shared_ptr<const CarryMap> carry;
 };
 
 struct Output {
@@ -95,6 +99,10 @@ struct Preparation {
   // p's rest-inert parameters alone, the others at their defaults (prepare/rest_physics.h).
   std::vector<float> rest_offset;
   float rest_offset_peak = 0;  // its largest magnitude
+  // With a carry map and DT at identity (evaluate_carried): vertex_stages and rest_offset carried
+  // onto the map's vertices, [carried][latent + modes][3] and [carried][3] (empty: none).
+  kernels::HyperTensor carried_stages;
+  std::vector<float> carried_rest;
   std::size_t bytes() const;
 };
 
@@ -131,14 +139,15 @@ class Avatar {
 
   AvatarStats stats() const;
 
-  // SoftDECA's correction of the linear blend S_t for 52 weights (checked and clamped as
-  // evaluate_weights does) into `correction` (skin_vertices x 3): the frame's skin minus S_t,
-  // the dynamics included when they are on. A fitted avatar carries it onto its own mesh. With
-  // the DT stage at identity and the dynamics off it is the vertex and residual stages' offsets
-  // alone (and the physics at prepare's), so the template is not blended at all. On
-  // Error(NON_FINITE) `correction` holds no valid frame: it is the caller's scratch, which only
-  // a frame that succeeds carries into an output.
-  void evaluate_correction(const float* weights, std::size_t count, float* correction);
+  // A fitted avatar's SoftDECA frame (an avatar made with a carry map): the model's correction
+  // of the linear blend S_t for 52 weights (checked and clamped as evaluate_weights does), the
+  // frame's skin minus S_t with the dynamics when they are on, carried onto the map's vertices
+  // (`carried`, CarryMap::size() x 3). With DT at identity and no dynamics the correction is the
+  // vertex and residual stages' offsets (and the physics at prepare's) whatever S_t is: the
+  // frame then contracts the carried table alone, with no blend of the template. On
+  // Error(NON_FINITE) `carried` holds no valid frame (it is the caller's scratch, carried into
+  // an output only after a frame succeeds).
+  void evaluate_carried(const float* weights, std::size_t count, float* carried);
   // The 52 weights of the last evaluate_weights or evaluate_linear, checked and clamped to
   // [0, 1] (read_weights). Frame thread only, valid until its next frame.
   const float* weights() const { return weights_.data(); }
@@ -167,8 +176,8 @@ class Avatar {
   // vertices of a caller's surface (0: blended from the weights read); `dynamics`, what finish
   // returned; `normals`, whether the output has normals.
   FrameBytes softdeca_bytes(const Preparation& prep, std::size_t surface, bool dynamics, bool normals) const;
-  // evaluate_correction's: `blended`, whether it blended the template (the dynamics or DT ran).
-  FrameBytes correction_bytes(const Preparation& prep, bool blended, bool dynamics) const;
+  // evaluate_carried's: `blended`, whether it ran the template's whole frame (the dynamics or DT on).
+  FrameBytes carried_bytes(const Preparation& prep, bool blended, bool dynamics) const;
   FrameBytes sparse_bytes(const Preparation& prep, bool dynamics, bool normals) const;
   FrameBytes linear_bytes(bool normals) const;
   // The tail's (finish): dynamics, the head written (and the neutral's non-skin vertices read
@@ -190,9 +199,10 @@ class Avatar {
   // The residual stage's prepare half for these parameters: its condition into `prep`; returns
   // its modes [Vs][modes][3] (empty: no residual stage).
   std::vector<float> prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
-  // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep`.
+  // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep` (and,
+  // `carried`, their table carried through the carry map where evaluate_carried reads it).
   void prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
-                               Preparation& prep) const;
+                               Preparation& prep, bool carried) const;
   // The networks' part of a preparation for these parameters and identity.
   std::shared_ptr<Preparation> prepare_networks(const prepare::ParameterState& params, const std::vector<float>& identity) const;
   // SoftDECA's static frame at rest (zero weights on the neutral) for a preparation, without
@@ -219,6 +229,7 @@ class Avatar {
   std::vector<int> jaw_vertices_, cranium_vertices_;
   Blendshapes blendshapes_;
   kernels::Worker worker_;
+  std::shared_ptr<const CarryMap> carry_;
 
   // Staged inputs of prepare (any thread).
   mutable std::mutex params_mutex_;

@@ -230,34 +230,55 @@ void Avatar::evaluate_weights(const float* weights, std::size_t count, const Out
   record(st);
 }
 
-void Avatar::evaluate_correction(const float* weights, std::size_t count, float* correction) {
+void Avatar::evaluate_carried(const float* weights, std::size_t count, float* carried) {
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
   require_model(*model_, false);
-  expect(!blendshapes_.empty(), [] { return std::string("the avatar was created without blendshapes"); });
+  expect(!blendshapes_.empty() && carry_ != nullptr,
+         [] { return std::string("evaluate_carried needs an avatar made with blendshapes and a carry map"); });
   read_weights(weights, count);
   const auto prep = require_prepared(current());
   AvatarStats st;
   encode_weights(*prep, st);
   const bool dynamics = dynamics_enabled_.load();
   const bool blended = dynamics || !prep->face_l.zero();
+  const std::size_t n = carry_->size();
   if (!blended) {
-    // The frame's skin is S_t + the stages' offsets (DT(S_t, I) = S_t, no dynamics): the
-    // correction is the offsets, whatever S_t is.
-    add_vertex_stages(*prep, nullptr, correction, st);
-    settle(*prep, kSoftDeca, correction, false, st);
-  } else {
+    // The frame's skin is S_t + the stages' offsets (DT(S_t, I) = S_t, no dynamics): its
+    // correction is the offsets whatever S_t is, and carried, the carried table's contraction.
+    const auto t = Clock::now();
+    const float* rest = prep->carried_rest.empty() ? nullptr : prep->carried_rest.data();
+    if (!prep->carried_stages.empty()) {
+      const std::size_t blocks = prep->carried_stages.blocks();
+      auto pass = [&](std::size_t part, std::size_t parts) {
+        kernels::vertex_offsets(prep->carried_stages, stage_coefficients_.data(), nullptr, rest, blocks * part / parts,
+                                blocks * (part + 1) / parts, carried);
+      };
+      worker_.run(pass);
+    } else {  // no stages: the physics at prepare's correction alone
+      for (std::size_t i = 0; i < n * 3; ++i) carried[i] = rest ? rest[i] : 0.0f;
+    }
+    st.hyper_ms += ms(t, Clock::now());
+    const auto t1 = Clock::now();
+    if (!all_finite(carried, n * 3))
+      throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
+    settle_static();
+    st.dynamics_ms = ms(t1, Clock::now());
+  } else {  // the template's whole frame, less its blend, carried
     const auto tb = Clock::now();
     auto blend = [&](std::size_t part, std::size_t) { blendshapes_.blend(weights_.data(), neutral_.data(), head_.data(), part); };
     worker_.run(blend);
     st.blend_ms = ms(tb, Clock::now());
     softdeca_frame(*prep, st);
     const float* result = settle(*prep, kSoftDeca, static_.data(), dynamics, st);
-    for (std::size_t i = 0; i < vs_ * 3; ++i) correction[i] = result[i] - head_[i];
+    const auto t = Clock::now();
+    for (std::size_t i = 0; i < vs_ * 3; ++i) static_[i] = result[i] - head_[i];
+    carry_->carry(static_.data(), carried);
+    st.output_ms = ms(t, Clock::now());
   }
   st.generation = prep->generation;
   st.frame_ms = ms(t0, Clock::now());
-  st.frame_bytes = correction_bytes(*prep, blended, dynamics);
+  st.frame_bytes = carried_bytes(*prep, blended, dynamics);
   record(st);
 }
 

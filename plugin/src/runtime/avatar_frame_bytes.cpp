@@ -35,12 +35,19 @@ FrameBytes Avatar::softdeca_bytes(const Preparation& prep, std::size_t surface, 
   return b;
 }
 
-FrameBytes Avatar::correction_bytes(const Preparation& prep, bool blended, bool dynamics) const {
-  // The frame's stages; the template's blend only where it ran; the correction written instead
-  // of the head, and no normals.
+FrameBytes Avatar::carried_bytes(const Preparation& prep, bool blended, bool dynamics) const {
+  // The template's whole frame where it ran, else the carried table in place of the stages'
+  // and no blend; then the carry map (where the frame carries its skin) and the carried
+  // correction written instead of the head, with no normals.
   FrameBytes b = softdeca_bytes(prep, 0, dynamics, false);
-  if (!blended) b.blend = 0;
-  b.output = vs_ * kVertexBytes;
+  if (blended) {
+    b.output = carry_->bytes() + carry_->size() * kVertexBytes;
+  } else {
+    b.blend = 0;
+    b.hyper = weight_bytes(model_->residual_coefficients()) + prep.carried_stages.stored_bytes() +
+              prep.carried_rest.size() * sizeof(float);
+    b.output = carry_->size() * kVertexBytes;
+  }
   return b;
 }
 

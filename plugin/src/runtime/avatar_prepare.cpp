@@ -47,7 +47,7 @@ kernels::HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vec
 
 std::size_t Preparation::bytes() const {
   return face_l.bytes() + vertex_l.bytes() + vertex_stages.bytes() + residual_condition.size() * 4 + dynamics[0].bytes() +
-         dynamics[1].bytes() + identity.size() * 4 + rest_offset.size() * 4;
+         dynamics[1].bytes() + identity.size() * 4 + rest_offset.size() * 4 + carried_stages.bytes() + carried_rest.size() * 4;
 }
 
 void Avatar::prepare() {
@@ -77,6 +77,10 @@ void Avatar::prepare() {
     const auto r0 = Clock::now();
     prep->rest_offset = rest_offset(*params, *prep, identity, physics_iterations);
     prep->rest_offset_peak = peak_magnitude(prep->rest_offset.data(), prep->rest_offset.size());
+    if (carry_ && prep->face_l.zero()) {
+      prep->carried_rest.resize(carry_->size() * 3);
+      carry_->carry(prep->rest_offset.data(), prep->carried_rest.data());
+    }
     physics_ms = ms(r0, Clock::now());
   }
   {
@@ -96,7 +100,7 @@ void Avatar::prepare() {
 // SoftDECA's stages for these parameters: its per-face hyper-tensor, its vertex stage and the
 // residual stage's prepare half (what softdeca_rest reads).
 void Avatar::prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
-                                     Preparation& prep) const {
+                                     Preparation& prep, bool carried) const {
   const OnnxNetwork& hyper = *model_->hyper(false);
   const auto& cols = hyper.spec().parameter_columns;
   std::vector<float> p(nf_ * cols.size());
@@ -110,9 +114,12 @@ void Avatar::prepare_softdeca_stages(const prepare::ParameterState& params, cons
   }
   const std::vector<float> modes = prepare_residual(params, prep);
   const std::size_t latents = stage_latents_ + residual_modes_;
-  if (latents > 0)
-    prep.vertex_stages = kernels::HyperTensor(side_by_side(vertex_l, stage_latents_, modes, residual_modes_, vs_).data(), vs_,
-                                              static_cast<int>(latents), 3, precision_);
+  if (latents == 0) return;
+  const std::vector<float> table = side_by_side(vertex_l, stage_latents_, modes, residual_modes_, vs_);
+  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, static_cast<int>(latents), 3, precision_);
+  if (carried && carry_ && prep.face_l.zero())  // carried from the values, not their stored rounding
+    prep.carried_stages = kernels::HyperTensor(carry_->carry_columns(table.data(), latents).data(), carry_->size(),
+                                               static_cast<int>(latents), 3, precision_);
 }
 
 // The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
@@ -130,7 +137,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterSt
       params.vertex_matrix(hyper.spec().parameter_columns, p.data());
       prep->vertex_l = hyper_tensor(hyper, p, identity, vs_, 3);
     } else {
-      prepare_softdeca_stages(params, identity, *prep);
+      prepare_softdeca_stages(params, identity, *prep, true);
     }
     // Dynamics coefficients per skin vertex.
     const OnnxNetwork& dyn = *model_->dynamics(sparse);
@@ -152,7 +159,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterSt
 std::vector<float> Avatar::softdeca_rest(const prepare::ParameterState& params, const std::vector<float>& identity) const {
   Preparation stages;
   stages.dt = dt_;
-  prepare_softdeca_stages(params, identity, stages);
+  prepare_softdeca_stages(params, identity, stages, false);
   return softdeca_rest(stages);
 }
 

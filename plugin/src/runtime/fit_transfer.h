@@ -18,6 +18,7 @@
 
 #include "fit/avatar_fit.h"
 #include "runtime/avatar.h"
+#include "runtime/carry_map.h"
 
 namespace softdeca::runtime {
 
@@ -34,8 +35,8 @@ class FitTransfer {
 
   // A SoftDECA frame of 52 weights into out: the identity fit's is the core's own frame;
   // through a fit, the avatar's own linear blend of the weights as the core read them (checked
-  // and clamped) plus the core's correction of its linear blend (Avatar::evaluate_correction)
-  // carried onto the avatar's vertices, so the registered template is blended only where the
+  // and clamped) plus the core's correction of its linear blend carried onto the avatar's
+  // vertices (Avatar::evaluate_carried), so the registered template is blended only where the
   // correction needs it (the dynamics on, a DT stage).
   virtual void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) = 0;
   // A frame of the linear blend alone: the core checks the weights and counts the frame, and
@@ -63,8 +64,10 @@ class FitTransfer {
 std::unique_ptr<FitTransfer> identity_transfer();
 
 // The avatar `mesh` through its fit `f` to the template `t`; `core_shapes` are the registered
-// template's 52 shapes (fit::carried_shapes), which give the shapes the avatar's rig lacks.
+// template's 52 shapes (fit::carried_shapes), which give the shapes the avatar's rig lacks;
+// `carry`, the fit's carry map, which the core (made with it) shares.
 std::unique_ptr<FitTransfer> embedding_transfer(const fit::TemplateData& t, const fit::AvatarMesh& mesh,
-                                                const fit::AvatarFit& f, const float* core_shapes);
+                                                const fit::AvatarFit& f, const float* core_shapes,
+                                                std::shared_ptr<const CarryMap> carry);
 
 }  // namespace softdeca::runtime
