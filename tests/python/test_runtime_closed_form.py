@@ -70,7 +70,9 @@ def refused_and_kept(avatar: NativeAvatar) -> None:
 
 def test_the_template_keeps_its_last_output(broken) -> None:
     head, model = broken
-    refused_and_kept(NativeAvatar(model, head.neutral, head.head_triangles, head.blendshapes))
+    refused_and_kept(
+        NativeAvatar(model, head.neutral, head.head_triangles, head.blendshapes)
+    )
 
 
 def test_a_fitted_avatar_keeps_its_last_output(broken) -> None:
