@@ -5,8 +5,9 @@
 // at prepare's offset.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
-#include <random>
+#include <string>
 #include <vector>
 
 #include "runtime_fixture.h"
@@ -23,31 +24,21 @@ TEST(ClosedFormFrames, TheFrameWrittenInPlaceIsTheCheckedFrame) {
   AvatarPtr avatar;
   const auto d = describe(head, 1, SOFTDECA_PRECISION_FLOAT);
   ASSERT_EQ(softdeca_avatar_create(model.p, &d, &avatar.p), SOFTDECA_OK) << softdeca_last_error();
-  uint32_t gravity = 0;
-  ASSERT_EQ(softdeca_model_find_parameter(model.p, "gravity_strength", &gravity), SOFTDECA_OK);
   const std::size_t n = head.vertices();
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  for (const double g : {1.0, 2.0}) {  // the defaults; a heavier head: the physics at prepare's offset
-    ASSERT_EQ(softdeca_avatar_set_parameter(avatar.p, gravity, g), SOFTDECA_OK);
-    ASSERT_EQ(softdeca_avatar_prepare(avatar.p), SOFTDECA_OK) << softdeca_last_error();
-    for (int frame = 0; frame < 3; ++frame) {
-      std::vector<float> w(52);
-      for (float& x : w) x = unit(rng);
-      Buffers in_place(n, NAN), linear(n), checked(n, NAN);
-      ASSERT_EQ(softdeca_avatar_evaluate_weights(avatar.p, w.data(), 52, &in_place.out), SOFTDECA_OK) << softdeca_last_error();
-      ASSERT_EQ(softdeca_avatar_evaluate_linear(avatar.p, w.data(), 52, &linear.out), SOFTDECA_OK);
-      ASSERT_EQ(softdeca_avatar_evaluate_surface(avatar.p, w.data(), 52, linear.vertices.data(), static_cast<uint32_t>(n),
-                                                 &checked.out),
-                SOFTDECA_OK)
-          << softdeca_last_error();
-      EXPECT_EQ(in_place.vertices, checked.vertices) << "gravity " << g << " frame " << frame;
-      EXPECT_EQ(in_place.normals, checked.normals) << "gravity " << g << " frame " << frame;
-      double moved = 0;
-      for (std::size_t i = 0; i < 3 * n; ++i) moved = std::max(moved, double(std::fabs(in_place.vertices[i] - linear.vertices[i])));
-      EXPECT_GT(moved, 1e-5) << "the stages correct the blend";
-    }
-  }
+  at_defaults_and_a_rest_offset(model.p, avatar.p, 4, [&](const std::vector<float>& w, const std::string& what) {
+    Buffers in_place(n, NAN), linear(n), checked(n, NAN);
+    ASSERT_EQ(softdeca_avatar_evaluate_weights(avatar.p, w.data(), 52, &in_place.out), SOFTDECA_OK) << softdeca_last_error();
+    ASSERT_EQ(softdeca_avatar_evaluate_linear(avatar.p, w.data(), 52, &linear.out), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_evaluate_surface(avatar.p, w.data(), 52, linear.vertices.data(), static_cast<uint32_t>(n),
+                                               &checked.out),
+              SOFTDECA_OK)
+        << softdeca_last_error();
+    EXPECT_EQ(in_place.vertices, checked.vertices) << what;
+    EXPECT_EQ(in_place.normals, checked.normals) << what;
+    double moved = 0;
+    for (std::size_t i = 0; i < 3 * n; ++i) moved = std::max(moved, double(std::fabs(in_place.vertices[i] - linear.vertices[i])));
+    EXPECT_GT(moved, 1e-5) << "the stages correct the blend";
+  });
 }
 
 }  // namespace

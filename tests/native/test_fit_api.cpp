@@ -199,33 +199,23 @@ TEST_F(FitApi, AFittedAvatarsCarriedFrameIsItsWholeFrameCarried) {
   rt::AvatarPtr a;
   ASSERT_EQ(rt::create_on_fit(closed.p, f.p, &user.mesh, 1, SOFTDECA_PRECISION_FLOAT, &a.p), SOFTDECA_OK)
       << softdeca_last_error();
-  uint32_t gravity = 0;
-  ASSERT_EQ(softdeca_model_find_parameter(closed.p, "gravity_strength", &gravity), SOFTDECA_OK);
-  std::mt19937 rng(6);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  for (const double g : {1.0, 2.0}) {  // the defaults; a heavier head: the physics at prepare's offset
-    ASSERT_EQ(softdeca_avatar_set_parameter(a.p, gravity, g), SOFTDECA_OK);
-    ASSERT_EQ(softdeca_avatar_prepare(a.p), SOFTDECA_OK) << softdeca_last_error();
-    for (int frame = 0; frame < 3; ++frame) {
-      std::vector<float> w(52);
-      for (float& x : w) x = unit(rng);
-      rt::Buffers carried(user.vertices()), whole(user.vertices()), linear(user.vertices());
-      ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_FALSE), SOFTDECA_OK);
-      ASSERT_EQ(softdeca_avatar_evaluate_weights(a.p, w.data(), 52, &carried.out), SOFTDECA_OK) << softdeca_last_error();
-      ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_TRUE), SOFTDECA_OK);
-      ASSERT_EQ(softdeca_avatar_reset_dynamics(a.p), SOFTDECA_OK);
-      ASSERT_EQ(softdeca_avatar_evaluate_weights(a.p, w.data(), 52, &whole.out), SOFTDECA_OK) << softdeca_last_error();
-      ASSERT_EQ(softdeca_avatar_evaluate_linear(a.p, w.data(), 52, &linear.out), SOFTDECA_OK);
-      double worst = 0, moved = 0;
-      for (std::size_t i = 0; i < carried.vertices.size(); ++i) {
-        worst = std::max(worst, double(std::fabs(carried.vertices[i] - whole.vertices[i])));
-        moved = std::max(moved, double(std::fabs(carried.vertices[i] - linear.vertices[i])));
-      }
-      // centimetres: float rounding of coordinates of tens of cm, corrections of tenths of a mm
-      EXPECT_LT(worst, 1e-4) << "gravity " << g << " frame " << frame;
-      EXPECT_GT(moved, 1e-3) << "the correction reaches the avatar";
+  rt::at_defaults_and_a_rest_offset(closed.p, a.p, 6, [&](const std::vector<float>& w, const std::string& what) {
+    rt::Buffers carried(user.vertices()), whole(user.vertices()), linear(user.vertices());
+    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_FALSE), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_evaluate_weights(a.p, w.data(), 52, &carried.out), SOFTDECA_OK) << softdeca_last_error();
+    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_TRUE), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_reset_dynamics(a.p), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_evaluate_weights(a.p, w.data(), 52, &whole.out), SOFTDECA_OK) << softdeca_last_error();
+    ASSERT_EQ(softdeca_avatar_evaluate_linear(a.p, w.data(), 52, &linear.out), SOFTDECA_OK);
+    double worst = 0, moved = 0;
+    for (std::size_t i = 0; i < carried.vertices.size(); ++i) {
+      worst = std::max(worst, double(std::fabs(carried.vertices[i] - whole.vertices[i])));
+      moved = std::max(moved, double(std::fabs(carried.vertices[i] - linear.vertices[i])));
     }
-  }
+    // centimetres: float rounding of coordinates of tens of cm, corrections of tenths of a mm
+    EXPECT_LT(worst, 1e-4) << what;
+    EXPECT_GT(moved, 1e-3) << "the correction reaches the avatar";
+  });
 }
 
 double number(const softdeca::bundle::Json& report, const std::string& name) { return report.at(name, "report").number(name); }

@@ -50,17 +50,11 @@ def write_test_data(out: Path) -> Path:
     specs = load_parameter_specs(TEST_PARAMETERS)
     nets = build_random(head.definition, specs, TEST_SIZES, seed=1)
     info = BundleInfo(untrained=True, description="native test bundle: synthetic head, random")
-    # with the physics at prepare (format version 4) on a shell head under the synthetic skin
-    export_bundle(
-        out / "bundle",
-        head.definition,
-        nets,
-        info,
-        rest_head=synthetic_rest_head(head),
-        template_head=template_head_of(
-            head.neutral, head.blendshapes, head.definition.skin_vertices
-        ),
-    )
+    # with the physics at prepare (format version 4) on a shell head under the synthetic skin,
+    # and the template head fits read
+    rest = synthetic_rest_head(head)
+    fits = template_head_of(head.neutral, head.blendshapes, head.definition.skin_vertices)
+    export_bundle(out / "bundle", head.definition, nets, info, rest_head=rest, template_head=fits)
     (out / "bundle.tar").write_bytes(pack_bundle(out / "bundle"))
     only = build_random(head.definition, specs, TEST_SIZES, seed=2, sparse=False)
     export_bundle(out / "bundle_softdeca_only", head.definition, only, info)
@@ -81,10 +75,8 @@ def write_test_data(out: Path) -> Path:
         head.definition,
         closed,
         info,
-        rest_head=synthetic_rest_head(head),
-        template_head=template_head_of(
-            head.neutral, head.blendshapes, head.definition.skin_vertices
-        ),
+        rest_head=rest,
+        template_head=fits,
     )
     for name, a in {
         "neutral.f32": head.neutral,
