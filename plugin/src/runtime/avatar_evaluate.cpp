@@ -18,6 +18,12 @@ using namespace avatar_detail;
 
 namespace {
 constexpr float kWeightSlack = 0.01f;  // weights may overshoot [0, 1] by this much (clamped)
+
+// A frame's result, checked before anything of it reaches an output.
+void require_finite_frame(const float* v, std::size_t n) {
+  if (!all_finite(v, n))
+    throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
+}
 }  // namespace
 
 void check_output_capacity(const Output& out, std::size_t vertices) {
@@ -154,8 +160,7 @@ const float* Avatar::settle(const Preparation& prep, int model, const float* ski
     worker_.run(pass);
     result = dynamics_.next();
   }
-  if (!all_finite(result, vs_ * 3))
-    throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
+  require_finite_frame(result, vs_ * 3);
   if (dynamics) dynamics_.commit(model);
   else dynamics_.invalidate();
   st.dynamics_ms = ms(t, Clock::now());
@@ -260,8 +265,7 @@ void Avatar::evaluate_carried(const float* weights, std::size_t count, float* ca
     }
     st.hyper_ms += ms(t, Clock::now());
     const auto t1 = Clock::now();
-    if (!all_finite(carried, n * 3))
-      throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
+    require_finite_frame(carried, n * 3);
     settle_static();
     st.dynamics_ms = ms(t1, Clock::now());
   } else {  // the template's whole frame, less its blend, carried
