@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -118,6 +119,25 @@ struct Buffers {
     out = {sizeof(softdeca_output), vertices.data(), static_cast<uint32_t>(n), normals.data(), static_cast<uint32_t>(n)};
   }
 };
+
+// `frame(weights, what)` for three random weight vectors at the defaults, and again with the
+// physics at prepare's offset (a head twice as heavy), `avatar` prepared for each.
+template <class Frame>
+void at_defaults_and_a_rest_offset(softdeca_model* model, softdeca_avatar* avatar, unsigned seed, Frame&& frame) {
+  uint32_t gravity = 0;
+  ASSERT_EQ(softdeca_model_find_parameter(model, "gravity_strength", &gravity), SOFTDECA_OK);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (const double g : {1.0, 2.0}) {
+    ASSERT_EQ(softdeca_avatar_set_parameter(avatar, gravity, g), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_prepare(avatar), SOFTDECA_OK) << softdeca_last_error();
+    for (int f = 0; f < 3; ++f) {
+      std::vector<float> w(52);
+      for (float& x : w) x = unit(rng);
+      frame(w, "gravity " + std::to_string(g) + " frame " + std::to_string(f));
+    }
+  }
+}
 
 // A temporary copy of a bundle folder, removed at the end of the test.
 struct BundleCopy {

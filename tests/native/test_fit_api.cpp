@@ -184,6 +184,40 @@ TEST_F(FitApi, FitsSavesLoadsAndAnimatesTheUsersOwnMesh) {
   std::filesystem::remove(path);
 }
 
+// On a bundle at SoftDECA's closed-form start (DT at identity) a fitted avatar's frame, with the
+// dynamics off, contracts the vertex stages carried onto its own vertices at prepare; it is the
+// registered template's whole frame carried (what a frame with the dynamics runs, and from rest
+// that frame is the static one), to float rounding, at the defaults and with the physics at
+// prepare's offset.
+TEST_F(FitApi, AFittedAvatarsCarriedFrameIsItsWholeFrameCarried) {
+  rt::ModelPtr closed;
+  ASSERT_EQ(softdeca_model_load((rt::data_dir() + "/bundle_closed_form").c_str(), nullptr, &closed.p), SOFTDECA_OK)
+      << softdeca_last_error();
+  UserAvatar user(head_);
+  FitPtr f;
+  ASSERT_EQ(softdeca_avatar_fit_create(closed.p, &user.mesh, &options_, &f.p), SOFTDECA_OK) << softdeca_last_error();
+  rt::AvatarPtr a;
+  ASSERT_EQ(rt::create_on_fit(closed.p, f.p, &user.mesh, 1, SOFTDECA_PRECISION_FLOAT, &a.p), SOFTDECA_OK)
+      << softdeca_last_error();
+  rt::at_defaults_and_a_rest_offset(closed.p, a.p, 6, [&](const std::vector<float>& w, const std::string& what) {
+    rt::Buffers carried(user.vertices()), whole(user.vertices()), linear(user.vertices());
+    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_FALSE), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_evaluate_weights(a.p, w.data(), 52, &carried.out), SOFTDECA_OK) << softdeca_last_error();
+    ASSERT_EQ(softdeca_avatar_set_dynamics(a.p, SOFTDECA_TRUE), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_reset_dynamics(a.p), SOFTDECA_OK);
+    ASSERT_EQ(softdeca_avatar_evaluate_weights(a.p, w.data(), 52, &whole.out), SOFTDECA_OK) << softdeca_last_error();
+    ASSERT_EQ(softdeca_avatar_evaluate_linear(a.p, w.data(), 52, &linear.out), SOFTDECA_OK);
+    double worst = 0, moved = 0;
+    for (std::size_t i = 0; i < carried.vertices.size(); ++i) {
+      worst = std::max(worst, double(std::fabs(carried.vertices[i] - whole.vertices[i])));
+      moved = std::max(moved, double(std::fabs(carried.vertices[i] - linear.vertices[i])));
+    }
+    // centimetres: float rounding of coordinates of tens of cm, corrections of tenths of a mm
+    EXPECT_LT(worst, 1e-4) << what;
+    EXPECT_GT(moved, 1e-3) << "the correction reaches the avatar";
+  });
+}
+
 double number(const softdeca::bundle::Json& report, const std::string& name) { return report.at(name, "report").number(name); }
 
 // The user's avatar with a shell around its head: a copy 1.5 times its size, moved by the same

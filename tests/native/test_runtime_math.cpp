@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -192,10 +193,11 @@ TEST(HyperTensor, VertexOffsetsMatchTheDirectProduct) {
   for (const int K : {32, 7}) {  // 7: int8 pads the latents to pairs
     std::mt19937 rng(5);
     std::normal_distribution<float> nd;
-    std::vector<float> L(n * K * 3), z(K), base(3 * n);
+    std::vector<float> L(n * K * 3), z(K), base(3 * n), add(3 * n);
     for (auto& x : L) x = 0.001f * nd(rng);
     for (auto& x : z) x = nd(rng);
     for (auto& x : base) x = nd(rng);
+    for (auto& x : add) x = 0.001f * nd(rng);
     for (const auto& [p, kernel] : std::vector<std::pair<Precision, Kernel>>{
              {Precision::Float, Kernel::Avx2}, {Precision::Float, Kernel::Portable}, {Precision::Half, Kernel::Avx2},
              {Precision::Half, Kernel::Portable}, {Precision::Int8, Kernel::Avx2}, {Precision::Int8, Kernel::Avx512Vnni},
@@ -204,12 +206,18 @@ TEST(HyperTensor, VertexOffsetsMatchTheDirectProduct) {
       if (!kernel_available(kernel)) continue;
       std::vector<float> out(3 * n + 3, -7.0f);
       const HyperTensor t(L.data(), n, K, 3, p);
-      vertex_offsets(t, z.data(), base.data(), 0, t.blocks(), out.data(), kernel);
+      vertex_offsets(t, z.data(), base.data(), add.data(), 0, t.blocks(), out.data(), kernel);
+      // In place (out is base), and without a base (the offsets alone): the same sums.
+      std::vector<float> in_place(base), alone(3 * n);
+      vertex_offsets(t, z.data(), in_place.data(), add.data(), 0, t.blocks(), in_place.data(), kernel);
+      vertex_offsets(t, z.data(), nullptr, add.data(), 0, t.blocks(), alone.data(), kernel);
+      EXPECT_EQ(in_place, std::vector<float>(out.begin(), out.end() - 3));
+      for (std::size_t i = 0; i < 3 * n; ++i) EXPECT_NEAR(alone[i] + base[i], out[i], 1e-6);
       // Tolerance: float rounding; half's 2^-11 and int8's 1/254 of each term, summed.
       const double step = p == Precision::Float ? 1e-6 : p == Precision::Half ? 1e-3 : 8e-3;
       for (std::size_t v = 0; v < n; ++v)
         for (int c = 0; c < 3; ++c) {
-          double want = base[3 * v + c], size = 0;
+          double want = base[3 * v + c] + add[3 * v + c], size = 0;
           for (int k = 0; k < K; ++k) {
             want += double(z[k]) * L[(v * K + k) * 3 + c];
             size += std::fabs(double(z[k])) * 0.004;  // |L| < 4 sigma
@@ -219,6 +227,10 @@ TEST(HyperTensor, VertexOffsetsMatchTheDirectProduct) {
           EXPECT_NEAR(t.at(v, K - 1, c), L[(v * K + K - 1) * 3 + c], p == Precision::Float ? 0.0 : 0.004 / 100);
         }
       for (int c = 0; c < 3; ++c) EXPECT_EQ(out[3 * n + c], -7.0f) << "wrote past the last vertex";
+      std::vector<double> peak(K, 0.0);  // each latent's largest stored magnitude bounds a frame's sums
+      for (std::size_t e = 0; e < n * K * 3; ++e)
+        peak[e / 3 % K] = std::max(peak[e / 3 % K], std::fabs(double(t.at(e / 3 / K, int(e / 3 % K), int(e % 3)))));
+      for (int k = 0; k < K; ++k) EXPECT_NEAR(t.peak(k), peak[k], 1e-6 * peak[k]) << "latent " << k;
     }
   }
 }
@@ -279,13 +291,18 @@ TEST(Blendshapes, RunsReproduceTheDenseBlendInEveryPart) {
     const Blendshapes b(deltas.data(), shapes, n, parts);
     std::vector<float> out(3 * n, 0.0f);
     for (std::size_t p = 0; p < parts; ++p) b.blend(w.data(), neutral.data(), out.data(), p);
+    double moved = 0;  // the most the shapes move a coordinate, which reach() bounds
     for (std::size_t v = 0; v < n; ++v)
       for (int c = 0; c < 3; ++c) {
         double want = neutral[3 * v + c];
         for (std::size_t s = 0; s < shapes; ++s) want += double(w[s]) * deltas[(s * n + v) * 3 + c];
         EXPECT_NEAR(out[3 * v + c], want, 1e-5) << parts;
+        moved = std::max(moved, std::fabs(want - neutral[3 * v + c]));
       }
+    EXPECT_GE(b.reach(w.data()), moved);
   }
+  deltas[(1 * n + 55) * 3] = std::numeric_limits<float>::infinity();  // a moved shape's: no bound
+  EXPECT_TRUE(std::isinf(Blendshapes(deltas.data(), shapes, n, 1).reach(w.data())));
 }
 
 TEST(Normals, AreUnitAreaWeightedAndZeroWhereUndefined) {

@@ -20,7 +20,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from bounds import above, below
-from softdeca_train.host.native import NativeAvatar, NativeError, NativeModel
+from softdeca_train.host.native import (
+    AvatarArrays,
+    NativeAvatar,
+    NativeError,
+    NativeFit,
+    NativeModel,
+)
 from softdeca_train.models import (
     TEST_SIZES,
     BundleInfo,
@@ -36,6 +42,7 @@ from softdeca_train.models.synthetic import (
     synthetic_head,
     synthetic_rest_head,
 )
+from softdeca_train.models.template_head import template_head_of
 
 BOUND_MM = {"float": 1e-4, "half": 1e-3, "int8": 0.02}
 REASON = {
@@ -419,16 +426,22 @@ def test_the_residual_stage_needs_version_three(setup, tmp_path):
         NativeModel(copy)
 
 
-def test_a_zero_deformation_stage_skips_the_solve_and_keeps_parity(setup, tmp_path):
-    """A bundle whose f_ph is zero (SoftDECA at its closed-form start): every G_f is I, so the
-    runtime leaves DT out (S_t itself) and the stages after it still match the reference."""
+def closed_form(nets):
+    """A copy of `nets` at SoftDECA's closed-form start: f_ph zero, so every G_f is I."""
     import copy
 
-    head, nets, _, _, _ = setup
     zero = copy.deepcopy(nets)
     last = zero.softdeca.f_ph.body.rest[-1][-1]
     last.weight.data.zero_()
     last.bias.data.zero_()
+    return zero
+
+
+def test_a_zero_deformation_stage_skips_the_solve_and_keeps_parity(setup, tmp_path):
+    """A bundle whose f_ph is zero (SoftDECA at its closed-form start): every G_f is I, so the
+    runtime leaves DT out (S_t itself) and the stages after it still match the reference."""
+    head, nets, _, _, _ = setup
+    zero = closed_form(nets)
     export_bundle(tmp_path / "b", head.definition, zero, BundleInfo(True, "zero f_ph"))
     ref, nat = pair((head, zero, NativeModel(tmp_path / "b"), None, None), "float")
     for w in frames(3, 13):
@@ -438,6 +451,42 @@ def test_a_zero_deformation_stage_skips_the_solve_and_keeps_parity(setup, tmp_pa
             err_mm(x, ref.blend(w)) > 0.05
         )  # the vertex and residual stages still act
     assert nat.stats().solve_ms == 0.0
+
+
+def test_a_non_finite_frame_at_the_closed_form_start_leaves_the_last_output(
+    setup, tmp_path
+):
+    """At SoftDECA's closed-form start the template's frame is written straight into the
+    caller's output, and a fitted avatar's is contracted from the stages carried onto it at
+    prepare: a model whose output is NaN (f_w's here) is still refused with the last good
+    output left as it was, on both."""
+    head, nets, _, _, _ = setup
+    broken = closed_form(nets)
+    broken.softdeca.f_w.net[-1].bias.data.fill_(float("nan"))
+    skin = head.definition.skin_vertices
+    export_bundle(
+        tmp_path / "b",
+        head.definition,
+        broken,
+        BundleInfo(True, "f_w gives NaN"),
+        check=False,
+        template_head=template_head_of(head.neutral, head.blendshapes, skin),
+    )
+    model = NativeModel(tmp_path / "b")
+    # the head in centimetres as a user's mesh (its random shapes tell no unit)
+    mesh = AvatarArrays(100 * head.neutral, head.head_triangles, 100 * head.blendshapes)
+    fit = NativeFit.create(model, mesh, metres_per_unit=0.01)
+    w = frames(1, 2)[0]
+    for avatar in (
+        NativeAvatar(model, head.neutral, head.head_triangles, head.blendshapes),
+        NativeAvatar.fitted(model, fit, mesh),
+    ):
+        avatar.prepare()
+        good_v, good_n = avatar.evaluate_linear(w)
+        with pytest.raises(NativeError, match="non-finite"):
+            avatar.evaluate_weights(w)
+        assert np.array_equal(avatar.vertices, good_v)
+        assert np.array_equal(avatar.normals, good_n)
 
 
 def test_the_rest_physics_needs_version_four(setup, tmp_path):

@@ -20,6 +20,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
   const std::size_t total = blocks() * block_stride();
   const std::size_t count = n * static_cast<std::size_t>(latent) * static_cast<std::size_t>(width);
   zero_ = std::all_of(source, source + count, [](float v) { return v == 0.0f; });
+  peaks_.assign(static_cast<std::size_t>(latent), 0.0f);
   const auto source_at = [&](std::size_t e, int k, int c) {
     return source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
                   static_cast<std::size_t>(c)];
@@ -34,6 +35,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
         for (std::size_t e = b * kLanes; e < std::min(n, (b + 1) * kLanes); ++e)
           for (int c = 0; c < width; ++c) peak = std::max(peak, std::fabs(source_at(e, k, c)));
         const float scale = peak > 0 ? peak / 127.0f : 1.0f;
+        if (peak > 0) peaks_[static_cast<std::size_t>(k)] = std::max(peaks_[static_cast<std::size_t>(k)], 127.0f * scale);
         scales_[b * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)] = scale;
         for (std::size_t e = b * kLanes; e < std::min(n, (b + 1) * kLanes); ++e)
           for (int c = 0; c < width; ++c)
@@ -52,6 +54,9 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
         const std::size_t at = index(b, k, c, lane);
         if (precision == Precision::Half) half_[at] = float_to_half(v);
         else float_[at] = v;
+        const float stored = precision == Precision::Half ? half_to_float(half_[at]) : v;
+        float& peak = peaks_[static_cast<std::size_t>(k)];
+        peak = std::max(peak, std::fabs(stored));
       }
   }
 }
@@ -143,17 +148,12 @@ void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float*
   }
 }
 
-void vertex_offsets_portable(const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0, std::size_t b1,
-                             float* out) {
+void vertex_offsets_portable(const HyperTensor& L, const float* z, const float* base_pos, const float* add, std::size_t b0,
+                             std::size_t b1, float* out) {
   for (std::size_t b = b0; b < b1; ++b) {
     float acc[3][kLanes];
     contract_portable<3>(L, z, b, acc);
-    const std::size_t end = std::min(kLanes, L.elements() - b * kLanes);
-    for (std::size_t l = 0; l < end; ++l)
-      for (int c = 0; c < 3; ++c) {
-        const std::size_t v = (b * kLanes + l) * 3 + static_cast<std::size_t>(c);
-        out[v] = base_pos[v] + acc[c][l];
-      }
+    add_block_offsets(acc, L, b, base_pos, add, out);
   }
 }
 
@@ -168,17 +168,39 @@ __attribute__((target("avx2,fma,f16c"))) inline __m256 load8(const HyperTensor& 
     return _mm256_loadu_ps(L.float_data() + at);
 }
 
-// out[c] (8 lanes) = sum_k z_k L[b, k, c] for c < W, half or float storage.
+// out[c] (8 lanes) = sum_k z_k L[b, k, c] for c < W, half or float storage. Each sum is a
+// chain of fused multiply-adds, each waiting on the one before (4 cycles); a width-3 table
+// (vertex offsets) would keep only three chains in flight, a third of what two FMA units take,
+// so its latents are dealt round-robin to S sets of accumulators (S W >= 8 chains), added up
+// at the end.
 template <Precision P, int W>
 __attribute__((target("avx2,fma,f16c"))) inline void contract(const HyperTensor& L, const float* z, std::size_t b, __m256* out) {
+  constexpr int S = W >= 8 ? 1 : (8 + W - 1) / W;
   const int K = L.latent();
   const std::size_t base = b * L.block_stride();
-  for (int c = 0; c < W; ++c) out[c] = _mm256_setzero_ps();
-  for (int k = 0; k < K; ++k) {
+  __m256 acc[S][W];
+  for (int s = 0; s < S; ++s)
+    for (int c = 0; c < W; ++c) acc[s][c] = _mm256_setzero_ps();
+  int k = 0;
+  for (; k + S <= K; k += S) {
+#pragma GCC unroll 3
+    for (int s = 0; s < S; ++s) {
+      const __m256 zk = _mm256_set1_ps(z[k + s]);
+      const std::size_t at = base + static_cast<std::size_t>(k + s) * W * kLanes;
+#pragma GCC unroll 9
+      for (int c = 0; c < W; ++c)
+        acc[s][c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), acc[s][c]);
+    }
+  }
+  for (; k < K; ++k) {
     const __m256 zk = _mm256_set1_ps(z[k]);
     const std::size_t at = base + static_cast<std::size_t>(k) * W * kLanes;
 #pragma GCC unroll 9
-    for (int c = 0; c < W; ++c) out[c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), out[c]);
+    for (int c = 0; c < W; ++c) acc[0][c] = _mm256_fmadd_ps(zk, load8<P>(L, at + static_cast<std::size_t>(c) * kLanes), acc[0][c]);
+  }
+  for (int c = 0; c < W; ++c) {
+    out[c] = acc[0][c];
+    for (int s = 1; s < S; ++s) out[c] = _mm256_add_ps(out[c], acc[s][c]);
   }
 }
 
@@ -314,12 +336,12 @@ __attribute__((target("avx2,fma"))) inline void accumulate_rhs(const __m256* d, 
   }
 }
 
-// out[v] = base[v] + the 8 lanes of a (3 components), for the elements of block b that exist.
+// out[v] = base[v] + add[v] + the 8 lanes of a (3 components), for the elements of block b that exist.
 __attribute__((target("avx2"))) inline void write_offsets(const __m256* a, const HyperTensor& L, std::size_t b, const float* base_pos,
-                                                        float* out) {
+                                                        const float* add, float* out) {
   alignas(32) float acc[3][kLanes];
   for (int c = 0; c < 3; ++c) _mm256_store_ps(acc[c], a[c]);
-  add_block_offsets(acc, L, b, base_pos, out);
+  add_block_offsets(acc, L, b, base_pos, add, out);
 }
 
 template <Precision P, class Pairs>
@@ -333,12 +355,12 @@ SOFTDECA_KERNEL void dg_rhs_blocks(const HyperTensor& L, const FaceBlocks& faces
 }
 
 template <Precision P, class Pairs>
-SOFTDECA_KERNEL void vertex_offsets_blocks(const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0,
-                                           std::size_t b1, float* out) {
+SOFTDECA_KERNEL void vertex_offsets_blocks(const HyperTensor& L, const float* z, const float* base_pos, const float* add,
+                                           std::size_t b0, std::size_t b1, float* out) {
   for (std::size_t b = b0; b < b1; ++b) {
     __m256 a[3];
     contract_any<P, 3, Pairs>(L, z, b, a);
-    write_offsets(a, L, b, base_pos, out);
+    write_offsets(a, L, b, base_pos, add, out);
   }
 }
 #undef SOFTDECA_KERNEL
@@ -357,13 +379,13 @@ __attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"), flatten)) vo
 
 template <Precision P>
 __attribute__((target("avx2,fma,f16c"))) void vertex_offsets_avx2(const HyperTensor& L, const float* z, const float* base_pos,
-                                                                 std::size_t b0, std::size_t b1, float* out) {
-  vertex_offsets_blocks<P, PairsAvx2>(L, z, base_pos, b0, b1, out);
+                                                                 const float* add, std::size_t b0, std::size_t b1, float* out) {
+  vertex_offsets_blocks<P, PairsAvx2>(L, z, base_pos, add, b0, b1, out);
 }
 
 __attribute__((target("avx2,fma,f16c,avx512f,avx512vl,avx512vnni"), flatten)) void vertex_offsets_vnni(
-    const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0, std::size_t b1, float* out) {
-  vertex_offsets_blocks<Precision::Int8, PairsVnni>(L, z, base_pos, b0, b1, out);
+    const HyperTensor& L, const float* z, const float* base_pos, const float* add, std::size_t b0, std::size_t b1, float* out) {
+  vertex_offsets_blocks<Precision::Int8, PairsVnni>(L, z, base_pos, add, b0, b1, out);
 }
 
 bool cpu_has_avx2() { return cpu_features().avx2; }
@@ -425,23 +447,23 @@ void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const
   }
 }
 
-void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out,
-                    Kernel kernel) {
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, const float* add, std::size_t b0,
+                    std::size_t b1, float* out, Kernel kernel) {
   switch (resolve(kernel, L)) {
 #ifdef SOFTDECA_X86
-    case Kernel::Avx512Vnni: vertex_offsets_vnni(L, z, base, b0, b1, out); return;
+    case Kernel::Avx512Vnni: vertex_offsets_vnni(L, z, base, add, b0, b1, out); return;
     case Kernel::Avx2:
       switch (L.precision()) {
-        case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, b0, b1, out); return;
-        case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, b0, b1, out); return;
-        case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, b0, b1, out); return;
+        case Precision::Half: vertex_offsets_avx2<Precision::Half>(L, z, base, add, b0, b1, out); return;
+        case Precision::Float: vertex_offsets_avx2<Precision::Float>(L, z, base, add, b0, b1, out); return;
+        case Precision::Int8: vertex_offsets_avx2<Precision::Int8>(L, z, base, add, b0, b1, out); return;
       }
       return;
 #endif
 #ifdef SOFTDECA_NEON
-    case Kernel::Neon: neon::vertex_offsets(L, z, base, b0, b1, out); return;
+    case Kernel::Neon: neon::vertex_offsets(L, z, base, add, b0, b1, out); return;
 #endif
-    default: vertex_offsets_portable(L, z, base, b0, b1, out); return;
+    default: vertex_offsets_portable(L, z, base, add, b0, b1, out); return;
   }
 }
 

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "kernels/aligned.h"
 
@@ -27,6 +28,9 @@ class HyperTensor {
   bool empty() const { return n_ == 0; }
   // Every entry of the source was zero: the product z . L is zero for every z.
   bool zero() const { return zero_; }
+  // The largest magnitude of latent k's stored entries (infinite where one overflowed binary16):
+  // |(z . L)[e, c]| <= sum_k |z_k| peak(k) for every element and component.
+  float peak(int k) const { return peaks_[static_cast<std::size_t>(k)]; }
   std::size_t elements() const { return n_; }
   std::size_t blocks() const { return (n_ + kLanes - 1) / kLanes; }
   int latent() const { return latent_; }
@@ -57,6 +61,7 @@ class HyperTensor {
   int latent_ = 0, width_ = 0;
   bool zero_ = false;
   Precision precision_ = Precision::Half;
+  std::vector<float> peaks_;  // by latent
   AlignedArray<std::uint16_t> half_;
   AlignedArray<float> float_;
   AlignedArray<std::int8_t> int8_;
@@ -83,19 +88,30 @@ bool kernel_available(Kernel kernel);
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
             std::size_t b1, float* rhs, Kernel kernel = Kernel::Best);
 
-// out[v] = base[v] + lanes[c][l] for the elements of block b that exist (the vector kernels'
-// write-out of one block's 3 components, stored lane by lane).
+// out[v] = base[v] + add[v] + lanes[c][l] for the elements of block b that exist (the vector
+// kernels' write-out of one block's 3 components, stored lane by lane); base and add may be
+// null (nothing added), and out may be base (in place).
 inline void add_block_offsets(const float (&lanes)[3][kLanes], const HyperTensor& L, std::size_t b, const float* base,
-                              float* out) {
+                              const float* add, float* out) {
   const std::size_t end = L.elements() - b * kLanes < kLanes ? L.elements() - b * kLanes : kLanes;
   for (std::size_t l = 0; l < end; ++l) {
     const std::size_t v = (b * kLanes + l) * 3;
-    for (std::size_t c = 0; c < 3; ++c) out[v + c] = base[v + c] + lanes[c][l];
+    for (std::size_t c = 0; c < 3; ++c) {
+      float x = lanes[c][l];
+      if (add) x += add[v + c];
+      out[v + c] = base ? base[v + c] + x : x;
+    }
   }
 }
 
-// out[v] = base[v] + sum_k z_k L[v, k] for the vertices of blocks [b0, b1) (width-3 tensor).
-void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out,
-                    Kernel kernel = Kernel::Best);
+// out[v] = base[v] + add[v] + sum_k z_k L[v, k] for the vertices of blocks [b0, b1) (width-3
+// tensor). base and add may be null (nothing added); out may be base (in place).
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, const float* add, std::size_t b0,
+                    std::size_t b1, float* out, Kernel kernel = Kernel::Best);
+// The same without `add`.
+inline void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1,
+                           float* out, Kernel kernel = Kernel::Best) {
+  vertex_offsets(L, z, base, nullptr, b0, b1, out, kernel);
+}
 
 }  // namespace softdeca::kernels

@@ -163,14 +163,14 @@ void accumulate_rhs(const Lanes* d, const FaceBlocks& faces, std::size_t b, cons
   }
 }
 
-// out[v] = base[v] + the 8 lanes of a (3 components), for the elements of block b that exist.
-void write_offsets(const Lanes* a, const HyperTensor& L, std::size_t b, const float* base_pos, float* out) {
+// out[v] = base[v] + add[v] + the 8 lanes of a (3 components), for the elements of block b that exist.
+void write_offsets(const Lanes* a, const HyperTensor& L, std::size_t b, const float* base_pos, const float* add, float* out) {
   alignas(16) float acc[3][kLanes];
   for (int c = 0; c < 3; ++c) {
     vst1q_f32(acc[c], a[c].lo);
     vst1q_f32(acc[c] + 4, a[c].hi);
   }
-  add_block_offsets(acc, L, b, base_pos, out);
+  add_block_offsets(acc, L, b, base_pos, add, out);
 }
 
 template <Precision P>
@@ -184,12 +184,12 @@ void dg_rhs_blocks(const HyperTensor& L, const FaceBlocks& faces, const float* z
 }
 
 template <Precision P>
-void vertex_offsets_blocks(const HyperTensor& L, const float* z, const float* base_pos, std::size_t b0, std::size_t b1,
-                           float* out) {
+void vertex_offsets_blocks(const HyperTensor& L, const float* z, const float* base_pos, const float* add, std::size_t b0,
+                           std::size_t b1, float* out) {
   for (std::size_t b = b0; b < b1; ++b) {
     Lanes a[3];
     contract_any<P, 3>(L, z, b, a);
-    write_offsets(a, L, b, base_pos, out);
+    write_offsets(a, L, b, base_pos, add, out);
   }
 }
 
@@ -204,11 +204,12 @@ void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const
   }
 }
 
-void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out) {
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, const float* add, std::size_t b0, std::size_t b1,
+                    float* out) {
   switch (L.precision()) {
-    case Precision::Half: vertex_offsets_blocks<Precision::Half>(L, z, base, b0, b1, out); return;
-    case Precision::Float: vertex_offsets_blocks<Precision::Float>(L, z, base, b0, b1, out); return;
-    case Precision::Int8: vertex_offsets_blocks<Precision::Int8>(L, z, base, b0, b1, out); return;
+    case Precision::Half: vertex_offsets_blocks<Precision::Half>(L, z, base, add, b0, b1, out); return;
+    case Precision::Float: vertex_offsets_blocks<Precision::Float>(L, z, base, add, b0, b1, out); return;
+    case Precision::Int8: vertex_offsets_blocks<Precision::Int8>(L, z, base, add, b0, b1, out); return;
   }
 }
 

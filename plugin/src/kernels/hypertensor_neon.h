@@ -19,7 +19,8 @@ constexpr int kMaxInt8Latent = 256;
 
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
             std::size_t b1, float* rhs);
-void vertex_offsets(const HyperTensor& L, const float* z, const float* base, std::size_t b0, std::size_t b1, float* out);
+void vertex_offsets(const HyperTensor& L, const float* z, const float* base, const float* add, std::size_t b0, std::size_t b1,
+                    float* out);
 
 }  // namespace softdeca::kernels::neon
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "runtime/peak_magnitude.h"
 
 namespace softdeca::runtime {
 
@@ -17,18 +18,22 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       nf_(static_cast<std::size_t>(m_.skin_triangles)),
       precision_(d.precision),
       neutral_(d.neutral, d.neutral + vh_ * 3),
+      neutral_peak_(peak_magnitude(neutral_.data(), neutral_.size())),
       triangles_(d.triangles, d.triangles + d.triangle_count * 3),
       geometry_(SkinGeometry::measure(neutral_.data(), vs_, model_->skin_triangles())),
       blendshapes_(d.blendshapes ? Blendshapes(d.blendshapes, d.blendshape_count, vh_, d.threads) : Blendshapes()),
       worker_(d.threads),
+      carry_(d.carry),
       params_(m_, model_->skin_triangles(), geometry_.face_area),
       weights_(bundle::kBlendshapeCount),
       z_(static_cast<std::size_t>(m_.latent)),
       offsets_(3 * m_.landmarks.size()),
       head_(vh_ * 3),
       static_(vs_ * 3),
+      stage_latents_(model_->softdeca_vertex_stage() ? static_cast<std::size_t>(m_.latent) : 0),
+      residual_modes_(model_->residual_condition() ? static_cast<std::size_t>(m_.residual_modes) : 0),
+      stage_coefficients_(stage_latents_ + residual_modes_),
       residual_condition_(static_cast<std::size_t>(m_.residual_condition)),
-      residual_coefficients_(static_cast<std::size_t>(m_.residual_modes)),
       solve_work_(vs_ * 4),
       dynamics_(vs_),
       normals_(triangles_, vh_) {
@@ -55,7 +60,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
   if (model_->has(false)) f_w_ = model_->encoder(false)->bind({weights_.data()}, {z_.data()}, 1);
   if (model_->has(true)) f_l_ = model_->encoder(true)->bind({offsets_.data()}, {z_.data()}, 1);
   if (const OnnxNetwork* r = model_->residual_coefficients())
-    f_r_w_ = r->bind({weights_.data(), residual_condition_.data()}, {residual_coefficients_.data()}, 1);
+    f_r_w_ = r->bind({weights_.data(), residual_condition_.data()}, {stage_coefficients_.data() + stage_latents_}, 1);
   stats_.threads = worker_.parts();
 }
 

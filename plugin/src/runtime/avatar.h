@@ -24,6 +24,7 @@
 #include "prepare/parameters.h"
 #include "prepare/rest_physics.h"
 #include "runtime/blendshapes.h"
+#include "runtime/carry_map.h"
 #include "runtime/deformation_transfer.h"
 #include "runtime/dynamics.h"
 #include "runtime/model.h"
@@ -40,6 +41,9 @@ struct AvatarDesc {
   std::size_t blendshape_count = 0;
   std::size_t threads = 1;
   kernels::Precision precision = kernels::Precision::Half;
+  // A fitted avatar's carry map (the avatar is its registered template): prepare also carries
+  // the vertex stages onto the map's vertices, for evaluate_carried. Null for other avatars.
+  std::shared_ptr<const CarryMap> carry;
 };
 
 struct Output {
@@ -84,16 +88,21 @@ struct Preparation {
   std::shared_ptr<const DeformationTransfer> dt;
   std::vector<float> identity;
   kernels::HyperTensor face_l, vertex_l;       // SoftDECA: [F][latent][9]; sparse: [Vs][latent][3]
-  kernels::HyperTensor softdeca_vertex_l;      // SoftDECA's vertex stage, [Vs][latent][3] (empty: none)
-  // SoftDECA's residual stage: the condition its frame half reads, and its modes
-  // [Vs][modes][3] (empty: none)
-  std::vector<float> residual_condition;
-  kernels::HyperTensor residual_modes;
+  // SoftDECA's vertex and residual stages as one table [Vs][latent + modes][3] (empty: neither):
+  // the vertex stage's L_v(p, h), weighed by z, then the residual stage's modes, weighed by its
+  // coefficients c(w, condition), so that one contraction with (z, c) adds both in one pass.
+  kernels::HyperTensor vertex_stages;
+  std::vector<float> residual_condition;  // what the residual stage's frame half reads with w
   DynamicsCoefficients dynamics[2];  // by model: 0 SoftDECA, 1 sparse
   // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
   // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)], p_inert being
   // p's rest-inert parameters alone, the others at their defaults (prepare/rest_physics.h).
   std::vector<float> rest_offset;
+  float rest_offset_peak = 0;  // its largest magnitude
+  // With a carry map and DT at identity (evaluate_carried): vertex_stages and rest_offset carried
+  // onto the map's vertices, [carried][latent + modes][3] and [carried][3] (empty: none).
+  kernels::HyperTensor carried_stages;
+  std::vector<float> carried_rest;
   std::size_t bytes() const;
 };
 
@@ -130,9 +139,15 @@ class Avatar {
 
   AvatarStats stats() const;
 
-  // S_t of the last evaluate_weights (skin_vertices x 3): the linear blend the model corrected.
-  // Frame thread only, valid until its next frame.
-  const float* linear_skin() const { return head_.data(); }
+  // A fitted avatar's SoftDECA frame (an avatar made with a carry map): the model's correction
+  // of the linear blend S_t for 52 weights (checked and clamped as evaluate_weights does), the
+  // frame's skin minus S_t with the dynamics when they are on, carried onto the map's vertices
+  // (`carried`, CarryMap::size() x 3). With DT at identity and no dynamics the correction is the
+  // vertex and residual stages' offsets (and the physics at prepare's) whatever S_t is: the
+  // frame then contracts the carried table alone, with no blend of the template. On
+  // Error(NON_FINITE) `carried` holds no valid frame (it is the caller's scratch, carried into
+  // an output only after a frame succeeds).
+  void evaluate_carried(const float* weights, std::size_t count, float* carried);
   // The 52 weights of the last evaluate_weights or evaluate_linear, checked and clamped to
   // [0, 1] (read_weights). Frame thread only, valid until its next frame.
   const float* weights() const { return weights_.data(); }
@@ -143,32 +158,51 @@ class Avatar {
   std::shared_ptr<const Preparation> current() const;
   kernels::HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                            const std::vector<float>& identity, std::size_t n, std::size_t width) const;
+  // The same network's values, checked, before they are stored ([n][latent][width]).
+  std::vector<float> hyper_values(const OnnxNetwork& net, const std::vector<float>& parameters,
+                                  const std::vector<float>& identity, std::size_t n, std::size_t width) const;
   void read_weights(const float* weights, std::size_t count);
   const float* select_landmarks(const float* points, std::size_t count, const char* what) const;
-  // The shared tail of a frame: dynamics, checks, output of the head and normals. Returns
-  // whether the dynamics ran.
-  bool finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
-              AvatarStats& st);
+  // The shared tail of a frame: settle, then the head written to `out` (the skin, and the
+  // non-skin vertices from `non_skin` or following the bones) and its normals.
+  void finish(const Preparation& prep, int model, const float* skin, const float* non_skin, bool dynamics,
+              const Output& out, AvatarStats& st);
+  // The dynamics on `skin` (when on) and the check that the result is finite (Error(NON_FINITE)
+  // otherwise, before anything is written); returns the frame's final skin.
+  const float* settle(const Preparation& prep, int model, const float* skin, bool dynamics, AvatarStats& st);
+  // A frame without dynamics forgets their past (a later frame with them starts at rest).
+  void settle_static();
   // FrameBytes of each kind of frame (avatar_frame_bytes.cpp), after it ran: `surface`, the
   // vertices of a caller's surface (0: blended from the weights read); `dynamics`, what finish
   // returned; `normals`, whether the output has normals.
   FrameBytes softdeca_bytes(const Preparation& prep, std::size_t surface, bool dynamics, bool normals) const;
+  // evaluate_carried's: `blended`, whether it ran the template's whole frame (the dynamics or DT on).
+  FrameBytes carried_bytes(const Preparation& prep, bool blended, bool dynamics) const;
   FrameBytes sparse_bytes(const Preparation& prep, bool dynamics, bool normals) const;
   FrameBytes linear_bytes(bool normals) const;
   // The tail's (finish): dynamics, the head written (and the neutral's non-skin vertices read
   // where they follow the bones), normals.
   void add_tail_bytes(const Preparation& prep, int model, bool dynamics, bool rigid_non_skin, bool normals,
                       FrameBytes& b) const;
+  // f_w's z and the vertex stages' coefficients (z, c) of the weights read.
+  void encode_weights(const Preparation& prep, AvatarStats& st);
+  // SoftDECA's static skin from the linear skin in head_ into static_: DT (unless every G_f is
+  // I), then the vertex stages.
   void softdeca_frame(const Preparation& prep, AvatarStats& st);
-  // static_ = base + c . modes (base may be static_ itself)
-  void add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients, const float* base);
-  // The vertex and residual stages on DT's result; their time from `since` joins hyper_ms.
-  void add_vertex_stages(const Preparation& prep, AvatarStats& st, std::chrono::steady_clock::time_point since,
-                         const float* base);
-  void prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
-  // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep`.
+  // out = base + the vertex and residual stages' offsets + the physics at prepare's (skin x 3;
+  // base may be out itself, or null for the offsets alone); their time joins hyper_ms.
+  void add_vertex_stages(const Preparation& prep, const float* base, float* out, AvatarStats& st);
+  // Whether the frame of the weights read may be written straight into the caller's output:
+  // no dynamics, DT at identity, and every sum it forms provably finite (so it needs no check
+  // afterwards that would have to leave the previous output untouched).
+  bool in_place(const Preparation& prep, bool dynamics) const;
+  // The residual stage's prepare half for these parameters: its condition into `prep`; returns
+  // its modes [Vs][modes][3] (empty: no residual stage).
+  std::vector<float> prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
+  // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep` (and,
+  // `carried`, their table carried through the carry map where evaluate_carried reads it).
   void prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
-                               Preparation& prep) const;
+                               Preparation& prep, bool carried) const;
   // The networks' part of a preparation for these parameters and identity.
   std::shared_ptr<Preparation> prepare_networks(const prepare::ParameterState& params, const std::vector<float>& identity) const;
   // SoftDECA's static frame at rest (zero weights on the neutral) for a preparation, without
@@ -187,6 +221,7 @@ class Avatar {
   std::size_t vh_, vs_, nf_;
   kernels::Precision precision_;
   std::vector<float> neutral_;  // Vh x 3
+  float neutral_peak_;          // its largest magnitude (infinite if one is not finite)
   std::vector<std::int32_t> triangles_;
   SkinGeometry geometry_;
   std::vector<double> neutral_landmarks_;  // K x 3, on the avatar's neutral skin
@@ -194,6 +229,7 @@ class Avatar {
   std::vector<int> jaw_vertices_, cranium_vertices_;
   Blendshapes blendshapes_;
   kernels::Worker worker_;
+  std::shared_ptr<const CarryMap> carry_;
 
   // Staged inputs of prepare (any thread).
   mutable std::mutex params_mutex_;
@@ -216,7 +252,10 @@ class Avatar {
   std::atomic<bool> busy_{false};
   std::atomic<bool> dynamics_enabled_{false}, reset_requested_{false};
   kernels::AlignedArray<float> weights_, z_, offsets_, head_, static_;
-  kernels::AlignedArray<float> residual_condition_, residual_coefficients_;  // the residual stage's frame half
+  // The vertex stages' coefficients (z, c): z's copy for the vertex stage (stage_latents_ of
+  // them), then the residual stage's frame half's output; and that half's condition input.
+  std::size_t stage_latents_, residual_modes_;
+  kernels::AlignedArray<float> stage_coefficients_, residual_condition_;
   std::vector<kernels::AlignedArray<float>> rhs_;  // one right-hand side per thread
   std::vector<const float*> rhs_parts_;
   kernels::AlignedArray<double> solve_work_;

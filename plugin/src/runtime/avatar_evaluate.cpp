@@ -18,6 +18,12 @@ using namespace avatar_detail;
 
 namespace {
 constexpr float kWeightSlack = 0.01f;  // weights may overshoot [0, 1] by this much (clamped)
+
+// A frame's result, checked before anything of it reaches an output.
+void require_finite_frame(const float* v, std::size_t n) {
+  if (!all_finite(v, n))
+    throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
+}
 }  // namespace
 
 void check_output_capacity(const Output& out, std::size_t vertices) {
@@ -47,18 +53,28 @@ void Avatar::read_weights(const float* weights, std::size_t count) {
   }
 }
 
-void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
+void Avatar::encode_weights(const Preparation& prep, AvatarStats& st) {
   auto t = Clock::now();
   model_->encoder(false)->run(f_w_);
   auto t1 = Clock::now();
-  st.encoder_ms = ms(t, t1);
+  st.encoder_ms += ms(t, t1);
+  std::memcpy(stage_coefficients_.data(), z_.data(), stage_latents_ * sizeof(float));
+  if (residual_modes_ > 0) {  // c from w and the preparation's condition
+    std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
+    model_->residual_coefficients()->run(f_r_w_);
+  }
+  st.hyper_ms += ms(t1, Clock::now());
+}
+
+void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   if (prep.face_l.zero()) {
     // Every G_f is I: DT(S_t, I) = S_t + K^-1 0 = S_t exactly, so neither the right-hand side
     // nor the solve is needed (a model started in closed form has no DT correction yet): the
     // vertex stages start from the blend itself.
-    add_vertex_stages(prep, st, Clock::now(), head_.data());
+    add_vertex_stages(prep, head_.data(), static_.data(), st);
     return;
   }
+  auto t1 = Clock::now();
   const std::size_t blocks = prep.face_l.blocks();
   auto pass = [&](std::size_t part, std::size_t n_parts) {
     float* rhs = rhs_[part].data();
@@ -68,7 +84,7 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   };
   worker_.run(pass);
   auto t2 = Clock::now();
-  st.hyper_ms = ms(t1, t2);
+  st.hyper_ms += ms(t1, t2);
   for (int phase = 0; phase < DeformationTransfer::kPhases; ++phase) {
     auto solve = [&](std::size_t part, std::size_t) {
       prep.dt->solve_phase(phase, part, rhs_parts_.data(), rhs_parts_.size(), head_.data(), solve_work_.data(),
@@ -77,41 +93,39 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
     if (phase == 1) solve(0, worker_.parts());  // the serial top part: on this thread, no hand-off
     else worker_.run(solve);
   }
-  auto t3 = Clock::now();
-  st.solve_ms = ms(t2, t3);
-  add_vertex_stages(prep, st, t3, static_.data());
+  st.solve_ms = ms(t2, Clock::now());
+  add_vertex_stages(prep, static_.data(), static_.data(), st);
 }
 
-void Avatar::add_vertex_stages(const Preparation& prep, AvatarStats& st, Clock::time_point since, const float* base) {
-  // static_ = base + z . L_v + c . modes (+ the physics at prepare): the first stage reads
-  // `base` (the blend, or DT's result already in static_), each later one works in place.
-  const float* from = base;
-  if (!prep.softdeca_vertex_l.empty()) {
-    add_vertex_offsets(prep.softdeca_vertex_l, z_.data(), from);
-    from = static_.data();
+void Avatar::add_vertex_stages(const Preparation& prep, const float* base, float* out, AvatarStats& st) {
+  const auto t = Clock::now();
+  // The physics at prepare's correction (empty at the defaults) joins the same pass.
+  const float* rest = prep.rest_offset.empty() ? nullptr : prep.rest_offset.data();
+  if (!prep.vertex_stages.empty()) {
+    const std::size_t blocks = prep.vertex_stages.blocks();
+    auto pass = [&](std::size_t part, std::size_t parts) {
+      kernels::vertex_offsets(prep.vertex_stages, stage_coefficients_.data(), base, rest, blocks * part / parts,
+                              blocks * (part + 1) / parts, out);
+    };
+    worker_.run(pass);
+  } else {  // no stages (a bundle before them): base and the physics' correction alone
+    for (std::size_t i = 0; i < vs_ * 3; ++i) out[i] = (base ? base[i] : 0.0f) + (rest ? rest[i] : 0.0f);
   }
-  // The residual stage: its coefficients from w and the preparation's condition.
-  if (!prep.residual_modes.empty()) {
-    std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
-    model_->residual_coefficients()->run(f_r_w_);
-    add_vertex_offsets(prep.residual_modes, residual_coefficients_.data(), from);
-    from = static_.data();
-  }
-  if (from != static_.data()) std::memcpy(static_.data(), from, vs_ * 3 * sizeof(float));
-  // The physics at prepare's correction (empty at the defaults).
-  if (!prep.rest_offset.empty()) {
-    float* x = static_.data();
-    for (std::size_t i = 0; i < prep.rest_offset.size(); ++i) x[i] += prep.rest_offset[i];
-  }
-  st.hyper_ms += ms(since, Clock::now());
+  st.hyper_ms += ms(t, Clock::now());
 }
 
-void Avatar::add_vertex_offsets(const kernels::HyperTensor& modes, const float* coefficients, const float* base) {
-  const std::size_t blocks = modes.blocks();
-  auto pass = [&](std::size_t part, std::size_t parts) {
-    vertex_offsets(modes, coefficients, base, blocks * part / parts, blocks * (part + 1) / parts, static_.data());
-  };
-  worker_.run(pass);
+bool Avatar::in_place(const Preparation& prep, bool dynamics) const {
+  if (dynamics || !prep.face_l.zero()) return false;
+  // No value the frame forms exceeds the neutral's largest coordinate plus what the blend and
+  // the stages can add at most (each |coefficient| times its table's largest entry): float
+  // sums of terms bounded so far below float's range cannot overflow, and every input is
+  // finite (a non-finite one makes the bound infinite or NaN). 1e12 m: no head comes near it,
+  // and its square (the normals' cross products) is still far inside float's range.
+  constexpr double kLimit = 1e12;
+  double reach = double(neutral_peak_) + blendshapes_.reach(weights_.data()) + double(prep.rest_offset_peak);
+  for (int k = 0; k < prep.vertex_stages.latent(); ++k)
+    reach += std::fabs(double(stage_coefficients_[static_cast<std::size_t>(k)])) * prep.vertex_stages.peak(k);
+  return reach < kLimit;  // false for NaN
 }
 
 void Avatar::write_rigid_non_skin(const float* skin, float* head) const {
@@ -134,12 +148,10 @@ void Avatar::compute_normals(const float* head, float* normals) {
   worker_.run(vertices);
 }
 
-bool Avatar::finish(const Preparation& prep, int model, const float* skin, const float* non_skin, const Output& out,
-                    AvatarStats& st) {
+const float* Avatar::settle(const Preparation& prep, int model, const float* skin, bool dynamics, AvatarStats& st) {
   auto t = Clock::now();
   if (reset_requested_.exchange(false)) dynamics_.invalidate();
   const float* result = skin;
-  const bool dynamics = dynamics_enabled_.load();
   if (dynamics) {
     const DynamicsCoefficients& c = prep.dynamics[model];
     auto pass = [&](std::size_t part, std::size_t parts) {
@@ -148,12 +160,22 @@ bool Avatar::finish(const Preparation& prep, int model, const float* skin, const
     worker_.run(pass);
     result = dynamics_.next();
   }
-  if (!all_finite(result, vs_ * 3))
-    throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite vertex; the previous output stays valid");
+  require_finite_frame(result, vs_ * 3);
   if (dynamics) dynamics_.commit(model);
   else dynamics_.invalidate();
+  st.dynamics_ms = ms(t, Clock::now());
+  return result;
+}
+
+void Avatar::settle_static() {
+  reset_requested_.store(false);
+  dynamics_.invalidate();
+}
+
+void Avatar::finish(const Preparation& prep, int model, const float* skin, const float* non_skin, bool dynamics,
+                    const Output& out, AvatarStats& st) {
+  const float* result = settle(prep, model, skin, dynamics, st);
   auto t1 = Clock::now();
-  st.dynamics_ms = ms(t, t1);
   float* head = out.vertices;
   std::memcpy(head, result, vs_ * 3 * sizeof(float));
   if (non_skin) std::memcpy(head + vs_ * 3, non_skin, (vh_ - vs_) * 3 * sizeof(float));
@@ -163,7 +185,6 @@ bool Avatar::finish(const Preparation& prep, int model, const float* skin, const
   if (out.normals) compute_normals(head, out.normals);
   st.normals_ms = ms(t2, Clock::now());
   st.generation = prep.generation;
-  return dynamics;
 }
 
 namespace {
@@ -186,13 +207,82 @@ void Avatar::evaluate_weights(const float* weights, std::size_t count, const Out
   read_weights(weights, count);
   const auto prep = require_prepared(current());
   AvatarStats st;
-  auto blend = [&](std::size_t part, std::size_t) { blendshapes_.blend(weights_.data(), neutral_.data(), head_.data(), part); };
-  worker_.run(blend);
   st.blend_ms = ms(t0, Clock::now());
-  softdeca_frame(*prep, st);
-  const bool dynamics = finish(*prep, kSoftDeca, static_.data(), head_.data() + vs_ * 3, out, st);
+  encode_weights(*prep, st);
+  const bool dynamics = dynamics_enabled_.load();
+  const bool direct = in_place(*prep, dynamics);
+  // In place, the frame is the linear blend straight into the output, its skin then corrected
+  // where it lies; otherwise the blend goes to head_ and the tail checks the skin before it
+  // writes the output.
+  float* blend_into = direct ? out.vertices : head_.data();
+  const auto tb = Clock::now();
+  auto blend = [&](std::size_t part, std::size_t) { blendshapes_.blend(weights_.data(), neutral_.data(), blend_into, part); };
+  worker_.run(blend);
+  st.blend_ms += ms(tb, Clock::now());
+  if (direct) {
+    add_vertex_stages(*prep, out.vertices, out.vertices, st);
+    settle_static();
+    const auto t = Clock::now();
+    if (out.normals) compute_normals(out.vertices, out.normals);
+    st.normals_ms = ms(t, Clock::now());
+    st.generation = prep->generation;
+  } else {
+    softdeca_frame(*prep, st);
+    finish(*prep, kSoftDeca, static_.data(), head_.data() + vs_ * 3, dynamics, out, st);
+  }
   st.frame_ms = ms(t0, Clock::now());
   st.frame_bytes = softdeca_bytes(*prep, 0, dynamics, out.normals != nullptr);
+  record(st);
+}
+
+void Avatar::evaluate_carried(const float* weights, std::size_t count, float* carried) {
+  FrameGuard guard(busy_);
+  const auto t0 = Clock::now();
+  require_model(*model_, false);
+  expect(!blendshapes_.empty() && carry_ != nullptr,
+         [] { return std::string("evaluate_carried needs an avatar made with blendshapes and a carry map"); });
+  read_weights(weights, count);
+  const auto prep = require_prepared(current());
+  AvatarStats st;
+  encode_weights(*prep, st);
+  const bool dynamics = dynamics_enabled_.load();
+  const bool blended = dynamics || !prep->face_l.zero();
+  const std::size_t n = carry_->size();
+  if (!blended) {
+    // The frame's skin is S_t + the stages' offsets (DT(S_t, I) = S_t, no dynamics): its
+    // correction is the offsets whatever S_t is, and carried, the carried table's contraction.
+    const auto t = Clock::now();
+    const float* rest = prep->carried_rest.empty() ? nullptr : prep->carried_rest.data();
+    if (!prep->carried_stages.empty()) {
+      const std::size_t blocks = prep->carried_stages.blocks();
+      auto pass = [&](std::size_t part, std::size_t parts) {
+        kernels::vertex_offsets(prep->carried_stages, stage_coefficients_.data(), nullptr, rest, blocks * part / parts,
+                                blocks * (part + 1) / parts, carried);
+      };
+      worker_.run(pass);
+    } else {  // no stages: the physics at prepare's correction alone
+      for (std::size_t i = 0; i < n * 3; ++i) carried[i] = rest ? rest[i] : 0.0f;
+    }
+    st.hyper_ms += ms(t, Clock::now());
+    const auto t1 = Clock::now();
+    require_finite_frame(carried, n * 3);
+    settle_static();
+    st.dynamics_ms = ms(t1, Clock::now());
+  } else {  // the template's whole frame, less its blend, carried
+    const auto tb = Clock::now();
+    auto blend = [&](std::size_t part, std::size_t) { blendshapes_.blend(weights_.data(), neutral_.data(), head_.data(), part); };
+    worker_.run(blend);
+    st.blend_ms = ms(tb, Clock::now());
+    softdeca_frame(*prep, st);
+    const float* result = settle(*prep, kSoftDeca, static_.data(), dynamics, st);
+    const auto t = Clock::now();
+    for (std::size_t i = 0; i < vs_ * 3; ++i) static_[i] = result[i] - head_[i];
+    carry_->carry(static_.data(), carried);
+    st.output_ms = ms(t, Clock::now());
+  }
+  st.generation = prep->generation;
+  st.frame_ms = ms(t0, Clock::now());
+  st.frame_bytes = carried_bytes(*prep, blended, dynamics);
   record(st);
 }
 
@@ -213,8 +303,10 @@ void Avatar::evaluate_surface(const float* weights, std::size_t count, const flo
   std::memcpy(head_.data(), surface, vertices * 3 * sizeof(float));
   AvatarStats st;
   st.blend_ms = ms(t0, Clock::now());
+  encode_weights(*prep, st);
   softdeca_frame(*prep, st);
-  const bool dynamics = finish(*prep, kSoftDeca, static_.data(), vertices == vh_ ? head_.data() + vs_ * 3 : nullptr, out, st);
+  const bool dynamics = dynamics_enabled_.load();
+  finish(*prep, kSoftDeca, static_.data(), vertices == vh_ ? head_.data() + vs_ * 3 : nullptr, dynamics, out, st);
   st.frame_ms = ms(t0, Clock::now());
   st.frame_bytes = softdeca_bytes(*prep, vertices, dynamics, out.normals != nullptr);
   record(st);
@@ -295,7 +387,8 @@ void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Ou
   };
   worker_.run(pass);
   st.hyper_ms = ms(t2, Clock::now());
-  const bool dynamics = finish(*prep, kSparse, static_.data(), nullptr, out, st);
+  const bool dynamics = dynamics_enabled_.load();
+  finish(*prep, kSparse, static_.data(), nullptr, dynamics, out, st);
   st.frame_ms = ms(t0, Clock::now());
   st.frame_bytes = sparse_bytes(*prep, dynamics, out.normals != nullptr);
   record(st);

@@ -29,11 +29,25 @@ FrameBytes Avatar::softdeca_bytes(const Preparation& prep, std::size_t surface, 
     b.hyper = prep.face_l.stored_bytes() + prep.dt->face_bytes();
     b.solve = prep.dt->solve_bytes();
   }
-  b.hyper += prep.softdeca_vertex_l.stored_bytes();
-  if (!prep.residual_modes.empty())
-    b.hyper += weight_bytes(model_->residual_coefficients()) + prep.residual_modes.stored_bytes();
-  b.hyper += prep.rest_offset.size() * sizeof(float);
+  b.hyper += prep.vertex_stages.stored_bytes() + weight_bytes(model_->residual_coefficients()) +
+             prep.rest_offset.size() * sizeof(float);
   add_tail_bytes(prep, kSoftDeca, dynamics, surface == vs_, normals, b);
+  return b;
+}
+
+FrameBytes Avatar::carried_bytes(const Preparation& prep, bool blended, bool dynamics) const {
+  // The template's whole frame where it ran, else the carried table in place of the stages'
+  // and no blend; then the carry map (where the frame carries its skin) and the carried
+  // correction written instead of the head, with no normals.
+  FrameBytes b = softdeca_bytes(prep, 0, dynamics, false);
+  if (blended) {
+    b.output = carry_->bytes() + carry_->size() * kVertexBytes;
+  } else {
+    b.blend = 0;
+    b.hyper = weight_bytes(model_->residual_coefficients()) + prep.carried_stages.stored_bytes() +
+              prep.carried_rest.size() * sizeof(float);
+    b.output = carry_->size() * kVertexBytes;
+  }
   return b;
 }
 

@@ -8,25 +8,46 @@
 
 #include "core/error.h"
 #include "runtime/avatar_detail.h"
+#include "runtime/peak_magnitude.h"
 
 namespace softdeca::runtime {
 
 using namespace avatar_detail;
 
-// A hypernetwork's L(p, h) for n elements of the given width, checked and stored.
-kernels::HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
-                                 const std::vector<float>& identity, std::size_t n, std::size_t width) const {
+namespace {
+// Per element, a's rows [n][ka][3] followed by b's [n][kb][3]: [n][ka + kb][3].
+std::vector<float> side_by_side(const std::vector<float>& a, std::size_t ka, const std::vector<float>& b, std::size_t kb,
+                                std::size_t n) {
+  std::vector<float> joint(n * (ka + kb) * 3);
+  for (std::size_t e = 0; e < n; ++e) {
+    float* row = joint.data() + e * (ka + kb) * 3;
+    std::copy_n(a.data() + e * ka * 3, ka * 3, row);
+    std::copy_n(b.data() + e * kb * 3, kb * 3, row + ka * 3);
+  }
+  return joint;
+}
+}  // namespace
+
+// A hypernetwork's L(p, h) for n elements of the given width, checked.
+std::vector<float> Avatar::hyper_values(const OnnxNetwork& net, const std::vector<float>& parameters,
+                                        const std::vector<float>& identity, std::size_t n, std::size_t width) const {
   std::vector<float> l(n * static_cast<std::size_t>(m_.latent) * width);
   net.run({parameters.data(), identity.data()}, {l.data()}, 1);
   if (!all_finite(l.data(), l.size()))
     throw Error(SOFTDECA_ERROR_FORMAT, net.spec().key + " produced non-finite values for these parameters");
-  return kernels::HyperTensor(l.data(), n, m_.latent, static_cast<int>(width), precision_);
+  return l;
+}
+
+// The same, stored.
+kernels::HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
+                                 const std::vector<float>& identity, std::size_t n, std::size_t width) const {
+  return kernels::HyperTensor(hyper_values(net, parameters, identity, n, width).data(), n, m_.latent, static_cast<int>(width),
+                              precision_);
 }
 
 std::size_t Preparation::bytes() const {
-  return face_l.bytes() + vertex_l.bytes() + softdeca_vertex_l.bytes() + residual_modes.bytes() +
-         residual_condition.size() * 4 + dynamics[0].bytes() + dynamics[1].bytes() + identity.size() * 4 +
-         rest_offset.size() * 4;
+  return face_l.bytes() + vertex_l.bytes() + vertex_stages.bytes() + residual_condition.size() * 4 + dynamics[0].bytes() +
+         dynamics[1].bytes() + identity.size() * 4 + rest_offset.size() * 4 + carried_stages.bytes() + carried_rest.size() * 4;
 }
 
 void Avatar::prepare() {
@@ -55,6 +76,11 @@ void Avatar::prepare() {
   if (model_->rest_head() && model_->has(false) && !params->at_defaults()) {
     const auto r0 = Clock::now();
     prep->rest_offset = rest_offset(*params, *prep, identity, physics_iterations);
+    prep->rest_offset_peak = peak_magnitude(prep->rest_offset.data(), prep->rest_offset.size());
+    if (carry_ && prep->face_l.zero()) {
+      prep->carried_rest.resize(carry_->size() * 3);
+      carry_->carry(prep->rest_offset.data(), prep->carried_rest.data());
+    }
     physics_ms = ms(r0, Clock::now());
   }
   {
@@ -74,18 +100,26 @@ void Avatar::prepare() {
 // SoftDECA's stages for these parameters: its per-face hyper-tensor, its vertex stage and the
 // residual stage's prepare half (what softdeca_rest reads).
 void Avatar::prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
-                                     Preparation& prep) const {
+                                     Preparation& prep, bool carried) const {
   const OnnxNetwork& hyper = *model_->hyper(false);
   const auto& cols = hyper.spec().parameter_columns;
   std::vector<float> p(nf_ * cols.size());
   params.face_matrix(cols, p.data());
   prep.face_l = hyper_tensor(hyper, p, identity, nf_, 9);
+  std::vector<float> vertex_l;
   if (const OnnxNetwork* stage = model_->softdeca_vertex_stage()) {
     std::vector<float> pv(vs_ * stage->spec().parameter_columns.size());
     params.vertex_matrix(stage->spec().parameter_columns, pv.data());
-    prep.softdeca_vertex_l = hyper_tensor(*stage, pv, identity, vs_, 3);
+    vertex_l = hyper_values(*stage, pv, identity, vs_, 3);
   }
-  prepare_residual(params, prep);
+  const std::vector<float> modes = prepare_residual(params, prep);
+  const std::size_t latents = stage_latents_ + residual_modes_;
+  if (latents == 0) return;
+  const std::vector<float> table = side_by_side(vertex_l, stage_latents_, modes, residual_modes_, vs_);
+  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, static_cast<int>(latents), 3, precision_);
+  if (carried && carry_ && prep.face_l.zero())  // carried from the values, not their stored rounding
+    prep.carried_stages = kernels::HyperTensor(carry_->carry_columns(table.data(), latents).data(), carry_->size(),
+                                               static_cast<int>(latents), 3, precision_);
 }
 
 // The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
@@ -103,7 +137,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterSt
       params.vertex_matrix(hyper.spec().parameter_columns, p.data());
       prep->vertex_l = hyper_tensor(hyper, p, identity, vs_, 3);
     } else {
-      prepare_softdeca_stages(params, identity, *prep);
+      prepare_softdeca_stages(params, identity, *prep, true);
     }
     // Dynamics coefficients per skin vertex.
     const OnnxNetwork& dyn = *model_->dynamics(sparse);
@@ -125,7 +159,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterSt
 std::vector<float> Avatar::softdeca_rest(const prepare::ParameterState& params, const std::vector<float>& identity) const {
   Preparation stages;
   stages.dt = dt_;
-  prepare_softdeca_stages(params, identity, stages);
+  prepare_softdeca_stages(params, identity, stages, false);
   return softdeca_rest(stages);
 }
 
@@ -142,12 +176,12 @@ std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
     const float* parts[] = {rhs.data()};
     prep.dt->solve(parts, 1, neutral_.data(), work.data(), out.data());
   }
-  if (!prep.softdeca_vertex_l.empty())
-    kernels::vertex_offsets(prep.softdeca_vertex_l, z.data(), out.data(), 0, prep.softdeca_vertex_l.blocks(), out.data());
-  if (!prep.residual_modes.empty()) {
-    std::vector<float> c(static_cast<std::size_t>(m_.residual_modes));
-    model_->residual_coefficients()->run({weights.data(), prep.residual_condition.data()}, {c.data()}, 1);
-    kernels::vertex_offsets(prep.residual_modes, c.data(), out.data(), 0, prep.residual_modes.blocks(), out.data());
+  if (!prep.vertex_stages.empty()) {  // the coefficients (z, c), as a frame's (encode_weights)
+    std::vector<float> zc(stage_latents_ + residual_modes_);
+    std::copy_n(z.begin(), stage_latents_, zc.begin());
+    if (residual_modes_ > 0)
+      model_->residual_coefficients()->run({weights.data(), prep.residual_condition.data()}, {zc.data() + stage_latents_}, 1);
+    kernels::vertex_offsets(prep.vertex_stages, zc.data(), out.data(), 0, prep.vertex_stages.blocks(), out.data());
   }
   return out;
 }
@@ -190,9 +224,9 @@ std::vector<float> Avatar::rest_offset(const prepare::ParameterState& params, co
 }
 
 // The residual stage's prepare half: its condition and modes for these parameters.
-void Avatar::prepare_residual(const prepare::ParameterState& params, Preparation& prep) const {
+std::vector<float> Avatar::prepare_residual(const prepare::ParameterState& params, Preparation& prep) const {
   const OnnxNetwork* net = model_->residual_condition();
-  if (!net) return;
+  if (!net) return {};
   const auto& cols = net->spec().parameter_columns;
   std::vector<float> pv(vs_ * cols.size());
   params.vertex_matrix(cols, pv.data());
@@ -202,7 +236,7 @@ void Avatar::prepare_residual(const prepare::ParameterState& params, Preparation
   if (!all_finite(condition.data(), condition.size()) || !all_finite(modes.data(), modes.size()))
     throw Error(SOFTDECA_ERROR_FORMAT, net->spec().key + " produced non-finite values for these parameters");
   prep.residual_condition = std::move(condition);
-  prep.residual_modes = kernels::HyperTensor(modes.data(), vs_, m_.residual_modes, 3, precision_);
+  return modes;
 }
 
 }  // namespace softdeca::runtime

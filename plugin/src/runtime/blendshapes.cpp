@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "runtime/peak_magnitude.h"
+
 namespace softdeca::runtime {
 
 Blendshapes::Blendshapes(const float* deltas, std::size_t n_shapes, std::size_t n_vertices, std::size_t parts) {
@@ -37,6 +39,7 @@ Blendshapes::Blendshapes(const float* deltas, std::size_t n_shapes, std::size_t 
       sh.part_begin.push_back(sh.runs.size());
     }
     for (const Run& run : sh.runs) sh.stored_bytes += sizeof(Run) + 3 * std::size_t{run.count} * sizeof(float);
+    sh.peak = peak_magnitude(d, n_vertices * 3);
   }
   deltas_.resize(deltas_stored.size());
   std::copy(deltas_stored.begin(), deltas_stored.end(), deltas_.data());
@@ -57,6 +60,13 @@ std::size_t Blendshapes::bytes_read(const float* weights) const {
   for (std::size_t s = 0; s < shapes_.size(); ++s)
     if (weights[s] != 0.0f) b += shapes_[s].stored_bytes;
   return b;
+}
+
+double Blendshapes::reach(const float* weights) const {
+  double r = 0;
+  for (std::size_t s = 0; s < shapes_.size(); ++s)
+    if (weights[s] != 0.0f) r += double(weights[s]) * shapes_[s].peak;
+  return r;
 }
 
 void Blendshapes::blend(const float* weights, const float* neutral, float* out, std::size_t part) const {

@@ -27,6 +27,9 @@ class Blendshapes {
   // What blend() reads of the basis for these weights: the runs and deltas of the shapes with a
   // non-zero weight.
   std::size_t bytes_read(const float* weights) const;
+  // An upper bound on |sum_i w_i B_i[v]| over the vertices for weights in [0, 1]: sum_i w_i
+  // times shape i's largest delta (infinite if a delta is not finite).
+  double reach(const float* weights) const;
 
   // out[v] = neutral[v] + sum_i w_i B_i[v] for the vertices of range `part`.
   void blend(const float* weights, const float* neutral, float* out, std::size_t part) const;
@@ -39,6 +42,7 @@ class Blendshapes {
     std::vector<Run> runs;
     std::vector<std::size_t> part_begin;  // first run of each part, plus the end
     std::size_t stored_bytes = 0;         // its runs and their deltas
+    float peak = 0;                       // its largest delta (magnitude)
   };
   std::vector<Shape> shapes_;
   kernels::AlignedArray<float> deltas_;  // every shape's runs, one after the other (one huge-page stream)

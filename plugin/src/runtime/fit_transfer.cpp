@@ -1,7 +1,5 @@
 #include "runtime/fit_transfer.h"
 
-#include <Eigen/Core>
-#include <Eigen/LU>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -17,7 +15,9 @@ class IdentityTransfer final : public FitTransfer {
  public:
   Output core_output(const Output& out) override { return out; }
   Output surface_output(const Output& out) override { return out; }
-  void blend(const float*, const Output&) override {}
+  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
+    core.evaluate_weights(weights, count, out);
+  }
   void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
     core.evaluate_linear(weights, count, out);
   }
@@ -35,26 +35,26 @@ class IdentityTransfer final : public FitTransfer {
 
 class EmbeddingTransfer final : public FitTransfer {
  public:
-  EmbeddingTransfer(const fit::TemplateData& t, const fit::AvatarMesh& a, const fit::AvatarFit& f, const float* core_shapes)
+  EmbeddingTransfer(const fit::TemplateData& t, const fit::AvatarMesh& a, const fit::AvatarFit& f, const float* core_shapes,
+                    std::shared_ptr<const CarryMap> carry)
       : n_(a.vertex_count),
         vs_(t.skin_vertices),
         vh_(t.head_vertices),
         neutral_(a.neutral, a.neutral + n_ * 3),
         triangles_(a.triangles, a.triangles + a.triangle_count * 3),
-        embedding_(f.embedding),
-        skin_triangles_(t.skin_triangles, t.skin_triangles + t.skin_triangle_count * 3),
-        to_avatar_(f.placement.linear.inverse().cast<float>()),
+        carry_(std::move(carry)),
         source_(f.source) {
     // The avatar's own shapes; a shape its rig lacks is the template's, carried back onto the
     // avatar's face through the embedding, so a rig without some (or any) shapes animates fully.
     std::vector<float> own(bundle::kBlendshapeCount * n_ * 3, 0.0f);
     for (std::size_t k = 0; k < static_cast<std::size_t>(bundle::kBlendshapeCount); ++k) {
       if (a.deltas[k]) std::memcpy(own.data() + k * n_ * 3, a.deltas[k], n_ * 3 * sizeof(float));
-      else if (f.origin[k] == fit::ShapeOrigin::Template) add_carried(core_shapes + k * vh_ * 3, own.data() + k * n_ * 3);
+      else if (f.origin[k] == fit::ShapeOrigin::Template) carry_->add_field(core_shapes + k * vh_ * 3, own.data() + k * n_ * 3);
     }
     blendshapes_ = Blendshapes(own.data(), bundle::kBlendshapeCount, n_, 1);
     head_out_.resize(vh_ * 3);
     field_.resize(vs_ * 3);
+    carried_.resize(carry_->size() * 3);
     normals_ = geometry::Normals(triangles_, n_);
   }
 
@@ -72,21 +72,24 @@ class EmbeddingTransfer final : public FitTransfer {
                 "landmarks");
   }
 
-  void blend(const float* weights, const Output& out) override {
-    blendshapes_.blend(weights, neutral_.data(), out.vertices, 0);
+  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
+    check_output_capacity(out, n_);
+    core.evaluate_carried(weights, count, carried_.data());  // checks the weights; out untouched on error
+    blendshapes_.blend(core.weights(), neutral_.data(), out.vertices, 0);
+    carry_->add(carried_.data(), out.vertices);
   }
 
   void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
     check_output_capacity(out, n_);
     core.read_frame_weights(weights, count);
-    blend(core.weights(), out);
+    blendshapes_.blend(core.weights(), neutral_.data(), out.vertices, 0);
   }
 
   void rest(const Output& out) override { std::memcpy(out.vertices, neutral_.data(), n_ * 3 * sizeof(float)); }
 
   void carry(const float* base, const Output& out) override {
     for (std::size_t i = 0; i < vs_ * 3; ++i) field_[i] = head_out_[i] - base[i];
-    add_carried(field_.data(), out.vertices);
+    carry_->add_field(field_.data(), out.vertices);
   }
 
   void finish(const Output& out) override {
@@ -136,25 +139,12 @@ class EmbeddingTransfer final : public FitTransfer {
   }
 
   std::size_t bytes() const override {
-    return (neutral_.size() + head_out_.size() + field_.size()) * 4 + triangles_.size() * 4 + blendshapes_.bytes() +
-           normals_.bytes() + embedding_.size() * 28 + source_.corners.size() * 4 + source_.bary.size() * 4 +
-           source_.weight.size() * 4 + skin_triangles_.size() * 4;
+    return (neutral_.size() + head_out_.size() + field_.size() + carried_.size()) * 4 + triangles_.size() * 4 +
+           blendshapes_.bytes() + normals_.bytes() + carry_->bytes() + source_.corners.size() * 4 + source_.bary.size() * 4 +
+           source_.weight.size() * 4;
   }
 
  private:
-  // out[v] += weight * A^-1 (sum of bary * field[corner]) over the embedding; field: skin x 3.
-  void add_carried(const float* field, float* out) const {
-    const std::size_t ne = embedding_.size();
-    for (std::size_t e = 0; e < ne; ++e) {
-      const std::int32_t* tri = skin_triangles_.data() + 3 * static_cast<std::size_t>(embedding_.triangle[e]);
-      const float* b = embedding_.bary.data() + 3 * e;
-      Eigen::Vector3f d = Eigen::Vector3f::Zero();
-      for (int k = 0; k < 3; ++k) d += b[k] * Eigen::Map<const Eigen::Vector3f>(field + 3 * static_cast<std::size_t>(tri[k]));
-      Eigen::Map<Eigen::Vector3f>(out + 3 * static_cast<std::size_t>(embedding_.vertex[e])) +=
-          embedding_.weight[e] * (to_avatar_ * d);
-    }
-  }
-
   std::size_t n_, vs_, vh_;
   // the avatar's own rig
   std::vector<float> neutral_;  // n x 3
@@ -162,12 +152,10 @@ class EmbeddingTransfer final : public FitTransfer {
   Blendshapes blendshapes_;
   geometry::Normals normals_;
   // the fit: where the avatar's vertices sit on the template's skin, and where the skin reads the avatar
-  fit::Embedding embedding_;
-  std::vector<std::int32_t> skin_triangles_;
-  Eigen::Matrix3f to_avatar_;  // the placement's inverse linear part (template vectors to the avatar's)
+  std::shared_ptr<const CarryMap> carry_;
   fit::ShapeSource source_;
   // frame buffers
-  std::vector<float> head_out_, field_;
+  std::vector<float> head_out_, field_, carried_;
 };
 
 }  // namespace
@@ -175,8 +163,9 @@ class EmbeddingTransfer final : public FitTransfer {
 std::unique_ptr<FitTransfer> identity_transfer() { return std::make_unique<IdentityTransfer>(); }
 
 std::unique_ptr<FitTransfer> embedding_transfer(const fit::TemplateData& t, const fit::AvatarMesh& mesh,
-                                                const fit::AvatarFit& f, const float* core_shapes) {
-  return std::make_unique<EmbeddingTransfer>(t, mesh, f, core_shapes);
+                                                const fit::AvatarFit& f, const float* core_shapes,
+                                                std::shared_ptr<const CarryMap> carry) {
+  return std::make_unique<EmbeddingTransfer>(t, mesh, f, core_shapes, std::move(carry));
 }
 
 }  // namespace softdeca::runtime

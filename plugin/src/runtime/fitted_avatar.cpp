@@ -1,5 +1,6 @@
 #include "runtime/fitted_avatar.h"
 
+#include <Eigen/LU>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
 
   // The registered template as an avatar of the template's topology, with the carried shapes.
   const std::vector<float> shapes = fit::carried_shapes(t, a, f);
+  auto carry = std::make_shared<const CarryMap>(f.embedding, t.skin_triangles, f.placement.linear.inverse().cast<float>());
   AvatarDesc core;
   core.neutral = f.registered.data();
   core.vertex_count = t.head_vertices;
@@ -56,6 +58,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   core.blendshape_count = bundle::kBlendshapeCount;
   core.threads = d.threads;
   core.precision = d.precision;
+  core.carry = carry;
   // The identity code of the template identity closest to the avatar: the encoder reads a head
   // of the template's own making, not the registration's (a few millimetres of sliding along
   // the skin changes its code far more than the head's shape does).
@@ -64,7 +67,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   core_ = std::make_unique<Avatar>(std::move(model), core);
   if (!identity.empty()) core_->set_identity(identity.data(), identity.size());
 
-  transfer_ = embedding_transfer(t, a, f, shapes.data());
+  transfer_ = embedding_transfer(t, a, f, shapes.data(), std::move(carry));
 }
 
 FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
@@ -73,9 +76,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const AvatarDesc&
 // One frame path for every avatar: the core's frame, then the transfer's steps onto the mesh.
 void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
   FrameGuard guard(busy_);
-  core_->evaluate_weights(weights, count, transfer_->core_output(out));  // checks the weights
-  transfer_->blend(core_->weights(), out);
-  transfer_->carry(core_->linear_skin(), out);  // the models' correction of the core's linear blend
+  transfer_->softdeca(*core_, weights, count, out);
   transfer_->finish(out);
 }
 

@@ -1,7 +1,7 @@
 """The inputs of the native runtime tests (tests/native/test_runtime_*.cpp), written once per
-test run by a ctest fixture: a small synthetic bundle (also packed as .tar, and a variant with
-only SoftDECA), the avatar as raw arrays and as a replay folder, and a short Live Link Face CSV
-take with face-lost rows."""
+test run by a ctest fixture: a small synthetic bundle (also packed as .tar, a variant with
+only SoftDECA and one at SoftDECA's closed-form start), the avatar as raw arrays and as a
+replay folder, and a short Live Link Face CSV take with face-lost rows."""
 
 from __future__ import annotations
 
@@ -50,20 +50,34 @@ def write_test_data(out: Path) -> Path:
     specs = load_parameter_specs(TEST_PARAMETERS)
     nets = build_random(head.definition, specs, TEST_SIZES, seed=1)
     info = BundleInfo(untrained=True, description="native test bundle: synthetic head, random")
-    # with the physics at prepare (format version 4) on a shell head under the synthetic skin
-    export_bundle(
-        out / "bundle",
-        head.definition,
-        nets,
-        info,
-        rest_head=synthetic_rest_head(head),
-        template_head=template_head_of(
-            head.neutral, head.blendshapes, head.definition.skin_vertices
-        ),
-    )
+    # with the physics at prepare (format version 4) on a shell head under the synthetic skin,
+    # and the template head fits read
+    rest = synthetic_rest_head(head)
+    fits = template_head_of(head.neutral, head.blendshapes, head.definition.skin_vertices)
+    export_bundle(out / "bundle", head.definition, nets, info, rest_head=rest, template_head=fits)
     (out / "bundle.tar").write_bytes(pack_bundle(out / "bundle"))
     only = build_random(head.definition, specs, TEST_SIZES, seed=2, sparse=False)
     export_bundle(out / "bundle_softdeca_only", head.definition, only, info)
+    # SoftDECA at its closed-form start (f_ph zero: DT at identity) with its vertex and residual
+    # stages, as the committed bundle: the frames written in place and the fitted avatars'
+    # carried frames run on it
+    closed = build_random(
+        head.definition,
+        specs,
+        TEST_SIZES,
+        seed=3,
+        dg_scale=0.0,
+        vertex_stage=True,
+        residual_stage=True,
+    )
+    export_bundle(
+        out / "bundle_closed_form",
+        head.definition,
+        closed,
+        info,
+        rest_head=rest,
+        template_head=fits,
+    )
     for name, a in {
         "neutral.f32": head.neutral,
         "blendshapes.f32": head.blendshapes,
