@@ -58,7 +58,8 @@ void Avatar::encode_weights(const Preparation& prep, AvatarStats& st) {
   model_->encoder(false)->run(f_w_);
   auto t1 = Clock::now();
   st.encoder_ms += ms(t, t1);
-  std::memcpy(stage_coefficients_.data(), z_.data(), stage_latents_ * sizeof(float));
+  if (stage_latents_ > 0)  // no vertex stages: no table, and memcpy takes no null pointer
+    std::memcpy(stage_coefficients_.data(), z_.data(), stage_latents_ * sizeof(float));
   if (residual_modes_ > 0) {  // c from w and the preparation's condition
     std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
     model_->residual_coefficients()->run(f_r_w_);
