@@ -36,6 +36,7 @@ from softdeca_train.models import (
     build_random,
     export_bundle,
     load_parameter_specs,
+    read_manifest,
 )
 from softdeca_train.models.synthetic import (
     TEST_PARAMETERS,
@@ -563,11 +564,10 @@ def test_at_rest_the_response_is_the_physics(setup):
     )
 
 
-def test_a_bundle_exact_at_rest_runs_as_its_reference(tmp_path):
-    """A bundle trained exact at rest (a rest gate: every network of w gives g(w) - g(0), the
-    residual stage's c(0) at the end of its condition, made at prepare): the native runtime
-    matches its reference, and at rest its frame is the linear blend (no rest physics at the
-    defaults), while a moving face is corrected."""
+@pytest.fixture(scope="module")
+def gated(tmp_path_factory):
+    """A bundle trained exact at rest, as setup's: z's last entry the rest gate (f_w's constant
+    slot, as the trained bundles have it; format version 6), with the physics at prepare."""
     head = synthetic_head()
     specs = load_parameter_specs(TEST_PARAMETERS)
     nets = build_random(
@@ -577,24 +577,24 @@ def test_a_bundle_exact_at_rest_runs_as_its_reference(tmp_path):
         seed=9,
         vertex_stage=True,
         residual_stage=True,
+        constant_slot=True,
+        # the constant slot's local map of p makes tables of this scale correct S_t by a few
+        # mm (setup's bundle: ~1 mm), which the storage bounds are relative to
+        offset_scale=1e-4,
     )
-    export_bundle(tmp_path / "gated", head.definition, nets, BundleInfo(True, "gated"))
-    ref = ReferenceAvatar(
-        TorchNetworks(as_stored(nets)),
-        head.definition,
-        head.neutral,
-        head.head_triangles,
-        head.blendshapes,
-    )
-    nat = NativeAvatar(
-        NativeModel(tmp_path / "gated"),
-        head.neutral,
-        head.head_triangles,
-        head.blendshapes,
-        precision="float",
-    )
-    ref.prepare()
-    nat.prepare()
+    folder = tmp_path_factory.mktemp("gated") / "bundle"
+    rest = replace(synthetic_rest_head(head), inert=("w_skin_strain",))
+    export_bundle(folder, head.definition, nets, BundleInfo(True, "gated"), rest_head=rest)
+    return head, nets, NativeModel(folder), folder, rest
+
+
+def test_a_bundle_exact_at_rest_runs_as_its_reference(gated):
+    """A bundle trained exact at rest (a rest gate: every network of w gives g(w) - g(0), the
+    residual stage's c(0) at the end of its condition, made at prepare): the native runtime
+    matches its reference, and at rest its frame is the linear blend (no rest physics at the
+    defaults), while a moving face is corrected."""
+    ref, nat = pair(gated, "float")
+    assert read_manifest(gated[3])["rest_gate"] == 0.1
     zero = np.zeros(52)
     below(
         err_mm(nat.evaluate_weights(zero)[0], nat.evaluate_linear(zero)[0]),
@@ -606,3 +606,153 @@ def test_a_bundle_exact_at_rest_runs_as_its_reference(tmp_path):
         x = nat.evaluate_weights(w)[0]
         below(err_mm(x, ref.evaluate_weights(w)[0]), BOUND_MM["float"], REASON["float"])
         above(err_mm(x, nat.evaluate_linear(w)[0]), 0.05, "a moving face is corrected")
+
+
+def gate_open_rest(avatar: ReferenceAvatar) -> np.ndarray:
+    """M1: the networks' static frame at zero weights on the neutral with the rest gate open
+    (z's last entry and the residual stage's mean mode at 1)."""
+    assert avatar.prep is not None
+    vs = avatar.d.skin_vertices
+    return avatar._softdeca_static(avatar.prep, np.zeros(52), avatar.neutral[:vs], gate=1.0)
+
+
+@pytest.mark.parametrize("precision", ["float", "half"])
+def test_a_gated_bundle_counts_p_at_rest_once(gated, precision):
+    """With a rest gate the networks add nothing at rest, so off the defaults the frame at
+    rest is the linear blend plus the physics' change Pd = P_rest(p) - P_rest(p0); on an
+    expression the gate opens the networks' own response to p at rest, which is taken off
+    as it opens: frame(w, p) = networks(w, p) + Pd - g(w) [M1(p) - M1(p_inert)]. Without that
+    term p's effect at rest is counted twice. The native runtime (the term folded into its
+    stage table at prepare) matches the reference (which takes it off per frame)."""
+    from softdeca_train.models.rest_physics import RestSolver
+
+    head, _, _, _, rest = gated
+    vs = head.definition.skin_vertices
+    zero = np.zeros(52)
+    ref0, nat0 = pair(gated, precision)
+    ref, nat = pair(gated, precision, localise=True)  # the skin strain too: p_inert is not p0
+    plain = [
+        ReferenceAvatar(
+            ref.nets, head.definition, head.neutral, head.head_triangles, head.blendshapes,
+            rest_physics=False,
+        )  # fmt: skip
+        for _ in range(2)
+    ]
+    plain[0].params = ref.params
+    plain[1].params = ref.params.with_defaults(
+        [s.name for s in ref.nets.specs if s.name not in rest.inert]
+    )
+    for a in plain:
+        a.prepare()
+    solver = RestSolver(rest, head.neutral, head.definition.skin_triangles)
+    physics = solver.solve(ref.params) - solver.solve(ref0.params)
+    above(np.abs(physics).max(), 1e-4, "1.7 g and volumes 0.6-1.4: tenths of a mm", what="m")
+    # at rest: the linear blend and the physics' change
+    below(
+        err_mm(ref.evaluate_weights(zero)[0][:vs] - head.neutral[:vs], physics),
+        1e-6,
+        REASON_SAME,
+        what="mm",
+    )
+    # on an expression: the networks' change from p0 to p, the physics' change, and the
+    # networks' response at rest (gate open) taken off, as far as the gate is open
+    model = gate_open_rest(plain[0]) - gate_open_rest(plain[1])
+    strong = np.full(52, 0.6)  # |w|^2 = 18.7 against tau^2 = 0.01: the gate at 0.9995
+    gate = float(ref.nets.f_w(strong.astype(np.float32)[None])[0, -1])
+    above(gate, 0.9, "a strong expression opens the gate (0.9995)", what="gate")
+    above(np.abs(gate * model).max(), 1e-5, "the networks respond to p at rest", what="m")
+    want = (
+        plain[0].evaluate_weights(strong)[0][:vs]
+        - ref0.evaluate_weights(strong)[0][:vs]
+        + physics
+        - gate * model
+    )
+    got = ref.evaluate_weights(strong)[0][:vs] - ref0.evaluate_weights(strong)[0][:vs]
+    below(err_mm(got, want), 1e-6, REASON_SAME, what="mm")
+    # the native runtime as its reference, at rest, on the strong expression and on others
+    bound = 3 * BOUND_MM[precision]
+    for w in [zero, strong, *frames(3, 21)]:
+        x = nat.evaluate_weights(w)[0]
+        below(err_mm(x, ref.evaluate_weights(w)[0]), bound, REASON_REST, what="mm")
+    moved = nat.evaluate_weights(zero)[0][:vs] - nat0.evaluate_weights(zero)[0][:vs]
+    below(err_mm(moved, physics), bound, REASON_REST, what="mm")
+
+
+def test_a_fitted_avatar_takes_the_gated_rest_physics_off_as_the_template_does(
+    gated, tmp_path
+):
+    """A fitted avatar at SoftDECA's closed-form start contracts the stage table carried onto
+    it at prepare; that table holds the rest gate's share of the physics at prepare as the
+    template's does: its frame is the template's whole frame carried (what a first frame with
+    dynamics, which starts at rest, gives)."""
+    head, nets, _, _, rest = gated
+    skin = head.definition.skin_vertices
+    export_bundle(
+        tmp_path / "b",
+        head.definition,
+        closed_form(nets),
+        BundleInfo(True, "gated closed form"),
+        rest_head=rest,
+        template_head=template_head_of(head.neutral, head.blendshapes, skin),
+    )
+    model = NativeModel(tmp_path / "b")
+    mesh = AvatarArrays(100 * head.neutral, head.head_triangles, 100 * head.blendshapes)
+    fit = NativeFit.create(model, mesh, metres_per_unit=0.01)
+    # float storage: the carried table and the template's round differently in half
+    avatar = NativeAvatar.fitted(model, fit, mesh, precision="float")
+    avatar.set_parameter("gravity_strength", 1.7)
+    avatar.set_parameter("target_volume", 1.3)
+    avatar.prepare()
+    w = np.full(52, 0.6)
+    carried = avatar.evaluate_weights(w)[0] / 100
+    avatar.set_dynamics(True)
+    whole = avatar.evaluate_weights(w)[0] / 100
+    linear = avatar.evaluate_linear(w)[0] / 100
+    above(err_mm(whole, linear), 0.05, "the model and the physics move the face", what="mm")
+    below(err_mm(carried, whole), 1e-4, "float32 sums in another order, cm", what="mm")
+
+
+def test_the_rest_gate_needs_the_vertex_stage_at_export(tmp_path):
+    head = synthetic_head()
+    nets = build_random(
+        head.definition,
+        load_parameter_specs(TEST_PARAMETERS),
+        replace(TEST_SIZES, rest_gate=0.1),
+        constant_slot=True,
+    )
+    with pytest.raises(ValueError, match="vertex stage"):
+        export_bundle(tmp_path / "b", head.definition, nets, BundleInfo(True, "no stage"))
+
+
+def _no_vertex_stage(m: dict) -> None:
+    del m["networks"]["softdeca.f_ph_v"]
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        ({"format_version": 5}, r"rest_gate \(SoftDECA's rest gate\) needs bundle format version 6"),
+        ({"rest_gate": 0}, "rest_gate .* must be positive"),
+        ({"rest_gate": -0.1}, "rest_gate .* must be positive"),
+        ({"rest_gate": "0.1"}, "rest_gate must be a number, not a string"),
+        ({"rest_gate": None}, "rest_gate must be a number, not null"),
+        ({"rest_gate": 1e999}, "JSON: unexpected character"),  # Infinity
+        (_no_vertex_stage, "rest_gate .* needs SoftDECA's vertex stage"),
+    ],
+)
+def test_the_rest_gate_is_checked_at_load(gated, tmp_path, edit, message):
+    """SoftDECA's rest gate is refused, by name, where it is not a positive number, where the
+    format version does not hold it and where the bundle has no vertex stage to weigh."""
+    import json
+    import shutil
+
+    copy = tmp_path / "bundle"
+    shutil.copytree(gated[3], copy)
+    manifest = json.loads((copy / "manifest.json").read_text())
+    if callable(edit):
+        edit(manifest)
+    else:
+        manifest.update(edit)
+    (copy / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(NativeError, match=message):
+        NativeModel(copy)

@@ -139,8 +139,9 @@ typedef struct softdeca_avatar softdeca_avatar;
 /* The newest bundle format version this library reads (manifest "format_version"); it reads
  * every version from 1 up to it. Version 2 adds SoftDECA's optional vertex stage, version 3
  * its optional residual stage, version 4 the optional physics at prepare (rest_physics),
- * version 5 the optional template head for fitting users' avatars (template_head). */
-#define SOFTDECA_BUNDLE_FORMAT_VERSION 5
+ * version 5 the optional template head for fitting users' avatars (template_head), version 6
+ * SoftDECA's optional rest gate (rest_gate). */
+#define SOFTDECA_BUNDLE_FORMAT_VERSION 6
 
 typedef struct softdeca_model_options {
   uint32_t struct_size;            /* sizeof(softdeca_model_options) */

@@ -5,8 +5,11 @@
 
 #include "bundle/json.h"
 #include "core/error.h"
+#include "softdeca/softdeca.h"
 
 namespace softdeca::bundle {
+
+static_assert(kBundleFormatVersion == SOFTDECA_BUNDLE_FORMAT_VERSION, "the public header states the version read here");
 
 namespace {
 [[noreturn]] void fail(const std::string& message) { throw Error(SOFTDECA_ERROR_FORMAT, "manifest: " + message); }
@@ -404,6 +407,16 @@ void parse_template_head(const Json& t, Manifest& m) {
 }
 }  // namespace
 
+namespace {
+void parse_rest_gate(const Json& j, Manifest& m) {
+  m.rest_gate = finite(j, "rest_gate");
+  check(m.rest_gate > 0, "rest_gate (SoftDECA's rest gate tau) must be positive");
+  check(m.has_softdeca_vertex_stage,
+        "rest_gate (SoftDECA's rest gate) needs SoftDECA's vertex stage (softdeca.f_ph_v), where the runtime weighs the "
+        "physics at prepare with the gate");
+}
+}  // namespace
+
 Manifest parse_manifest(const std::string& text) {
   const Json doc = Json::parse(text);
   Manifest m;
@@ -415,6 +428,7 @@ Manifest parse_manifest(const std::string& text) {
   parse_networks(doc, m);
   if (const Json* r = optional_section(doc, "rest_physics", 4, "the physics at prepare", m)) parse_rest_physics(*r, m);
   if (const Json* t = optional_section(doc, "template_head", 5, "fitting users' avatars", m)) parse_template_head(*t, m);
+  if (const Json* g = optional_section(doc, "rest_gate", 6, "SoftDECA's rest gate", m)) parse_rest_gate(*g, m);
   return m;
 }
 

@@ -13,9 +13,10 @@
 namespace softdeca::bundle {
 
 // Versions this runtime reads: 1, 2 (adds SoftDECA's optional vertex stage), 3 (adds its
-// optional residual stage), 4 (adds the optional physics at prepare, `rest_physics`) and 5
-// (adds the optional template head for fitting users' avatars, `template_head`).
-constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 5;
+// optional residual stage), 4 (adds the optional physics at prepare, `rest_physics`), 5
+// (adds the optional template head for fitting users' avatars, `template_head`) and 6 (adds
+// SoftDECA's optional rest gate, `rest_gate`).
+constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 6;
 constexpr const char* kBundleFormat = "softdeca-bundle";
 constexpr const char* kDtFormulation = "cotangent-poisson-1";
 // The 52 ARKit shapes in canonical order: names from the one definition, stream/arkit_names.h.
@@ -80,6 +81,10 @@ struct Manifest {
   int residual_modes = 0, residual_condition = 0;
   bool has_rest_physics = false;  // format version 4
   RestPhysicsSpec rest_physics;
+  // SoftDECA's rest gate tau (format version 6; 0: none): z's last entry is then
+  // |w|^2 / (|w|^2 + tau^2), not a constant 1, and the physics at prepare weighs the networks'
+  // rest response with it (docs/bundle.md, "Rest physics").
+  double rest_gate = 0;
   // The template head (format version 5): the neutral head (float32), the 52 ARKit shapes
   // and template_identity_modes identity modes over the skin (float16) in one file.
   bool has_template_head = false;

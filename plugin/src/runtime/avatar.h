@@ -97,6 +97,9 @@ struct Preparation {
   // The physics at prepare's correction of SoftDECA's frames, [Vs][3] (empty: none, as at the
   // defaults): c(p) = [P_rest(p) - P_rest(p0)] - [M_rest(p) - M_rest(p_inert)], p_inert being
   // p's rest-inert parameters alone, the others at their defaults (prepare/rest_physics.h).
+  // With a rest gate (Manifest::rest_gate) only P_rest(p) - P_rest(p0); the networks' part,
+  // -[M1(p) - M1(p_inert)] with the gate open, is in vertex_stages' column of z's last entry,
+  // which each frame weighs with its gate (docs/bundle.md, "Rest physics").
   std::vector<float> rest_offset;
   float rest_offset_peak = 0;  // its largest magnitude
   // With a carry map and DT at identity (evaluate_carried): vertex_stages and rest_offset carried
@@ -199,18 +202,28 @@ class Avatar {
   // The residual stage's prepare half for these parameters: its condition into `prep`; returns
   // its modes [Vs][modes][3] (empty: no residual stage).
   std::vector<float> prepare_residual(const prepare::ParameterState& params, Preparation& prep) const;
-  // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep` (and,
-  // `carried`, their table carried through the carry map where evaluate_carried reads it).
-  void prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
-                               Preparation& prep, bool carried) const;
-  // The networks' part of a preparation for these parameters and identity.
-  std::shared_ptr<Preparation> prepare_networks(const prepare::ParameterState& params, const std::vector<float>& identity) const;
+  // SoftDECA's hyper-tensor, vertex and residual stages for these parameters into `prep`;
+  // returns the stages' table as computed, [Vs][latent + modes][3] (empty: no stages).
+  std::vector<float> prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
+                                             Preparation& prep) const;
+  // The stages' table into `prep` at the avatar's precision.
+  void store_stages(Preparation& prep, const std::vector<float>& table) const;
+  // The networks' part of a preparation for these parameters and identity; `stages` gets
+  // SoftDECA's stage table as computed (prepare_softdeca_stages).
+  std::shared_ptr<Preparation> prepare_networks(const prepare::ParameterState& params, const std::vector<float>& identity,
+                                                std::vector<float>& stages) const;
   // SoftDECA's static frame at rest (zero weights on the neutral) for a preparation, without
-  // touching the frame thread's buffers (prepare runs beside frames).
+  // touching the frame thread's buffers (prepare runs beside frames): M_rest, or with a rest
+  // gate M1, the gate open (z's last entry and the residual stage's mean mode at 1).
   std::vector<float> softdeca_rest(const Preparation& prep) const;
   std::vector<float> softdeca_rest(const prepare::ParameterState& params, const std::vector<float>& identity) const;
-  // c(p) of Preparation::rest_offset (prepare_mutex_ held); iterations: of the physics' solve.
-  std::vector<float> rest_offset(const prepare::ParameterState& params, const Preparation& prep,
+  // The physics at prepare's correction for these parameters (prepare_mutex_ held): `offset`,
+  // Preparation::rest_offset; with a rest gate also `gated`, -[M1(p) - M1(p_inert)], which the
+  // frame weighs with its gate (empty without one). iterations: of the physics' solve.
+  struct RestCorrection {
+    std::vector<float> offset, gated;  // [Vs][3]
+  };
+  RestCorrection rest_correction(const prepare::ParameterState& params, const Preparation& prep,
                                  const std::vector<float>& identity, int& iterations);
   void write_rigid_non_skin(const float* skin, float* head) const;
   void compute_normals(const float* head, float* normals);
@@ -239,8 +252,8 @@ class Avatar {
   std::mutex prepare_mutex_;
   std::shared_ptr<const DeformationTransfer> dt_;  // built by the first prepare
   // The physics at prepare (bundles with a rest head): the avatar's head, built by the first
-  // prepare away from the defaults, and P_rest(p0) and M_rest(p0) (for the identity they were
-  // computed with); all under prepare_mutex_.
+  // prepare away from the defaults, and P_rest(p0) and M_rest(p0) (softdeca_rest; for the
+  // identity they were computed with); all under prepare_mutex_.
   std::unique_ptr<prepare::RestPhysics> rest_physics_;
   sim::Positions rest_physics0_;
   std::vector<float> rest_model0_, rest_model0_identity_;

@@ -26,6 +26,13 @@ std::vector<float> side_by_side(const std::vector<float>& a, std::size_t ka, con
   }
   return joint;
 }
+
+// `add` [n][3] into column `column` of `table` [n][width][3].
+void add_to_column(std::vector<float>& table, std::size_t width, std::size_t column, const std::vector<float>& add,
+                   std::size_t n) {
+  for (std::size_t e = 0; e < n; ++e)
+    for (std::size_t c = 0; c < 3; ++c) table[(e * width + column) * 3 + c] += add[e * 3 + c];
+}
 }  // namespace
 
 // A hypernetwork's L(p, h) for n elements of the given width, checked.
@@ -68,20 +75,33 @@ void Avatar::prepare() {
     factorisation_ms = ms(f0, Clock::now());
   }
   const auto n0 = Clock::now();
-  std::shared_ptr<Preparation> prep = prepare_networks(*params, identity);
-  const double networks_ms = ms(n0, Clock::now());
+  std::vector<float> stages;  // SoftDECA's stage table as computed, before its storage rounding
+  std::shared_ptr<Preparation> prep = prepare_networks(*params, identity, stages);
+  double networks_ms = ms(n0, Clock::now());
   // The physics at prepare: nothing to correct at the defaults (c(p0) = 0).
   double physics_ms = 0;
   int physics_iterations = 0;
   if (model_->rest_head() && model_->has(false) && !params->at_defaults()) {
     const auto r0 = Clock::now();
-    prep->rest_offset = rest_offset(*params, *prep, identity, physics_iterations);
+    RestCorrection rest = rest_correction(*params, *prep, identity, physics_iterations);
+    prep->rest_offset = std::move(rest.offset);
     prep->rest_offset_peak = peak_magnitude(prep->rest_offset.data(), prep->rest_offset.size());
+    if (!rest.gated.empty()) {  // into the column the gate weighs, stored again from the values
+      add_to_column(stages, stage_latents_ + residual_modes_, stage_latents_ - 1, rest.gated, vs_);
+      store_stages(*prep, stages);
+    }
     if (carry_ && prep->face_l.zero()) {
       prep->carried_rest.resize(carry_->size() * 3);
       carry_->carry(prep->rest_offset.data(), prep->carried_rest.data());
     }
     physics_ms = ms(r0, Clock::now());
+  }
+  if (carry_ && prep->face_l.zero() && !stages.empty()) {  // carried from the values, not their stored rounding
+    const auto c0 = Clock::now();
+    const std::size_t latents = stage_latents_ + residual_modes_;
+    prep->carried_stages = kernels::HyperTensor(carry_->carry_columns(stages.data(), latents).data(), carry_->size(),
+                                                static_cast<int>(latents), 3, precision_);
+    networks_ms += ms(c0, Clock::now());
   }
   {
     std::lock_guard<std::mutex> lock(current_mutex_);
@@ -99,8 +119,8 @@ void Avatar::prepare() {
 
 // SoftDECA's stages for these parameters: its per-face hyper-tensor, its vertex stage and the
 // residual stage's prepare half (what softdeca_rest reads).
-void Avatar::prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
-                                     Preparation& prep, bool carried) const {
+std::vector<float> Avatar::prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
+                                                   Preparation& prep) const {
   const OnnxNetwork& hyper = *model_->hyper(false);
   const auto& cols = hyper.spec().parameter_columns;
   std::vector<float> p(nf_ * cols.size());
@@ -113,18 +133,19 @@ void Avatar::prepare_softdeca_stages(const prepare::ParameterState& params, cons
     vertex_l = hyper_values(*stage, pv, identity, vs_, 3);
   }
   const std::vector<float> modes = prepare_residual(params, prep);
-  const std::size_t latents = stage_latents_ + residual_modes_;
-  if (latents == 0) return;
-  const std::vector<float> table = side_by_side(vertex_l, stage_latents_, modes, residual_modes_, vs_);
-  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, static_cast<int>(latents), 3, precision_);
-  if (carried && carry_ && prep.face_l.zero())  // carried from the values, not their stored rounding
-    prep.carried_stages = kernels::HyperTensor(carry_->carry_columns(table.data(), latents).data(), carry_->size(),
-                                               static_cast<int>(latents), 3, precision_);
+  if (stage_latents_ + residual_modes_ == 0) return {};
+  std::vector<float> table = side_by_side(vertex_l, stage_latents_, modes, residual_modes_, vs_);
+  store_stages(prep, table);
+  return table;
+}
+
+void Avatar::store_stages(Preparation& prep, const std::vector<float>& table) const {
+  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, static_cast<int>(stage_latents_ + residual_modes_), 3, precision_);
 }
 
 // The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
-std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterState& params,
-                                                      const std::vector<float>& identity) const {
+std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterState& params, const std::vector<float>& identity,
+                                                      std::vector<float>& stages) const {
   auto prep = std::make_shared<Preparation>();
   prep->dt = dt_;
   prep->identity = identity;
@@ -137,7 +158,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterSt
       params.vertex_matrix(hyper.spec().parameter_columns, p.data());
       prep->vertex_l = hyper_tensor(hyper, p, identity, vs_, 3);
     } else {
-      prepare_softdeca_stages(params, identity, *prep, true);
+      stages = prepare_softdeca_stages(params, identity, *prep);
     }
     // Dynamics coefficients per skin vertex.
     const OnnxNetwork& dyn = *model_->dynamics(sparse);
@@ -159,7 +180,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterSt
 std::vector<float> Avatar::softdeca_rest(const prepare::ParameterState& params, const std::vector<float>& identity) const {
   Preparation stages;
   stages.dt = dt_;
-  prepare_softdeca_stages(params, identity, stages, false);
+  prepare_softdeca_stages(params, identity, stages);
   return softdeca_rest(stages);
 }
 
@@ -167,6 +188,8 @@ std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
   const std::vector<float> weights(bundle::kBlendshapeCount, 0.0f);
   std::vector<float> z(static_cast<std::size_t>(m_.latent)), out(vs_ * 3);
   model_->encoder(false)->run({weights.data()}, {z.data()}, 1);
+  const bool gate_open = m_.rest_gate > 0;  // M1: the networks' w-independent part as an expression has it
+  if (gate_open) z.back() = 1.0f;
   if (prep.face_l.zero()) {
     std::copy(neutral_.begin(), neutral_.begin() + static_cast<std::ptrdiff_t>(vs_ * 3), out.begin());
   } else {
@@ -181,13 +204,14 @@ std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
     std::copy_n(z.begin(), stage_latents_, zc.begin());
     if (residual_modes_ > 0)
       model_->residual_coefficients()->run({weights.data(), prep.residual_condition.data()}, {zc.data() + stage_latents_}, 1);
+    if (gate_open) zc.back() = 1.0f;  // the mean mode's coefficient: the gate too
     kernels::vertex_offsets(prep.vertex_stages, zc.data(), out.data(), 0, prep.vertex_stages.blocks(), out.data());
   }
   return out;
 }
 
-std::vector<float> Avatar::rest_offset(const prepare::ParameterState& params, const Preparation& prep,
-                                       const std::vector<float>& identity, int& iterations) {
+Avatar::RestCorrection Avatar::rest_correction(const prepare::ParameterState& params, const Preparation& prep,
+                                               const std::vector<float>& identity, int& iterations) {
   if (!rest_physics_) {  // kept only once its defaults' solve succeeded
     auto physics = std::make_unique<prepare::RestPhysics>(*model_->rest_head(), m_, neutral_.data(), model_->skin_triangles(),
                                                  static_cast<int>(worker_.parts()));
@@ -211,16 +235,24 @@ std::vector<float> Avatar::rest_offset(const prepare::ParameterState& params, co
   const std::vector<float>& model_inert = inert_only.at_defaults() ? rest_model0_
                                           : inert_only == params    ? model
                                                                     : inert_rest.emplace(softdeca_rest(inert_only, identity));
-  std::vector<float> offset(vs_ * 3);
+  // With a rest gate the networks add nothing at rest: the frame then gets the physics' change
+  // whole, and the networks' own change (the gate open) is taken off as the gate opens.
+  const bool gated = m_.rest_gate > 0;
+  RestCorrection r;
+  r.offset.resize(vs_ * 3);
+  if (gated) r.gated.resize(vs_ * 3);
   for (std::size_t v = 0; v < vs_; ++v)
     for (std::size_t c = 0; c < 3; ++c) {
       const std::size_t i = 3 * v + c;
       const auto row = static_cast<Eigen::Index>(v), col = static_cast<Eigen::Index>(c);
-      offset[i] = static_cast<float>((physics(row, col) - rest_physics0_(row, col)) - (double(model[i]) - double(model_inert[i])));
+      const double physics_change = physics(row, col) - rest_physics0_(row, col);
+      const double model_change = double(model[i]) - double(model_inert[i]);
+      r.offset[i] = static_cast<float>(gated ? physics_change : physics_change - model_change);
+      if (gated) r.gated[i] = static_cast<float>(-model_change);
     }
-  if (!all_finite(offset.data(), offset.size()))
+  if (!all_finite(r.offset.data(), r.offset.size()) || !all_finite(r.gated.data(), r.gated.size()))
     throw Error(SOFTDECA_ERROR_NON_FINITE, "the physics at prepare produced a non-finite skin for these parameters");
-  return offset;
+  return r;
 }
 
 // The residual stage's prepare half: its condition and modes for these parameters.

@@ -49,10 +49,11 @@ FORMAT = "softdeca-bundle"
 # Version 2 adds SoftDECA's optional vertex stage (softdeca.f_ph_v), version 3 its optional
 # residual stage (softdeca.f_r_ph, softdeca.f_r_w), version 4 the physics at prepare
 # (rest_physics, rest_head.bin), version 5 the template head for fitting users' avatars
-# (template_head, template_head.bin); a bundle is written with the lowest
+# (template_head, template_head.bin), version 6 SoftDECA's rest gate (rest_gate: a runtime
+# that ignored it would count p's effect at rest twice); a bundle is written with the lowest
 # version that holds it, so runtimes that read only older versions still run what they can.
-FORMAT_VERSION = 5
-FORMAT_VERSIONS = (1, 2, 3, 4, 5)
+FORMAT_VERSION = 6
+FORMAT_VERSIONS = (1, 2, 3, 4, 5, 6)
 OPSET = 17
 MANIFEST = "manifest.json"
 SKIN_TRIANGLES_FILE = "skin_triangles.i32"
@@ -323,13 +324,10 @@ def export_bundle(
     (folder / SKIN_TRIANGLES_FILE).write_bytes(tri.tobytes())
     (folder / NON_SKIN_BONES_FILE).write_bytes(bones.tobytes())
     lm = definition.landmarks
+    gate = _rest_gate(nets)
     manifest: dict[str, Any] = {
         "format": FORMAT,
-        "format_version": 3
-        if "softdeca.f_r_ph" in specs
-        else 2
-        if "softdeca.f_ph_v" in specs
-        else 1,
+        "format_version": 1,  # below, once the manifest says what the bundle holds
         "untrained": info.untrained,
         "description": info.description,
         "units": "metre",
@@ -389,16 +387,33 @@ def export_bundle(
         },
         "networks": specs,
         **_residual_sizes(nets),
+        **({} if gate is None else {"rest_gate": gate}),
         "export_check_max_abs": deviations or None,
         "training": info.training,
         "errors": info.errors,
     }
+    manifest["format_version"] = lowest_format_version(manifest)
     (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
     if rest_head is not None:
         add_rest_physics(folder, rest_head)
     if template_head is not None:
         add_template_head(folder, template_head)
     return folder
+
+
+def lowest_format_version(manifest: dict[str, Any]) -> int:
+    """The lowest format version that holds what `manifest` says the bundle has (FORMAT)."""
+    networks = manifest.get("networks") or {}
+    for version, held in (
+        (6, "rest_gate" in manifest),
+        (5, "template_head" in manifest),
+        (4, "rest_physics" in manifest),
+        (3, "softdeca.f_r_ph" in networks),
+        (2, "softdeca.f_ph_v" in networks),
+    ):
+        if held:
+            return version
+    return 1
 
 
 def replace_networks(
@@ -472,14 +487,13 @@ def _add_file(
     key: str,
     data: bytes,
     entry: dict[str, Any],
-    version: int,
 ) -> None:
     """Write one of a bundle's optional files and its manifest entry `key` (entry, with the
     file's sha256), and raise the format version to the one that entry needs (a bundle that
     already holds a later version's entry keeps that version)."""
     (folder / entry["file"]).write_bytes(data)
     manifest[key] = {**entry, "sha256": hashlib.sha256(data).hexdigest()}
-    manifest["format_version"] = max(version, manifest["format_version"])
+    manifest["format_version"] = max(lowest_format_version(manifest), manifest["format_version"])
     (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
 
 
@@ -505,7 +519,7 @@ def add_template_head(folder: str | Path, head: TemplateHead) -> None:
     t = manifest["template"]
     if head.neutral.shape[0] != t["head_vertices"] or head.shapes.shape[1] != t["skin_vertices"]:
         raise ValueError("the template head does not match the bundle's template sizes")
-    _add_file(folder, manifest, "template_head", *template_head_file(head), version=5)
+    _add_file(folder, manifest, "template_head", *template_head_file(head))
 
 
 def read_bundle_template_head(folder: str | Path, manifest: dict[str, Any]) -> TemplateHead | None:
@@ -523,7 +537,7 @@ def add_rest_physics(folder: str | Path, head: RestHead) -> None:
         raise ValueError("the rest head's skin does not match the bundle's template")
     if "softdeca.f_w" not in manifest["networks"]:
         raise ValueError("the physics at prepare corrects SoftDECA: the bundle has no SoftDECA")
-    _add_file(folder, manifest, "rest_physics", *rest_head_file(head), version=4)
+    _add_file(folder, manifest, "rest_physics", *rest_head_file(head))
 
 
 def read_rest_physics(folder: str | Path, manifest: dict[str, Any]) -> RestHead | None:
@@ -532,6 +546,16 @@ def read_rest_physics(folder: str | Path, manifest: dict[str, Any]) -> RestHead 
     if found is None:
         return None
     return read_rest_head(*found, manifest["template"]["skin_vertices"])
+
+
+def _rest_gate(nets: BundleNetworks) -> float | None:
+    """The manifest's `rest_gate` (BundleNetworks.rest_gate), or None when it has none. The
+    runtime folds the physics at prepare's share of the gated correction into the vertex
+    stage's column of z's last entry, so a gated SoftDECA needs that stage."""
+    gate = nets.rest_gate
+    if gate is not None and (nets.softdeca is None or nets.softdeca.f_ph_v is None):
+        raise ValueError("a SoftDECA with a rest gate needs its vertex stage (softdeca.f_ph_v)")
+    return gate
 
 
 def _residual_sizes(nets: BundleNetworks) -> dict[str, Any]:
@@ -636,6 +660,7 @@ class OnnxNetworks:
         self.manifest = read_manifest(folder)
         self.specs = tuple(ParameterSpec.from_dict(p) for p in self.manifest["parameters"])
         self.rest_head = read_rest_physics(folder, self.manifest)
+        self.rest_gate: float | None = self.manifest.get("rest_gate")
         so = ort.SessionOptions()
         so.log_severity_level = 3
         self.sessions = {

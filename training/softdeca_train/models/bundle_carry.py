@@ -13,7 +13,12 @@ import os
 from pathlib import Path
 from typing import Any
 
-from softdeca_train.models.bundle import MANIFEST, read_manifest, replaced_description
+from softdeca_train.models.bundle import (
+    MANIFEST,
+    lowest_format_version,
+    read_manifest,
+    replaced_description,
+)
 
 # what a bundle's networks read besides their own inputs: equal in both bundles, or the
 # carried networks would run on another head, landmark set, parameter list or identity code
@@ -29,6 +34,10 @@ SHARED_KEYS = (
     "landmarks",
     "template_head",
 )
+# the manifest keys a model's networks bring with them: the residual stage's sizes (its
+# networks' shapes use them) and SoftDECA's rest gate (what z's last entry is, which f_w, always
+# carried, decides: absent where the source has none)
+OWN_KEYS = {"sparse": (), "softdeca": ("residual_stage", "rest_gate")}
 # a model's networks and the keys of `errors` that belong to it
 MODELS: dict[str, tuple[tuple[str, ...], str]] = {
     "sparse": (("sparse.f_l", "sparse.f_ph_v", "sparse.f_dyn"), "sparse"),
@@ -92,6 +101,12 @@ def carry_model(source: str | Path, folder: str | Path, model: str, command: str
         spec = dict(src["networks"][name])
         _write_atomic(folder / spec["file"], data)
         dst["networks"][name] = spec
+    for key in OWN_KEYS[model]:
+        if key in src:
+            dst[key] = src[key]
+        elif key == "rest_gate":
+            dst.pop(key, None)
+    dst["format_version"] = max(lowest_format_version(dst), dst["format_version"])
     record = {
         "command": command,
         "carried_from": str(source),

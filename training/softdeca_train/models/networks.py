@@ -405,6 +405,18 @@ class BundleNetworks:
     softdeca: SoftDecaNetworks | None
     sparse: SparseNetworks | None
 
+    @property
+    def rest_gate(self) -> float | None:
+        """tau of SoftDECA's rest gate where z's last entry is the gate (WeightEncoder's
+        constant slot with sizes.rest_gate > 0): the bundle's `rest_gate`, which the physics at
+        prepare weighs the networks' rest response with (models/reference.py). None where that
+        entry is a constant 1 (tau None), 0 (tau 0) or no slot at all: there the rest physics
+        needs nothing of the gate."""
+        f_w = self.softdeca.f_w if self.softdeca is not None else None
+        if f_w is None or not f_w.constant_slot or not f_w.rest_tau:
+            return None
+        return float(f_w.rest_tau)
+
     def modules(self) -> list[nn.Module]:
         out: list[nn.Module] = [self.identity_encoder]
         for m in (self.softdeca, self.sparse):
@@ -429,6 +441,7 @@ def build_random(
     offset_scale: float = 1e-3,
     vertex_stage: bool = False,
     residual_stage: bool = False,
+    constant_slot: bool = False,
 ) -> BundleNetworks:
     """Random-weight networks (untrained). `dg_scale` sets the size of the deformation-gradient
     corrections (G - I) and `offset_scale` that of the vertex offsets (metres), so that an
@@ -437,7 +450,8 @@ def build_random(
     parameters among its inputs where the definition has the skin at rest, the region means
     where it has regions); `residual_stage`
     adds the residual stage (models/residual.py) over the definition's regions (one region
-    where it has none), its modes random of size `offset_scale`."""
+    where it has none), its modes random of size `offset_scale`. `constant_slot` makes z's
+    last entry f_w's constant slot, as the trained bundles have it (WeightEncoder)."""
     torch.manual_seed(seed)
     specs = tuple(specs)
     nf, nv = definition.n_faces, definition.skin_vertices
@@ -446,7 +460,7 @@ def build_random(
     sd = sp = None
     if softdeca:
         sd = SoftDecaNetworks(
-            f_w=WeightEncoder(len(definition.blendshapes), sizes),
+            f_w=WeightEncoder(len(definition.blendshapes), sizes, constant_slot=constant_slot),
             f_ph=HyperNetwork(nf, specs, sizes, 9, dg_scale),
             f_dyn=DynamicsNetwork(nv, specs, sizes),
             f_ph_v=HyperNetwork(

@@ -7,7 +7,9 @@ G_f = I + sum_k z_k L[f, k], X = DT(S_t, G) on the skin, plus sum_k z_k L_v[v, k
 bundle has SoftDECA's vertex stage and sum_k c_k M[v, k] where it has the residual stage
 (c = f_r_w(w, f_r_ph(p)), M its modes). SparseSoftDECA: offsets of the
 retargeted landmarks from the avatar's neutral landmarks, z = f_l(offsets),
-X = neutral_skin + sum_k z_k L_v[v, k]. Then, if enabled, dynamics per skin vertex
+X = neutral_skin + sum_k z_k L_v[v, k]. SoftDECA's frames then get the physics at prepare
+(Preparation.rest_offset; with a rest gate, less the gate z_last times rest_gated). Then, if
+enabled, dynamics per skin vertex
 X_t = gamma Y_t + 2 alpha X_{t-1} - beta X_{t-2}, the non-skin vertices, and normals.
 
 Oracle: a deliberate second implementation of the runtime's frame (plugin/src/runtime/), the
@@ -39,6 +41,7 @@ class Networks(Protocol):
 
     specs: tuple[ParameterSpec, ...]
     rest_head: RestHead | None  # the bundle's physics at prepare, if it has one
+    rest_gate: float | None  # tau where z's last entry is SoftDECA's rest gate (BundleNetworks)
 
     def has(self, model: Model) -> bool: ...
     def identity(self, neutral_skin: np.ndarray) -> np.ndarray: ...
@@ -61,6 +64,7 @@ class TorchNetworks:
         self.nets = nets
         self.specs = nets.specs
         self.rest_head = rest_head
+        self.rest_gate = nets.rest_gate
 
     def has(self, model: Model) -> bool:
         return (self.nets.softdeca if model == "softdeca" else self.nets.sparse) is not None
@@ -146,8 +150,11 @@ class Preparation:
     # SoftDECA's residual stage: its condition (1, C) and modes (Vs, K, 3), or None
     residual: tuple[np.ndarray, np.ndarray] | None
     dynamics: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]  # model -> alpha, beta, gamma
-    # SoftDECA's rest physics c(p) (Vs, 3) added to every frame (rest_physics.py), or None
+    # SoftDECA's rest physics (Vs, 3) added to every frame (rest_physics.py), or None: c(p),
+    # or with a rest gate Pd = P_rest(p) - P_rest(p0)
     rest_offset: np.ndarray | None = None
+    # with a rest gate, Md = M1(p) - M1(p_inert) (Vs, 3), taken off every frame times its gate
+    rest_gated: np.ndarray | None = None
 
 
 class ReferenceAvatar:
@@ -190,7 +197,8 @@ class ReferenceAvatar:
         # always uses it then; `rest_physics=False` measures the networks alone).
         self.rest_head = nets.rest_head if rest_physics else None
         self._rest_solver: RestSolver | None = None
-        self._rest_defaults: tuple[np.ndarray, np.ndarray] | None = None  # P_rest(p0), M_rest(p0)
+        # P_rest(p0) and M_rest(p0) (with a rest gate, M1(p0))
+        self._rest_defaults: tuple[np.ndarray, np.ndarray] | None = None
 
     # ---- per avatar ------------------------------------------------------------------------
     def _networks(self, params: ParameterState) -> Preparation:
@@ -236,14 +244,24 @@ class ReferenceAvatar:
             )
             model = self._softdeca_rest(prep)
             physics = self._rest_solver.solve(self.params)
-            prep.rest_offset = (physics - physics0) - (model - model_inert)
+            if self.nets.rest_gate is None:
+                prep.rest_offset = (physics - physics0) - (model - model_inert)
+            else:
+                # Gated: at rest the networks add nothing, so the physics' Pd is the frame's;
+                # on an expression the gate g(w) opens the networks' own response to p,
+                # which Md, taken off times g(w), brings back to p_inert's.
+                prep.rest_offset = physics - physics0
+                prep.rest_gated = model - model_inert
         self.prep = prep
         return prep
 
     def _softdeca_rest(self, prep: Preparation) -> np.ndarray:
-        """SoftDECA's static frame at rest: zero weights on the neutral."""
+        """SoftDECA's static frame at rest as the physics at prepare compares it: zero weights
+        on the neutral (M_rest); with a rest gate, the gate open (M1: the networks'
+        w-independent response as it acts on an expression)."""
         vs = self.d.skin_vertices
-        return self._softdeca_static(prep, np.zeros(52), self.neutral[:vs])
+        gate = None if self.nets.rest_gate is None else 1.0
+        return self._softdeca_static(prep, np.zeros(52), self.neutral[:vs], gate)
 
     def calibrate(self, user_neutral: np.ndarray) -> None:
         """The user's neutral landmarks (K, 3): similarity user -> avatar neutral landmarks."""
@@ -273,14 +291,26 @@ class ReferenceAvatar:
     def softdeca_static(self, weights: np.ndarray, skin: np.ndarray) -> np.ndarray:
         prep = self._need()
         out = self._softdeca_static(prep, weights, skin)
-        return out if prep.rest_offset is None else out + prep.rest_offset
+        if prep.rest_offset is not None:
+            out = out + prep.rest_offset
+        if prep.rest_gated is not None:
+            gate = float(self.nets.f_w(np.asarray(weights, np.float32)[None])[0, -1])
+            out = out - gate * prep.rest_gated
+        return out
 
     def _softdeca_static(
-        self, prep: Preparation, weights: np.ndarray, skin: np.ndarray
+        self,
+        prep: Preparation,
+        weights: np.ndarray,
+        skin: np.ndarray,
+        gate: float | None = None,
     ) -> np.ndarray:
-        """The networks' static frame (without the rest physics)."""
+        """The networks' static frame (without the rest physics); `gate` replaces the rest
+        gate's value (z's last entry and the residual stage's mean mode coefficient)."""
         assert prep.face_l is not None
         z = self.nets.f_w(np.asarray(weights, np.float32)[None])[0].astype(np.float64)
+        if gate is not None:
+            z[-1] = gate
         g = np.einsum("k,fkc->fc", z, prep.face_l).reshape(-1, 3, 3)
         x = deformation_transfer(self.dt, torch.from_numpy(skin[None]), torch.from_numpy(g[None]))
         out = x[0].numpy()
@@ -290,6 +320,8 @@ class ReferenceAvatar:
             condition, modes = prep.residual
             w = np.asarray(weights, np.float32)[None]
             c = self.nets.residual_coefficients(w, condition)[0].astype(np.float64)
+            if gate is not None:
+                c[-1] = gate
             out = out + np.einsum("k,vkc->vc", c, modes.astype(np.float64))
         return out
 
