@@ -114,3 +114,23 @@ def test_bundles_that_read_other_inputs_are_refused_and_left_as_they_were(
     with pytest.raises(ValueError, match="unknown model"):
         carry_model(source, dest, "everything", "carry")
     assert _files(dest) == before
+
+
+def test_softdeca_brings_its_rest_gate(bundles, tmp_path) -> None:
+    """SoftDECA's rest gate says what its f_w's last entry is: carried with its networks (and
+    the format version that holds it), taken away by a SoftDECA without one."""
+    dest, source = bundles
+    plain = tmp_path / "plain"
+    shutil.copytree(source, plain)
+    m = read_manifest(source)
+    m["rest_gate"], m["format_version"] = 0.3, 6
+    (source / "manifest.json").write_text(json.dumps(m))
+    carry_model(source, dest, "softdeca", "carry")
+    after = read_manifest(dest)
+    assert after["rest_gate"] == 0.3 and after["format_version"] == 6
+    carry_model(plain, dest, "softdeca", "carry")
+    assert "rest_gate" not in read_manifest(dest)
+    # SparseSoftDECA's networks leave it as it is
+    carry_model(source, dest, "softdeca", "carry")
+    carry_model(plain, dest, "sparse", "carry")
+    assert read_manifest(dest)["rest_gate"] == 0.3

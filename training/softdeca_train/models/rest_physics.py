@@ -14,7 +14,10 @@ parameters that leave the unloaded head at rest as it is (the bundle's `inert_pa
 tissue weights, w_target, max_strain), the others at their defaults: the physics says nothing
 about those at rest, so the networks' response to them alone stays; what they do together
 with a load (softer tissue sagging more under heavier gravity) is the physics'. At the
-defaults c = 0; a frame costs one add.
+defaults c = 0; a frame costs one add. A bundle with a rest gate (the manifest's rest_gate)
+adds nothing of the networks at rest, so its frames get Pd = P_rest(p) - P_rest(p0) less the
+frame's gate times M1(p) - M1(p_inert), M1 the model at rest with the gate open
+(models/reference.py, docs/bundle.md "Rest physics").
 
 The head is the bundle's (rest_head.py) carried to the avatar. Parameter maps reach the
 physics' elements as the data's regions do (template/regions.py, element_regions): a tet takes the
