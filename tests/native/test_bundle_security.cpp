@@ -317,3 +317,26 @@ TEST_F(HostileBundle, RestHeadFileIsCheckedAtLoad) {
   replace("rest_head.bin", bad);
   EXPECT_NE(load_error().find("fill vertices: value 1 is not finite"), std::string::npos) << load_error();
 }
+
+// SoftDECA's rest gate (format version 6): anything but a positive number, in a bundle of an
+// older version or without SoftDECA's vertex stage (the test bundle has none), is refused at
+// load, by name.
+TEST_F(HostileBundle, RestGateIsCheckedAtLoad) {
+  const std::string manifest = read_text(bundle_ / "manifest.json");
+  const std::string version = "\"format_version\": 5";
+  ASSERT_NE(manifest.find(version), std::string::npos);
+  const auto load_with = [&](const std::string& v, const std::string& gate) {
+    std::string m = manifest;
+    m.replace(m.find(version), version.size(), "\"format_version\": " + v + ", \"rest_gate\": " + gate);
+    write_text(bundle_ / "manifest.json", m);
+    return load_error();
+  };
+  std::string e = load_with("5", "0.3");
+  EXPECT_NE(e.find("rest_gate (SoftDECA's rest gate) needs bundle format version 6"), std::string::npos) << e;
+  e = load_with("6", "-0.3");
+  EXPECT_NE(e.find("rest_gate (SoftDECA's rest gate tau) must be positive"), std::string::npos) << e;
+  e = load_with("6", "\"0.3\"");
+  EXPECT_NE(e.find("rest_gate must be a number, not a string"), std::string::npos) << e;
+  e = load_with("6", "0.3");
+  EXPECT_NE(e.find("needs SoftDECA's vertex stage"), std::string::npos) << e;
+}

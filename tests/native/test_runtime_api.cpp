@@ -133,7 +133,8 @@ TEST_F(Runtime, LoadsFromMemoryAndFromATarFile) {
 }
 
 TEST_F(Runtime, RefusesAnotherFormatVersion) {
-  const std::string newest = std::to_string(SOFTDECA_BUNDLE_FORMAT_VERSION), next = std::to_string(SOFTDECA_BUNDLE_FORMAT_VERSION + 1);
+  const std::string newest = std::to_string(SOFTDECA_BUNDLE_FORMAT_VERSION);
+  const std::string next = std::to_string(SOFTDECA_BUNDLE_FORMAT_VERSION + 1);
   BundleCopy copy(data_dir() + "/bundle", "version");
   copy.replace_in("manifest.json", "\"format_version\": 5", "\"format_version\": " + next);
   softdeca_model* m = nullptr;

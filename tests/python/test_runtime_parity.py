@@ -454,6 +454,20 @@ def test_a_zero_deformation_stage_skips_the_solve_and_keeps_parity(setup, tmp_pa
     assert nat.stats().solve_ms == 0.0
 
 
+def fitted_to_itself(tmp_path, head, nets, info: BundleInfo, **export):
+    """`nets` exported with the template head into tmp_path / "b", and the head itself in
+    centimetres as a user's mesh (its random shapes tell no unit) fitted to it: the bundle's
+    model, the fit and the mesh."""
+    skin = head.definition.skin_vertices
+    template = template_head_of(head.neutral, head.blendshapes, skin)
+    export_bundle(
+        tmp_path / "b", head.definition, nets, info, template_head=template, **export
+    )
+    model = NativeModel(tmp_path / "b")
+    mesh = AvatarArrays(100 * head.neutral, head.head_triangles, 100 * head.blendshapes)
+    return model, NativeFit.create(model, mesh, metres_per_unit=0.01), mesh
+
+
 def test_a_non_finite_frame_at_the_closed_form_start_leaves_the_last_output(
     setup, tmp_path
 ):
@@ -464,19 +478,8 @@ def test_a_non_finite_frame_at_the_closed_form_start_leaves_the_last_output(
     head, nets, _, _, _ = setup
     broken = closed_form(nets)
     broken.softdeca.f_w.net[-1].bias.data.fill_(float("nan"))
-    skin = head.definition.skin_vertices
-    export_bundle(
-        tmp_path / "b",
-        head.definition,
-        broken,
-        BundleInfo(True, "f_w gives NaN"),
-        check=False,
-        template_head=template_head_of(head.neutral, head.blendshapes, skin),
-    )
-    model = NativeModel(tmp_path / "b")
-    # the head in centimetres as a user's mesh (its random shapes tell no unit)
-    mesh = AvatarArrays(100 * head.neutral, head.head_triangles, 100 * head.blendshapes)
-    fit = NativeFit.create(model, mesh, metres_per_unit=0.01)
+    info = BundleInfo(True, "f_w gives NaN")
+    model, fit, mesh = fitted_to_itself(tmp_path, head, broken, info, check=False)
     w = frames(1, 2)[0]
     for avatar in (
         NativeAvatar(model, head.neutral, head.head_triangles, head.blendshapes),
@@ -503,6 +506,19 @@ def test_the_rest_physics_needs_version_four(setup, tmp_path):
         NativeModel(copy)
 
 
+def physics_change(solver, ref: ReferenceAvatar, ref0: ReferenceAvatar) -> np.ndarray:
+    """P_rest(p) - P_rest(p0) of the parameters of `ref` against those of `ref0` (at the
+    defaults), checked to move the head (gravity 1.7 g and the volumes)."""
+    physics = solver.solve(ref.params) - solver.solve(ref0.params)
+    above(
+        np.abs(physics).max(),
+        1e-4,
+        "1.7 g and volumes 0.6-1.4: tenths of a mm",
+        what="m",
+    )
+    return physics
+
+
 def test_at_rest_the_response_is_the_physics(setup):
     """With the physics at prepare, what a parameter change does to the avatar at rest (zero
     weights) is what it does to the avatar's head under the physics, in the reference and the
@@ -525,14 +541,7 @@ def test_at_rest_the_response_is_the_physics(setup):
     nat.prepare()
     assert nat.stats().physics_iterations > 0 and nat.stats().prepare_physics_ms > 0
     solver = RestSolver(rest, head.neutral, head.definition.skin_triangles)
-    physics = solver.solve(ref.params) - solver.solve(ref0.params)
-    # gravity 1.7 g and the volumes move the head
-    above(
-        np.abs(physics).max(),
-        1e-4,
-        "1.7 g and volumes 0.6-1.4: tenths of a mm",
-        what="m",
-    )
+    physics = physics_change(solver, ref, ref0)
     moved_ref = ref.evaluate_weights(zero)[0] - ref0.evaluate_weights(zero)[0]
     moved_nat = nat.evaluate_weights(zero)[0] - nat0.evaluate_weights(zero)[0]
     below(err_mm(moved_ref[:vs], physics), 1e-6, REASON_SAME, what="mm")
@@ -655,13 +664,7 @@ def test_a_gated_bundle_counts_p_at_rest_once(gated, precision):
     for a in plain:
         a.prepare()
     solver = RestSolver(rest, head.neutral, head.definition.skin_triangles)
-    physics = solver.solve(ref.params) - solver.solve(ref0.params)
-    above(
-        np.abs(physics).max(),
-        1e-4,
-        "1.7 g and volumes 0.6-1.4: tenths of a mm",
-        what="m",
-    )
+    physics = physics_change(solver, ref, ref0)
     # at rest: the linear blend and the physics' change
     below(
         err_mm(ref.evaluate_weights(zero)[0][:vs] - head.neutral[:vs], physics),
@@ -703,18 +706,10 @@ def test_a_fitted_avatar_takes_the_gated_rest_physics_off_as_the_template_does(
     template's does: its frame is the template's whole frame carried (what a first frame with
     dynamics, which starts at rest, gives)."""
     head, nets, _, _, rest = gated
-    skin = head.definition.skin_vertices
-    export_bundle(
-        tmp_path / "b",
-        head.definition,
-        closed_form(nets),
-        BundleInfo(True, "gated closed form"),
-        rest_head=rest,
-        template_head=template_head_of(head.neutral, head.blendshapes, skin),
+    info = BundleInfo(True, "gated closed form")
+    model, fit, mesh = fitted_to_itself(
+        tmp_path, head, closed_form(nets), info, rest_head=rest
     )
-    model = NativeModel(tmp_path / "b")
-    mesh = AvatarArrays(100 * head.neutral, head.head_triangles, 100 * head.blendshapes)
-    fit = NativeFit.create(model, mesh, metres_per_unit=0.01)
     # float storage: the carried table and the template's round differently in half
     avatar = NativeAvatar.fitted(model, fit, mesh, precision="float")
     avatar.set_parameter("gravity_strength", 1.7)

@@ -140,7 +140,8 @@ std::vector<float> Avatar::prepare_softdeca_stages(const prepare::ParameterState
 }
 
 void Avatar::store_stages(Preparation& prep, const std::vector<float>& table) const {
-  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, static_cast<int>(stage_latents_ + residual_modes_), 3, precision_);
+  const auto latents = static_cast<int>(stage_latents_ + residual_modes_);
+  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, latents, 3, precision_);
 }
 
 // The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
