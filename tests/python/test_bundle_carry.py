@@ -111,6 +111,12 @@ def test_bundles_that_read_other_inputs_are_refused_and_left_as_they_were(
     f.write_bytes(f.read_bytes()[:-1] + b"\0")
     with pytest.raises(ValueError, match="sha256"):
         carry_model(other, dest, "sparse", "carry")
+    # a source without one of the model's networks: the destination would mix two origins
+    m = read_manifest(source)
+    del m["networks"]["sparse.f_dyn"]
+    (other / "manifest.json").write_text(json.dumps(m))
+    with pytest.raises(ValueError, match="lacks"):
+        carry_model(other, dest, "sparse", "carry")
     with pytest.raises(ValueError, match="unknown model"):
         carry_model(source, dest, "everything", "carry")
     assert _files(dest) == before

@@ -38,21 +38,9 @@ SHARED_KEYS = (
 # networks' shapes use them) and SoftDECA's rest gate (what z's last entry is, which f_w, always
 # carried, decides: absent where the source has none)
 OWN_KEYS = {"sparse": (), "softdeca": ("residual_stage", "rest_gate")}
-# a model's networks and the keys of `errors` that belong to it
-MODELS: dict[str, tuple[tuple[str, ...], str]] = {
-    "sparse": (("sparse.f_l", "sparse.f_ph_v", "sparse.f_dyn"), "sparse"),
-    "softdeca": (
-        (
-            "softdeca.f_w",
-            "softdeca.f_ph",
-            "softdeca.f_dyn",
-            "softdeca.f_ph_v",
-            "softdeca.f_r_ph",
-            "softdeca.f_r_w",
-        ),
-        "softdeca",
-    ),
-}
+# the models that can be carried: a model's networks are the manifest's networks named
+# "<model>.*", and its errors the `errors` keys named "<model>", "<model>_*" or "<model>-*"
+MODELS = tuple(OWN_KEYS)
 
 
 def _differences(source: dict[str, Any], dest: dict[str, Any]) -> list[str]:
@@ -71,10 +59,11 @@ def _contract(spec: dict[str, Any]) -> dict[str, Any]:
 
 
 def carry_model(source: str | Path, folder: str | Path, model: str, command: str) -> list[str]:
-    """Copy `model`'s networks (MODELS) from bundle folder `source` into bundle folder
-    `folder` in place; returns the networks carried. Raises ValueError, with what differs,
-    when the bundles do not share what the networks read, a network's contract (inputs,
-    outputs) differs, or a source file does not match its manifest; nothing is written then."""
+    """Copy `model`'s networks (every network named "<model>.*") from bundle folder `source`
+    into bundle folder `folder` in place; returns the networks carried. Raises ValueError, with
+    what differs, when the bundles do not share what the networks read, a network's contract
+    (inputs, outputs) differs, the destination has networks of the model the source lacks, or
+    a source file does not match its manifest; nothing is written then."""
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}; one of {', '.join(MODELS)}")
     source, folder = Path(source), Path(folder)
@@ -84,10 +73,12 @@ def carry_model(source: str | Path, folder: str | Path, model: str, command: str
     differs = _differences(src, dst)
     if differs:
         raise ValueError(f"{source} and {folder} differ in {', '.join(differs)}: not carried")
-    names, prefix = MODELS[model]
-    present = [n for n in names if n in src["networks"]]
+    present = [n for n in src["networks"] if n.startswith(f"{model}.")]
     if not present:
         raise ValueError(f"{source} has no {model} networks")
+    left = [n for n in dst["networks"] if n.startswith(f"{model}.") and n not in present]
+    if left:  # the destination would run networks of two origins as one model
+        raise ValueError(f"{folder} has {', '.join(left)}, which {source} lacks: not carried")
     files: dict[str, bytes] = {}
     for name in present:
         spec = src["networks"][name]
@@ -118,7 +109,7 @@ def carry_model(source: str | Path, folder: str | Path, model: str, command: str
     errors = {
         k: v
         for k, v in (src.get("errors") or {}).items()
-        if k == prefix or k.startswith((f"{prefix}_", f"{prefix}-"))
+        if k == model or k.startswith((f"{model}_", f"{model}-"))
     }
     training = dst.get("training") or {}
     training["replaced"] = [*training.get("replaced", []), {"networks": present, **record}]
