@@ -17,7 +17,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from softdeca_train.data.config import KINDS, GenerateConfig, RunSettings
-from softdeca_train.data.generate import generate, made_first
+from softdeca_train.data.generate import generate, made_first, summarise
 from softdeca_train.data.shards import verify
 
 TINY = GenerateConfig(
@@ -101,6 +101,9 @@ def test_killed_generator_resumes_without_loss_corruption_or_duplicates(
     done = sum(s["instances"] for s in m["shards"])
     assert 0 < done < total, "the kill should land mid-run"
     assert verify(out) == []  # what is listed is intact
+    partial = summarise(m)  # what a report of the killed dataset shows
+    assert not partial["complete"]
+    assert sum(partial["kinds"][k]["instances"] for k in KINDS) == done
     r = subprocess.run(
         _cmd(out, 2), check=False, capture_output=True, text=True, timeout=600
     )
@@ -110,6 +113,14 @@ def test_killed_generator_resumes_without_loss_corruption_or_duplicates(
     ids = np.concatenate([d["instance_id"] for d in _shards(out).values()])
     assert len(ids) == len(set(ids.tolist())) == total
     assert len(m["runs"]) == 2
+    full = summarise(m)
+    assert full["complete"]
+    for k in KINDS:
+        planned = m["dataset"]["kinds"][k]["instances"]
+        assert (full["kinds"][k]["train"], full["kinds"][k]["test"]) == (
+            planned["train"],
+            planned["test"],
+        ), k
     _same(out, reference)
 
 

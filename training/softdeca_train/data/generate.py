@@ -150,19 +150,24 @@ def _results(
     return executors.run_processes(todo, cfg, run.ict, run.threads, run.workers)
 
 
-def summarise(m: Manifest) -> dict:
-    """Totals from the listed (finished) shards."""
-    shards = m.doc["shards"]
+def summarise(doc: dict) -> dict:
+    """Totals from a manifest's listed (finished) shards: what a run ended with, and what a
+    report of a dataset still being made (or killed mid-run) shows."""
+    shards = doc["shards"]
     out: dict = {"complete": False, "kinds": {}}
-    planned = m.doc["dataset"]["kinds"]
+    planned = doc["dataset"]["kinds"]
     for kind in KINDS:
         ss = [s for s in shards if s["kind"] == kind]
         n = sum(s["instances"] for s in ss)
+        # a shard is one split's (data/plan.py)
+        n_test = sum(s["instances"] for s in ss if s.get("split") == TEST)
         nbytes = sum(s["bytes"] for s in ss)
         secs = sum(s.get("seconds", 0.0) for s in ss)
         out["kinds"][kind] = {
             "shards": len(ss),
             "instances": n,
+            "train": n - n_test,
+            "test": n_test,
             "bytes": nbytes,
             "bytes_per_instance": round(nbytes / n) if n else None,
             "worker_seconds_per_instance": round(secs / n, 3) if n else None,
@@ -258,6 +263,6 @@ def generate(cfg: GenerateConfig, run: RunSettings) -> dict:
         record["wall_seconds"] = round(time.time() - started, 2)
         n = sum(record["instances"].values())
         record["instances_per_hour"] = round(n * 3600 / record["wall_seconds"]) if n else 0
-        m.doc["summary"] = summarise(m)
+        m.doc["summary"] = summarise(m.doc)
         m.save()
     return m.doc["summary"]

@@ -27,6 +27,7 @@ from softdeca_train import paths
 from softdeca_train.data.blend import SkinBlend
 from softdeca_train.data.config import KINDS, GenerateConfig
 from softdeca_train.data.expressions import expression_sources, load_takes
+from softdeca_train.data.generate import summarise
 from softdeca_train.data.offset_structure import RIDGE, offset_structure
 from softdeca_train.data.ranges import sampling_parameters
 from softdeca_train.data.shards import iter_shards
@@ -388,10 +389,14 @@ def _identity_spread(template: Template, h: np.ndarray) -> np.ndarray:
     )
 
 
+def _of(made: int, planned: int) -> str:
+    return f"{made}" if made == planned else f"{made} of {planned}"
+
+
 def _overview_lines(folder: Path, manifest: dict, st: _Stats) -> list[str]:
     """Title, configuration, contents table, splits, storage and solver summary."""
     cfg = manifest["header"]["config"]
-    summary = manifest.get("summary", {})
+    summary = summarise(manifest)  # from the shards: right also while a dataset is being made
     ds = manifest["dataset"]
     lines = [
         f"# Dataset report: {folder.name}",
@@ -404,14 +409,21 @@ def _overview_lines(folder: Path, manifest: dict, st: _Stats) -> list[str]:
         "",
         "## Contents",
         "",
+        "Made of planned (the plan's count where they differ: a dataset still being made).",
+        "",
         "| kind | shards | train | test | frames per instance | bytes per instance |",
         "| --- | ---: | ---: | ---: | ---: | ---: |",
     ]
     for k in KINDS:
-        kd, sk = ds["kinds"][k], summary.get("kinds", {}).get(k, {})
+        kd, sk = ds["kinds"][k], summary["kinds"][k]
+        made = [
+            _of(sk["shards"], kd["shards"]),
+            _of(sk["train"], kd["instances"]["train"]),
+            _of(sk["test"], kd["instances"]["test"]),
+        ]
         lines.append(
-            f"| {k} | {kd['shards']} | {kd['instances']['train']} | {kd['instances']['test']} "
-            f"| {kd['frames_per_instance']} | {sk.get('bytes_per_instance')} |"
+            f"| {k} | {' | '.join(made)} | {kd['frames_per_instance']} "
+            f"| {sk['bytes_per_instance']} |"
         )
     sp = ds["splits"]
     lines += [
