@@ -304,7 +304,16 @@ def test_bundle_at_softdecas_start_is_exported_and_evaluated(small, tmp_path) ->
     from softdeca_train.train.report import write_report
 
     folder, _ = small
-    fresh = Run(tmp_path / "run", RunConfig(str(folder), "test", seed=4))
+    # one member in the residual stage (--residual-members): the run keeps it, the bundle
+    # runs it (its condition is each member's first-layer share, then c(0))
+    fresh = Run(
+        tmp_path / "run", RunConfig(str(folder), "test", seed=4, residual_members=1)
+    )
+    assert Run(tmp_path / "run").sizes.residual_members == 1
+    with pytest.raises(ValueError, match="residual members"):
+        Run(
+            tmp_path / "run", RunConfig(str(folder), "test", seed=4, residual_members=2)
+        )
     bundle = train_bundle(
         fresh,
         tmp_path / "bundle",
@@ -316,6 +325,10 @@ def test_bundle_at_softdecas_start_is_exported_and_evaluated(small, tmp_path) ->
         json.loads((fresh.folder / "softdeca.summary.json").read_text())["steps"] == 0
     )
     _check_export_deviation(read_manifest(bundle))
+    sizes = fresh.sizes
+    assert read_manifest(bundle)["residual_stage"]["condition"] == (
+        sizes.residual_hidden + sizes.residual_modes
+    )
     # a new run is exact at rest (rest gate 0): the exported networks give no correction at
     # w = 0, whatever their weights, in the bundle as the runtime runs it
     assert fresh.config.rest_gate == 0.0

@@ -47,6 +47,13 @@ def _run_args(p: argparse.ArgumentParser, dataset_required: bool = True) -> None
         "part independent of w gated by |w|^2 / (|w|^2 + TAU^2); 'none', the form of the "
         "bundles trained before (a constant part) (0; with --dataset, when the run is new)",
     )
+    p.add_argument(
+        "--residual-members",
+        type=int,
+        default=None,
+        help="members of SoftDECA's residual stage (default: the sizes' own, 5 at full size; "
+        "each costs the frame its weights; with --dataset, when the run is new)",
+    )
     p.add_argument("--seed", type=int, default=0, help="training seed (0)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
@@ -72,10 +79,14 @@ def _open_run(args: argparse.Namespace):  # -> Run
             contrasts=contrasts,
             more_static=more,
             rest_gate=gate,
+            residual_members=args.residual_members,
         )
         return Run(args.run, config)
-    if args.contrasts or args.more_static:
-        raise SystemExit("--contrasts and --more-static are part of a new run: give --dataset")
+    if args.contrasts or args.more_static or args.residual_members is not None:
+        raise SystemExit(
+            "--contrasts, --more-static and --residual-members are part of a new run: give "
+            "--dataset"
+        )
     return Run(args.run)
 
 

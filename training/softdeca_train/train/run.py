@@ -50,9 +50,18 @@ class RunConfig:
     # with no part independent of w; tau > 0, that part gated by |w|^2 / (|w|^2 + tau^2);
     # None, the form of the runs before (a constant part, not exact at rest)
     rest_gate: float | None = 0.0
+    # members of SoftDECA's residual stage (ResidualSizes), None: the sizes' own. Each member
+    # reads its own weights every frame (1.74 MB of float weights for five at full size): fewer
+    # members cost the frame less
+    residual_members: int | None = None
 
     def __post_init__(self) -> None:  # run.json holds a list (and a caller may give paths)
         object.__setattr__(self, "more_static", tuple(str(d) for d in self.more_static))
+
+
+def _key(c: RunConfig) -> tuple:
+    """What a run's checkpoints depend on: a run folder keeps one."""
+    return (c.dataset, c.sizes, c.seed, c.contrasts, c.more_static, c.rest_gate, c.residual_members)
 
 
 def _read_config(path: Path) -> RunConfig:
@@ -70,19 +79,21 @@ class Run:
             config = _read_config(path)
         elif path.is_file():
             old = _read_config(path)
-            key = lambda c: (c.dataset, c.sizes, c.seed, c.contrasts, c.more_static, c.rest_gate)  # noqa: E731
-            if key(old) != key(config):
+            if _key(old) != _key(config):
                 raise ValueError(
                     f"{self.folder} trains on {old.dataset} ({old.sizes}, seed {old.seed}, "
                     f"contrasts {old.contrasts}, more static data {list(old.more_static)}, "
-                    f"rest gate {old.rest_gate}); use another folder for another dataset, "
-                    "sizes, seed, contrasts, more data or rest gate"
+                    f"rest gate {old.rest_gate}, residual members {old.residual_members}); use "
+                    "another folder for another dataset, sizes, seed, contrasts, more data, rest "
+                    "gate or residual members"
                 )
         else:
             self.folder.mkdir(parents=True, exist_ok=True)
             path.write_text(json.dumps(asdict(config), indent=1) + "\n")
         if config.sizes not in SIZES:
             raise ValueError(f"sizes must be one of {sorted(SIZES)}")
+        if config.residual_members is not None and config.residual_members < 1:
+            raise ValueError("the residual stage needs at least one member")
         self.config = config
 
     @cached_property
@@ -136,7 +147,10 @@ class Run:
 
     @property
     def sizes(self) -> NetworkSizes:
-        return replace(SIZES[self.config.sizes], rest_gate=self.config.rest_gate)
+        sizes = replace(SIZES[self.config.sizes], rest_gate=self.config.rest_gate)
+        if self.config.residual_members is not None:
+            sizes = replace(sizes, residual_members=self.config.residual_members)
+        return sizes
 
     @cached_property
     def specs(self) -> tuple[ParameterSpec, ...]:
