@@ -140,3 +140,28 @@ def test_softdeca_brings_its_rest_gate(bundles, tmp_path) -> None:
     carry_model(source, dest, "softdeca", "carry")
     carry_model(plain, dest, "sparse", "carry")
     assert read_manifest(dest)["rest_gate"] == 0.3
+
+
+def test_the_bench_figures_are_of_the_shipped_sparse_networks(tmp_path) -> None:
+    """models.json names what the bundle ships: the run's own SparseSoftDECA figures, or with
+    carried networks the bundle's figure on the same split, never the run's in their place."""
+    from types import SimpleNamespace
+
+    from softdeca_train.train.report import _write_bench
+
+    errors = {
+        "sparse/other_head_noise": {"mean_mm": 0.7},
+        "sparse/arkit_face": {"mean_mm": 0.65},
+    }
+    result = {
+        "errors": errors,
+        "ms_per_frame": {},
+        "bundle": {"sparse": {"mean_mm": 0.6}},
+    }
+    run = SimpleNamespace(folder=tmp_path / "run")
+    for carried, expected in ((False, {0.7, 0.65}), (True, {0.6})):
+        _write_bench(tmp_path, result, run, carried)  # type: ignore[arg-type]
+        figs = json.loads((tmp_path / "models.json").read_text())
+        assert {
+            f["value"] for k, f in figs.items() if k.startswith("sparse")
+        } == expected
