@@ -5,7 +5,7 @@ resumes from its checkpoint, so `train-bundle` can be killed and rerun at any po
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from functools import cached_property
 from pathlib import Path
 
@@ -60,8 +60,8 @@ class RunConfig:
 
 
 def _key(c: RunConfig) -> tuple:
-    """What a run's checkpoints depend on: a run folder keeps one."""
-    return (c.dataset, c.sizes, c.seed, c.contrasts, c.more_static, c.rest_gate, c.residual_members)
+    """What a run's checkpoints depend on (every setting but `extra`): a run folder keeps one."""
+    return tuple(getattr(c, f.name) for f in fields(c) if f.name != "extra")
 
 
 def _read_config(path: Path) -> RunConfig:
