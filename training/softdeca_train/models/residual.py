@@ -16,7 +16,7 @@ coefficient fixed at 1."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -202,24 +202,37 @@ class ResidualStage(nn.Module):
         `gates` (N, 1): each frame's coefficient of the mean mode (the rest gate; 1 without):
         the mean is then their least-squares mean, and what is left of it is fitted by modes."""
         n, k = len(residual), self.sizes.modes
-        r = residual.reshape(n, -1).double()
+        # Column block by column block in double: a whole double copy of the residual (and of
+        # its centred form) is gigabytes for thousands of frames of the skin.
+        r = residual.reshape(n, -1)
         g = torch.ones(n, dtype=torch.float64) if gates is None else gates.double().reshape(n)
         weight = float((g * g).sum())
-        mean = (g[:, None] * r).sum(0) / weight if weight > 0 else torch.zeros_like(r[0])
-        rc = r - g[:, None] * mean
+        mean = torch.zeros(r.shape[1], dtype=torch.float64)
+        if weight > 0:
+            for cols in _column_blocks(r.shape[1]):
+                mean[cols] = g @ r[:, cols].double() / weight
+
+        def centred(cols: slice) -> torch.Tensor:
+            return r[:, cols].double() - g[:, None] * mean[cols]
+
         extra = 0 if contrasts is None else min(extra, k)
-        basis = _leading_rows(rc, k - extra)  # (k1, 3V) orthonormal
-        scale = _rms(rc @ basis.T)
+        basis = _leading_rows(centred, n, r.shape[1], k - extra)  # (k1, 3V) orthonormal
+        scale = _rms(_project(centred, n, basis))
         if extra:
             assert contrasts is not None
-            d = contrasts.reshape(len(contrasts), -1).double()
-            more = _leading_rows(d - (d @ basis.T) @ basis, extra)
+            d = contrasts.reshape(len(contrasts), -1)
+            on = _project(lambda cols: d[:, cols].double(), len(d), basis)
+
+            def rest(cols: slice) -> torch.Tensor:
+                return d[:, cols].double() - on @ basis[:, cols]
+
+            more = _leading_rows(rest, len(d), d.shape[1], extra)
             basis = torch.cat([basis, more])
-            scale = torch.cat([scale, _rms(d @ more.T)])  # over the frames it can be tiny
+            scale = torch.cat([scale, _rms(_project(lambda c: d[:, c].double(), len(d), more))])
         keep = scale > scale.max() * 1e-9 if len(scale) else scale > 0
         scale = torch.where(keep, scale, torch.ones_like(scale))
         coef = torch.zeros(n, k, dtype=torch.float64)
-        coef[:, : len(basis)] = (rc @ basis.T) / scale * keep
+        coef[:, : len(basis)] = _project(centred, n, basis) / scale * keep
         table = torch.zeros_like(self.table, dtype=torch.float64)
         v = self.table.shape[0]
         table[:, : len(basis)] = (
@@ -320,23 +333,49 @@ class ResidualStage(nn.Module):
             every = torch.arange(len(xn))
             c = torch.stack([out(m, every) for m in self.members]).mean(0)
             c = torch.cat([c, gates], dim=1)
-            fitted = torch.einsum("bk,vkc->bvc", c, self.table)
-            before = residual.norm(dim=-1).mean()
-            after = (residual - fitted).norm(dim=-1).mean()
-        return {"residual_mm": float(before) * 1e3, "after_mm": float(after) * 1e3}
+            before = after = 0.0
+            for i in range(0, len(residual), 256):  # a frame batch at a time: N meshes each
+                part = residual[i : i + 256]
+                fitted = torch.einsum("bk,vkc->bvc", c[i : i + 256], self.table)
+                before += float(part.norm(dim=-1).mean(dim=1).sum())
+                after += float((part - fitted).norm(dim=-1).mean(dim=1).sum())
+        n = max(len(residual), 1)
+        return {"residual_mm": before / n * 1e3, "after_mm": after / n * 1e3}
 
 
-def _leading_rows(x: torch.Tensor, k: int) -> torch.Tensor:
-    """(k', D) orthonormal rows spanning the k leading directions of the rows of x (N, D),
-    from the N x N Gram matrix (N is thousands, D tens of thousands); k' <= k where x has
-    fewer independent rows."""
-    if k <= 0 or len(x) == 0:
-        return x.new_zeros(0, x.shape[1])
-    ev, u = torch.linalg.eigh(x @ x.T)
+def _column_blocks(d: int, size: int = 4096) -> list[slice]:
+    return [slice(i, min(i + size, d)) for i in range(0, d, size)]
+
+
+def _leading_rows(
+    block: Callable[[slice], torch.Tensor], n: int, d: int, k: int
+) -> torch.Tensor:
+    """(k', d) orthonormal rows spanning the k leading directions of the rows of a matrix
+    X (n, d) given by its column blocks (`block(cols)`, double), from the n x n Gram matrix
+    (n is thousands, d tens of thousands); k' <= k where X has fewer independent rows."""
+    if k <= 0 or n == 0:
+        return torch.zeros(0, d, dtype=torch.float64)
+    gram = torch.zeros(n, n, dtype=torch.float64)
+    for cols in _column_blocks(d):
+        x = block(cols)
+        gram += x @ x.T
+    ev, u = torch.linalg.eigh(gram)
     order = torch.argsort(ev, descending=True)[:k]
     s = ev[order].clamp_min(0).sqrt()
     order = order[s > s[0] * 1e-9]
-    return (u[:, order].T @ x) / s[: len(order), None]
+    ut = u[:, order].T / s[: len(order), None]
+    out = torch.empty(len(order), d, dtype=torch.float64)
+    for cols in _column_blocks(d):
+        out[:, cols] = ut @ block(cols)
+    return out
+
+
+def _project(block: Callable[[slice], torch.Tensor], n: int, basis: torch.Tensor) -> torch.Tensor:
+    """X @ basis.T (n, k) for X (n, d) given by its column blocks."""
+    out = torch.zeros(n, len(basis), dtype=torch.float64)
+    for cols in _column_blocks(basis.shape[1]):
+        out += block(cols) @ basis[:, cols].T
+    return out
 
 
 def _rms(x: torch.Tensor) -> torch.Tensor:

@@ -356,8 +356,8 @@ class SoftDecaHybrid(Trainable):
             assert isinstance(last, nn.Linear)
             last.weight.zero_()
             last.bias.zero_()
+        del fit, coef  # gigabytes of normal equations: the stages after need their own
         if hyper.local.slots:
-            del fit, coef  # gigabytes of normal equations: the second fit needs its own
             self._fit_on_codes(sources, kept, progress, ridge)
         if self.f_r is not None:
             self.fit_residual(data, kept, progress, contrasts, more)
@@ -406,18 +406,25 @@ class SoftDecaHybrid(Trainable):
         assert self.f_r is not None
         with torch.no_grad():
             self.f_r.table.zero_()  # the model without the stage
-        weights, features, residual = [], [], []
+        weights, features = [], []
         keys: list[tuple[int, int, bytes]] = []  # (identity, param_id, weights) of each frame
         sources = [data, *more] + ([] if contrasts is None else [contrasts])
         if contrasts is not None:
             frames += contrasts.left_out("static", "train")["kept"]
+        # filled in place: a list of frames joined at the end would hold the skin's residual
+        # of every frame twice (gigabytes)
+        residual = torch.empty(frames, self.n_vertices, 3)
+        done = 0
         bar = tqdm(total=frames, desc="residual of the start", unit="frame", disable=not progress)
         for source in sources:
             for b in source.batches("static", "train"):
+                if done + b.frames > frames:
+                    raise ValueError(f"more static train frames than the {frames} counted")
                 with torch.no_grad():
-                    residual.append((b.T - self.predict(b)).float())
+                    residual[done : done + b.frames] = b.T - self.predict(b)
                     pv = b.vertex_parameters(self.n_vertices)
                     features.append(self.f_r.parameter_features(pv).expand(b.frames, -1))
+                done += b.frames
                 weights.append(b.weights.float())
                 if source is contrasts:
                     keys += [(b.identity_id, b.param_id, w.numpy().tobytes()) for w in b.weights]
@@ -425,10 +432,12 @@ class SoftDecaHybrid(Trainable):
                     keys += [(-1, -1, b"")] * b.frames
                 bar.update(b.frames)
         bar.close()
+        if done != frames:
+            raise ValueError(f"{done} static train frames, {frames} counted")
         return self.f_r.fit(
             torch.cat(weights),
             torch.cat(features),
-            torch.cat(residual),
+            residual,
             self.residual_fit,
             progress,
             contrast_pairs(keys) if contrasts is not None else None,
