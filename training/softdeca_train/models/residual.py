@@ -347,9 +347,7 @@ def _column_blocks(d: int, size: int = 4096) -> list[slice]:
     return [slice(i, min(i + size, d)) for i in range(0, d, size)]
 
 
-def _leading_rows(
-    block: Callable[[slice], torch.Tensor], n: int, d: int, k: int
-) -> torch.Tensor:
+def _leading_rows(block: Callable[[slice], torch.Tensor], n: int, d: int, k: int) -> torch.Tensor:
     """(k', d) orthonormal rows spanning the k leading directions of the rows of a matrix
     X (n, d) given by its column blocks (`block(cols)`, double), from the n x n Gram matrix
     (n is thousands, d tens of thousands); k' <= k where X has fewer independent rows."""
