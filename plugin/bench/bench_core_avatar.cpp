@@ -22,6 +22,7 @@ CoreAvatar::CoreAvatar(const std::string& bundle_path, const std::vector<float>&
   desc.triangle_count = triangles.size() / 3;
   desc.blendshapes = deltas.empty() ? nullptr : deltas.data();
   desc.blendshape_count = deltas.empty() ? 0 : 52;
+  desc.precisions = {kernels::Precision::Half, kernels::Precision::Half};
   state_->avatar = std::make_unique<runtime::Avatar>(state_->model, desc);
   state_->avatar->prepare();
 }

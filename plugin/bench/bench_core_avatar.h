@@ -13,7 +13,8 @@ namespace softdeca::cli {
 
 class CoreAvatar {
  public:
-  // `deltas`: 52 x vertices x 3 (empty: no blendshapes). Prepared at the defaults.
+  // `deltas`: 52 x vertices x 3 (empty: no blendshapes). Both models' tables in half, as the
+  // handle it is timed against (cmd_bench_runtime.cpp); prepared at the defaults.
   CoreAvatar(const std::string& bundle_path, const std::vector<float>& neutral, const std::vector<std::int32_t>& triangles,
              const std::vector<float>& deltas);
   ~CoreAvatar();

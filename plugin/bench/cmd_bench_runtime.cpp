@@ -2,8 +2,8 @@
 // a real take: plain linear blendshapes, SoftDECA static and dynamic, SparseSoftDECA, with one
 // and with two threads; prepare time, memory per avatar, and the error the compact hyper-tensor
 // storage adds (half and int8 against float, same frames), what the C ABI's handle adds to the
-// template's frame over the core avatar it holds, and the shipped bundle's frames against the
-// machine's memory bandwidth. Writes the benchmark JSON of
+// template's frame over the core avatar it holds, and the shipped bundle's frames (at the
+// library's default precisions, as users run it) against the machine's memory bandwidth. Writes the benchmark JSON of
 // docs/ARCHITECTURE.md, Conventions ({figure: {value, unit, target, better, how}}).
 // Kept whole: every figure is measured in one run on the same inputs (take, avatars, bundles),
 // so their ratios hold; each figure's measurement is a function of its own.
@@ -35,6 +35,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kPaperStaticMs = 7.45, kPaperDynamicMs = 9.87, kPaperFaces = 71358;
+
+// The random bundle's figures: both models' tables in half, as those figures have always been
+// measured (the shipped bundle's run at the library's defaults instead).
+constexpr AvatarPrecisions kHalf{SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_HALF};
+// Both models' tables at one precision.
+AvatarPrecisions both(int32_t precision) { return {precision, precision}; }
 
 // The shared figure (bench_figures.h) with this command's argument order: most figures have no target.
 std::string figure(double value, const std::string& unit, const std::string& how, double target = NAN,
@@ -106,7 +112,7 @@ struct Bench {
 Frames sparse_inputs(const Take& take, std::size_t frames, const FaceRig& rig, const FaceRig& user, Model& model) {
   const uint32_t vh = model.info.head_vertex_count;
   Frames input{take, {}, 0};
-  Avatar a(model, rig.neutral, rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  Avatar a(model, rig.neutral, rig.deltas, 1);  // its linear blend only
   std::vector<float> head(vh * 3);
   softdeca_output out{sizeof(softdeca_output), head.data(), vh, nullptr, 0};
   for (std::size_t f = 0; f < frames; ++f) {
@@ -151,7 +157,7 @@ void record_prepare_and_memory(Bench& bench, const Avatar& a, const softdeca_sta
 // (carrying the tissue fill, the contact sets, the defaults' solve and p's) and later prepares
 // after a gravity change (p's solve only) and after a soft-tissue weight change (refactorised).
 void measure_rest_physics(Bench& bench) {
-  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, kHalf);
   check(softdeca_avatar_prepare(a.handle), "prepare");
   const auto gravity = static_cast<uint32_t>(bench.model.parameter("gravity_strength"));
   const auto soft = static_cast<uint32_t>(bench.model.parameter("w_soft_strain"));
@@ -169,7 +175,7 @@ void measure_rest_physics(Bench& bench) {
     by_tissue.push_back(a.stats().prepare_physics_ms);
   }
   // A frame with the rest offset against one at the defaults, alternately on two avatars.
-  Avatar plain(bench.model, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  Avatar plain(bench.model, bench.rig.neutral, bench.rig.deltas, 1, kHalf);
   check(softdeca_avatar_prepare(plain.handle), "prepare");
   const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
   Times with{}, without{};
@@ -204,7 +210,7 @@ void measure_rest_physics(Bench& bench) {
 void measure_with_threads(Bench& bench, unsigned threads) {
   const std::string suffix = threads == 1 ? "" : "_2threads";
   const std::string tag = threads == 1 ? " (1 thread)" : " (2 threads)";
-  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, threads, SOFTDECA_PRECISION_HALF);
+  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, threads, kHalf);
   check(softdeca_avatar_prepare(a.handle), "prepare");
   const softdeca_stats first = a.stats();
   std::vector<double> prep;
@@ -268,9 +274,9 @@ void measure_with_threads(Bench& bench, unsigned threads) {
 }
 
 // The speed of another hyper-tensor storage, single thread (same frames, same run).
-void measure_storage(Bench& bench, unsigned precision) {
+void measure_storage(Bench& bench, int32_t precision) {
   const char* name = precision == SOFTDECA_PRECISION_INT8 ? "int8" : "float";
-  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, precision);
+  Avatar a(bench.model, bench.rig.neutral, bench.rig.deltas, 1, both(precision));
   check(softdeca_avatar_prepare(a.handle), "prepare");
   const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
   softdeca_output* output = &bench.output;
@@ -309,11 +315,11 @@ void measure_storage(Bench& bench, unsigned precision) {
 void measure_storage_error(Bench& bench, const Model& model, const std::string& prefix, const std::string& networks) {
   const std::size_t n = std::min<std::size_t>(bench.frames, 100);
   double worst[2] = {0, 0}, mean[2] = {0, 0}, worst_sp[2] = {0, 0};
-  const unsigned precisions[3] = {SOFTDECA_PRECISION_FLOAT, SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_INT8};
+  const int32_t precisions[3] = {SOFTDECA_PRECISION_FLOAT, SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_INT8};
   std::vector<std::vector<float>> ref_sd, ref_sp;
   const std::vector<float>& vertices = bench.vertices;
   for (int p = 0; p < 3; ++p) {
-    Avatar a(model, bench.rig.neutral, bench.rig.deltas, 1, precisions[p]);
+    Avatar a(model, bench.rig.neutral, bench.rig.deltas, 1, both(precisions[p]));
     check(softdeca_avatar_prepare(a.handle), "prepare");
     if (!bench.user.empty())
       check(softdeca_avatar_calibrate_landmarks(a.handle, bench.user.neutral.vertices.data(), bench.user.neutral.vertex_count()),
@@ -378,8 +384,8 @@ void measure_own_avatar(Bench& bench, const std::string& path) {
     load_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
   }
   std::remove(saved.c_str());
-  Avatar own(bench.model, *fit, mesh, 1, SOFTDECA_PRECISION_HALF);
-  Avatar plain(bench.model, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  Avatar own(bench.model, *fit, mesh, 1, kHalf);
+  Avatar plain(bench.model, bench.rig.neutral, bench.rig.deltas, 1, kHalf);
   check(softdeca_avatar_prepare(own.handle), "prepare");
   check(softdeca_avatar_prepare(plain.handle), "prepare");
   const auto n = static_cast<uint32_t>(file.vertex_count());
@@ -430,7 +436,7 @@ std::pair<double, double> alternating_ms(const Bench& bench, const std::function
 void measure_identity_fit(Bench& bench, const std::string& bundle_path) {
   const FaceRig& rig = bench.rig;
   CoreAvatar core(bundle_path, rig.neutral.vertices, rig.neutral.triangles, rig.deltas);
-  Avatar handle(bench.model, rig.neutral, rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  Avatar handle(bench.model, rig.neutral, rig.deltas, 1, kHalf);
   check(softdeca_avatar_prepare(handle.handle), "prepare");
   const std::size_t capacity = bench.vertices.size() / 3;
   const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
@@ -459,7 +465,7 @@ constexpr double kFrame60HzMs = 1000.0 / 60.0;
 void measure_crowd(Bench& bench, Model& shipped, const std::string& how) {
   std::vector<std::unique_ptr<Avatar>> crowd;
   for (std::size_t i = 0; i < kCrowd; ++i) {
-    crowd.push_back(std::make_unique<Avatar>(shipped, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF));
+    crowd.push_back(std::make_unique<Avatar>(shipped, bench.rig.neutral, bench.rig.deltas, 1));
     check(softdeca_avatar_prepare(crowd.back()->handle), "prepare");
   }
   const Times t = median_ms(bench.frames, bench.warmup, [&](std::size_t f) {
@@ -467,7 +473,8 @@ void measure_crowd(Bench& bench, Model& shipped, const std::string& how) {
       check(softdeca_avatar_evaluate_weights(a->handle, bench.take.weights[f].data(), 52, &bench.output), "crowd");
   });
   const double per_avatar = t.wall / static_cast<double>(kCrowd);
-  const std::string crowd_how = "; " + std::to_string(kCrowd) + " avatars of the shipped bundle on the template head, each frame "
+  const std::string crowd_how = "; " + std::to_string(kCrowd) + " avatars of the shipped bundle on the template head (the library's "
+                                "default precisions), each frame "
                                 "evaluated on every one in turn (evaluate_weights, with normals), median frame over the " +
                                 std::to_string(kCrowd) + "; 1 thread" + how;
   bench.figures.raw("runtime.crowd_softdeca_ms_per_avatar", figure(per_avatar, "ms", "wall-clock per avatar" + crowd_how));
@@ -524,12 +531,13 @@ void measure_bandwidth_share(Bench& bench, const Avatar& a, const std::vector<Fr
   std::fprintf(stderr, "\n");
 }
 
-// The path users run: the shipped (trained) bundle, on the template and on a fitted avatar,
-// each against its own linear blend with frames alternating, and SparseSoftDECA (1 thread).
+// The path users run: the shipped (trained) bundle at the library's default precisions, on the
+// template and on a fitted avatar, each against its own linear blend with frames alternating,
+// and SparseSoftDECA (1 thread).
 void measure_shipped(Bench& bench, const std::string& bundle_path, const std::string& own_path) {
   Model shipped(bundle_path);
   const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
-  Avatar head(shipped, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_HALF);
+  Avatar head(shipped, bench.rig.neutral, bench.rig.deltas, 1);
   check(softdeca_avatar_prepare(head.handle), "prepare");
   if (!bench.user.empty())
     check(softdeca_avatar_calibrate_landmarks(head.handle, bench.user.neutral.vertices.data(), bench.user.neutral.vertex_count()),
@@ -543,8 +551,11 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
       bench,
       [&](std::size_t f) { check(softdeca_avatar_evaluate_landmarks(head.handle, input.points[f].data(), input.point_count, out), "sparse"); },
       [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); });
-  const std::string how = "; the shipped bundle " + bundle_path + ", the template head, dynamics off, with normals, frames "
-                          "alternating with the linear blend of the same avatar, wall-clock; 1 thread; " + bench.how;
+  const auto template_how = [&](const std::string& storage) {
+    return "; the shipped bundle " + bundle_path + ", the template head, " + storage + ", dynamics off, with normals, frames "
+           "alternating with the linear blend of the same avatar, wall-clock; 1 thread; " + bench.how;
+  };
+  const std::string how = template_how("the library's default precisions");
   bench.figures.raw("runtime.shipped_softdeca_ms", figure(softdeca, "ms", "evaluate_weights" + how));
   bench.figures.raw("runtime.shipped_linear_ms", figure(linear, "ms", "evaluate_linear" + how));
   bench.figures.raw("runtime.shipped_softdeca_over_linear",
@@ -565,18 +576,20 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
        {"linear", "shipped_linear_ms", linear,
         [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); }}},
       how);
-  // The same head with int8 hyper-tensors (a quarter of float's bytes), against its own linear
+  // The same head with SoftDECA's tables in half (twice int8's bytes), against its own linear
   // blend in the same way, and what each compact storage adds to the trained networks' output.
-  Avatar head_int8(shipped, bench.rig.neutral, bench.rig.deltas, 1, SOFTDECA_PRECISION_INT8);
-  check(softdeca_avatar_prepare(head_int8.handle), "prepare");
-  const auto [softdeca_int8, linear_int8] = alternating_ms(
-      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(head_int8.handle, w(f), 52, out), "softdeca"); },
-      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head_int8.handle, w(f), 52, out), "linear"); });
-  bench.figures.raw("runtime.shipped_softdeca_ms_int8", figure(softdeca_int8, "ms", "evaluate_weights, int8 hyper-tensors" + how));
-  bench.figures.raw("runtime.shipped_softdeca_over_linear_int8",
-                    figure(softdeca_int8 / linear_int8, "x", "shipped_softdeca_ms_int8 over the linear blend's frames between them" + how, 1.5));
-  std::fprintf(stderr, "shipped bundle, template, int8: softdeca %.3f ms, linear %.3f ms (x%.2f)\n", softdeca_int8, linear_int8,
-               softdeca_int8 / linear_int8);
+  Avatar head_half(shipped, bench.rig.neutral, bench.rig.deltas, 1, {SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_DEFAULT});
+  check(softdeca_avatar_prepare(head_half.handle), "prepare");
+  const auto [softdeca_half, linear_half] = alternating_ms(
+      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(head_half.handle, w(f), 52, out), "softdeca"); },
+      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head_half.handle, w(f), 52, out), "linear"); });
+  const std::string half_how = template_how("SoftDECA's tables (hyper-tensor, vertex and residual stages) in half");
+  bench.figures.raw("runtime.shipped_softdeca_ms_half", figure(softdeca_half, "ms", "evaluate_weights" + half_how));
+  bench.figures.raw("runtime.shipped_softdeca_over_linear_half",
+                    figure(softdeca_half / linear_half, "x", "shipped_softdeca_ms_half over the linear blend's frames between them" +
+                                                                 half_how, 1.5));
+  std::fprintf(stderr, "shipped bundle, template, SoftDECA in half: softdeca %.3f ms, linear %.3f ms (x%.2f)\n", softdeca_half,
+               linear_half, softdeca_half / linear_half);
   measure_storage_error(bench, shipped, "shipped_", "the shipped bundle's trained networks, the template head");
   measure_crowd(bench, shipped, "; " + bench.how);
   if (own_path.empty()) return;
@@ -586,7 +599,7 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
   options.struct_size = sizeof options;
   check(softdeca_fit_options_init(&options), "fit options");
   const Fit fit(shipped, mesh, options);
-  Avatar own(shipped, fit, mesh, 1, SOFTDECA_PRECISION_HALF);
+  Avatar own(shipped, fit, mesh, 1);
   check(softdeca_avatar_prepare(own.handle), "prepare");
   const auto n = static_cast<uint32_t>(file.vertex_count());
   std::vector<float> vertices(3 * n), normals(3 * n);
@@ -595,7 +608,8 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
       bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(own.handle, w(f), 52, &own_out), "softdeca"); },
       [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(own.handle, w(f), 52, &own_out), "linear"); });
   const std::string own_how = "; the shipped bundle " + bundle_path + " fitted to " + own_path + " (" + std::to_string(n) +
-                              " vertices), dynamics off, with normals, frames alternating with the avatar's own linear blend, "
+                              " vertices), the library's default precisions, dynamics off, with normals, frames alternating with "
+                              "the avatar's own linear blend, "
                               "wall-clock; 1 thread; " + bench.how;
   bench.figures.raw("runtime.shipped_softdeca_fitted_ms", figure(own_softdeca, "ms", "evaluate_weights" + own_how));
   bench.figures.raw("runtime.shipped_softdeca_over_linear_fitted",
@@ -642,7 +656,7 @@ int run_bench_runtime(const Args& args) {
 
   for (const unsigned threads : {1u, 2u}) measure_with_threads(bench, threads);
   measure_identity_fit(bench, o.text("--bundle"));
-  for (const unsigned precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) measure_storage(bench, precision);
+  for (const int32_t precision : {SOFTDECA_PRECISION_INT8, SOFTDECA_PRECISION_FLOAT}) measure_storage(bench, precision);
   measure_storage_error(bench, bench.model, "", "untrained networks: the size of their corrections sets this");
   measure_rest_physics(bench);
   if (o.given("--own-avatar")) measure_own_avatar(bench, o.text("--own-avatar"));

@@ -146,11 +146,14 @@ struct Timing {
   }
 };
 
-unsigned precision_of(const std::string& p) {
+// The softdeca_precision that `option`'s value names.
+int32_t precision_of(const Options& o, const std::string& option) {
+  const std::string p = o.text(option);
+  if (p == "default") return SOFTDECA_PRECISION_DEFAULT;
   if (p == "half") return SOFTDECA_PRECISION_HALF;
   if (p == "float") return SOFTDECA_PRECISION_FLOAT;
   if (p == "int8") return SOFTDECA_PRECISION_INT8;
-  throw UsageError("--precision must be half, float or int8");
+  throw UsageError(option + " must be default, half, float or int8, not '" + p + "'");
 }
 
 // The take's frames from --start, at most --frames of them.
@@ -295,7 +298,9 @@ int run_replay(const Args& args) {
       .option("--start", "N", "skip the take's first N frames", "0")
       .option("--frames", "N", "at most N frames of the take after --start (0: all)", "0")
       .option("--threads", "N", "threads per frame (1 or 2)", "1")
-      .option("--precision", "P", "hyper-tensor storage: half, float or int8", "half")
+      .option("--precision", "P", "SoftDECA's storage (hyper-tensor, vertex and residual stages): default (the "
+                                  "library's choice for the model, docs/runtime.md), half, float or int8", "default")
+      .option("--sparse-precision", "P", "SparseSoftDECA's hyper-tensor storage: default, half, float or int8", "default")
       .option("--obj-every", "N", "also write every Nth frame as OBJ (0: none)", "0")
       .flag("--dynamics", "enable the second-order dynamics");
   declare_fit_options(o);  // for an avatar fitted now
@@ -305,14 +310,14 @@ int run_replay(const Args& args) {
   const std::string out = o.text("--out");
   make_directories(out);
   const unsigned threads = static_cast<unsigned>(o.integer("--threads"));
-  const unsigned precision = precision_of(o.text("--precision"));
+  const AvatarPrecisions precisions{precision_of(o, "--precision"), precision_of(o, "--sparse-precision")};
   const long start = o.integer("--start");
   const Take take = read_replay_take(o.arg(0), start, o.integer("--frames"), read_limits(o));
   const std::vector<std::string> models = models_to_run(o.text("--models"), o.given("--localised"));
   const std::string avatar_path = o.text("--avatar");
 
   Model model(o.text("--bundle"));
-  ReplayAvatar target = open_replay_avatar(model, avatar_path, shape_names(o), fit_options(o), threads, precision);
+  ReplayAvatar target = open_replay_avatar(model, avatar_path, shape_names(o), fit_options(o), threads, precisions);
   softdeca_avatar* avatar = target.avatar->handle;
   apply(model, target, parse_changes(o.text("--set")));
   check(softdeca_avatar_set_dynamics(avatar, o.on("--dynamics") ? SOFTDECA_TRUE : SOFTDECA_FALSE), "dynamics");
@@ -351,6 +356,7 @@ int run_replay(const Args& args) {
       .raw("dynamics", o.on("--dynamics") ? "true" : "false")
       .number("threads", threads)
       .text("precision", o.text("--precision"))
+      .text("sparse_precision", o.text("--sparse-precision"))
       .text("set", o.text("--set"))
       .text("localised", o.text("--localised"))
       .number("localised_faces", static_cast<double>(localised_faces))

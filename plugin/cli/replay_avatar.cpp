@@ -15,11 +15,12 @@ bool template_topology(const Model& model, const std::string& path) {
   return read_avatar_obj(path, "neutral.obj").vertex_count() == model.info.head_vertex_count;
 }
 
-void open_template(const Model& model, const std::string& path, unsigned threads, unsigned precision, ReplayAvatar& a) {
+void open_template(const Model& model, const std::string& path, unsigned threads, AvatarPrecisions precisions,
+                   ReplayAvatar& a) {
   a.kind = "template topology";
   a.rig = read_rig(path);
   a.vertex_count = model.info.head_vertex_count;
-  a.avatar = std::make_unique<Avatar>(model, a.rig.neutral, a.rig.deltas, threads, precision);
+  a.avatar = std::make_unique<Avatar>(model, a.rig.neutral, a.rig.deltas, threads, precisions);
   AvatarPart whole{"avatar", 0, a.vertex_count, 0, a.rig.neutral.triangles.size() / 3, {}, false};
   const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   std::copy(identity, identity + 16, whole.transform);
@@ -30,7 +31,7 @@ void open_template(const Model& model, const std::string& path, unsigned threads
 }
 
 void open_fitted(const Model& model, const std::string& path, const ShapeNames& names, const softdeca_fit_options& options,
-                 unsigned threads, unsigned precision, ReplayAvatar& a) {
+                 unsigned threads, AvatarPrecisions precisions, ReplayAvatar& a) {
   if (is_fit_folder(path)) {
     a.kind = "fit folder";
     a.mesh = std::make_unique<AvatarFile>(read_fitted_mesh(path));
@@ -49,7 +50,7 @@ void open_fitted(const Model& model, const std::string& path, const ShapeNames& 
                                " To replay it anyway: softdeca fit " + path + " --keep-poor-fit --out DIR, then --avatar DIR.");
   }
   a.vertex_count = a.mesh->vertex_count();
-  a.avatar = std::make_unique<Avatar>(model, *a.fit, a.mesh->abi_mesh(), threads, precision);
+  a.avatar = std::make_unique<Avatar>(model, *a.fit, a.mesh->abi_mesh(), threads, precisions);
   a.space = std::make_unique<PartSpace>(*a.mesh);
   a.map_vertices = a.mesh->neutral;
   a.map_triangles = a.mesh->triangles;
@@ -65,10 +66,10 @@ void open_fitted(const Model& model, const std::string& path, const ShapeNames& 
 }  // namespace
 
 ReplayAvatar open_replay_avatar(const Model& model, const std::string& path, const ShapeNames& names,
-                                const softdeca_fit_options& options, unsigned threads, unsigned precision) {
+                                const softdeca_fit_options& options, unsigned threads, AvatarPrecisions precisions) {
   ReplayAvatar a;
-  if (template_topology(model, path)) open_template(model, path, threads, precision, a);
-  else open_fitted(model, path, names, options, threads, precision, a);
+  if (template_topology(model, path)) open_template(model, path, threads, precisions, a);
+  else open_fitted(model, path, names, options, threads, precisions, a);
   a.user = read_rig(path, "user_face", true);
   if (a.user.empty() && a.kind == "fit folder") a.user = read_rig(a.mesh->path, "user_face", true);  // beside the fitted mesh
   if (!a.user.empty()) {

@@ -44,6 +44,6 @@ struct ReplayAvatar {
 
 // `names` and `options` are those of an avatar fitted now.
 ReplayAvatar open_replay_avatar(const Model& model, const std::string& path, const ShapeNames& names,
-                                const softdeca_fit_options& options, unsigned threads, unsigned precision);
+                                const softdeca_fit_options& options, unsigned threads, AvatarPrecisions precisions);
 
 }  // namespace softdeca::cli

@@ -30,7 +30,7 @@ int Model::parameter(const std::string& name) const {
 }
 
 Avatar::Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads,
-               unsigned precision) {
+               AvatarPrecisions precisions) {
   softdeca_avatar_mesh mesh{};
   mesh.struct_size = sizeof mesh;
   mesh.neutral = neutral.vertices.data();
@@ -39,21 +39,23 @@ Avatar::Avatar(const Model& model, const ObjMesh& neutral, const std::vector<flo
   mesh.triangle_count = static_cast<uint32_t>(neutral.triangles.size() / 3);
   mesh.blendshapes = deltas.empty() ? nullptr : deltas.data();
   mesh.blendshape_count = deltas.empty() ? 0 : 52;
-  create(model, mesh, nullptr, threads, precision);
+  create(model, mesh, nullptr, threads, precisions);
 }
 
-Avatar::Avatar(const Model& model, const Fit& fit, const softdeca_avatar_mesh& mesh, unsigned threads, unsigned precision) {
-  create(model, mesh, fit.handle, threads, precision);
+Avatar::Avatar(const Model& model, const Fit& fit, const softdeca_avatar_mesh& mesh, unsigned threads,
+               AvatarPrecisions precisions) {
+  create(model, mesh, fit.handle, threads, precisions);
 }
 
 void Avatar::create(const Model& model, const softdeca_avatar_mesh& mesh, const softdeca_avatar_fit* fit, unsigned threads,
-                    unsigned precision) {
+                    AvatarPrecisions precisions) {
   softdeca_avatar_desc d{};
   d.struct_size = sizeof d;
   d.mesh = &mesh;
   d.fit = fit;
   d.threads = threads;
-  d.precision = static_cast<int32_t>(precision);
+  d.precision = precisions.softdeca;
+  d.sparse_precision = precisions.sparse;
   check(softdeca_avatar_create(model.handle, &d, &handle), fit ? "creating the fitted avatar" : "creating the avatar");
 }
 

@@ -41,11 +41,20 @@ struct Fit {
   std::vector<float> registered(const Model& model) const;  // the template's skin on the avatar
 };
 
+// The storage precision of each model's tables (softdeca_precision values): as constructed, the
+// library's choice per model (SOFTDECA_PRECISION_DEFAULT).
+struct AvatarPrecisions {
+  int32_t softdeca = SOFTDECA_PRECISION_DEFAULT;  // softdeca_avatar_desc.precision
+  int32_t sparse = SOFTDECA_PRECISION_DEFAULT;    // softdeca_avatar_desc.sparse_precision
+};
+
 struct Avatar {
   softdeca_avatar* handle = nullptr;
-  Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads, unsigned precision);
+  Avatar(const Model& model, const ObjMesh& neutral, const std::vector<float>& deltas, unsigned threads,
+         AvatarPrecisions precisions = {});
   // On the user's own mesh, through its fit (outputs hold the mesh's vertices).
-  Avatar(const Model& model, const Fit& fit, const softdeca_avatar_mesh& mesh, unsigned threads, unsigned precision);
+  Avatar(const Model& model, const Fit& fit, const softdeca_avatar_mesh& mesh, unsigned threads,
+         AvatarPrecisions precisions = {});
   ~Avatar() { softdeca_avatar_destroy(handle); }
   Avatar(const Avatar&) = delete;
   Avatar& operator=(const Avatar&) = delete;
@@ -53,7 +62,7 @@ struct Avatar {
 
  private:
   void create(const Model& model, const softdeca_avatar_mesh& mesh, const softdeca_avatar_fit* fit, unsigned threads,
-              unsigned precision);
+              AvatarPrecisions precisions);
 };
 
 struct FaceRig {  // a neutral mesh and 52 blendshape deltas

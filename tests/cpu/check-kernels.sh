@@ -21,7 +21,7 @@ suites='^(HyperTensor|SparseLdlt|DeformationTransfer|CpuFeatures|Runtime|Threads
 tolerance() { [ "$1" = int8 ] && echo 2e-6 || echo 1e-6; }
 for precision in half float int8; do
   "$build/plugin/cli/softdeca" replay "$take" --bundle models/softdeca-default --avatar "$avatar" --models softdeca \
-    --precision "$precision" --start "$first" --frames "$frames" --out "$out/$precision" > "$out/$precision.log"
+    --precision "$precision" --sparse-precision "$precision" --start "$first" --frames "$frames" --out "$out/$precision" > "$out/$precision.log"
 done
 for family in avx2 portable; do
   echo "== kernel family $family (tests/cpu/run-as.sh $family)"

@@ -6,7 +6,8 @@
 // usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES [PRECISION [MODEL [MODE]]]
 //   AVATAR_DIR: neutral.obj and blendshapes/<ARKit name>.obj (as `softdeca replay --avatar` reads)
 //   EXPECTED.pc2: `softdeca replay TAKE.sdrec --models MODEL --start FIRST_FRAME ...`
-//   PRECISION: half (default, as softdeca replay), float or int8: the replay's --precision
+//   PRECISION: default (as softdeca replay), half, float or int8: both models' tables, the
+//     replay's --precision and --sparse-precision
 //   MODEL: softdeca (default) or sparse (driven by the landmarks of the avatar's linear blend)
 //   MODE: static (default) or dynamic: the replay without or with --dynamics
 // Also run on one machine under another kernel family (tests/cpu/run-as.sh, make test-kernels)
@@ -86,10 +87,10 @@ Pc2 read_pc2(const std::string& path) {
 }
 
 struct Options {
-  std::string bundle, avatar_dir, take, expected_path, precision_name = "half", model_name = "softdeca";
+  std::string bundle, avatar_dir, take, expected_path, precision_name = "default", model_name = "softdeca";
   uint32_t first = 0;
   double tolerance = 0;
-  int32_t precision = SOFTDECA_PRECISION_HALF;
+  int32_t precision = SOFTDECA_PRECISION_DEFAULT;
   bool sparse = false, dynamic = false;
 };
 
@@ -97,7 +98,7 @@ struct Options {
 bool parse(int argc, char** argv, Options& o) {
   if (argc < 7 || argc > 10) {
     std::fprintf(stderr, "usage: replay_check BUNDLE AVATAR_DIR TAKE.sdrec FIRST_FRAME EXPECTED.pc2 TOLERANCE_METRES "
-                         "[half|float|int8 [softdeca|sparse [static|dynamic]]]\n");
+                         "[default|half|float|int8 [softdeca|sparse [static|dynamic]]]\n");
     return false;
   }
   o.bundle = argv[1];
@@ -112,11 +113,12 @@ bool parse(int argc, char** argv, Options& o) {
   o.precision = o.precision_name == "float" ? SOFTDECA_PRECISION_FLOAT
                 : o.precision_name == "int8" ? SOFTDECA_PRECISION_INT8
                 : o.precision_name == "half" ? SOFTDECA_PRECISION_HALF
+                : o.precision_name == "default" ? SOFTDECA_PRECISION_DEFAULT
                                              : -1;
   o.sparse = o.model_name == "sparse";
   o.dynamic = mode == "dynamic";
   if (o.precision < 0 || (!o.sparse && o.model_name != "softdeca") || (!o.dynamic && mode != "static")) {
-    std::fprintf(stderr, "replay_check: precision half, float or int8; model softdeca or sparse; static or dynamic\n");
+    std::fprintf(stderr, "replay_check: precision default, half, float or int8; model softdeca or sparse; static or dynamic\n");
     return false;
   }
   return true;
@@ -155,7 +157,7 @@ Rig read_rig(const std::string& dir, bool optional) {
   return rig;
 }
 
-// The avatar's rig as the C ABI's avatar, prepared at the given precision.
+// The avatar's rig as the C ABI's avatar, both models' tables at the given precision, prepared.
 softdeca_avatar* make_avatar(softdeca_model* model, const Rig& rig, int32_t precision) {
   softdeca_avatar_mesh mesh{};
   mesh.struct_size = sizeof mesh;
@@ -169,6 +171,7 @@ softdeca_avatar* make_avatar(softdeca_model* model, const Rig& rig, int32_t prec
   desc.struct_size = sizeof desc;
   desc.mesh = &mesh;
   desc.precision = precision;
+  desc.sparse_precision = precision;
   softdeca_avatar* avatar = nullptr;
   check(softdeca_avatar_create(model, &desc, &avatar), "creating the avatar");
   check(softdeca_avatar_prepare(avatar), "prepare");

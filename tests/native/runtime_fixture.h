@@ -84,7 +84,7 @@ struct Described : softdeca_avatar_desc {
   }
 };
 
-// softdeca_avatar_create of `mesh` on the fit made for it.
+// softdeca_avatar_create of `mesh` on the fit made for it, both models' tables at `precision`.
 inline softdeca_status create_on_fit(softdeca_model* model, const softdeca_avatar_fit* fit, const softdeca_avatar_mesh* mesh,
                                      uint32_t threads, int32_t precision, softdeca_avatar** out) {
   softdeca_avatar_desc d{};
@@ -93,11 +93,12 @@ inline softdeca_status create_on_fit(softdeca_model* model, const softdeca_avata
   d.fit = fit;
   d.threads = threads;
   d.precision = precision;
+  d.sparse_precision = precision;
   return softdeca_avatar_create(model, &d, out);
 }
 
-// The template path's desc of `h` (no fit).
-inline Described describe(const Head& h, uint32_t threads = 1, uint32_t precision = SOFTDECA_PRECISION_HALF) {
+// The template path's desc of `h` (no fit), both models' tables at `precision`.
+inline Described describe(const Head& h, uint32_t threads = 1, int32_t precision = SOFTDECA_PRECISION_HALF) {
   Described d;
   d.struct_size = sizeof(softdeca_avatar_desc);
   d.m.struct_size = sizeof d.m;
@@ -108,7 +109,8 @@ inline Described describe(const Head& h, uint32_t threads = 1, uint32_t precisio
   d.m.blendshapes = h.blendshapes.data();
   d.m.blendshape_count = 52;
   d.threads = threads;
-  d.precision = static_cast<int32_t>(precision);
+  d.precision = precision;
+  d.sparse_precision = precision;
   return d;
 }
 

@@ -39,7 +39,8 @@ replay() {
         local dir="$out/$tag-$precision-$model-$mode" flag=()
         [ "$mode" = dynamic ] && flag=(--dynamics)
         "$x86/plugin/cli/softdeca" replay "$take" --bundle "$bundle" --avatar "$avatar" --models "$model" \
-          --precision "$precision" --start "$first" --frames "$frames" "${flag[@]}" --out "$dir" > "$dir.log" 2>&1
+          --precision "$precision" --sparse-precision "$precision" --start "$first" --frames "$frames" "${flag[@]}" \
+          --out "$dir" > "$dir.log" 2>&1
         "${qemu[@]}" "$arm/tests/native/replay_check" "$bundle" "$avatar" "$take" "$first" \
           "$dir/$model.pc2" "$(tolerance "$precision")" "$precision" "$model" "$mode"
       done

@@ -39,7 +39,7 @@ cc -O2 -Wall -Wextra -shared -fPIC -I "$header_dir" tests/platforms/qemu_insn_co
 count() {  # count FAMILY MODEL FRAMES: the instructions of one replay_check run
   local dir="$out/$2-$3"
   [ -f "$dir/$2.pc2" ] || "$x86/plugin/cli/softdeca" replay "$take" --bundle models/softdeca-default --avatar "$avatar" \
-    --models "$2" --precision "$precision" --start "$first" --frames "$3" --out "$dir" > "$dir.log" 2>&1
+    --models "$2" --precision "$precision" --sparse-precision "$precision" --start "$first" --frames "$3" --out "$dir" > "$dir.log" 2>&1
   SOFTDECA_CPU=$1 qemu-aarch64 -cpu cortex-a76 -L .deps/arm64-qemu-prefix -plugin "$plugin" -d plugin -D "$out/$1-$2-$3.txt" \
     "$arm/tests/native/replay_check" models/softdeca-default "$avatar" "$take" "$first" "$dir/$2.pc2" 1e-5 "$precision" "$2" > /dev/null
   awk '/^instructions/ {print $2}' "$out/$1-$2-$3.txt"

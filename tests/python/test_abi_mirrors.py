@@ -2,8 +2,9 @@
 (unity_package/Runtime/Core/NativeTypes.cs) and the Python binding (softdeca_train/host/
 native.py) mirror them by hand. These tests parse the header and hold every mirror to it: the
 same fields in the same order with the same types (and names, up to the languages' spelling),
-the same ABI version, and C#'s P/Invoke declarations (NativeMethods.cs) the header's
-signatures, and Python's function table (native.SIGNATURES) the same.
+the same ABI version, the same enum values (C#'s enums, Python's PRECISIONS), and C#'s
+P/Invoke declarations (NativeMethods.cs) the header's signatures, and Python's function table
+(native.SIGNATURES) the same.
 
 Kept whole: one parser of the header, and every mirror held to what it read."""
 
@@ -306,6 +307,51 @@ def test_mirrors_name_the_headers_abi_version() -> None:
     _, version = header_structs()
     assert csharp_abi_version() == version, "NativeMethods.AbiVersion"
     assert native.ABI_VERSION == version, "softdeca_train.host.native.ABI_VERSION"
+
+
+# ---- enums: C#'s and Python's values against the header's ------------------------------------
+# Header enum -> (C# mirror, the prefix its members' names drop there).
+ENUM_MIRRORS: dict[str, tuple[str, str]] = {
+    "softdeca_status": ("Status", r"SOFTDECA_(ERROR_)?"),
+    "softdeca_precision": ("Precision", "SOFTDECA_PRECISION_"),
+    "softdeca_tracking": ("Tracking", "SOFTDECA_TRACKING_"),
+    "softdeca_stream_format": ("StreamFormat", "SOFTDECA_FORMAT_"),
+}
+
+
+def _enum_values(body: str) -> dict[str, int]:
+    return {k: int(v) for k, v in re.findall(r"(\w+)\s*=\s*(\d+)", body)}
+
+
+def header_enums() -> dict[str, dict[str, int]]:
+    """Every enum of the header: its members' values by name."""
+    pattern = r"typedef\s+enum\s+\w*\s*\{([^}]*)\}\s*(\w+)\s*;"
+    return {m[2]: _enum_values(m[1]) for m in re.finditer(pattern, _header_text())}
+
+
+def csharp_enums() -> dict[str, dict[str, int]]:
+    text = re.sub(r"//[^\n]*", " ", CSHARP_TYPES.read_text(encoding="utf-8"))
+    pattern = r"\benum\s+(\w+)\s*\{([^}]*)\}"
+    return {m[1]: _enum_values(m[2]) for m in re.finditer(pattern, text)}
+
+
+def spelled(values: dict[str, int], prefix: str = "") -> dict[str, int]:
+    return {spelling(re.sub(f"^{prefix}", "", k)): v for k, v in values.items()}
+
+
+def test_enum_mirrors_have_the_headers_values() -> None:
+    header, cs = header_enums(), csharp_enums()
+    assert sorted(header) == sorted(ENUM_MIRRORS), (
+        "every enum of the header has a mirror"
+    )
+    problems = {
+        c: (spelled(header[c], prefix), spelled(cs.get(mirror, {})))
+        for c, (mirror, prefix) in ENUM_MIRRORS.items()
+        if spelled(header[c], prefix) != spelled(cs.get(mirror, {}))
+    }
+    assert problems == {}
+    precision = spelled(header["softdeca_precision"], "SOFTDECA_PRECISION_")
+    assert native.PRECISIONS == precision, "softdeca_train.host.native.PRECISIONS"
 
 
 # ---- functions: C#'s P/Invoke declarations against the header's prototypes -------------------

@@ -52,7 +52,10 @@ namespace SoftDeca.Unity
         public SoftDecaFaceInput input;
         public Method method = Method.SoftDeca;
         public bool dynamics;
-        public Precision precision = Precision.Half;
+        [Tooltip("How SoftDECA stores its tables (hyper-tensor, vertex and residual stages). Default: the library's choice for this model, within its accuracy bound")]
+        public Precision precision = Precision.Default;
+        [Tooltip("How SparseSoftDECA stores its hyper-tensor. Default: the library's choice for this model, within its accuracy bound")]
+        public Precision sparsePrecision = Precision.Default;
         [Range(1, 8)] public int threads = 1;
         public List<ParameterSetting> parameters = new List<ParameterSetting>();
         public List<MaterialRegion> regions = new List<MaterialRegion>();
@@ -188,7 +191,7 @@ namespace SoftDeca.Unity
         {
             AvatarMesh own = ReadAvatarMesh(source);
             avatarFit = AvatarFit.LoadBytes(model, fit.bytes, Application.temporaryCachePath);
-            avatar = new Avatar(model, avatarFit, own, (uint)threads, precision);
+            avatar = new Avatar(model, avatarFit, own, (uint)threads, precision, sparsePrecision);
             toAvatar = own.UnityToAvatar;
             libraryNeutral = own.Neutral;
             mapTriangles = own.Triangles;
@@ -226,7 +229,7 @@ namespace SoftDeca.Unity
                 templateTriangles = rig.Triangles;
             }
             avatar = new Avatar(model, libraryNeutral, templateTriangles, rig.ShapesFound == 0 ? null : rig.Blendshapes, (uint)threads,
-                                precision);
+                                precision, sparsePrecision);
             mapTriangles = model.SkinTriangles();
         }
 

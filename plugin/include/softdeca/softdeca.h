@@ -50,6 +50,10 @@
  *      softdeca_embed_points, softdeca_compute_tet_volumes), and four library-wide queries keep
  *      the C idiom: softdeca_abi_version, softdeca_version, softdeca_last_error and
  *      softdeca_status_name. tests/python/test_abi_names.py holds every declaration to this.
+ *  10. Library defaults. Where the library chooses a setting's value itself (softdeca_precision),
+ *      the enum's zero means that choice (SOFTDECA_PRECISION_DEFAULT = 0), so a zero-initialised
+ *      struct gets the library's defaults. A binding passes the zero on and never restates
+ *      which value it stands for: the choice is the library's, and may differ per model.
  *
  * Units are metres; the frame is right-handed, +Y up, +Z out of the face (ARKit's face-anchor
  * frame). Arrays of 3D points are packed xyz floats. The library keeps no global mutable state
@@ -90,7 +94,7 @@ typedef enum softdeca_status {
 } softdeca_status;
 
 /* The version of the ABI convention and signatures in this header; see softdeca_abi_version. */
-#define SOFTDECA_ABI_VERSION 4u
+#define SOFTDECA_ABI_VERSION 5u
 
 /* softdeca_bool: 0 false, 1 true (inputs: non-zero is true). */
 typedef int32_t softdeca_bool;
@@ -213,10 +217,16 @@ SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_mo
                                                                uint32_t vertex_count, float* out_points,
                                                                uint32_t point_capacity);
 
+/* How an avatar stores a model's per-element tables (its hyper-tensor; SoftDECA's vertex and
+ * residual stages too). DEFAULT is each model's own, within that model's parity bound
+ * (docs/runtime.md): int8 for SoftDECA (on the shipped bundle it adds at most 0.0051 mm to
+ * float storage's frames and takes about 5 % off them), half for SparseSoftDECA (int8 would
+ * add 0.025 mm, over its 0.02 mm bound). */
 typedef enum softdeca_precision {
-  SOFTDECA_PRECISION_HALF = 0, /* hyper-tensors in binary16 (default: half the memory traffic) */
-  SOFTDECA_PRECISION_FLOAT = 1, /* binary32 */
-  SOFTDECA_PRECISION_INT8 = 2   /* int8 with a scale per 8 elements and latent: a quarter of float */
+  SOFTDECA_PRECISION_DEFAULT = 0, /* the model's default, above */
+  SOFTDECA_PRECISION_HALF = 1,    /* binary16: half of float */
+  SOFTDECA_PRECISION_FLOAT = 2,   /* binary32 */
+  SOFTDECA_PRECISION_INT8 = 3     /* int8 with a scale per 8 elements and latent: a quarter of float */
 } softdeca_precision;
 
 typedef struct softdeca_avatar_fit softdeca_avatar_fit; /* opaque: a user's own avatar, below */
@@ -257,7 +267,9 @@ typedef struct softdeca_avatar_desc {
   const softdeca_avatar_fit* fit;     /* NULL: mesh is in the template's topology; else mesh's fit */
   uint32_t threads;                   /* threads per frame: 0 or 1 the caller only; 2 or more: the
                                          caller plus helper threads owned by the avatar (max 8) */
-  int32_t precision;                  /* softdeca_precision */
+  int32_t precision;                  /* softdeca_precision of SoftDECA's tables (per-face
+                                         hyper-tensor, vertex and residual stages) */
+  int32_t sparse_precision;           /* softdeca_precision of SparseSoftDECA's hyper-tensor */
 } softdeca_avatar_desc;
 
 /* Checks the mesh (sizes, finite values, indices, no degenerate skin triangle) and runs the

@@ -209,12 +209,12 @@ runtime::AvatarDesc template_mesh(const softdeca_avatar_mesh* mesh, const runtim
 
 std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
                                                       const softdeca_avatar_fit* fit, std::size_t threads,
-                                                      kernels::Precision precision) {
+                                                      const runtime::Precisions& precisions) {
   const runtime::Model& m = model_of(model);
   if (!fit) {  // the identity fit
     runtime::AvatarDesc d = template_mesh(mesh, m);
     d.threads = threads;
-    d.precision = precision;
+    d.precisions = precisions;
     return std::make_unique<runtime::FittedAvatar>(model->model, d);
   }
   const softdeca_avatar_fit& f = fit_of(fit);
@@ -224,7 +224,7 @@ std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* mode
   d.fit = &f.fit;
   d.mesh = &a;
   d.threads = threads;
-  d.precision = precision;
+  d.precisions = precisions;
   return std::make_unique<runtime::FittedAvatar>(model->model, d);
 }
 

@@ -194,9 +194,9 @@ SOFTDECA_API softdeca_status softdeca_avatar_create(const softdeca_model* model,
     require_not_null(out_avatar, "out_avatar");
     require(desc->threads <= kMaxThreads, "desc->threads must be at most " + std::to_string(kMaxThreads));
     const std::size_t threads = desc->threads == 0 ? 1 : desc->threads;
-    const kernels::Precision precision = precision_of(desc->precision, "desc->precision");
+    const runtime::Precisions precisions = precisions_of(*desc);
     create_handle(out_avatar, "out_avatar",
-                  [&](softdeca_avatar& h) { h.avatar = avatar_on_mesh(model, desc->mesh, desc->fit, threads, precision); });
+                  [&](softdeca_avatar& h) { h.avatar = avatar_on_mesh(model, desc->mesh, desc->fit, threads, precisions); });
   });
 }
 

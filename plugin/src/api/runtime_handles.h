@@ -33,19 +33,31 @@ inline const runtime::Model& model_of(const softdeca_model* m) {
   return *m->model;
 }
 
-// A softdeca_precision value, checked.
-inline kernels::Precision precision_of(int32_t precision, const char* name) {
-  require(precision >= SOFTDECA_PRECISION_HALF && precision <= SOFTDECA_PRECISION_INT8,
-          std::string(name) + " is not a softdeca_precision");
-  return precision == SOFTDECA_PRECISION_FLOAT  ? kernels::Precision::Float
-         : precision == SOFTDECA_PRECISION_INT8 ? kernels::Precision::Int8
-                                                : kernels::Precision::Half;
+// A softdeca_precision value, checked; DEFAULT is `model_default`.
+inline kernels::Precision precision_of(int32_t precision, kernels::Precision model_default, const char* name) {
+  switch (precision) {
+    case SOFTDECA_PRECISION_DEFAULT: return model_default;
+    case SOFTDECA_PRECISION_HALF: return kernels::Precision::Half;
+    case SOFTDECA_PRECISION_FLOAT: return kernels::Precision::Float;
+    case SOFTDECA_PRECISION_INT8: return kernels::Precision::Int8;
+    default:
+      throw Error(SOFTDECA_ERROR_INVALID_ARGUMENT, std::string(name) + " is " + std::to_string(precision) +
+                                                       ", not a softdeca_precision (0 default, 1 half, 2 float, 3 int8)");
+  }
+}
+
+// Each model's precision from the desc: DEFAULT is the library's choice for that model
+// (runtime::Precisions as constructed).
+inline runtime::Precisions precisions_of(const softdeca_avatar_desc& desc) {
+  const runtime::Precisions library;
+  return {precision_of(desc.precision, library.softdeca, "desc->precision"),
+          precision_of(desc.sparse_precision, library.sparse, "desc->sparse_precision")};
 }
 
 // The avatar on `mesh` (fit_api.cpp): through `fit`, its bundle and the mesh checked; without
 // one, the mesh in the template's topology as the identity fit. softdeca_avatar_create's one way.
 std::unique_ptr<runtime::FittedAvatar> avatar_on_mesh(const softdeca_model* model, const softdeca_avatar_mesh* mesh,
                                                       const softdeca_avatar_fit* fit, std::size_t threads,
-                                                      kernels::Precision precision);
+                                                      const runtime::Precisions& precisions);
 
 }  // namespace softdeca::api

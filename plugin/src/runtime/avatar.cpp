@@ -16,7 +16,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       vh_(static_cast<std::size_t>(m_.head_vertices)),
       vs_(static_cast<std::size_t>(m_.skin_vertices)),
       nf_(static_cast<std::size_t>(m_.skin_triangles)),
-      precision_(d.precision),
+      precisions_(d.precisions),
       neutral_(d.neutral, d.neutral + vh_ * 3),
       neutral_peak_(peak_magnitude(neutral_.data(), neutral_.size())),
       triangles_(d.triangles, d.triangles + d.triangle_count * 3),

@@ -32,6 +32,16 @@
 
 namespace softdeca::runtime {
 
+// How an avatar stores each model's per-element tables. As constructed: the library's choice
+// per model (SOFTDECA_PRECISION_DEFAULT), each within its model's parity bound against the
+// reference (docs/runtime.md), measured against float storage on the shipped bundle: SoftDECA's
+// in int8, which adds at most 0.0051 mm (mean 0.00057 mm) and takes about 5 % off its frame;
+// SparseSoftDECA's in half, as int8 would add 0.025 mm, over its 0.02 mm bound.
+struct Precisions {
+  kernels::Precision softdeca = kernels::Precision::Int8;  // face_l, vertex_stages, carried_stages
+  kernels::Precision sparse = kernels::Precision::Half;    // vertex_l
+};
+
 struct AvatarDesc {
   const float* neutral = nullptr;  // head_vertices x 3
   std::size_t vertex_count = 0;
@@ -40,7 +50,7 @@ struct AvatarDesc {
   const float* blendshapes = nullptr;  // 52 x head_vertices x 3 deltas, or null
   std::size_t blendshape_count = 0;
   std::size_t threads = 1;
-  kernels::Precision precision = kernels::Precision::Half;
+  Precisions precisions;
   // A fitted avatar's carry map (the avatar is its registered template): prepare also carries
   // the vertex stages onto the map's vertices, for evaluate_carried. Null for other avatars.
   std::shared_ptr<const CarryMap> carry;
@@ -159,8 +169,10 @@ class Avatar {
 
  private:
   std::shared_ptr<const Preparation> current() const;
+  // A hypernetwork's values stored at `precision` (its model's).
   kernels::HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
-                           const std::vector<float>& identity, std::size_t n, std::size_t width) const;
+                           const std::vector<float>& identity, std::size_t n, std::size_t width,
+                           kernels::Precision precision) const;
   // The same network's values, checked, before they are stored ([n][latent][width]).
   std::vector<float> hyper_values(const OnnxNetwork& net, const std::vector<float>& parameters,
                                   const std::vector<float>& identity, std::size_t n, std::size_t width) const;
@@ -206,7 +218,7 @@ class Avatar {
   // returns the stages' table as computed, [Vs][latent + modes][3] (empty: no stages).
   std::vector<float> prepare_softdeca_stages(const prepare::ParameterState& params, const std::vector<float>& identity,
                                              Preparation& prep) const;
-  // The stages' table into `prep` at the avatar's precision.
+  // The stages' table into `prep` at SoftDECA's precision.
   void store_stages(Preparation& prep, const std::vector<float>& table) const;
   // The networks' part of a preparation for these parameters and identity; `stages` gets
   // SoftDECA's stage table as computed (prepare_softdeca_stages).
@@ -232,7 +244,7 @@ class Avatar {
   std::shared_ptr<const Model> model_;
   const bundle::Manifest& m_;
   std::size_t vh_, vs_, nf_;
-  kernels::Precision precision_;
+  Precisions precisions_;
   std::vector<float> neutral_;  // Vh x 3
   float neutral_peak_;          // its largest magnitude (infinite if one is not finite)
   std::vector<std::int32_t> triangles_;

@@ -47,9 +47,10 @@ std::vector<float> Avatar::hyper_values(const OnnxNetwork& net, const std::vecto
 
 // The same, stored.
 kernels::HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
-                                 const std::vector<float>& identity, std::size_t n, std::size_t width) const {
+                                 const std::vector<float>& identity, std::size_t n, std::size_t width,
+                                 kernels::Precision precision) const {
   return kernels::HyperTensor(hyper_values(net, parameters, identity, n, width).data(), n, m_.latent, static_cast<int>(width),
-                              precision_);
+                              precision);
 }
 
 std::size_t Preparation::bytes() const {
@@ -100,7 +101,7 @@ void Avatar::prepare() {
     const auto c0 = Clock::now();
     const std::size_t latents = stage_latents_ + residual_modes_;
     prep->carried_stages = kernels::HyperTensor(carry_->carry_columns(stages.data(), latents).data(), carry_->size(),
-                                                static_cast<int>(latents), 3, precision_);
+                                                static_cast<int>(latents), 3, precisions_.softdeca);
     networks_ms += ms(c0, Clock::now());
   }
   {
@@ -125,7 +126,7 @@ std::vector<float> Avatar::prepare_softdeca_stages(const prepare::ParameterState
   const auto& cols = hyper.spec().parameter_columns;
   std::vector<float> p(nf_ * cols.size());
   params.face_matrix(cols, p.data());
-  prep.face_l = hyper_tensor(hyper, p, identity, nf_, 9);
+  prep.face_l = hyper_tensor(hyper, p, identity, nf_, 9, precisions_.softdeca);
   std::vector<float> vertex_l;
   if (const OnnxNetwork* stage = model_->softdeca_vertex_stage()) {
     std::vector<float> pv(vs_ * stage->spec().parameter_columns.size());
@@ -141,7 +142,7 @@ std::vector<float> Avatar::prepare_softdeca_stages(const prepare::ParameterState
 
 void Avatar::store_stages(Preparation& prep, const std::vector<float>& table) const {
   const auto latents = static_cast<int>(stage_latents_ + residual_modes_);
-  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, latents, 3, precision_);
+  prep.vertex_stages = kernels::HyperTensor(table.data(), vs_, latents, 3, precisions_.softdeca);
 }
 
 // The networks' part of a preparation: hyper-tensors, stages and dynamics coefficients.
@@ -157,7 +158,7 @@ std::shared_ptr<Preparation> Avatar::prepare_networks(const prepare::ParameterSt
       const OnnxNetwork& hyper = *model_->hyper(true);
       std::vector<float> p(vs_ * hyper.spec().parameter_columns.size());
       params.vertex_matrix(hyper.spec().parameter_columns, p.data());
-      prep->vertex_l = hyper_tensor(hyper, p, identity, vs_, 3);
+      prep->vertex_l = hyper_tensor(hyper, p, identity, vs_, 3, precisions_.sparse);
     } else {
       stages = prepare_softdeca_stages(params, identity, *prep);
     }

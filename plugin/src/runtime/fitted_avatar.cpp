@@ -57,7 +57,7 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const FittedAvata
   core.blendshapes = shapes.data();
   core.blendshape_count = bundle::kBlendshapeCount;
   core.threads = d.threads;
-  core.precision = d.precision;
+  core.precisions = d.precisions;
   core.carry = carry;
   // The identity code of the template identity closest to the avatar: the encoder reads a head
   // of the template's own making, not the registration's (a few millimetres of sliding along

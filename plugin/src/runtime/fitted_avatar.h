@@ -27,7 +27,7 @@ struct FittedAvatarDesc {
   const fit::AvatarFit* fit = nullptr;
   const fit::AvatarMesh* mesh = nullptr;  // the mesh the fit was made for (checked by its hash)
   std::size_t threads = 1;
-  kernels::Precision precision = kernels::Precision::Half;
+  Precisions precisions;
 };
 
 class FittedAvatar {

@@ -17,8 +17,9 @@ import numpy as np
 from softdeca_train.paths import REPO_ROOT
 
 SOFTDECA_OK = 0
-ABI_VERSION = 4  # SOFTDECA_ABI_VERSION of the header these structs mirror
-PRECISIONS = {"half": 0, "float": 1, "int8": 2}  # softdeca_precision
+ABI_VERSION = 5  # SOFTDECA_ABI_VERSION of the header these structs mirror
+# softdeca_precision; "default" leaves each model's storage to the library
+PRECISIONS = {"default": 0, "half": 1, "float": 2, "int8": 3}
 STATUS_NAMES = {
     0: "ok",
     1: "invalid argument",
@@ -105,6 +106,7 @@ class AvatarDesc(C.Structure):
         ("fit", C.c_void_p),
         ("threads", C.c_uint32),
         ("precision", C.c_int32),
+        ("sparse_precision", C.c_int32),
     ]
 
 
@@ -421,7 +423,8 @@ class NativeAvatar:
         triangles: np.ndarray,
         blendshapes: np.ndarray | None = None,
         threads: int = 1,
-        precision: str = "half",
+        precision: str = "default",
+        sparse_precision: str = "default",
     ) -> None:
         self.model = model
         self.vh = model.info.head_vertex_count
@@ -440,15 +443,26 @@ class NativeAvatar:
             0,
         )
         self.handle = C.c_void_p()
-        self._create(mesh, None, threads, precision)
+        self._create(mesh, None, threads, precision, sparse_precision)
         self._buffers(self.vh)
 
     def _create(
-        self, mesh: AvatarMesh, fit: C.c_void_p | None, threads: int, precision: str
+        self,
+        mesh: AvatarMesh,
+        fit: C.c_void_p | None,
+        threads: int,
+        precision: str,
+        sparse_precision: str,
     ) -> None:
-        """softdeca_avatar_create: the template path (no fit) or the mesh on its fit."""
+        """softdeca_avatar_create: the template path (no fit) or the mesh on its fit;
+        `precision` is SoftDECA's storage, `sparse_precision` SparseSoftDECA's (PRECISIONS)."""
         desc = AvatarDesc(
-            C.sizeof(AvatarDesc), C.pointer(mesh), fit, threads, PRECISIONS[precision]
+            C.sizeof(AvatarDesc),
+            C.pointer(mesh),
+            fit,
+            threads,
+            PRECISIONS[precision],
+            PRECISIONS[sparse_precision],
         )
         check(lib().softdeca_avatar_create(self.model.handle, C.byref(desc), C.byref(self.handle)))
 
@@ -459,13 +473,14 @@ class NativeAvatar:
         fit: NativeFit,
         mesh: AvatarArrays,
         threads: int = 1,
-        precision: str = "half",
+        precision: str = "default",
+        sparse_precision: str = "default",
     ) -> NativeAvatar:
         """An avatar on the user's own mesh: outputs hold the mesh's own vertices."""
         self = cls.__new__(cls)
         self.model, self.fit, self.mesh = model, fit, mesh
         self.handle = C.c_void_p()
-        self._create(mesh.abi, fit.handle, threads, precision)
+        self._create(mesh.abi, fit.handle, threads, precision, sparse_precision)
         self.vh = len(mesh.neutral)
         self._buffers(self.vh)
         return self

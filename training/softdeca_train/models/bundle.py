@@ -61,7 +61,8 @@ NON_SKIN_BONES_FILE = "non_skin_bones.u8"
 # The per-element tables (one row per face or vertex: HyperNetwork.base, the positional
 # encodings, LocalLinear.table and .slot_table) are stored as float16 and cast back to float32
 # inside the graph. They are most of a bundle (SoftDECA's base table alone is 28,068 x 32 x
-# 9), and the runtime keeps the per-avatar tensors in half precision anyway (docs/bundle.md).
+# 9), and the runtime stores the per-avatar tensors in half or int8 by default anyway
+# (docs/bundle.md).
 # Encoders and MLP weights stay float32.
 HALF_TABLES = ("base", "positional", "table", "slot_table")
 

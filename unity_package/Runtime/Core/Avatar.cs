@@ -34,9 +34,11 @@ namespace SoftDeca
         /// <param name="neutral">the avatar's neutral head, xyz per vertex (HeadVertexCount vertices)</param>
         /// <param name="triangles">triangles over the whole head, 3 indices each</param>
         /// <param name="blendshapes">null, or 52 * HeadVertexCount * 3 deltas from the neutral, canonical ARKit order</param>
+        /// <param name="precision">SoftDECA's storage (Default: the library's choice for the model)</param>
+        /// <param name="sparsePrecision">SparseSoftDECA's storage (Default: the library's choice for the model)</param>
         public Avatar(Model model, float[] neutral, int[] triangles, float[] blendshapes = null, uint threads = 1,
-                      Precision precision = Precision.Half)
-            : this(model, CreateTemplate(model, neutral, triangles, blendshapes, threads, precision), null, -1)
+                      Precision precision = Precision.Default, Precision sparsePrecision = Precision.Default)
+            : this(model, CreateTemplate(model, neutral, triangles, blendshapes, threads, precision, sparsePrecision), null, -1)
         {
         }
 
@@ -46,8 +48,9 @@ namespace SoftDeca
         /// avatar's own vertices, and parameter maps are given per avatar triangle or vertex.
         /// Keep the fit until this avatar is disposed.
         /// </summary>
-        public Avatar(Model model, AvatarFit fit, AvatarMesh mesh, uint threads = 1, Precision precision = Precision.Half)
-            : this(model, CreateFitted(model, fit, mesh, threads, precision), fit, mesh.VertexCount)
+        public Avatar(Model model, AvatarFit fit, AvatarMesh mesh, uint threads = 1, Precision precision = Precision.Default,
+                      Precision sparsePrecision = Precision.Default)
+            : this(model, CreateFitted(model, fit, mesh, threads, precision, sparsePrecision), fit, mesh.VertexCount)
         {
         }
 
@@ -65,7 +68,7 @@ namespace SoftDeca
         }
 
         private static AvatarHandle CreateTemplate(Model model, float[] neutral, int[] triangles, float[] blendshapes, uint threads,
-                                                   Precision precision)
+                                                   Precision precision, Precision sparsePrecision)
         {
             if (model == null) throw new ArgumentNullException("model");
             if (neutral == null) throw new ArgumentNullException("neutral");
@@ -89,18 +92,19 @@ namespace SoftDeca
                 mesh.Neutral = (IntPtr)n;
                 mesh.Triangles = (IntPtr)t;
                 mesh.Blendshapes = (IntPtr)b;
-                s = CreateNative(model, ref mesh, null, threads, precision, out native);
+                s = CreateNative(model, ref mesh, null, threads, precision, sparsePrecision, out native);
             }
             return Adopt(s, native);
         }
 
         // softdeca_avatar_create: the mesh on its fit, or (fit null) in the template's topology.
         private static Status CreateNative(Model model, ref NativeAvatarMesh mesh, AvatarFit fit, uint threads, Precision precision,
-                                           out IntPtr native)
+                                           Precision sparsePrecision, out IntPtr native)
         {
             var desc = AvatarDesc.Create();
             desc.Threads = threads;
             desc.Precision = (int)precision;
+            desc.SparsePrecision = (int)sparsePrecision;
             bool added = false;
             try
             {
@@ -121,7 +125,8 @@ namespace SoftDeca
             }
         }
 
-        private static AvatarHandle CreateFitted(Model model, AvatarFit fit, AvatarMesh mesh, uint threads, Precision precision)
+        private static AvatarHandle CreateFitted(Model model, AvatarFit fit, AvatarMesh mesh, uint threads, Precision precision,
+                                                 Precision sparsePrecision)
         {
             if (model == null) throw new ArgumentNullException("model");
             if (fit == null) throw new ArgumentNullException("fit");
@@ -129,7 +134,7 @@ namespace SoftDeca
             IntPtr native;
             Status s;
             using (var pinned = new PinnedAvatarMesh(mesh))
-                s = CreateNative(model, ref pinned.Native, fit, threads, precision, out native);
+                s = CreateNative(model, ref pinned.Native, fit, threads, precision, sparsePrecision, out native);
             return Adopt(s, native);
         }
 

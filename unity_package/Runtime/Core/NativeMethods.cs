@@ -9,7 +9,7 @@ namespace SoftDeca
     internal static unsafe class NativeMethods
     {
         /// <summary>SOFTDECA_ABI_VERSION of the header these declarations mirror.</summary>
-        public const uint AbiVersion = 4;
+        public const uint AbiVersion = 5;
 
 #if (UNITY_IOS || UNITY_TVOS || UNITY_VISIONOS) && !UNITY_EDITOR
         // iOS links the static library into the app.

@@ -20,12 +20,16 @@ namespace SoftDeca
         NotReady = 8,
     }
 
-    /// <summary>softdeca_precision: how an avatar stores its hyper-tensors.</summary>
+    /// <summary>
+    /// softdeca_precision: how an avatar stores a model's tables (its hyper-tensor; SoftDECA's
+    /// vertex and residual stages too). Default leaves the choice to the library, per model.
+    /// </summary>
     public enum Precision
     {
-        Half = 0,
-        Float = 1,
-        Int8 = 2,
+        Default = 0,
+        Half = 1,
+        Float = 2,
+        Int8 = 3,
     }
 
     /// <summary>softdeca_stream_format: what a receiver accepts.</summary>
@@ -115,6 +119,7 @@ namespace SoftDeca
         public IntPtr Fit;
         public uint Threads;
         public int Precision;
+        public int SparsePrecision;
 
         public static AvatarDesc Create()
         {
