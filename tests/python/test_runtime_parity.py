@@ -497,11 +497,13 @@ def test_a_non_finite_frame_at_the_closed_form_start_leaves_the_last_output(
     """At SoftDECA's closed-form start the template's frame is written straight into the
     caller's output, and a fitted avatar's is contracted from the stages carried onto it at
     prepare: a model whose output is NaN (f_w's here) is still refused with the last good
-    output left as it was, on both."""
+    output left as it was, on both; so is SparseSoftDECA's when f_l's output is NaN. At the
+    default and int8 storage too, whose kernels quantise the networks' coefficients."""
     head, nets, _, _, _ = setup
     broken = closed_form(nets)
     broken.softdeca.f_w.net[-1].bias.data.fill_(float("nan"))
-    info = BundleInfo(True, "f_w gives NaN")
+    broken.sparse.f_l.net[-1].bias.data.fill_(float("nan"))
+    info = BundleInfo(True, "f_w and f_l give NaN")
     model, fit, mesh = fitted_to_itself(tmp_path, head, broken, info, check=False)
     w = frames(1, 2)[0]
     for avatar in (
@@ -514,6 +516,21 @@ def test_a_non_finite_frame_at_the_closed_form_start_leaves_the_last_output(
             avatar.evaluate_weights(w)
         assert np.array_equal(avatar.vertices, good_v)
         assert np.array_equal(avatar.normals, good_n)
+    d = head.definition
+    points = d.landmarks.evaluate(head.neutral[: d.skin_vertices], d.skin_triangles)
+    for precision in ("default", "int8"):
+        avatar = NativeAvatar(
+            model,
+            head.neutral,
+            head.head_triangles,
+            head.blendshapes,
+            sparse_precision=precision,
+        )
+        avatar.prepare()
+        good_v, _ = avatar.evaluate_linear(w)
+        with pytest.raises(NativeError, match="non-finite"):
+            avatar.evaluate_landmarks(points + 0.001)
+        assert np.array_equal(avatar.vertices, good_v)
 
 
 def test_the_rest_physics_needs_version_four(setup, tmp_path):
