@@ -220,7 +220,7 @@ SOFTDECA_API softdeca_status softdeca_model_evaluate_landmarks(const softdeca_mo
 /* How an avatar stores a model's per-element tables (its hyper-tensor; SoftDECA's vertex and
  * residual stages too). DEFAULT is each model's own, within that model's parity bound
  * (docs/runtime.md): int8 for SoftDECA (on the shipped bundle it adds at most 0.0051 mm to
- * float storage's frames and takes about 5 % off them), half for SparseSoftDECA (int8 would
+ * float storage's frames and reads half of half's bytes), half for SparseSoftDECA (int8 would
  * add 0.025 mm, over its 0.02 mm bound). */
 typedef enum softdeca_precision {
   SOFTDECA_PRECISION_DEFAULT = 0, /* the model's default, above */

@@ -35,7 +35,7 @@ namespace softdeca::runtime {
 // How an avatar stores each model's per-element tables. As constructed: the library's choice
 // per model (SOFTDECA_PRECISION_DEFAULT), each within its model's parity bound against the
 // reference (docs/runtime.md), measured against float storage on the shipped bundle: SoftDECA's
-// in int8, which adds at most 0.0051 mm (mean 0.00057 mm) and takes about 5 % off its frame;
+// in int8, which adds at most 0.0051 mm (mean 0.00057 mm) and reads half of half's bytes;
 // SparseSoftDECA's in half, as int8 would add 0.025 mm, over its 0.02 mm bound.
 struct Precisions {
   kernels::Precision softdeca = kernels::Precision::Int8;  // face_l, vertex_stages, carried_stages

@@ -28,8 +28,8 @@ void require_finite_frame(const float* v, std::size_t n) {
 // A per-frame network's coefficients, checked before a table is contracted with them: an int8
 // table's kernels quantise the coefficients to integers, where a NaN or an infinity becomes a
 // finite, wrong frame that the frame's own check cannot see.
-void require_finite_coefficients(const kernels::AlignedArray<float>& c) {
-  if (!all_finite(c.data(), c.size()))
+void require_finite_coefficients(const float* c, std::size_t n) {
+  if (!all_finite(c, n))
     throw Error(SOFTDECA_ERROR_NON_FINITE, "the model produced a non-finite coefficient; the previous output stays valid");
 }
 }  // namespace
@@ -66,14 +66,14 @@ void Avatar::encode_weights(const Preparation& prep, AvatarStats& st) {
   model_->encoder(false)->run(f_w_);
   auto t1 = Clock::now();
   st.encoder_ms += ms(t, t1);
-  require_finite_coefficients(z_);
+  require_finite_coefficients(z_.data(), z_.size());
   if (stage_latents_ > 0)  // no vertex stages: no table, and memcpy takes no null pointer
     std::memcpy(stage_coefficients_.data(), z_.data(), stage_latents_ * sizeof(float));
   if (residual_modes_ > 0) {  // c from w and the preparation's condition
     std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
-    model_->residual_coefficients()->run(f_r_w_);
+    model_->residual_coefficients()->run(f_r_w_);  // after z's copy: only its own part to check
+    require_finite_coefficients(stage_coefficients_.data() + stage_latents_, residual_modes_);
   }
-  require_finite_coefficients(stage_coefficients_);
   st.hyper_ms += ms(t1, Clock::now());
 }
 
@@ -391,7 +391,7 @@ void Avatar::evaluate_landmarks(const float* points, std::size_t count, const Ou
   model_->encoder(true)->run(f_l_);
   auto t2 = Clock::now();
   st.encoder_ms = ms(t1, t2);
-  require_finite_coefficients(z_);
+  require_finite_coefficients(z_.data(), z_.size());
   const std::size_t blocks = prep->vertex_l.blocks();
   auto pass = [&](std::size_t part, std::size_t parts) {
     kernels::vertex_offsets(prep->vertex_l, z_.data(), neutral_.data(), blocks * part / parts, blocks * (part + 1) / parts,
