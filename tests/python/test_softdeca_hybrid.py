@@ -14,6 +14,7 @@ import torch
 from bounds import below
 from softdeca_train.data.plan import FIXED
 from softdeca_train.models.networks import TEST_SIZES, LocalLinear, WeightEncoder
+from softdeca_train.train.evaluate import time_per_frame
 from softdeca_train.train.linear_baseline import ParameterScaling
 from softdeca_train.train.run import Run, RunConfig
 from softdeca_train.train.trainable import CM, SoftDecaHybrid
@@ -229,13 +230,9 @@ def test_only_the_tissues_weights_reach_the_expression_slots(small) -> None:
         assert torch.equal(change[2:-1], torch.zeros_like(change[2:-1]))
 
 
-def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
-    folder, _ = small
-    run = Run(folder / "run-hybrid", RunConfig(str(folder), "test", seed=3))
-    # latent 53: the w part keeps its full rank 52, so the start is the fit itself
-    model = SoftDecaHybrid(run.definition, run.specs, replace(run.sizes, latent=53))
-    ridge = 1e-3
-    model.init_from_dataset(run.data, progress=False, ridge=ridge)
+def _assert_is_the_ridge_fit(model: SoftDecaHybrid, run: Run, ridge: float) -> list:
+    """The start's per-vertex solution against an independent float64 fit on a few vertices;
+    returns the train batches."""
     batches = list(run.data.batches("static", "train"))
     picked = np.arange(0, model.n_vertices, 997)  # an independent fit on a few vertices
     xs, ys = [], []
@@ -274,6 +271,38 @@ def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
                     "the model's float32 ridge solution against numpy's float64 solve",
                     what=f"vertex {vtx} m",
                 )
+    return batches
+
+
+def test_a_frame_timing_leaves_later_fits_right(small, monkeypatch) -> None:
+    """The report times each model's frame at one thread. Lowering torch's thread count and
+    raising it again in one process left later closed-form fits in it wrong (by 0.2 mm), so the
+    timing never changes this process's count: after it the start is still the ridge fit."""
+    folder, _ = small
+    run = Run(folder / "run-hybrid-timed", RunConfig(str(folder), "test", seed=3))
+    model = SoftDecaHybrid(run.definition, run.specs, replace(run.sizes, latent=53))
+    changed: list[int] = []
+    real = torch.set_num_threads
+    monkeypatch.setattr(
+        torch, "set_num_threads", lambda n: (changed.append(n), real(n))
+    )
+    threads = torch.get_num_threads()
+    batch = next(iter(run.data.batches("static", "test")))
+    assert time_per_frame(model, batch, repeats=2) > 0
+    assert changed == [] and torch.get_num_threads() == threads
+    ridge = 1e-3
+    model.init_from_dataset(run.data, progress=False, ridge=ridge)
+    _assert_is_the_ridge_fit(model, run, ridge)
+
+
+def test_the_start_is_the_per_vertex_ridge_fit(small) -> None:
+    folder, _ = small
+    run = Run(folder / "run-hybrid", RunConfig(str(folder), "test", seed=3))
+    # latent 53: the w part keeps its full rank 52, so the start is the fit itself
+    model = SoftDecaHybrid(run.definition, run.specs, replace(run.sizes, latent=53))
+    ridge = 1e-3
+    model.init_from_dataset(run.data, progress=False, ridge=ridge)
+    batches = _assert_is_the_ridge_fit(model, run, ridge)
     # and it is a correction: closer to T than S_t on the train frames
     with torch.no_grad():
         b = batches[0]
