@@ -20,11 +20,13 @@ from softdeca_train.host.fit_check import (
 )
 from softdeca_train.host.fit_coverage import face_coverage
 from softdeca_train.host.native import (
+    SOFTDECA_OK,
     AvatarArrays,
     NativeAvatar,
     NativeError,
     NativeFit,
     NativeModel,
+    evaluate_weights_batch,
 )
 from softdeca_train.landmarks.arkit_reference import ArkitFace
 from softdeca_train.paths import default_takes_path
@@ -205,11 +207,10 @@ def test_low_poly_heads_are_covered_by_the_registered_template(
     )
 
 
-def test_the_fitted_head_is_the_template_paths_on_its_own_topology(
-    model, template
-) -> None:
-    """The held-out identity in the template's own topology: its fitted correction is the
-    template path's nearly exactly."""
+@pytest.fixture(scope="module")
+def held_out_pair(model, template) -> tuple:
+    """The held-out identity seed 505 in the template's topology, in centimetres, on its fit;
+    the same head on the template path; both prepared."""
     a = make_avatar(AvatarConfig(identity="seed 505", unit="cm"), template)
     mesh = avatar_arrays(a)
     fit = NativeFit.create(model, mesh)
@@ -218,6 +219,15 @@ def test_the_fitted_head_is_the_template_paths_on_its_own_topology(
     reference = NativeAvatar(model, neutral, template.triangles, deltas)
     for x in (fitted, reference):
         x.prepare()
+    return a, fit, fitted, reference
+
+
+def test_the_fitted_head_is_the_template_paths_on_its_own_topology(
+    held_out_pair,
+) -> None:
+    """The held-out identity in the template's own topology: its fitted correction is the
+    template path's nearly exactly."""
+    a, _, fitted, reference = held_out_pair
     w = np.zeros(52, np.float32)
     w[[24, 43, 44]] = (0.7, 0.5, 0.5)  # jawOpen, smiles
     out, _ = fitted.evaluate_weights(w)
@@ -229,6 +239,30 @@ def test_the_fitted_head_is_the_template_paths_on_its_own_topology(
     magnitude = np.linalg.norm(truth[skin], axis=1).mean()
     ratio = np.linalg.norm((out - lin)[skin] - truth[skin], axis=1).mean() / magnitude
     below(ratio, LIMIT_RATIO, "acceptance: within 20 %")
+
+
+def test_a_batch_of_a_fitted_avatar_and_a_template_path_gives_each_its_own_frame(
+    held_out_pair, take_weights
+) -> None:
+    """softdeca_avatar_evaluate_weights_batch over a fitted avatar (the carried table) and one on
+    the template path, frame networks run once for both: each frame is its own call's, up to
+    the networks' sums in another order (float rounding, far under a micrometre)."""
+    _, _, fitted, reference = held_out_pair
+    avatars = [fitted, reference, fitted]
+    weights = take_weights[:3]
+    own = [x.evaluate_weights(w)[0] for x, w in zip(avatars, weights)]
+    assert evaluate_weights_batch(avatars, weights) == [SOFTDECA_OK] * 3
+    # the fitted avatar's buffers hold its second frame, the template path's its own
+    below(
+        np.abs(fitted.vertices - own[2]).max(), 1e-7, "batch against own call", what="m"
+    )
+    below(
+        np.abs(reference.vertices - own[1]).max(),
+        1e-7,
+        "batch against own call",
+        what="m",
+    )
+    assert np.abs(own[0] - own[2]).max() > 1e-5  # two frames, not one copied
 
 
 def test_a_template_on_a_patch_of_the_face_is_judged_poor_from_the_avatars_side(

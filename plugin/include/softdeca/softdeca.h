@@ -322,6 +322,21 @@ typedef struct softdeca_output {
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* avatar, const float* weights,
                                                               uint32_t weight_count, const softdeca_output* output);
 
+/* SoftDECA frames of several avatars in one call: as softdeca_avatar_evaluate_weights on each
+ * in turn, except that the per-frame networks run once for all avatars of one model (and the
+ * residual stage's once for those set to the same parameters), so their weights are read once a
+ * call instead of once an avatar; each avatar's frame equals its own call's. Crowds and
+ * collaborations driving several faces of one bundle gain the most.
+ * avatars: avatar_count handles (1 to 4096); weights: avatar_count x weight_count floats, avatar
+ * i's at weights + i * weight_count (weight_count is 52); outputs: avatar_count outputs;
+ * statuses: avatar_count statuses, each avatar's as its own call would return it (its message,
+ * the first failing avatar's, from softdeca_last_error). Returns SOFTDECA_OK once every avatar
+ * was evaluated, whatever each frame's status; a failure of the call itself (null arrays, a
+ * count out of range) evaluates none and leaves every output untouched. */
+SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights_batch(softdeca_avatar* const* avatars, uint32_t avatar_count,
+                                                                    const float* weights, uint32_t weight_count,
+                                                                    const softdeca_output* outputs, int32_t* statuses);
+
 /* SoftDECA on a caller-blended S_t: `surface` holds the skin (skin_vertex_count) or the whole
  * head (head_vertex_count); `weights` still drive f_w. Non-skin vertices come from a whole-head
  * surface, else they follow the skin rigidly (cranium fixed, jaw with the jaw anchors). */

@@ -8,6 +8,7 @@
 #include "api/handles.h"
 #include "api/runtime_handles.h"
 #include "bundle/bundle_files.h"
+#include "runtime/frame_batch.h"
 
 namespace {
 using namespace softdeca;
@@ -259,6 +260,34 @@ SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* a
   return guarded(__func__, [&] {
     on_mesh(avatar).evaluate_weights(weights, weight_count, output_of(output));
   });
+}
+
+SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights_batch(softdeca_avatar* const* avatars, uint32_t avatar_count,
+                                                                    const float* weights, uint32_t weight_count,
+                                                                    const softdeca_output* outputs, int32_t* statuses) {
+  runtime::FrameBatch batch;
+  const softdeca_status call = guarded(__func__, [&] {
+    require_not_null(avatars, "avatars");
+    require_not_null(outputs, "outputs");
+    require_not_null(statuses, "statuses");
+    runtime::require_batch_size(avatar_count);
+    std::vector<Avatar*> cores(avatar_count, nullptr);
+    for (uint32_t i = 0; i < avatar_count; ++i)
+      if (avatars[i]) cores[i] = &avatars[i]->avatar->core();
+    batch = runtime::encode_weights_batch(cores.data(), avatar_count, weights, weight_count);
+  });
+  if (call != SOFTDECA_OK) return call;
+  // each avatar's frame as its own call; the first failure's message stays for softdeca_last_error
+  std::string first_failure;
+  for (uint32_t i = 0; i < avatar_count; ++i) {
+    const float* w = weights + static_cast<std::size_t>(i) * weight_count;
+    statuses[i] = guarded(__func__, [&] { on_mesh(avatars[i]).evaluate_weights(w, weight_count, output_of(&outputs[i]), batch.of(i)); });
+    if (statuses[i] != SOFTDECA_OK && first_failure.empty())
+      first_failure = std::string("avatar ") + std::to_string(i) + ": " + last_error_text();
+  }
+  if (first_failure.empty()) clear_last_error();
+  else set_last_error(first_failure);
+  return SOFTDECA_OK;
 }
 
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_surface(softdeca_avatar* avatar, const float* weights,

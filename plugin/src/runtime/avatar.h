@@ -119,6 +119,17 @@ struct Preparation {
   std::size_t bytes() const;
 };
 
+// A SoftDECA frame's codes computed outside the avatar (runtime/frame_batch.h runs the frame
+// networks of several avatars at once): f_w's z (latent floats) and the residual stage's c
+// (its modes; null without one), for the preparation they were computed with, which the frame
+// then uses whatever prepare has published since.
+struct FrameCodes {
+  std::shared_ptr<const Preparation> prep;
+  const float* z = nullptr;
+  const float* c = nullptr;
+  double network_ms = 0;  // this avatar's share of the networks' time (its encoder_ms)
+};
+
 class Avatar {
  public:
   Avatar(std::shared_ptr<const Model> model, const AvatarDesc& desc);
@@ -136,7 +147,8 @@ class Avatar {
 
   void prepare();
 
-  void evaluate_weights(const float* weights, std::size_t count, const Output& out);
+  // `codes`: the frame's z and c as a batch computed them (null: the avatar runs f_w and f_r_w).
+  void evaluate_weights(const float* weights, std::size_t count, const Output& out, const FrameCodes* codes = nullptr);
   void evaluate_surface(const float* weights, std::size_t count, const float* surface, std::size_t vertices,
                         const Output& out);
   void evaluate_landmarks(const float* points, std::size_t count, const Output& out);
@@ -144,6 +156,11 @@ class Avatar {
   // A linear frame blended outside the core (a fitted avatar's own rig): the weights checked and
   // clamped (weights()) and the frame counted; its timings are the caller's.
   void read_frame_weights(const float* weights, std::size_t count);
+  // 52 weights as every frame reads them: Error(INVALID_ARGUMENT) for a wrong count, a
+  // non-finite weight or one outside [0, 1] by more than the slack; clamped to [0, 1] into `out`.
+  static void check_weights(const float* weights, std::size_t count, float* out);
+  // The preparation frames use now; Error(NOT_READY) before the first prepare.
+  std::shared_ptr<const Preparation> prepared() const;
   void calibrate_landmarks(const float* points, std::size_t count);
   void clear_calibration();
 
@@ -160,7 +177,7 @@ class Avatar {
   // frame then contracts the carried table alone, with no blend of the template. On
   // Error(NON_FINITE) `carried` holds no valid frame (it is the caller's scratch, carried into
   // an output only after a frame succeeds).
-  void evaluate_carried(const float* weights, std::size_t count, float* carried);
+  void evaluate_carried(const float* weights, std::size_t count, float* carried, const FrameCodes* codes = nullptr);
   // The 52 weights of the last evaluate_weights or evaluate_linear, checked and clamped to
   // [0, 1] (read_weights). Frame thread only, valid until its next frame.
   const float* weights() const { return weights_.data(); }
@@ -199,8 +216,8 @@ class Avatar {
   // where they follow the bones), normals.
   void add_tail_bytes(const Preparation& prep, int model, bool dynamics, bool rigid_non_skin, bool normals,
                       FrameBytes& b) const;
-  // f_w's z and the vertex stages' coefficients (z, c) of the weights read.
-  void encode_weights(const Preparation& prep, AvatarStats& st);
+  // f_w's z and the vertex stages' coefficients (z, c) of the weights read, or `codes`' copied.
+  void encode_weights(const Preparation& prep, AvatarStats& st, const FrameCodes* codes);
   // SoftDECA's static skin from the linear skin in head_ into static_: DT (unless every G_f is
   // I), then the vertex stages.
   void softdeca_frame(const Preparation& prep, AvatarStats& st);

@@ -47,7 +47,7 @@ void check_output_capacity(const Output& out, std::size_t vertices) {
     }, SOFTDECA_ERROR_BUFFER_TOO_SMALL);
 }
 
-void Avatar::read_weights(const float* weights, std::size_t count) {
+void Avatar::check_weights(const float* weights, std::size_t count, float* out) {
   require_not_null(weights, "weights");
   expect(count == bundle::kBlendshapeCount,
          [&] { return "expected 52 blendshape weights (canonical ARKit order), got " + std::to_string(count); });
@@ -57,22 +57,30 @@ void Avatar::read_weights(const float* weights, std::size_t count) {
       return "weights[" + std::to_string(i) + "] (" + stream::blendshape_name(i) + ") = " + std::to_string(weights[i]) +
              " is outside [0, 1]";
     });
-    weights_[i] = std::min(1.0f, std::max(0.0f, weights[i]));
+    out[i] = std::min(1.0f, std::max(0.0f, weights[i]));
   }
 }
 
-void Avatar::encode_weights(const Preparation& prep, AvatarStats& st) {
+void Avatar::read_weights(const float* weights, std::size_t count) { check_weights(weights, count, weights_.data()); }
+
+void Avatar::encode_weights(const Preparation& prep, AvatarStats& st, const FrameCodes* codes) {
   auto t = Clock::now();
-  model_->encoder(false)->run(f_w_);
+  if (codes) std::memcpy(z_.data(), codes->z, z_.size() * sizeof(float));
+  else model_->encoder(false)->run(f_w_);
   auto t1 = Clock::now();
-  st.encoder_ms += ms(t, t1);
+  st.encoder_ms += ms(t, t1) + (codes ? codes->network_ms : 0.0);
   require_finite_coefficients(z_.data(), z_.size());
   if (stage_latents_ > 0)  // no vertex stages: no table, and memcpy takes no null pointer
     std::memcpy(stage_coefficients_.data(), z_.data(), stage_latents_ * sizeof(float));
   if (residual_modes_ > 0) {  // c from w and the preparation's condition
-    std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
-    model_->residual_coefficients()->run(f_r_w_);  // after z's copy: only its own part to check
-    require_finite_coefficients(stage_coefficients_.data() + stage_latents_, residual_modes_);
+    float* c = stage_coefficients_.data() + stage_latents_;
+    if (codes) {
+      std::memcpy(c, codes->c, residual_modes_ * sizeof(float));
+    } else {
+      std::memcpy(residual_condition_.data(), prep.residual_condition.data(), prep.residual_condition.size() * sizeof(float));
+      model_->residual_coefficients()->run(f_r_w_);  // after z's copy: only its own part to check
+    }
+    require_finite_coefficients(c, residual_modes_);
   }
   st.hyper_ms += ms(t1, Clock::now());
 }
@@ -208,7 +216,9 @@ std::shared_ptr<const Preparation> require_prepared(std::shared_ptr<const Prepar
 }
 }  // namespace
 
-void Avatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
+std::shared_ptr<const Preparation> Avatar::prepared() const { return require_prepared(current()); }
+
+void Avatar::evaluate_weights(const float* weights, std::size_t count, const Output& out, const FrameCodes* codes) {
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
   require_model(*model_, false);
@@ -216,10 +226,10 @@ void Avatar::evaluate_weights(const float* weights, std::size_t count, const Out
   expect(!blendshapes_.empty(),
          [] { return std::string("the avatar was created without blendshapes: use softdeca_avatar_evaluate_surface"); });
   read_weights(weights, count);
-  const auto prep = require_prepared(current());
+  const auto prep = codes ? codes->prep : require_prepared(current());
   AvatarStats st;
   st.blend_ms = ms(t0, Clock::now());
-  encode_weights(*prep, st);
+  encode_weights(*prep, st, codes);
   const bool dynamics = dynamics_enabled_.load();
   const bool direct = in_place(*prep, dynamics);
   // In place, the frame is the linear blend straight into the output, its skin then corrected
@@ -246,16 +256,16 @@ void Avatar::evaluate_weights(const float* weights, std::size_t count, const Out
   record(st);
 }
 
-void Avatar::evaluate_carried(const float* weights, std::size_t count, float* carried) {
+void Avatar::evaluate_carried(const float* weights, std::size_t count, float* carried, const FrameCodes* codes) {
   FrameGuard guard(busy_);
   const auto t0 = Clock::now();
   require_model(*model_, false);
   expect(!blendshapes_.empty() && carry_ != nullptr,
          [] { return std::string("evaluate_carried needs an avatar made with blendshapes and a carry map"); });
   read_weights(weights, count);
-  const auto prep = require_prepared(current());
+  const auto prep = codes ? codes->prep : require_prepared(current());
   AvatarStats st;
-  encode_weights(*prep, st);
+  encode_weights(*prep, st, codes);
   const bool dynamics = dynamics_enabled_.load();
   const bool blended = dynamics || !prep->face_l.zero();
   const std::size_t n = carry_->size();
@@ -314,7 +324,7 @@ void Avatar::evaluate_surface(const float* weights, std::size_t count, const flo
   std::memcpy(head_.data(), surface, vertices * 3 * sizeof(float));
   AvatarStats st;
   st.blend_ms = ms(t0, Clock::now());
-  encode_weights(*prep, st);
+  encode_weights(*prep, st, nullptr);
   softdeca_frame(*prep, st);
   const bool dynamics = dynamics_enabled_.load();
   finish(*prep, kSoftDeca, static_.data(), vertices == vh_ ? head_.data() + vs_ * 3 : nullptr, dynamics, out, st);

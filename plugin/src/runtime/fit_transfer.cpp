@@ -15,8 +15,8 @@ class IdentityTransfer final : public FitTransfer {
  public:
   Output core_output(const Output& out) override { return out; }
   Output surface_output(const Output& out) override { return out; }
-  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
-    core.evaluate_weights(weights, count, out);
+  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out, const FrameCodes* codes) override {
+    core.evaluate_weights(weights, count, out, codes);
   }
   void linear(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
     core.evaluate_linear(weights, count, out);
@@ -72,9 +72,9 @@ class EmbeddingTransfer final : public FitTransfer {
                 "landmarks");
   }
 
-  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) override {
+  void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out, const FrameCodes* codes) override {
     check_output_capacity(out, n_);
-    core.evaluate_carried(weights, count, carried_.data());  // checks the weights; out untouched on error
+    core.evaluate_carried(weights, count, carried_.data(), codes);  // checks the weights; out untouched on error
     blendshapes_.blend(core.weights(), neutral_.data(), out.vertices, 0);
     carry_->add(carried_.data(), out.vertices);
   }

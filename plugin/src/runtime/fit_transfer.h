@@ -38,7 +38,9 @@ class FitTransfer {
   // and clamped) plus the core's correction of its linear blend carried onto the avatar's
   // vertices (Avatar::evaluate_carried), so the registered template is blended only where the
   // correction needs it (the dynamics on, a DT stage).
-  virtual void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out) = 0;
+  // `codes`: the core's z and c as a batch computed them (null: the core runs its networks).
+  virtual void softdeca(Avatar& core, const float* weights, std::size_t count, const Output& out,
+                        const FrameCodes* codes) = 0;
   // A frame of the linear blend alone: the core checks the weights and counts the frame, and
   // blends only where its head is the avatar's (the identity fit); through a fit the avatar's
   // own rig blends them, so the registered template is not blended for nothing.

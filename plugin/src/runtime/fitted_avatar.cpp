@@ -74,9 +74,9 @@ FittedAvatar::FittedAvatar(std::shared_ptr<const Model> model, const AvatarDesc&
     : core_(std::make_unique<Avatar>(std::move(model), d)), transfer_(identity_transfer()) {}
 
 // One frame path for every avatar: the core's frame, then the transfer's steps onto the mesh.
-void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, const Output& out) {
+void FittedAvatar::evaluate_weights(const float* weights, std::size_t count, const Output& out, const FrameCodes* codes) {
   FrameGuard guard(busy_);
-  transfer_->softdeca(*core_, weights, count, out);
+  transfer_->softdeca(*core_, weights, count, out, codes);
   transfer_->finish(out);
 }
 

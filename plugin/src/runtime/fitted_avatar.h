@@ -45,7 +45,8 @@ class FittedAvatar {
   void set_parameter_faces(int index, const float* values, std::size_t count);
   void set_parameter_vertices(int index, const float* values, std::size_t count);
 
-  void evaluate_weights(const float* weights, std::size_t count, const Output& out);
+  // `codes`: the core's z and c as a batch computed them (runtime/frame_batch.h; null: none).
+  void evaluate_weights(const float* weights, std::size_t count, const Output& out, const FrameCodes* codes = nullptr);
   void evaluate_landmarks(const float* points, std::size_t count, const Output& out);
   void evaluate_linear(const float* weights, std::size_t count, const Output& out);
   // A surface in the template's topology: the identity fit's only (another mesh's correction

@@ -10,6 +10,7 @@ from __future__ import annotations
 import ctypes as C
 import json
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -189,6 +190,7 @@ SIGNATURES: dict[str, tuple[type | None, tuple[type, ...]]] = {
     "softdeca_avatar_set_identity": (_STATUS, (_PTR, _PTR, _U32)),
     "softdeca_avatar_prepare": (_STATUS, (_PTR,)),
     "softdeca_avatar_evaluate_weights": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
+    "softdeca_avatar_evaluate_weights_batch": (_STATUS, (_PTR, _U32, _PTR, _U32, _PTR, _PTR)),
     "softdeca_avatar_evaluate_surface": (_STATUS, (_PTR, _PTR, _U32, _PTR, _U32, _PTR)),
     "softdeca_avatar_evaluate_linear": (_STATUS, (_PTR, _PTR, _U32, _PTR)),
     "softdeca_avatar_calibrate_landmarks": (_STATUS, (_PTR, _PTR, _U32)),
@@ -579,3 +581,17 @@ class NativeAvatar:
         s.struct_size = C.sizeof(Stats)
         check(lib().softdeca_avatar_get_stats(self.handle, C.byref(s)))
         return s
+
+
+def evaluate_weights_batch(avatars: Sequence[NativeAvatar], weights: np.ndarray) -> list[int]:
+    """softdeca_avatar_evaluate_weights_batch: one SoftDECA frame for each avatar, weights
+    (len(avatars), 52), into each avatar's own buffers (its `vertices` and `normals`), the
+    frame networks run once for the batch. Returns each avatar's status, as its own
+    evaluate_weights would have it (SOFTDECA_OK: its frame is in its buffers)."""
+    n = len(avatars)
+    w = _f32(np.asarray(weights, dtype=np.float32).reshape(n, 52))
+    handles = (C.c_void_p * n)(*[a.handle for a in avatars])
+    outputs = (Output * n)(*[a._out for a in avatars])
+    statuses = (C.c_int32 * n)()
+    check(lib().softdeca_avatar_evaluate_weights_batch(handles, n, _ptr(w), 52, outputs, statuses))
+    return list(statuses)
