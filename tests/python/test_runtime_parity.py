@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from bounds import above, below
+from gated_bundle import edited_copy, gated_bundle, reference_and_native
 from softdeca_train.host.native import (
     AvatarArrays,
     NativeAvatar,
@@ -103,22 +104,8 @@ def storage(model: str, precision: str) -> str:
 
 def pair(setup, precision: str, localise: bool = False):
     """The reference and the native avatar, both models' tables at `precision`."""
-    head, nets, model, _, rest = setup
-    ref = ReferenceAvatar(
-        TorchNetworks(as_stored(nets), rest_head=rest),
-        head.definition,
-        head.neutral,
-        head.head_triangles,
-        head.blendshapes,
-    )
-    nat = NativeAvatar(
-        model,
-        head.neutral,
-        head.head_triangles,
-        head.blendshapes,
-        precision=precision,
-        sparse_precision=precision,
-    )
+    head = setup[0]
+    ref, nat = reference_and_native(setup, precision)
     assert np.allclose(nat.identity(), ref.identity, atol=1e-6)
     if localise:  # a per-face map, a per-vertex map and a global change
         nf, nv = head.definition.n_faces, head.definition.skin_vertices
@@ -615,28 +602,8 @@ def test_at_rest_the_response_is_the_physics(setup):
 
 @pytest.fixture(scope="module")
 def gated(tmp_path_factory):
-    """A bundle trained exact at rest, as setup's: z's last entry the rest gate (f_w's constant
-    slot, as the trained bundles have it; format version 6), with the physics at prepare."""
-    head = synthetic_head()
-    specs = load_parameter_specs(TEST_PARAMETERS)
-    nets = build_random(
-        head.definition,
-        specs,
-        replace(TEST_SIZES, rest_gate=0.1),
-        seed=9,
-        vertex_stage=True,
-        residual_stage=True,
-        constant_slot=True,
-        # the constant slot's local map of p makes tables of this scale correct S_t by a few
-        # mm (setup's bundle: ~1 mm), which the storage bounds are relative to
-        offset_scale=1e-4,
-    )
-    folder = tmp_path_factory.mktemp("gated") / "bundle"
-    rest = replace(synthetic_rest_head(head), inert=("w_skin_strain",))
-    export_bundle(
-        folder, head.definition, nets, BundleInfo(True, "gated"), rest_head=rest
-    )
-    return head, nets, NativeModel(folder), folder, rest
+    """A bundle trained exact at rest, as setup's (tests/python/gated_bundle.py)."""
+    return gated_bundle(tmp_path_factory.mktemp("gated") / "bundle")
 
 
 def test_a_bundle_exact_at_rest_runs_as_its_reference(gated):
@@ -805,16 +772,6 @@ def _no_vertex_stage(m: dict) -> None:
 def test_the_rest_gate_is_checked_at_load(gated, tmp_path, edit, message):
     """SoftDECA's rest gate is refused, by name, where it is not a positive number, where the
     format version does not hold it and where the bundle has no vertex stage to weigh."""
-    import json
-    import shutil
-
-    copy = tmp_path / "bundle"
-    shutil.copytree(gated[3], copy)
-    manifest = json.loads((copy / "manifest.json").read_text())
-    if callable(edit):
-        edit(manifest)
-    else:
-        manifest.update(edit)
-    (copy / "manifest.json").write_text(json.dumps(manifest))
+    copy = edited_copy(gated[3], tmp_path / "bundle", edit)
     with pytest.raises(NativeError, match=message):
         NativeModel(copy)

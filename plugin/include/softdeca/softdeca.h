@@ -144,8 +144,9 @@ typedef struct softdeca_avatar softdeca_avatar;
  * every version from 1 up to it. Version 2 adds SoftDECA's optional vertex stage, version 3
  * its optional residual stage, version 4 the optional physics at prepare (rest_physics),
  * version 5 the optional template head for fitting users' avatars (template_head), version 6
- * SoftDECA's optional rest gate (rest_gate). */
-#define SOFTDECA_BUNDLE_FORMAT_VERSION 6
+ * SoftDECA's optional rest gate (rest_gate), version 7 SoftDECA trained on the rest physics
+ * (rest_changes). */
+#define SOFTDECA_BUNDLE_FORMAT_VERSION 7
 
 typedef struct softdeca_model_options {
   uint32_t struct_size;            /* sizeof(softdeca_model_options) */
@@ -332,7 +333,8 @@ SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights(softdeca_avatar* a
  * statuses: avatar_count statuses, each avatar's as its own call would return it (its message,
  * the first failing avatar's, from softdeca_last_error). Returns SOFTDECA_OK once every avatar
  * was evaluated, whatever each frame's status; a failure of the call itself (null arrays, a
- * count out of range) evaluates none and leaves every output untouched. */
+ * count out of range, a frame network that fails to run) evaluates none and leaves every output
+ * untouched. Unlike a single frame, the call allocates its working arrays. */
 SOFTDECA_API softdeca_status softdeca_avatar_evaluate_weights_batch(softdeca_avatar* const* avatars, uint32_t avatar_count,
                                                                     const float* weights, uint32_t weight_count,
                                                                     const softdeca_output* outputs, int32_t* statuses);

@@ -429,6 +429,11 @@ Manifest parse_manifest(const std::string& text) {
   if (const Json* r = optional_section(doc, "rest_physics", 4, "the physics at prepare", m)) parse_rest_physics(*r, m);
   if (const Json* t = optional_section(doc, "template_head", 5, "fitting users' avatars", m)) parse_template_head(*t, m);
   if (const Json* g = optional_section(doc, "rest_gate", 6, "SoftDECA's rest gate", m)) parse_rest_gate(*g, m);
+  if (const Json* c = optional_section(doc, "rest_changes", 7, "SoftDECA trained on the rest physics", m)) {
+    m.rest_changes = c->boolean("rest_changes");
+    check(!m.rest_changes || m.has_rest_physics,
+          "rest_changes (SoftDECA trained on the rest physics) needs the physics at prepare (rest_physics)");
+  }
   return m;
 }
 

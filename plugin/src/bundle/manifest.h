@@ -14,9 +14,10 @@ namespace softdeca::bundle {
 
 // Versions this runtime reads: 1, 2 (adds SoftDECA's optional vertex stage), 3 (adds its
 // optional residual stage), 4 (adds the optional physics at prepare, `rest_physics`), 5
-// (adds the optional template head for fitting users' avatars, `template_head`) and 6 (adds
-// SoftDECA's optional rest gate, `rest_gate`).
-constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 6;
+// (adds the optional template head for fitting users' avatars, `template_head`), 6 (adds
+// SoftDECA's optional rest gate, `rest_gate`) and 7 (adds `rest_changes`: SoftDECA trained on
+// the rest physics).
+constexpr int kBundleFormatVersionMin = 1, kBundleFormatVersion = 7;
 constexpr const char* kBundleFormat = "softdeca-bundle";
 constexpr const char* kDtFormulation = "cotangent-poisson-1";
 // The 52 ARKit shapes in canonical order: names from the one definition, stream/arkit_names.h.
@@ -85,6 +86,9 @@ struct Manifest {
   // |w|^2 / (|w|^2 + tau^2), not a constant 1, and the physics at prepare weighs the networks'
   // rest response with it (docs/bundle.md, "Rest physics").
   double rest_gate = 0;
+  // SoftDECA trained on S_t + Pd, Pd the physics' rest change (format version 7): the physics
+  // at prepare adds Pd whole and takes nothing of the networks off (docs/bundle.md).
+  bool rest_changes = false;
   // The template head (format version 5): the neutral head (float32), the 52 ARKit shapes
   // and template_identity_modes identity modes over the skin (float16) in one file.
   bool has_template_head = false;

@@ -220,6 +220,23 @@ Avatar::RestCorrection Avatar::rest_correction(const prepare::ParameterState& pa
     rest_physics0_ = physics->solve(prepare::ParameterState(m_, model_->skin_triangles(), geometry_.face_area));
     rest_physics_ = std::move(physics);
   }
+  const sim::Positions physics = rest_physics_->solve(params);
+  iterations = rest_physics_->iterations();
+  RestCorrection r;
+  r.offset.resize(vs_ * 3);
+  const auto physics_change = [&](std::size_t v, std::size_t c) {
+    const auto row = static_cast<Eigen::Index>(v), col = static_cast<Eigen::Index>(c);
+    return physics(row, col) - rest_physics0_(row, col);
+  };
+  if (m_.rest_changes) {
+    // Trained on S_t + Pd: the networks' response to p is what an expression adds on top of
+    // the rest physics, so the frame gets the physics' change whole and keeps theirs.
+    for (std::size_t v = 0; v < vs_; ++v)
+      for (std::size_t c = 0; c < 3; ++c) r.offset[3 * v + c] = static_cast<float>(physics_change(v, c));
+    if (!all_finite(r.offset.data(), r.offset.size()))
+      throw Error(SOFTDECA_ERROR_NON_FINITE, "the physics at prepare produced a non-finite skin for these parameters");
+    return r;
+  }
   // Each distinct parameter set runs the networks once: p's own stages are the preparation's,
   // the defaults' are kept per identity, and p's rest-inert part is p itself when every
   // parameter p moves is rest-inert.
@@ -227,8 +244,6 @@ Avatar::RestCorrection Avatar::rest_correction(const prepare::ParameterState& pa
     rest_model0_ = softdeca_rest(prepare::ParameterState(m_, model_->skin_triangles(), geometry_.face_area), identity);
     rest_model0_identity_ = identity;
   }
-  const sim::Positions physics = rest_physics_->solve(params);
-  iterations = rest_physics_->iterations();
   // The networks' own rest response to p, less their response to p's rest-inert parameters
   // alone: the physics says nothing about those at rest, so that part stays the networks'.
   const prepare::ParameterState inert_only = params.only(m_.rest_physics.inert_parameters);
@@ -240,16 +255,12 @@ Avatar::RestCorrection Avatar::rest_correction(const prepare::ParameterState& pa
   // With a rest gate the networks add nothing at rest: the frame then gets the physics' change
   // whole, and the networks' own change (the gate open) is taken off as the gate opens.
   const bool gated = m_.rest_gate > 0;
-  RestCorrection r;
-  r.offset.resize(vs_ * 3);
   if (gated) r.gated.resize(vs_ * 3);
   for (std::size_t v = 0; v < vs_; ++v)
     for (std::size_t c = 0; c < 3; ++c) {
       const std::size_t i = 3 * v + c;
-      const auto row = static_cast<Eigen::Index>(v), col = static_cast<Eigen::Index>(c);
-      const double physics_change = physics(row, col) - rest_physics0_(row, col);
       const double model_change = double(model[i]) - double(model_inert[i]);
-      r.offset[i] = static_cast<float>(gated ? physics_change : physics_change - model_change);
+      r.offset[i] = static_cast<float>(gated ? physics_change(v, c) : physics_change(v, c) - model_change);
       if (gated) r.gated[i] = static_cast<float>(-model_change);
     }
   if (!all_finite(r.offset.data(), r.offset.size()) || !all_finite(r.gated.data(), r.gated.size()))

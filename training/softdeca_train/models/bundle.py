@@ -50,10 +50,12 @@ FORMAT = "softdeca-bundle"
 # residual stage (softdeca.f_r_ph, softdeca.f_r_w), version 4 the physics at prepare
 # (rest_physics, rest_head.bin), version 5 the template head for fitting users' avatars
 # (template_head, template_head.bin), version 6 SoftDECA's rest gate (rest_gate: a runtime
-# that ignored it would count p's effect at rest twice); a bundle is written with the lowest
-# version that holds it, so runtimes that read only older versions still run what they can.
-FORMAT_VERSION = 6
-FORMAT_VERSIONS = (1, 2, 3, 4, 5, 6)
+# that ignored it would count p's effect at rest twice), version 7 SoftDECA trained on the rest
+# physics (rest_changes: a runtime that ignored it would take the networks' response to p
+# off); a bundle is written with the lowest version that holds it, so runtimes that read only
+# older versions still run what they can.
+FORMAT_VERSION = 7
+FORMAT_VERSIONS = (1, 2, 3, 4, 5, 6, 7)
 OPSET = 17
 MANIFEST = "manifest.json"
 SKIN_TRIANGLES_FILE = "skin_triangles.i32"
@@ -326,6 +328,8 @@ def export_bundle(
     (folder / NON_SKIN_BONES_FILE).write_bytes(bones.tobytes())
     lm = definition.landmarks
     gate = _rest_gate(nets)
+    if nets.rest_changes and rest_head is None:
+        raise ValueError("a SoftDECA trained on the rest physics needs its physics at prepare")
     manifest: dict[str, Any] = {
         "format": FORMAT,
         "format_version": 1,  # below, once the manifest says what the bundle holds
@@ -389,6 +393,7 @@ def export_bundle(
         "networks": specs,
         **_residual_sizes(nets),
         **({} if gate is None else {"rest_gate": gate}),
+        **({"rest_changes": True} if nets.rest_changes else {}),
         "export_check_max_abs": deviations or None,
         "training": info.training,
         "errors": info.errors,
@@ -406,6 +411,7 @@ def lowest_format_version(manifest: dict[str, Any]) -> int:
     """The lowest format version that holds what `manifest` says the bundle has (FORMAT)."""
     networks = manifest.get("networks") or {}
     for version, held in (
+        (7, "rest_changes" in manifest),
         (6, "rest_gate" in manifest),
         (5, "template_head" in manifest),
         (4, "rest_physics" in manifest),
@@ -662,6 +668,7 @@ class OnnxNetworks:
         self.specs = tuple(ParameterSpec.from_dict(p) for p in self.manifest["parameters"])
         self.rest_head = read_rest_physics(folder, self.manifest)
         self.rest_gate: float | None = self.manifest.get("rest_gate")
+        self.rest_changes: bool = bool(self.manifest.get("rest_changes", False))
         so = ort.SessionOptions()
         so.log_severity_level = 3
         self.sessions = {

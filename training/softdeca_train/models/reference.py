@@ -42,6 +42,7 @@ class Networks(Protocol):
     specs: tuple[ParameterSpec, ...]
     rest_head: RestHead | None  # the bundle's physics at prepare, if it has one
     rest_gate: float | None  # tau where z's last entry is SoftDECA's rest gate (BundleNetworks)
+    rest_changes: bool  # SoftDECA trained on the rest physics (BundleNetworks)
 
     def has(self, model: Model) -> bool: ...
     def identity(self, neutral_skin: np.ndarray) -> np.ndarray: ...
@@ -65,6 +66,7 @@ class TorchNetworks:
         self.specs = nets.specs
         self.rest_head = rest_head
         self.rest_gate = nets.rest_gate
+        self.rest_changes = nets.rest_changes
 
     def has(self, model: Model) -> bool:
         return (self.nets.softdeca if model == "softdeca" else self.nets.sparse) is not None
@@ -244,7 +246,11 @@ class ReferenceAvatar:
             )
             model = self._softdeca_rest(prep)
             physics = self._rest_solver.solve(self.params)
-            if self.nets.rest_gate is None:
+            if self.nets.rest_changes:
+                # trained on S_t + Pd: the networks' response to p is what an expression adds
+                # on top of the rest physics, kept whole
+                prep.rest_offset = physics - physics0
+            elif self.nets.rest_gate is None:
                 prep.rest_offset = (physics - physics0) - (model - model_inert)
             else:
                 # Gated: at rest the networks add nothing, so the physics' Pd is the frame's;

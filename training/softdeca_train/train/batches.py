@@ -58,6 +58,29 @@ def index_ranges(indices: list[int]) -> str:
 
 SOURCES = ("source_take", "source_index")  # where an instance's expression came from
 
+# The rest physics' change of each group (train/rest_changes.py), one file per shard of the
+# kinds a SoftDECA run trains on, beside the shards.
+REST_CHANGES = "rest-changes"
+RESTED_KINDS = ("static", "dynamic")
+
+
+def rest_changes_path(folder: Path, shard: str) -> Path:
+    return folder / REST_CHANGES / shard
+
+
+def read_rest_changes(folder: Path, shard: str, instance_id: np.ndarray) -> np.ndarray:
+    """(n, N_SKIN, 3) float16: Pd of each instance of the shard, checked to be its own."""
+    path = rest_changes_path(folder, shard)
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"{path} is missing: make the dataset's rest changes first "
+            f"(python -m softdeca_train rest-changes --dataset {folder})"
+        )
+    with np.load(path) as z:
+        if not np.array_equal(z["instance_id"], instance_id):
+            raise ValueError(f"{path} is not of this shard's instances: make it again")
+        return z["rest_change"]
+
 
 @dataclass
 class Batch:
@@ -129,10 +152,14 @@ class Dataset:
         folder: str | Path,
         template: Template | None = None,
         parameters: list[str] | None = None,
+        rest_changes: bool = False,
     ) -> None:
         """`parameters`: the columns of p a model takes, by name (default: all of them, in
-        plugin/data/parameters.json order, which is the order of the stored p)."""
+        plugin/data/parameters.json order, which is the order of the stored p).
+        `rest_changes`: static and dynamic batches carry S_t on the rest physics, S_t + Pd
+        (train/rest_changes.py), so a model learns the correction on top of it."""
         self.folder = Path(folder)
+        self.rest_changes = rest_changes
         path = self.folder / "manifest.json"
         if not path.is_file():
             raise FileNotFoundError(f"no dataset at {self.folder} (manifest.json missing)")
@@ -228,21 +255,36 @@ class Dataset:
         if rng is not None:
             files = [files[k] for k in rng.permutation(len(files))]
         for f in files:
-            with np.load(self.folder / f) as z:
-                a = {k: z[k] for k in z.files if k != "meta"}
-            solved, sane = training_mask(a, limit)
-            ok = solved & sane
-            groups = [np.flatnonzero(ok & (a["param_id"] == g)) for g in np.unique(a["param_id"])]
-            if rng is not None:
-                groups = [groups[k] for k in rng.permutation(len(groups))]
-            for idx in groups:
-                if kind == "dynamic":
-                    for i in idx:
-                        yield self._batch(kind, a, np.array([i]))
-                else:
-                    for b in range(0, len(idx), max_frames):
-                        if len(idx[b : b + max_frames]):
-                            yield self._batch(kind, a, idx[b : b + max_frames])
+            for _, batch in self.shard_batches(kind, f, rng, max_frames, limit):
+                yield batch
+
+    def shard_batches(
+        self,
+        kind: str,
+        file: str,
+        rng: np.random.Generator | None = None,
+        max_frames: int = 8,
+        limit: float = EVERY_FRAME,
+    ) -> Iterator[tuple[np.ndarray, Batch]]:
+        """The batches of one shard (as `batches` makes them), each with its instances'
+        indices in the shard."""
+        with np.load(self.folder / file) as z:
+            a = {k: z[k] for k in z.files if k != "meta"}
+        if self.rest_changes and kind in RESTED_KINDS:
+            a["rest_change"] = read_rest_changes(self.folder, file, a["instance_id"])
+        solved, sane = training_mask(a, limit)
+        ok = solved & sane
+        groups = [np.flatnonzero(ok & (a["param_id"] == g)) for g in np.unique(a["param_id"])]
+        if rng is not None:
+            groups = [groups[k] for k in rng.permutation(len(groups))]
+        for idx in groups:
+            if kind == "dynamic":
+                for i in idx:
+                    yield np.array([i]), self._batch(kind, a, np.array([i]))
+            else:
+                for b in range(0, len(idx), max_frames):
+                    if len(idx[b : b + max_frames]):
+                        yield idx[b : b + max_frames], self._batch(kind, a, idx[b : b + max_frames])
 
     def _batch(self, kind: str, a: dict[str, np.ndarray], idx: np.ndarray) -> Batch:
         i0 = int(idx[0])
@@ -250,6 +292,10 @@ class Dataset:
         w = a["weights"][idx].reshape(-1, 52)  # dynamic: the sequence's frames
         s = self.blend.targets(neutral, w)
         t = s + a["offsets"][idx].reshape(-1, N_SKIN, 3).astype(np.float64)
+        # on the rest physics: every frame of a group shares its Pd (a sequence is one group)
+        rest = a["rest_change"][i0].astype(np.float64) if "rest_change" in a else None
+        if rest is not None:
+            s = s + rest[None]
         f32 = lambda x: torch.from_numpy(np.ascontiguousarray(x, dtype=np.float32))  # noqa: E731
         batch = Batch(
             kind=kind,
@@ -276,7 +322,7 @@ class Dataset:
             batch.landmarks_clean = f32(a["landmarks_clean"][idx])
         if "prev_weights" in a:
             ps = self.blend.targets(neutral, a["prev_weights"][i0])
-            batch.prev_S = f32(ps)
-            batch.prev_weights = f32(a["prev_weights"][i0])
             batch.prev_T = f32(ps + a["prev_offsets"][i0].astype(np.float64))
+            batch.prev_S = f32(ps if rest is None else ps + rest[None])
+            batch.prev_weights = f32(a["prev_weights"][i0])
         return batch

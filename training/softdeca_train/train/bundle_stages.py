@@ -97,6 +97,7 @@ def train_bundle(
         identity_encoder=enc,
         softdeca=SoftDecaNetworks(sd.f_w, sd.f_ph, sd_dyn.f_dyn, sd.f_ph_v, sd.f_r),
         sparse=SparseNetworks(sp.f_l, sp.f_ph_v, sp_dyn.f_dyn),
+        rest_changes=run.config.rest_changes,
     ).eval()
     info = BundleInfo(
         untrained=False,

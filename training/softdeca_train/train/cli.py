@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 from pathlib import Path
 
 from softdeca_train.commands import Command
+from softdeca_train.paths import REPO_ROOT
 from softdeca_train.train.registry import MODELS
 
 DEFAULT_RUN = "out/train/default"
@@ -54,6 +56,13 @@ def _run_args(p: argparse.ArgumentParser, dataset_required: bool = True) -> None
         help="members of SoftDECA's residual stage (default: the sizes' own, 5 at full size; "
         "each costs the frame its weights; with --dataset, when the run is new)",
     )
+    p.add_argument(
+        "--rest-changes",
+        action="store_true",
+        help="SoftDECA learns the correction on top of the rest physics, which the runtime adds "
+        "whole at prepare (the dataset's rest changes: python -m softdeca_train rest-changes; "
+        "with --dataset, when the run is new)",
+    )
     p.add_argument("--seed", type=int, default=0, help="training seed (0)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
@@ -80,12 +89,13 @@ def _open_run(args: argparse.Namespace):  # -> Run
             more_static=more,
             rest_gate=gate,
             residual_members=args.residual_members,
+            rest_changes=args.rest_changes,
         )
         return Run(args.run, config)
-    if args.contrasts or args.more_static or args.residual_members is not None:
+    if args.contrasts or args.more_static or args.residual_members is not None or args.rest_changes:
         raise SystemExit(
-            "--contrasts, --more-static and --residual-members are part of a new run: give "
-            "--dataset"
+            "--contrasts, --more-static, --residual-members and --rest-changes are part of a "
+            "new run: give --dataset"
         )
     return Run(args.run)
 
@@ -328,6 +338,28 @@ def run_linear(args: argparse.Namespace) -> int:
     return 0
 
 
+def add_rest_changes_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--dataset", required=True, help="dataset folder (with manifest.json)")
+    p.add_argument(
+        "--bundle",
+        default=str(REPO_ROOT / "models" / "softdeca-default"),
+        help="bundle whose physics at prepare is used (default: models/softdeca-default)",
+    )
+    p.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="processes (all cores)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def run_rest_changes(args: argparse.Namespace) -> int:
+    from softdeca_train.train.rest_changes import RestChangesConfig, make_rest_changes
+
+    config = RestChangesConfig(
+        Path(args.dataset), Path(args.bundle), args.workers, not args.no_progress
+    )
+    written = sum(1 for _ in make_rest_changes(config))
+    print(f"rest changes: {written} shard files written in {Path(args.dataset) / 'rest-changes'}")
+    return 0
+
+
 COMMANDS = [
     Command(
         "train-bundle",
@@ -372,5 +404,12 @@ COMMANDS = [
         "of deformation transfer.",
         add_linear_args,
         run_linear,
+    ),
+    Command(
+        "rest-changes",
+        "The rest physics' change of every static and dynamic group of a dataset (what the "
+        "runtime adds at prepare), for train-bundle --rest-changes; resumable.",
+        add_rest_changes_args,
+        run_rest_changes,
     ),
 ]

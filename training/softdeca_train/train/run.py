@@ -54,6 +54,10 @@ class RunConfig:
     # reads its own weights every frame (1.74 MB of float weights for five at full size): fewer
     # members cost the frame less
     residual_members: int | None = None
+    # SoftDECA learns the correction on top of the rest physics: its frames' S_t + Pd, Pd the
+    # physics' rest change under the group's parameters (train/rest_changes.py), which the
+    # runtime adds whole at prepare (the bundle's `rest_changes`); False: on S_t
+    rest_changes: bool = False
 
     def __post_init__(self) -> None:  # run.json holds a list (and a caller may give paths)
         object.__setattr__(self, "more_static", tuple(str(d) for d in self.more_static))
@@ -102,13 +106,17 @@ class Run:
 
     @cached_property
     def data(self) -> Dataset:
-        return Dataset(self.config.dataset, self.template, [s.name for s in self.specs])
+        return self._dataset(self.config.dataset)
+
+    def _dataset(self, folder: str) -> Dataset:
+        names = [s.name for s in self.specs]
+        return Dataset(folder, self.template, names, rest_changes=self.config.rest_changes)
 
     @cached_property
     def contrasts(self) -> Dataset | None:
         if self.config.contrasts is None:
             return None
-        data = Dataset(self.config.contrasts, self.template, [s.name for s in self.specs])
+        data = self._dataset(self.config.contrasts)
         if not data.manifest["header"]["config"].get("contrasts"):
             raise ValueError(f"{self.config.contrasts} was not generated with --contrasts")
         return data
@@ -122,7 +130,7 @@ class Run:
         main = GenerateConfig.from_dict(self.data.manifest["header"]["config"])
         seeds = {main.seed}
         for folder in self.config.more_static:
-            data = Dataset(folder, self.template, [s.name for s in self.specs])
+            data = self._dataset(folder)
             cfg = GenerateConfig.from_dict(data.manifest["header"]["config"])
             if cfg.seed in seeds:  # identities come from the seed: the test split's among them
                 raise ValueError(

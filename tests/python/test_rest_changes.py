@@ -1,0 +1,166 @@
+"""SoftDECA trained on the rest physics (train/rest_changes.py, the bundle's `rest_changes`):
+a dataset's rest changes Pd are what the bundle's physics at prepare computes, resumable, and
+put on S_t by the loader; a bundle trained on them gets Pd whole at prepare and keeps the
+networks' response to p (nothing taken off), natively as in its reference."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from bounds import above, below
+from gated_bundle import edited_copy, gated_bundle, reference_and_native
+from softdeca_train.host.fit_check import DEFAULT_BUNDLE
+from softdeca_train.host.native import NativeError, NativeModel
+from softdeca_train.models import (
+    read_manifest,
+)
+from softdeca_train.models.rest_physics import RestSolver
+from softdeca_train.train.batches import (
+    EVERY_FRAME,
+    REST_CHANGES,
+    Dataset,
+    rest_changes_path,
+)
+from softdeca_train.train.rest_changes import (
+    GroupSolver,
+    RestChangesConfig,
+    make_rest_changes,
+)
+
+SHIPPED = Path(DEFAULT_BUNDLE)  # its physics at prepare: the template's
+# float16 storage of Pd (tenths of a mm): 2^-11 relative, with margin
+REASON_STORED = "float16 storage of the rest change: 2^-11 of ~0.3 mm"
+REASON_SAME = "the reference adds the same arrays it was given: float64 rounding"
+REASON_NATIVE = "one solver, same tolerance and start; float32 networks against float64"
+
+
+@pytest.fixture(scope="module")
+def rested(small, tmp_path_factory):
+    """The small dataset (a copy) with its rest changes made by the shipped bundle's physics."""
+    folder, _ = small
+    copy = tmp_path_factory.mktemp("rested") / "data"
+    shutil.copytree(folder, copy)
+    written = list(make_rest_changes(RestChangesConfig(copy, SHIPPED, 1, False)))
+    return copy, written
+
+
+def test_every_static_and_dynamic_shard_gets_its_rest_changes(rested) -> None:
+    folder, written = rested
+    data = Dataset(folder)
+    kinds = [f for k in ("static", "dynamic") for f in data.shards(k, "all")]
+    assert sorted(written) == sorted(kinds)
+    assert not any(f in written for f in data.shards("sparse", "all"))
+    # a rerun writes nothing; one file gone is made again, as it was
+    assert list(make_rest_changes(RestChangesConfig(folder, SHIPPED, 1, False))) == []
+    path = rest_changes_path(folder, kinds[0])
+    before = np.load(path)["rest_change"]
+    path.unlink()
+    assert list(make_rest_changes(RestChangesConfig(folder, SHIPPED, 1, False))) == [
+        kinds[0]
+    ]
+    assert np.array_equal(np.load(path)["rest_change"], before)
+
+
+def test_the_loader_puts_the_rest_change_on_s_t(rested) -> None:
+    folder, _ = rested
+    groups = GroupSolver(SHIPPED, Dataset(folder).template)
+    names = [s.name for s in groups.specs]
+    plain = Dataset(folder, groups.template, names)
+    on_rest = Dataset(folder, groups.template, names, rest_changes=True)
+    shard = plain.shards("static", "train")[0]
+    pairs = zip(
+        plain.shard_batches("static", shard, limit=EVERY_FRAME),
+        on_rest.shard_batches("static", shard, limit=EVERY_FRAME),
+    )
+    for (idx, a), (_, b) in pairs:
+        pd = groups.rest_change(a)  # the group's Pd, solved again here
+        above(np.abs(pd).max(), 1e-5, "p moves the head at rest", what="m")
+        assert np.array_equal(a.T.numpy(), b.T.numpy())  # the physics is the physics
+        moved = (b.S - a.S).double().numpy()
+        for f in range(a.frames):  # every frame of a group gets its Pd
+            below(np.abs(moved[f] - pd).max() / np.abs(pd).max(), 2e-3, REASON_STORED)
+    # without the files the loader says what to run
+    shutil.move(folder / REST_CHANGES, folder / "moved")
+    try:
+        with pytest.raises(FileNotFoundError, match="rest-changes --dataset"):
+            next(on_rest.batches("static", "train"))
+        next(on_rest.batches("sparse", "train"))  # no rest change: SparseSoftDECA's
+    finally:
+        shutil.move(folder / "moved", folder / REST_CHANGES)
+
+
+@pytest.fixture(scope="module")
+def trained_on_rest(tmp_path_factory):
+    """A gated bundle trained on the rest physics (format version 7)."""
+    return gated_bundle(
+        tmp_path_factory.mktemp("rest-changes") / "bundle", rest_changes=True
+    )
+
+
+def _avatars(setup, gravity: float, rest_physics: bool = True):
+    ref, nat = reference_and_native(setup, "float", rest_physics)
+    for set_parameter in (ref.params.set_global, nat.set_parameter):
+        set_parameter("gravity_strength", gravity)
+    ref.prepare()
+    nat.prepare()
+    return ref, nat
+
+
+def test_a_bundle_trained_on_the_rest_physics_adds_it_whole(trained_on_rest) -> None:
+    """frame(w, p) = networks(w, p) + Pd: at rest the linear blend and Pd, on an expression the
+    networks' own response to p kept (the gated rule would take M1(p) - M1(p0) off)."""
+    head, _, _, folder, rest = trained_on_rest
+    manifest = read_manifest(folder)
+    assert manifest["rest_changes"] is True and manifest["format_version"] == 7
+    vs = head.definition.skin_vertices
+    ref0, nat0 = _avatars(trained_on_rest, 1.0)
+    ref, nat = _avatars(trained_on_rest, 1.7)
+    plain, plain0 = _avatars(trained_on_rest, 1.7, False)[0], ref0
+    solver = RestSolver(rest, head.neutral, head.definition.skin_triangles)
+    physics = solver.solve(ref.params) - solver.solve(ref0.params)
+    above(
+        np.abs(physics).max(), 1e-5, "1.7 g moves the synthetic head at rest", what="m"
+    )
+    zero, strong = np.zeros(52), np.full(52, 0.6)
+    got = ref.evaluate_weights(zero)[0][:vs] - head.neutral[:vs]
+    below(np.abs(got - physics).max() * 1e3, 1e-6, REASON_SAME, what="mm")
+    networks = (
+        plain.evaluate_weights(strong)[0][:vs] - plain0.evaluate_weights(strong)[0][:vs]
+    )
+    above(np.abs(networks).max(), 1e-5, "the networks respond to p", what="m")
+    got = ref.evaluate_weights(strong)[0][:vs] - ref0.evaluate_weights(strong)[0][:vs]
+    below(np.abs(got - (networks + physics)).max() * 1e3, 1e-6, REASON_SAME, what="mm")
+    for w in (zero, strong):
+        x, want = nat.evaluate_weights(w)[0], ref.evaluate_weights(w)[0]
+        below(np.abs(x - want).max() * 1e3, 3e-4, REASON_NATIVE, what="mm")
+    moved = nat.evaluate_weights(zero)[0][:vs] - nat0.evaluate_weights(zero)[0][:vs]
+    below(np.abs(moved - physics).max() * 1e3, 3e-4, REASON_NATIVE, what="mm")
+
+
+def _no_rest_physics(m: dict) -> None:
+    del m["rest_physics"]
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (
+            {"format_version": 6},
+            r"rest_changes \(SoftDECA trained on the rest physics\) needs bundle format version 7",
+        ),
+        ({"rest_changes": 1}, "rest_changes must be"),
+        (_no_rest_physics, "rest_changes .* needs the physics at prepare"),
+    ],
+)
+def test_rest_changes_are_checked_at_load(
+    trained_on_rest, tmp_path, edit, message
+) -> None:
+    """A runtime that ignored `rest_changes` would take the networks' response to p off: it
+    needs format version 7, a boolean and the physics at prepare it speaks of."""
+
+    copy = edited_copy(trained_on_rest[3], tmp_path / "bundle", edit)
+    with pytest.raises(NativeError, match=message):
+        NativeModel(copy)

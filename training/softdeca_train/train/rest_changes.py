@@ -1,0 +1,147 @@
+"""The rest physics' change of every group of a dataset: Pd = P_rest(p) - P_rest(p0), the skin
+of the group's identity simulated at rest under its parameters (and its regional pattern) less
+the same under the defaults, by the bundle's physics at prepare (models/rest_physics.py, which
+the parity tests hold to the runtime's).
+
+The runtime adds Pd to every frame at prepare. Most of a calm static frame's T - S_t is Pd
+(measured on softdeca-l3-e1: 0.35 of 0.36 mm on a calm frame), and a model exact at rest
+cannot fit it there: a run trained on S_t + Pd (`train-bundle --rest-changes`) learns only what
+an expression adds on top of the rest physics, as the runtime will use it.
+
+One file per static and dynamic shard in <dataset>/rest-changes/, written atomically: a rerun
+goes on where one stopped, and workers share the shards."""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import queue
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from softdeca_train.models.bundle import OnnxNetworks
+from softdeca_train.models.dt import face_geometry
+from softdeca_train.models.parameters import ParameterState
+from softdeca_train.models.rest_physics import RestSolver
+from softdeca_train.template import Template
+from softdeca_train.template.model import N_SKIN
+from softdeca_train.train.batches import (
+    EVERY_FRAME,
+    REST_CHANGES,
+    RESTED_KINDS,
+    Batch,
+    Dataset,
+    rest_changes_path,
+)
+
+
+@dataclass(frozen=True)
+class RestChangesConfig:
+    dataset: Path
+    bundle: Path  # whose physics at prepare (its rest_head.bin): the runtime's for that bundle
+    workers: int = 1
+    progress: bool = True
+
+
+class GroupSolver:
+    """Pd of the groups of one identity after another, the identity's solver and its rest
+    under the defaults kept while its groups come."""
+
+    def __init__(self, bundle: Path, template: Template) -> None:
+        nets = OnnxNetworks(bundle)
+        if nets.rest_head is None:
+            raise ValueError(f"{bundle} has no physics at prepare (rest_head.bin)")
+        self.head, self.specs, self.template = nets.rest_head, nets.specs, template
+        self._identity: int | None = None
+
+    def _start(self, b: Batch) -> None:
+        neutral = self.template.identity_neutral(b.h[0].double().numpy())
+        tris = self.template.skin_triangles
+        self.solver = RestSolver(self.head, neutral, tris)
+        area = face_geometry(neutral[:N_SKIN], tris)[0]
+        self.state = lambda: ParameterState(self.specs, tris, area)
+        self.rest0 = self.solver.solve(self.state())
+        self._identity = b.identity_id
+
+    def rest_change(self, b: Batch) -> np.ndarray:
+        """(N_SKIN, 3): the group's Pd, zero under the defaults."""
+        if b.identity_id != self._identity:
+            self._start(b)
+        params = self.state()
+        for k, s in enumerate(self.specs):
+            params.set_global(s.name, float(b.p[0, k]))
+            if b.p_vertices is not None and s.localisable:
+                params.set_vertices(s.name, b.p_vertices[:, k].double().numpy())
+        if params.at_defaults():
+            return np.zeros((N_SKIN, 3))
+        return self.solver.solve(params) - self.rest0
+
+
+def shards_to_do(dataset: Dataset) -> list[tuple[str, str]]:
+    """(kind, shard) of every static and dynamic shard whose file is not written yet."""
+    return [
+        (kind, f)
+        for kind in RESTED_KINDS
+        for f in dataset.shards(kind, "all")
+        if not rest_changes_path(dataset.folder, f).is_file()
+    ]
+
+
+def write_shard(dataset: Dataset, groups: GroupSolver, kind: str, shard: str) -> None:
+    with np.load(dataset.folder / shard) as z:
+        ids = z["instance_id"]
+    out = np.zeros((len(ids), N_SKIN, 3), np.float16)
+    for idx, b in dataset.shard_batches(kind, shard, max_frames=len(ids), limit=EVERY_FRAME):
+        out[idx] = groups.rest_change(b).astype(np.float16)
+    path = rest_changes_path(dataset.folder, shard)
+    tmp = path.with_name(path.name + ".tmp.npz")
+    np.savez(tmp, instance_id=ids, rest_change=out)
+    os.replace(tmp, path)
+
+
+def _worker(config: RestChangesConfig, jobs: list[tuple[str, str]], done) -> None:
+    groups = GroupSolver(config.bundle, Template.load())
+    dataset = Dataset(config.dataset, groups.template, [s.name for s in groups.specs])
+    for kind, shard in jobs:
+        write_shard(dataset, groups, kind, shard)
+        done.put(shard)
+
+
+def make_rest_changes(config: RestChangesConfig) -> Iterator[str]:
+    """Writes every missing file; yields each shard as its file is written."""
+    dataset = Dataset(config.dataset)
+    (dataset.folder / REST_CHANGES).mkdir(exist_ok=True)
+    todo = shards_to_do(dataset)
+    if not todo:
+        return
+    workers = max(1, min(config.workers, len(todo)))
+    ctx = mp.get_context("spawn")
+    done = ctx.Queue()
+    # shards of one identity stay with one worker (its solver is built once)
+    procs = [
+        ctx.Process(target=_worker, args=(config, todo[k::workers], done), daemon=True)
+        for k in range(workers)
+    ]
+    for p in procs:
+        p.start()
+    with tqdm(
+        total=len(todo), desc="rest changes", unit="shard", disable=not config.progress
+    ) as bar:
+        for _ in range(len(todo)):
+            while True:
+                try:
+                    shard = done.get(timeout=5)
+                    break
+                except queue.Empty:  # the workers still run?
+                    if not any(p.is_alive() for p in procs) and done.empty():
+                        raise RuntimeError(
+                            "the rest-change workers stopped; rerun to go on"
+                        ) from None
+            bar.update()
+            yield shard
+    for p in procs:
+        p.join()
