@@ -36,7 +36,7 @@ namespace SoftDeca.Unity
             }
             finally
             {
-                pending.Clear();  // a failed call drops the rest of this frame's frames, not the next frame's
+                pending.Clear();  // an exception (a disposed avatar) drops the rest of this frame's frames, not the next's
                 Clear();          // and no component or avatar is held until the next frame
             }
         }
@@ -60,7 +60,16 @@ namespace SoftDeca.Unity
                 weights.Add(c.FrameWeights);
             }
             pending.RemoveRange(kept, pending.Count - kept);
-            batch.EvaluateWeights(avatars, weights);
+            try
+            {
+                batch.EvaluateWeights(avatars, weights);
+            }
+            catch (SoftDecaException e)
+            {
+                // the call itself failed (a network's run): no avatar of this model got its frame
+                for (int i = 0; i < members.Count; ++i) members[i].FinishFrame(e);
+                return;
+            }
             for (int i = 0; i < members.Count; ++i)
                 members[i].FinishFrame(batch.StatusOf(i) == Status.Ok ? null : batch.ErrorOf(i));
         }
