@@ -35,7 +35,9 @@ namespace SoftDeca.Unity
     /// Its blendshapes named after ARKit's 52 give the avatar's expressions. The corrected
     /// vertices are written into the mesh the renderer draws, so a SkinnedMeshRenderer's bones
     /// still skin them. Each frame writes positions and normals through NativeArrays: nothing is
-    /// allocated on the managed heap per frame.
+    /// allocated on the managed heap per frame. Components naming the same bundle share its
+    /// loaded Model, and their SoftDECA frames run in one batch call per frame (AvatarBatch: the
+    /// model's per-frame networks run once for all of them) in the frame's first LateUpdate.
     /// </summary>
     [AddComponentMenu("SoftDECA/SoftDECA Avatar")]
     [DisallowMultipleComponent]
@@ -60,6 +62,7 @@ namespace SoftDeca.Unity
         public List<ParameterSetting> parameters = new List<ParameterSetting>();
         public List<MaterialRegion> regions = new List<MaterialRegion>();
 
+        private SharedModel sharedModel;    // the bundle's Model, shared with the other components naming it
         private Model model;
         private Avatar avatar;
         private AvatarFit avatarFit;
@@ -80,7 +83,9 @@ namespace SoftDeca.Unity
         public Avatar Native { get { return avatar; } }
         /// <summary>Whether a material change is still being prepared (frames show the previous one).</summary>
         public bool Preparing { get { return preparing != null && !preparing.IsCompleted; } }
+        /// <summary>The bundle's loaded Model, shared by every enabled component naming the same bundle: not to be disposed.</summary>
         public Model Model { get { return model; } }
+        internal float[] FrameWeights { get { return weights; } }
 
         /// <summary>The bundle's path: bundlePath under StreamingAssets, or as it is when absolute.</summary>
         public string BundleFullPath
@@ -105,7 +110,8 @@ namespace SoftDeca.Unity
         {
             Mesh source = SourceMesh;
             if (source == null) throw new InvalidOperationException("SoftDecaAvatar needs a MeshFilter or SkinnedMeshRenderer with a mesh");
-            model = Model.Load(BundleFullPath);
+            sharedModel = SharedModel.Acquire(BundleFullPath);
+            model = sharedModel.Model;
             if (fit != null) BuildFitted(source);
             else BuildTemplate(source);
             avatar.SetDynamics(dynamics);
@@ -122,12 +128,14 @@ namespace SoftDeca.Unity
 
         private void OnDisable()
         {
+            BatchedFrames.Withdraw(this);
             FinishPrepare(true);
             if (avatar != null) avatar.Dispose();
             if (avatarFit != null) avatarFit.Dispose();
-            if (model != null) model.Dispose();
+            if (sharedModel != null) sharedModel.Release();
             avatar = null;
             avatarFit = null;
+            sharedModel = null;
             model = null;
             if (sourceMesh != null) AssignMesh(sourceMesh, false);
             if (mesh != null) Destroy(mesh);
@@ -290,11 +298,26 @@ namespace SoftDeca.Unity
                 avatar.EvaluateLandmarks(landmarks.Points);
             else if (input.TryGetWeights(weights))
             {
-                if (method == Method.Linear) avatar.EvaluateLinear(weights);
-                else avatar.EvaluateWeights(weights);
+                if (method != Method.Linear)
+                {
+                    BatchedFrames.Defer(this);  // SoftDECA: with the bundle's other avatars, in LateUpdate
+                    return;
+                }
+                avatar.EvaluateLinear(weights);
             }
             else return;
             WriteMesh();
+        }
+
+        private void LateUpdate() { BatchedFrames.EvaluateOnce(Time.frameCount); }
+
+        // A deferred SoftDECA frame's outcome: the mesh written, or (error) logged and the mesh
+        // left at its last frame.
+        internal void FinishFrame(SoftDecaException error)
+        {
+            if (avatar == null) return;  // disabled meanwhile
+            if (error != null) Debug.LogException(error, this);
+            else WriteMesh();
         }
 
         private unsafe void WriteMesh()

@@ -29,7 +29,7 @@ namespace SoftDeca
         public int VertexCount { get { return vertexCount; } }
         /// <summary>Whether this avatar is a user's own mesh made from an AvatarFit.</summary>
         public bool Fitted { get { return fit != null; } }
-        private AvatarHandle Handle { get { handle.ThrowIfClosed("Avatar"); return handle; } }
+        internal AvatarHandle Handle { get { handle.ThrowIfClosed("Avatar"); return handle; } }
 
         /// <param name="neutral">the avatar's neutral head, xyz per vertex (HeadVertexCount vertices)</param>
         /// <param name="triangles">triangles over the whole head, 3 indices each</param>
@@ -302,7 +302,7 @@ namespace SoftDeca
             Library.Check(NativeMethods.softdeca_avatar_evaluate_landmarks(Handle, points, (uint)pointCount, ref o));
         }
 
-        private static Output MakeOutput(float* vertices, int vertexCapacity, float* normals, int normalCapacity)
+        internal static Output MakeOutput(float* vertices, int vertexCapacity, float* normals, int normalCapacity)
         {
             var o = Output.Create();
             o.Vertices = (IntPtr)vertices;

@@ -52,12 +52,16 @@ namespace SoftDeca
             if (status != Status.Ok) Throw(status);
         }
 
-        internal static void Throw(Status status)
+        internal static void Throw(Status status) { throw new SoftDecaException(status, LastError(status)); }
+
+        /// <summary>This thread's message of the last failure, or the status's name when the library left none.</summary>
+        internal static string LastError(Status status)
         {
             string message = Utf8.FromNative(NativeMethods.softdeca_last_error());
-            if (string.IsNullOrEmpty(message)) message = Utf8.FromNative(NativeMethods.softdeca_status_name(status));
-            throw new SoftDecaException(status, message);
+            return string.IsNullOrEmpty(message) ? StatusName(status) : message;
         }
+
+        internal static string StatusName(Status status) { return Utf8.FromNative(NativeMethods.softdeca_status_name(status)); }
     }
 
     /// <summary>NUL-terminated UTF-8 strings to and from the library.</summary>

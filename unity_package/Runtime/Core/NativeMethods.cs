@@ -67,6 +67,10 @@ namespace SoftDeca
         [DllImport(Library, CallingConvention = Cdecl)] public static extern Status softdeca_avatar_prepare(AvatarHandle avatar);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_avatar_evaluate_weights(AvatarHandle avatar, float* weights, uint count, ref Output output);
+        // avatars: raw handle pointers, each kept alive by the caller (SafeHandle.DangerousAddRef)
+        [DllImport(Library, CallingConvention = Cdecl)]
+        public static extern Status softdeca_avatar_evaluate_weights_batch(IntPtr* avatars, uint avatarCount, float* weights, uint weightCount,
+                                                                           Output* outputs, int* statuses);
         [DllImport(Library, CallingConvention = Cdecl)]
         public static extern Status softdeca_avatar_evaluate_surface(AvatarHandle avatar, float* weights, uint count, float* surface,
                                                                      uint vertexCount, ref Output output);
