@@ -1,5 +1,6 @@
 using System;
 using System.Collections.Generic;
+using System.IO;
 using SoftDeca;
 
 namespace SoftDeca.Unity
@@ -27,14 +28,21 @@ namespace SoftDeca.Unity
         /// <summary>The bundle at path, loaded by its first user; each Acquire is matched by one Release.</summary>
         public static SharedModel Acquire(string path)
         {
+            string key = Key(path);
             SharedModel shared;
-            if (!loaded.TryGetValue(path, out shared))
+            if (!loaded.TryGetValue(key, out shared))
             {
-                shared = new SharedModel(path, Model.Load(path));
-                loaded.Add(path, shared);
+                shared = new SharedModel(key, Model.Load(path));
+                loaded.Add(key, shared);
             }
             ++shared.users;
             return shared;
+        }
+
+        // One entry per bundle however its path is written ("a/b", "a/b/", "a/./b").
+        private static string Key(string path)
+        {
+            return Path.GetFullPath(path).TrimEnd(Path.DirectorySeparatorChar, Path.AltDirectorySeparatorChar);
         }
 
         /// <summary>One user lets go; the last disposes the model (avatars made from it keep what they need).</summary>
