@@ -87,9 +87,10 @@ class Run:
                 raise ValueError(
                     f"{self.folder} trains on {old.dataset} ({old.sizes}, seed {old.seed}, "
                     f"contrasts {old.contrasts}, more static data {list(old.more_static)}, "
-                    f"rest gate {old.rest_gate}, residual members {old.residual_members}); use "
-                    "another folder for another dataset, sizes, seed, contrasts, more data, rest "
-                    "gate or residual members"
+                    f"rest gate {old.rest_gate}, residual members {old.residual_members}, "
+                    f"rest changes {old.rest_changes}); use another folder for another dataset, "
+                    "sizes, seed, contrasts, more data, rest gate, residual members or rest "
+                    "changes"
                 )
         else:
             self.folder.mkdir(parents=True, exist_ok=True)
