@@ -404,10 +404,7 @@ class BundleNetworks:
     identity_encoder: IdentityEncoder
     softdeca: SoftDecaNetworks | None
     sparse: SparseNetworks | None
-    # SoftDECA trained on S_t + Pd (train-bundle --rest-changes): the physics at prepare adds
-    # the physics' rest change whole and takes nothing of the networks off (the bundle's
-    # `rest_changes`, models/reference.py)
-    rest_changes: bool = False
+    rest_changes: bool = False  # SoftDECA trained on S_t + Pd (the bundle's `rest_changes`)
 
     @property
     def rest_gate(self) -> float | None:
