@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import torch
 from bounds import above, below
 from gated_bundle import edited_copy, gated_bundle, reference_and_native
 from softdeca_train.host.fit_check import DEFAULT_BUNDLE
@@ -29,6 +30,7 @@ from softdeca_train.train.rest_changes import (
     RestChangesConfig,
     make_rest_changes,
 )
+from softdeca_train.train.run import Run, RunConfig
 
 SHIPPED = Path(DEFAULT_BUNDLE)  # its physics at prepare: the template's
 # float16 storage of Pd (tenths of a mm): 2^-11 relative, with margin
@@ -90,6 +92,21 @@ def test_the_loader_puts_the_rest_change_on_s_t(rested) -> None:
         next(on_rest.batches("sparse", "train"))  # no rest change: SparseSoftDECA's
     finally:
         shutil.move(folder / "moved", folder / REST_CHANGES)
+
+
+def test_a_run_on_the_rest_changes_evaluates_its_bundle_on_the_blend(
+    rested, tmp_path
+) -> None:
+    """The run trains on S_t + Pd; its bundle reads S_t (the runtime adds Pd at prepare), so
+    the report's bundle pass takes its frames from blend_data."""
+    folder, _ = rested
+    run = Run(tmp_path / "run", RunConfig(str(folder), "test", rest_changes=True))
+    a = next(run.data.batches("static", "test", None, 8, EVERY_FRAME))
+    b = next(run.blend_data.batches("static", "test", None, 8, EVERY_FRAME))
+    assert a.param_id == b.param_id and torch.equal(a.T, b.T)
+    above(float((a.S - b.S).abs().max()), 1e-5, "Pd on the run's frames", what="m")
+    plain = Run(tmp_path / "plain", RunConfig(str(folder), "test"))
+    assert plain.blend_data is plain.data
 
 
 @pytest.fixture(scope="module")

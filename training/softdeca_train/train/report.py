@@ -85,7 +85,7 @@ def _bundle_errors(
     avatars: dict[tuple[int, int], ReferenceAvatar] = {}
     kinds = {"softdeca": "static", "sparse": "sparse"}
     for kind, model in ((kinds[m], m) for m in models):
-        batches = list(run.data.batches(kind, "test", None, 8, EVERY_FRAME))
+        batches = list(run.blend_data.batches(kind, "test", None, 8, EVERY_FRAME))
         for b in tqdm(batches, desc=f"bundle {model}", disable=not progress):
             key = (b.identity_id, b.param_id)
             if key not in avatars:

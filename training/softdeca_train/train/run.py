@@ -109,6 +109,14 @@ class Run:
     def data(self) -> Dataset:
         return self._dataset(self.config.dataset)
 
+    @cached_property
+    def blend_data(self) -> Dataset:
+        """The dataset with S_t the linear blend, what a bundle's frames read (with
+        rest_changes the run's own `data` carry S_t + Pd; the bundle adds Pd at prepare)."""
+        if not self.config.rest_changes:
+            return self.data
+        return Dataset(self.config.dataset, self.template, [s.name for s in self.specs])
+
     def _dataset(self, folder: str) -> Dataset:
         names = [s.name for s in self.specs]
         return Dataset(folder, self.template, names, rest_changes=self.config.rest_changes)
