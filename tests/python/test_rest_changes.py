@@ -29,6 +29,7 @@ from softdeca_train.train.rest_changes import (
     GroupSolver,
     RestChangesConfig,
     make_rest_changes,
+    write_shard,
 )
 from softdeca_train.train.run import Run, RunConfig
 
@@ -92,6 +93,46 @@ def test_the_loader_puts_the_rest_change_on_s_t(rested) -> None:
         next(on_rest.batches("sparse", "train"))  # no rest change: SparseSoftDECA's
     finally:
         shutil.move(folder / "moved", folder / REST_CHANGES)
+
+
+class RefusingOne:
+    """A group solver whose physics refuses the first identity it is given, as the physics at
+    prepare refuses a head whose carried tissue fill inverts a tet."""
+
+    def __init__(self, groups: GroupSolver) -> None:
+        self.groups, self.refused = groups, None
+
+    def rest_change(self, b):
+        if self.refused in (None, b.identity_id):
+            self.refused = b.identity_id
+            raise ValueError("soft_tets[1] is inverted")
+        return self.groups.rest_change(b)
+
+
+def test_a_head_the_physics_refuses_is_left_out_and_counted(rested, tmp_path) -> None:
+    folder, _ = rested
+    copy = tmp_path / "data"
+    shutil.copytree(folder, copy)
+    groups = GroupSolver(SHIPPED, Dataset(copy).template)
+    names = [s.name for s in groups.specs]
+    data = Dataset(copy, groups.template, names, rest_changes=True)
+    shard = data.shards("static", "train")[0]
+    before = data.left_out("static", "train")
+    write_shard(data, RefusingOne(groups), "static", shard)
+    with np.load(rest_changes_path(copy, shard)) as z:
+        refused = ~z["solved"]
+        assert refused.any() and all("inverted" in r for r in z["refusal"][refused])
+    after = data.left_out("static", "train")
+    assert after["no_rest_physics"] == before["no_rest_physics"] + int(refused.sum())
+    assert after["kept"] == before["kept"] - int(refused.sum())
+    kept = sum(b.frames for b in data.batches("static", "train"))
+    assert kept == after["kept"]
+    everything = sum(
+        b.frames for b in data.batches("static", "train", None, 8, EVERY_FRAME)
+    )
+    assert everything < sum(
+        b.frames for b in Dataset(copy).batches("static", "train", None, 8, EVERY_FRAME)
+    )
 
 
 def test_a_run_on_the_rest_changes_evaluates_its_bundle_on_the_blend(

@@ -68,8 +68,12 @@ def rest_changes_path(folder: Path, shard: str) -> Path:
     return folder / REST_CHANGES / shard
 
 
-def read_rest_changes(folder: Path, shard: str, instance_id: np.ndarray) -> np.ndarray:
-    """(n, N_SKIN, 3) float16: Pd of each instance of the shard, checked to be its own."""
+def read_rest_changes(
+    folder: Path, shard: str, instance_id: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Pd of each instance of the shard, (n, N_SKIN, 3) float16, checked to be its own, and
+    whether the physics at prepare could simulate its head (n,) bool: an instance it refuses
+    (a head whose carried tissue fill inverts a tet) has no Pd and is left out, counted."""
     path = rest_changes_path(folder, shard)
     if not path.is_file():
         raise FileNotFoundError(
@@ -79,7 +83,7 @@ def read_rest_changes(folder: Path, shard: str, instance_id: np.ndarray) -> np.n
     with np.load(path) as z:
         if not np.array_equal(z["instance_id"], instance_id):
             raise ValueError(f"{path} is not of this shard's instances: make it again")
-        return z["rest_change"]
+        return z["rest_change"], z["solved"]
 
 
 @dataclass
@@ -197,12 +201,17 @@ class Dataset:
         their solver error (`left_out`, same limit as `batches`) and, of the others, for a
         failed sanity bound (`failed_bounds`, sim/sanity.py): reported, never silent."""
         limit = 3 * self.tolerance if max_error is None else max_error
-        kept = left = failed = 0
-        for _, solved, sane in self._judged(kind, split, limit):
-            kept += int((solved & sane).sum())
+        kept = left = failed = unrested = 0
+        for arrays, solved, sane in self._judged(kind, split, limit):
+            rested = arrays.get("rest_solved", np.ones(len(solved), bool))
+            kept += int((solved & sane & rested).sum())
             left += int((~solved).sum())
             failed += int((solved & ~sane).sum())
-        return {"kept": kept, "left_out": left, "failed_bounds": failed, "max_error": limit}  # type: ignore[dict-item]
+            unrested += int((solved & sane & ~rested).sum())
+        out = {"kept": kept, "left_out": left, "failed_bounds": failed, "max_error": limit}
+        if self.rest_changes and kind in RESTED_KINDS:  # and the physics at prepare refused
+            out["no_rest_physics"] = unrested
+        return out  # type: ignore[return-value]
 
     def take_frames(self, split: str = "train") -> dict[str, dict]:
         """Which frames of which recorded takes the kept instances of `split` came from (every
@@ -237,6 +246,8 @@ class Dataset:
             with np.load(self.folder / f) as z:
                 keys = ("instance_id", "estimated_error", "failures", *more)
                 arrays = {k: z[k] for k in keys if k in z}
+            if self.rest_changes and kind in RESTED_KINDS:
+                arrays["rest_solved"] = read_rest_changes(self.folder, f, arrays["instance_id"])[1]
             yield (arrays, *training_mask(arrays, limit))
 
     def batches(
@@ -271,9 +282,11 @@ class Dataset:
         with np.load(self.folder / file) as z:
             a = {k: z[k] for k in z.files if k != "meta"}
         if self.rest_changes and kind in RESTED_KINDS:
-            a["rest_change"] = read_rest_changes(self.folder, file, a["instance_id"])
+            a["rest_change"], a["rest_solved"] = read_rest_changes(
+                self.folder, file, a["instance_id"]
+            )
         solved, sane = training_mask(a, limit)
-        ok = solved & sane
+        ok = solved & sane & a.get("rest_solved", True)  # no Pd: out, also of the evaluation
         groups = [np.flatnonzero(ok & (a["param_id"] == g)) for g in np.unique(a["param_id"])]
         if rng is not None:
             groups = [groups[k] for k in rng.permutation(len(groups))]

@@ -264,14 +264,25 @@ def _left_out_line(left: dict[str, dict[str, int]]) -> str:
     (evaluation: none)."""
     if not left:
         return "Frames left out for the solver's estimated error: not counted."
-    total = lambda v: v["kept"] + v["left_out"] + v.get("failed_bounds", 0)  # noqa: E731
+
+    def total(v: dict[str, int]) -> int:
+        return v["kept"] + v["left_out"] + v.get("failed_bounds", 0) + v.get("no_rest_physics", 0)
+
     parts = [f"{k} {v['left_out']} of {total(v)}" for k, v in left.items()]
     failed = [f"{k} {v.get('failed_bounds', 0)}" for k, v in left.items()]
+    unrested = [f"{k} {v['no_rest_physics']}" for k, v in left.items() if "no_rest_physics" in v]
     return (
         "The evaluation reads every test frame. Frames left out of training because the "
         "volumetric solver's estimated error exceeds 3x the dataset's tolerance: "
         f"{', '.join(parts)}; because they fail a sanity bound (docs/physics.md): "
-        f"{', '.join(failed)}."
+        f"{', '.join(failed)}"
+        + (
+            "; because the physics at prepare refuses their head (also out of the evaluation "
+            f"on S_t + Pd): {', '.join(unrested)}"
+            if unrested
+            else ""
+        )
+        + "."
     )
 
 

@@ -95,11 +95,16 @@ def write_shard(dataset: Dataset, groups: GroupSolver, kind: str, shard: str) ->
     with np.load(dataset.folder / shard) as z:
         ids = z["instance_id"]
     out = np.zeros((len(ids), N_SKIN, 3), np.float16)
+    solved = np.ones(len(ids), bool)
+    refusal = np.full(len(ids), "", dtype=object)
     for idx, b in dataset.shard_batches(kind, shard, max_frames=len(ids), limit=EVERY_FRAME):
-        out[idx] = groups.rest_change(b).astype(np.float16)
+        try:
+            out[idx] = groups.rest_change(b).astype(np.float16)
+        except ValueError as e:  # the physics at prepare refuses this head: so would the runtime
+            solved[idx], refusal[idx] = False, str(e)
     path = rest_changes_path(dataset.folder, shard)
     tmp = path.with_name(path.name + ".tmp.npz")
-    np.savez(tmp, instance_id=ids, rest_change=out)
+    np.savez(tmp, instance_id=ids, rest_change=out, solved=solved, refusal=refusal.astype(str))
     os.replace(tmp, path)
 
 
