@@ -104,13 +104,18 @@ class LocalRidge:
         elements at a time: a copy of every element's system at once would double the memory
         the normal equations already take (gigabytes for the skin's vertices)."""
         d = self.gram.shape[-1] if features is None else features
-        eye = torch.eye(d, dtype=torch.float64)
+        eye = np.eye(d)
         out = torch.empty(len(self.cross), d, self.cross.shape[-1], dtype=torch.float64)
         for i in range(0, len(self.gram), chunk):
-            g = self.gram[i : i + chunk, :d, :d]
-            scale = torch.diagonal(g, dim1=1, dim2=2).mean(dim=1).clamp_min(1e-30)
-            out[i : i + chunk] = torch.linalg.solve(
-                g + ridge * scale[:, None, None] * eye, self.cross[i : i + chunk, :d]
+            g = self.gram[i : i + chunk, :d, :d].numpy()
+            scale = np.maximum(np.diagonal(g, axis1=1, axis2=2).mean(axis=1), 1e-30)
+            # numpy's LAPACK, not torch's batched LU: once a process has set torch's thread
+            # count, that LU returned wrong solutions (0.2 mm off, or invalid pivots) in a
+            # process that had also made a dataset (tests/python/test_softdeca_hybrid.py)
+            out[i : i + chunk] = torch.from_numpy(
+                np.linalg.solve(
+                    g + ridge * scale[:, None, None] * eye, self.cross[i : i + chunk, :d].numpy()
+                )
             )
         return out
 
