@@ -23,10 +23,11 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from softdeca_train.models.bundle import OnnxNetworks
+from softdeca_train.models.bundle import read_manifest, read_rest_physics
 from softdeca_train.models.dt import face_geometry
 from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_physics import RestSolver
+from softdeca_train.parameters import ParameterSpec
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
 from softdeca_train.train.batches import (
@@ -52,10 +53,13 @@ class GroupSolver:
     under the defaults kept while its groups come."""
 
     def __init__(self, bundle: Path, template: Template) -> None:
-        nets = OnnxNetworks(bundle)
-        if nets.rest_head is None:
+        # the manifest's parameters and the rest head: no network of the bundle is run
+        manifest = read_manifest(bundle)
+        head = read_rest_physics(bundle, manifest)
+        if head is None:
             raise ValueError(f"{bundle} has no physics at prepare (rest_head.bin)")
-        self.head, self.specs, self.template = nets.rest_head, nets.specs, template
+        self.head, self.template = head, template
+        self.specs = tuple(ParameterSpec.from_dict(p) for p in manifest["parameters"])
         self._identity: int | None = None
 
     def _start(self, b: Batch) -> None:
