@@ -18,6 +18,7 @@ using namespace softdeca::geometry;
 void bind_sim(nb::module_& m);  // sim_bindings.cpp: the physics simulator
 void bind_fit(nb::module_& m);  // fit_bindings.cpp: fitting a user's avatar
 void bind_prepare(nb::module_& m);  // prepare_bindings.cpp: the contact rules
+void bind_rest_physics(nb::module_& m);  // rest_physics_bindings.cpp: the physics at prepare
 
 NB_MODULE(softdeca_native, m) {
   m.doc() = "SoftDECA native geometry (C++), used by the training pipeline";
@@ -50,4 +51,5 @@ NB_MODULE(softdeca_native, m) {
   bind_sim(m);
   bind_fit(m);
   bind_prepare(m);
+  bind_rest_physics(m);
 }

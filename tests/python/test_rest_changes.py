@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import softdeca_native
 import torch
 from bounds import above, below
 from gated_bundle import edited_copy, gated_bundle, reference_and_native
@@ -18,6 +19,9 @@ from softdeca_train.host.native import NativeError, NativeModel
 from softdeca_train.models import (
     read_manifest,
 )
+from softdeca_train.models.bundle import read_rest_physics
+from softdeca_train.models.dt import face_geometry
+from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_physics import RestSolver
 from softdeca_train.train.batches import (
     EVERY_FRAME,
@@ -37,6 +41,7 @@ SHIPPED = Path(DEFAULT_BUNDLE)  # its physics at prepare: the template's
 # float16 storage of Pd (tenths of a mm): 2^-11 relative, with margin
 REASON_STORED = "float16 storage of the rest change: 2^-11 of ~0.3 mm"
 REASON_SAME = "the reference adds the same arrays it was given: float64 rounding"
+REASON_ORACLE = "two solves to the physics' tolerance 1e-4 of ~0.3 mm, float32 neutral"
 REASON_NATIVE = "one solver, same tolerance and start; float32 networks against float64"
 
 
@@ -93,6 +98,34 @@ def test_the_loader_puts_the_rest_change_on_s_t(rested) -> None:
         next(on_rest.batches("sparse", "train"))  # no rest change: SparseSoftDECA's
     finally:
         shutil.move(folder / "moved", folder / REST_CHANGES)
+
+
+def test_the_rest_changes_are_the_runtimes_physics_at_prepare(rested) -> None:
+    """Pd comes from the runtime's solve (softdeca_native.RestPhysics) and agrees with the
+    Python oracle of it, regional patterns included."""
+    folder, _ = rested
+    groups = GroupSolver(SHIPPED, Dataset(folder).template)
+    data = Dataset(folder, groups.template, [s.name for s in groups.specs])
+    rest = read_rest_physics(SHIPPED, read_manifest(SHIPPED))
+    tris = groups.template.skin_triangles
+    for kind in ("static", "dynamic"):
+        shard = data.shards(kind, "all")[0]
+        for _, b in data.shard_batches(kind, shard, limit=EVERY_FRAME):
+            neutral = groups.template.identity_neutral(b.h[0].double().numpy())
+            oracle = RestSolver(rest, neutral, tris)
+            area = face_geometry(neutral[: b.S.shape[1]], tris)[0]
+            params = ParameterState(groups.specs, tris, area)
+            rest0 = oracle.solve(params)
+            for k, spec in enumerate(groups.specs):
+                params.set_global(spec.name, float(b.p[0, k]))
+                if b.p_vertices is not None and spec.localisable:
+                    params.set_vertices(spec.name, b.p_vertices[:, k].double().numpy())
+            want = oracle.solve(params) - rest0
+            got = groups.rest_change(b)
+            above(np.abs(want).max(), 1e-5, "p moves the head at rest", what="m")
+            below(np.abs(got - want).max() / np.abs(want).max(), 0.02, REASON_ORACLE)
+            break
+    assert isinstance(groups.solver, softdeca_native.RestPhysics)
 
 
 class RefusingOne:

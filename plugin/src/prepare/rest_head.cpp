@@ -1,5 +1,6 @@
 #include "prepare/rest_head.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -35,10 +36,19 @@ std::size_t RestHead::bytes() const {
 }
 
 RestHead parse_rest_head(const bundle::Manifest& m, const bundle::Bytes& data) {
+  RestHead h;
+  // Every parameter must be one the physics knows, over a range it accepts.
+  const auto& table = sim::parameter_table();
+  for (const ParameterSpec& p : m.parameters) {
+    const auto it = std::find_if(table.begin(), table.end(), [&](const ParameterSpec& s) { return p.name == s.name; });
+    if (it == table.end()) fail("rest_physics: parameter " + p.name + " is not one of the physics' parameters");
+    if (p.minimum < it->minimum || p.maximum > it->maximum)
+      fail("rest_physics: parameter " + p.name + "'s range is wider than the physics accepts");
+    h.parameter_ids.push_back(static_cast<sim::Param>(it - table.begin()));  // the table is in Param's order
+  }
   const bundle::RestPhysicsSpec& s = m.rest_physics;
   const std::string& f = s.file;
   BinaryReader in(data.data(), data.size(), f);
-  RestHead h;
   const auto n = static_cast<Eigen::Index>(s.fill_vertices);
   const auto ns = static_cast<Eigen::Index>(m.skin_vertices);
   h.vertices.resize(n, 3);

@@ -7,8 +7,10 @@
 // parameters, which the frames' rest correction compares across parameter values. The lip and
 // lid sets are found on the avatar's neutral (prepare/contact_sets.h), and a parameter map
 // reaches a tet through the skin vertex nearest its centroid, as in the training data.
-// Mirrors training/softdeca_train/models/rest_physics.py; the carry is this file's alone (the
-// training package calls carry_fill and add_fill_stiffness through softdeca_native).
+// The training package calls this file through softdeca_native: carry_fill and
+// add_fill_stiffness for its carried fills, RestPhysics for its data's rest changes
+// (train/rest_changes.py). training/softdeca_train/models/rest_physics.py is its oracle in the
+// parity tests.
 #pragma once
 
 #include <Eigen/SparseCore>

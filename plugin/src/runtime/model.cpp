@@ -10,7 +10,6 @@
 #include "bundle/onnx_model_scan.h"
 #include "bundle/sha256.h"
 #include "core/error.h"
-#include "sim/parameters.h"
 
 namespace softdeca::runtime {
 
@@ -100,19 +99,8 @@ std::shared_ptr<const Model> Model::load(const bundle::BundleFiles& files, const
   m->non_skin_bones_.assign(bones.begin(), bones.end());
 
   if (mf.has_rest_physics) {
-    // Every parameter must be one the physics knows, over a range it accepts.
-    std::vector<sim::Param> ids;
-    for (const ParameterSpec& p : mf.parameters) {
-      const auto& table = sim::parameter_table();
-      const auto it = std::find_if(table.begin(), table.end(), [&](const ParameterSpec& s) { return p.name == s.name; });
-      if (it == table.end()) fail("rest_physics: parameter " + p.name + " is not one of the physics' parameters");
-      if (p.minimum < it->minimum || p.maximum > it->maximum)
-        fail("rest_physics: parameter " + p.name + "'s range is wider than the physics accepts");
-      ids.push_back(static_cast<sim::Param>(it - table.begin()));  // the table is in Param's order
-    }
     const bundle::Bytes& data = verified(files, mf.rest_physics.file, mf.rest_physics.sha256);
     prepare::RestHead head = prepare::parse_rest_head(mf, data);
-    head.parameter_ids = std::move(ids);
     m->rest_head_ = std::make_unique<const prepare::RestHead>(std::move(head));
   }
 

@@ -555,6 +555,12 @@ def read_rest_physics(folder: str | Path, manifest: dict[str, Any]) -> RestHead 
     return read_rest_head(*found, manifest["template"]["skin_vertices"])
 
 
+def read_rest_physics_bytes(folder: str | Path, manifest: dict[str, Any]) -> bytes | None:
+    """A bundle's rest head file as it is stored (checked against its sha256), or None."""
+    found = _read_file(folder, manifest, "rest_physics")
+    return None if found is None else found[1]
+
+
 def _rest_gate(nets: BundleNetworks) -> float | None:
     """The manifest's `rest_gate` (BundleNetworks.rest_gate), or None when it has none. The
     runtime folds the physics at prepare's share of the gated correction into the vertex

@@ -1,7 +1,7 @@
 """The rest physics' change of every group of a dataset: Pd = P_rest(p) - P_rest(p0), the skin
 of the group's identity simulated at rest under its parameters (and its regional pattern) less
-the same under the defaults, by the bundle's physics at prepare (models/rest_physics.py, which
-the parity tests hold to the runtime's).
+the same under the defaults, by the bundle's physics at prepare: the runtime's own solve
+(plugin/src/prepare/rest_physics.cpp through softdeca_native), as it adds Pd to every frame.
 
 The runtime adds Pd to every frame at prepare. Most of a calm static frame's T - S_t is Pd
 (measured on softdeca-l3-e1: 0.35 of 0.36 mm on a calm frame), and a model exact at rest
@@ -13,6 +13,7 @@ goes on where one stopped, and workers share the shards."""
 
 from __future__ import annotations
 
+import json
 import multiprocessing as mp
 import os
 import queue
@@ -23,10 +24,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from softdeca_train.models.bundle import read_manifest, read_rest_physics
-from softdeca_train.models.dt import face_geometry
-from softdeca_train.models.parameters import ParameterState
-from softdeca_train.models.rest_physics import RestSolver
+from softdeca_train.models.bundle import read_manifest, read_rest_physics_bytes
 from softdeca_train.parameters import ParameterSpec
 from softdeca_train.template import Template
 from softdeca_train.template.model import N_SKIN
@@ -49,40 +47,54 @@ class RestChangesConfig:
 
 
 class GroupSolver:
-    """Pd of the groups of one identity after another, the identity's solver and its rest
-    under the defaults kept while its groups come."""
+    """Pd of the groups of one identity after another, by the runtime's physics at prepare
+    (softdeca_native.RestPhysics: plugin/src/prepare/rest_physics.cpp), the identity's solver
+    and its rest under the defaults kept while its groups come."""
 
     def __init__(self, bundle: Path, template: Template) -> None:
-        # the manifest's parameters and the rest head: no network of the bundle is run
+        # the manifest and the rest head: no network of the bundle is run
         manifest = read_manifest(bundle)
-        head = read_rest_physics(bundle, manifest)
-        if head is None:
+        found = read_rest_physics_bytes(bundle, manifest)
+        if found is None:
             raise ValueError(f"{bundle} has no physics at prepare (rest_head.bin)")
-        self.head, self.template = head, template
+        self.manifest_json, self.rest_head = json.dumps(manifest), found
+        self.template = template
         self.specs = tuple(ParameterSpec.from_dict(p) for p in manifest["parameters"])
+        self.defaults = np.array([s.default_value for s in self.specs], np.float64)
+        self.localisable = np.array([s.localisable for s in self.specs], np.int32)
         self._identity: int | None = None
 
     def _start(self, b: Batch) -> None:
+        import softdeca_native as native  # compiled with the plugin
+
+        self._identity = None  # until its solver and rest exist
         neutral = self.template.identity_neutral(b.h[0].double().numpy())
-        tris = self.template.skin_triangles
-        self.solver = RestSolver(self.head, neutral, tris)
-        area = face_geometry(neutral[:N_SKIN], tris)[0]
-        self.state = lambda: ParameterState(self.specs, tris, area)
-        self.rest0 = self.solver.solve(self.state())
+        self.solver = native.RestPhysics(
+            self.manifest_json,
+            self.rest_head,
+            np.ascontiguousarray(neutral, np.float32),
+            np.ascontiguousarray(self.template.skin_triangles, np.int32),
+        )
+        self.rest0 = self._solve(self.defaults, None)
         self._identity = b.identity_id
 
+    def _solve(self, globals_: np.ndarray, vertex_maps: np.ndarray | None) -> np.ndarray:
+        localised = self.localisable if vertex_maps is not None else 0 * self.localisable
+        maps = vertex_maps if vertex_maps is not None else np.zeros((0, 0))
+        return np.asarray(self.solver.solve(globals_, maps, localised), np.float64)
+
     def rest_change(self, b: Batch) -> np.ndarray:
-        """(N_SKIN, 3): the group's Pd, zero under the defaults."""
+        """(N_SKIN, 3): the group's Pd, zero under the defaults (where the runtime solves
+        nothing)."""
         if b.identity_id != self._identity:
             self._start(b)
-        params = self.state()
-        for k, s in enumerate(self.specs):
-            params.set_global(s.name, float(b.p[0, k]))
-            if b.p_vertices is not None and s.localisable:
-                params.set_vertices(s.name, b.p_vertices[:, k].double().numpy())
-        if params.at_defaults():
+        globals_ = b.p[0].double().numpy()
+        maps = None
+        if b.p_vertices is not None and self.localisable.any():
+            maps = np.ascontiguousarray(b.p_vertices.double().numpy())
+        if maps is None and np.array_equal(globals_, self.defaults):
             return np.zeros((N_SKIN, 3))
-        return self.solver.solve(params) - self.rest0
+        return self._solve(globals_, maps) - self.rest0
 
 
 def shards_to_do(dataset: Dataset) -> list[tuple[str, str]]:
