@@ -5,6 +5,7 @@ networks' response to p (nothing taken off), natively as in its reference."""
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -19,7 +20,7 @@ from softdeca_train.host.native import NativeError, NativeModel
 from softdeca_train.models import (
     read_manifest,
 )
-from softdeca_train.models.bundle import read_rest_physics
+from softdeca_train.models.bundle import read_rest_physics, read_rest_physics_bytes
 from softdeca_train.models.dt import face_geometry
 from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_physics import RestSolver
@@ -126,6 +127,29 @@ def test_the_rest_changes_are_the_runtimes_physics_at_prepare(rested) -> None:
             below(np.abs(got - want).max() / np.abs(want).max(), 0.02, REASON_ORACLE)
             break
     assert isinstance(groups.solver, softdeca_native.RestPhysics)
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (None, "no_such_parameter is not one of the physics' parameters"),
+        ({"max": 1e9}, "range is wider than the physics accepts"),
+    ],
+)
+def test_the_physics_at_prepare_refuses_a_parameter_it_cannot_take(
+    template, edit, message
+) -> None:
+    manifest = read_manifest(SHIPPED)
+    rest = read_rest_physics_bytes(SHIPPED, manifest)
+    first = manifest["parameters"][0]
+    if edit is None:  # one more parameter, no network's column: only the physics can object
+        manifest["parameters"].append({**first, "name": "no_such_parameter"})
+    else:
+        first.update(edit)
+    neutral = np.ascontiguousarray(template.neutral, np.float32)
+    tris = np.ascontiguousarray(template.skin_triangles, np.int32)
+    with pytest.raises(ValueError, match=message):
+        softdeca_native.RestPhysics(json.dumps(manifest), rest, neutral, tris)
 
 
 class RefusingOne:
