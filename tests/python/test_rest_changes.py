@@ -142,7 +142,9 @@ def test_the_physics_at_prepare_refuses_a_parameter_it_cannot_take(
     manifest = read_manifest(SHIPPED)
     rest = read_rest_physics_bytes(SHIPPED, manifest)
     first = manifest["parameters"][0]
-    if edit is None:  # one more parameter, no network's column: only the physics can object
+    if (
+        edit is None
+    ):  # one more parameter, no network's column: only the physics can object
         manifest["parameters"].append({**first, "name": "no_such_parameter"})
     else:
         first.update(edit)
