@@ -28,16 +28,17 @@ from softdeca_train.models.synthetic import (
 )
 
 
-def gated_bundle(folder: Path, rest_changes: bool = False) -> tuple:
+def gated_bundle(folder: Path, rest_changes: bool = False, seed: int = 9) -> tuple:
     """(head, nets, NativeModel, folder, rest head) of the bundle written to `folder`;
-    `rest_changes`: its SoftDECA trained on the rest physics (format version 7)."""
+    `rest_changes`: its SoftDECA trained on the rest physics (format version 7); `seed`: its
+    random weights'."""
     head = synthetic_head()
     specs = load_parameter_specs(TEST_PARAMETERS)
     nets = build_random(
         head.definition,
         specs,
         replace(TEST_SIZES, rest_gate=0.1),
-        seed=9,
+        seed=seed,
         vertex_stage=True,
         residual_stage=True,
         constant_slot=True,

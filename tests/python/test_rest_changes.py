@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,11 @@ from softdeca_train.host.native import NativeError, NativeModel
 from softdeca_train.models import (
     read_manifest,
 )
-from softdeca_train.models.bundle import read_rest_physics, read_rest_physics_bytes
+from softdeca_train.models.bundle import (
+    read_rest_physics,
+    read_rest_physics_bytes,
+    replace_softdeca,
+)
 from softdeca_train.models.dt import face_geometry
 from softdeca_train.models.parameters import ParameterState
 from softdeca_train.models.rest_physics import RestSolver
@@ -281,3 +286,56 @@ def test_rest_changes_are_checked_at_load(
     copy = edited_copy(trained_on_rest[3], tmp_path / "bundle", edit)
     with pytest.raises(NativeError, match=message):
         NativeModel(copy)
+
+
+def test_a_softdeca_trained_on_the_rest_physics_replaces_a_bundles_own(
+    trained_on_rest, tmp_path
+) -> None:
+    """bundle-softdeca (models/bundle.replace_softdeca): a gated bundle's SoftDECA frame
+    networks give way to one trained on the rest physics; its dynamics network and
+    SparseSoftDECA stay, the manifest says rest_changes (format version 7), and the runtime
+    runs the new networks as the reference does. A model the bundle cannot take leaves the
+    bundle as it was."""
+    head, nets, _, _, rest = trained_on_rest
+    _, plain_nets, _, plain, _ = gated_bundle(tmp_path / "plain", seed=10)
+    before = read_manifest(plain)
+    assert before["format_version"] == 6 and "rest_changes" not in before
+    folder = edited_copy(plain, tmp_path / "bundle", {})
+    record = {"model": "softdeca", "command": "test"}
+    replace_softdeca(folder, nets, record, {"softdeca_static": {"mean_mm": 0.1}})
+    after = read_manifest(folder)
+    assert after["rest_changes"] is True and after["format_version"] == 7
+    assert after["rest_gate"] == before["rest_gate"]
+    for name, spec in after["networks"].items():
+        moved = spec["sha256"] != before["networks"][name]["sha256"]
+        frame = name.startswith("softdeca.") and name != "softdeca.f_dyn"
+        assert moved == frame, name
+    assert after["training"]["replaced"][-1]["model"] == "softdeca"
+    assert after["errors"]["softdeca_static"] == {"mean_mm": 0.1}
+    # what the bundle now holds: the plain bundle's identity encoder, dynamics and sparse
+    # networks with the new SoftDECA frame networks
+    held = replace(
+        plain_nets,
+        softdeca=replace(nets.softdeca, f_dyn=plain_nets.softdeca.f_dyn),
+        rest_changes=True,
+    )
+    setup = (head, held, NativeModel(folder), folder, rest)
+    ref, nat = reference_and_native(setup, "float")
+    ref.prepare()
+    nat.prepare()
+    for w in (np.zeros(52), np.full(52, 0.6)):
+        x, want = nat.evaluate_weights(w)[0], ref.evaluate_weights(w)[0]
+        below(np.abs(x - want).max() * 1e3, 3e-4, REASON_NATIVE, what="mm")
+    # refused before anything is written: no physics at prepare for the rest changes, or a
+    # SoftDECA without the bundle's residual stage
+    bare = edited_copy(plain, tmp_path / "bare", _no_rest_physics)
+    kept = read_manifest(bare)
+    with pytest.raises(ValueError, match="needs its physics at prepare"):
+        replace_softdeca(bare, nets, record)
+    assert read_manifest(bare) == kept
+    no_residual = replace(
+        nets, softdeca=replace(nets.softdeca, f_r=None), rest_changes=False
+    )
+    with pytest.raises(ValueError, match="the bundle's SoftDECA has"):
+        replace_softdeca(folder, no_residual, record)
+    assert read_manifest(folder) == after

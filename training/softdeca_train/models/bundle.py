@@ -477,6 +477,44 @@ def replace_networks(
     return deviations
 
 
+def replace_softdeca(
+    folder: str | Path,
+    nets: BundleNetworks,
+    record: dict[str, Any],
+    errors: dict[str, Any] | None = None,
+) -> dict[str, float]:
+    """Replace a bundle's SoftDECA frame networks (f_w, f_ph and the vertex and residual
+    stages) by `nets.softdeca`'s, as replace_networks does; SoftDECA's dynamics network stays
+    the bundle's (f_dyn reads p and h, not the static model). The manifest's `rest_gate`,
+    `rest_changes` and `residual_stage` become those of `nets`, and its format version the
+    lowest that holds them. Everything is checked before the first file is written."""
+    folder = Path(folder)
+    manifest = read_manifest(folder)
+    gate = _rest_gate(nets)
+    if nets.rest_changes and "rest_physics" not in manifest:
+        raise ValueError(
+            f"{folder}: a SoftDECA trained on the rest physics needs its physics at prepare"
+        )
+    frame = {k for k in manifest["networks"] if k.startswith("softdeca.") and k != "softdeca.f_dyn"}
+    modules = {k: m for k, m in _modules(nets).items() if k in frame}
+    if set(modules) != frame:
+        raise ValueError(
+            f"{folder}: the bundle's SoftDECA has {sorted(frame)}, the model {sorted(modules)}"
+        )
+    deviations = replace_networks(folder, modules, record, errors)
+    manifest = read_manifest(folder)
+    for key in ("rest_gate", "rest_changes", "residual_stage"):
+        manifest.pop(key, None)
+    manifest |= {
+        **({} if gate is None else {"rest_gate": gate}),
+        **({"rest_changes": True} if nets.rest_changes else {}),
+        **_residual_sizes(nets),
+    }
+    manifest["format_version"] = lowest_format_version(manifest)
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n")
+    return deviations
+
+
 REPLACED = "; replaced since: "
 
 

@@ -14,7 +14,12 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from softdeca_train.data.generate import code_version
-from softdeca_train.models.bundle import BundleInfo, export_bundle, replace_networks
+from softdeca_train.models.bundle import (
+    BundleInfo,
+    export_bundle,
+    replace_networks,
+    replace_softdeca,
+)
 from softdeca_train.models.networks import BundleNetworks, SoftDecaNetworks, SparseNetworks
 from softdeca_train.models.rest_head import rest_head_for_bundle
 from softdeca_train.models.template_head import template_head_from
@@ -176,3 +181,39 @@ def replace_sparse(
     }
     modules = {"sparse.f_l": model.f_l, "sparse.f_ph_v": model.f_ph_v}
     return replace_networks(bundle, modules, record, errors)
+
+
+def replace_softdeca_model(
+    run: Run, bundle: Path, command: str, progress: bool = True
+) -> dict[str, float]:
+    """Put the run's trained SoftDECA (`softdeca`: its weight encoder, hypernetworks, vertex
+    and residual stages) into an existing bundle, with its rest gate and whether it learned on
+    the rest physics (the run's --rest-changes); the bundle's SoftDECA static test error
+    becomes this model's on the run's dataset, and the manifest records what trained it.
+    SoftDECA's dynamics network stays the bundle's: its recorded dynamic errors are of the
+    static model it was trained with (the record says so)."""
+    model = run.load("softdeca")
+    if not isinstance(model, SoftDecaHybrid):
+        raise ValueError("the run's softdeca is no SoftDECA with vertex and residual stages")
+    nets = BundleNetworks(
+        sizes=run.sizes,
+        specs=run.specs,
+        identity_encoder=None,  # type: ignore[arg-type]  # only SoftDECA's frame networks move
+        softdeca=SoftDecaNetworks(model.f_w, model.f_ph, None, model.f_ph_v, model.f_r),  # type: ignore[arg-type]
+        sparse=None,
+        rest_changes=run.config.rest_changes,
+    )
+    errors = {"softdeca_static": measure(run, "softdeca_static", model, None).summary()}
+    record = {
+        "command": command,
+        "code_version": code_version(),
+        "model": "softdeca",
+        "rest_changes": run.config.rest_changes,
+        "dataset": _dataset_summary(run.data),
+        "stage": json.loads((run.folder / "softdeca.summary.json").read_text()),
+        "errors": errors,
+        "kept": "softdeca.f_dyn (its dynamic errors are of the static model before)",
+    }
+    if progress:
+        print(f"{bundle}: SoftDECA's frame networks from {run.folder}")
+    return replace_softdeca(bundle, nets, record, errors)

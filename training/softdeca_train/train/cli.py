@@ -1,5 +1,6 @@
 """Command lines of the training: `train-bundle` (every bundle network, then the bundle),
-`bundle-sparse` (a retrained SparseSoftDECA into a bundle), `bundle-carry` (one model's
+`bundle-sparse` (a retrained SparseSoftDECA into a bundle), `bundle-softdeca` (a retrained
+SoftDECA into a bundle), `bundle-carry` (one model's
 networks as they are from another bundle), `train-model` (one model of the
 registry, e.g. a baseline), `evaluate` (the report), `linear-baseline` (closed-form linear
 fits of the data)."""
@@ -168,6 +169,25 @@ def run_replace_sparse(args: argparse.Namespace) -> int:
             run, Path(args.bundle), Path(args.report), args.model, not args.no_progress
         )
         print(f"{path}: SparseSoftDECA's rows re-measured")
+    return 0
+
+
+def add_replace_softdeca_args(p: argparse.ArgumentParser) -> None:
+    _run_args(p)
+    p.add_argument(
+        "--bundle", default=DEFAULT_BUNDLE, help=f"bundle to change in place ({DEFAULT_BUNDLE})"
+    )
+
+
+def run_replace_softdeca(args: argparse.Namespace) -> int:
+    from softdeca_train.train.bundle_stages import default_command, replace_softdeca_model
+
+    run = _open_run(args)
+    deviations = replace_softdeca_model(
+        run, Path(args.bundle), default_command(), not args.no_progress
+    )
+    checks = ", ".join(f"{k} {v:.1e}" for k, v in deviations.items())
+    print(f"{args.bundle}: SoftDECA's frame networks replaced (export check: {checks})")
     return 0
 
 
@@ -374,6 +394,14 @@ COMMANDS = [
         "a run's trained one, with its test errors and training record in the manifest.",
         add_replace_sparse_args,
         run_replace_sparse,
+    ),
+    Command(
+        "bundle-softdeca",
+        "Replace a bundle's SoftDECA frame networks (weight encoder, hypernetworks, vertex and "
+        "residual stages) by a run's trained `softdeca`, with its rest gate, rest changes, test "
+        "error and training record in the manifest; its dynamics network stays.",
+        add_replace_softdeca_args,
+        run_replace_softdeca,
     ),
     Command(
         "bundle-carry",
