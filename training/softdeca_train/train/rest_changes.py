@@ -79,7 +79,7 @@ class GroupSolver:
         self._identity = b.identity_id
 
     def _solve(self, globals_: np.ndarray, vertex_maps: np.ndarray | None) -> np.ndarray:
-        localised = self.localisable if vertex_maps is not None else 0 * self.localisable
+        localised = self.localisable if vertex_maps is not None else np.zeros_like(self.localisable)
         maps = vertex_maps if vertex_maps is not None else np.zeros((0, 0))
         return np.asarray(self.solver.solve(globals_, maps, localised), np.float64)
 
