@@ -200,6 +200,19 @@ def test_region_means_are_inputs_of_every_vertex() -> None:
         LocalLinear(6, specs, 3, inputs=("no_such_parameter",))
 
 
+def test_a_run_on_the_rest_physics_has_no_region_means(small, tmp_path) -> None:
+    """The physics at prepare carries a region's rest response in such a run: the vertex stage
+    keeps its own and averaged parameters but reads no region's mean."""
+    folder, _ = small
+    for rest_changes in (False, True):
+        cfg = RunConfig(str(folder), "test", seed=3, rest_changes=rest_changes)
+        run = Run(tmp_path / f"run-{rest_changes}", cfg)
+        assert run.definition.skin_regions is not None
+        local = SoftDecaHybrid(run.definition, run.specs, run.sizes).f_ph_v.local
+        assert local is not None and local.smoothing is not None
+        assert bool(local.regional) is not rest_changes
+
+
 def test_only_the_tissues_weights_reach_the_expression_slots(small) -> None:
     from softdeca_train.models.networks import EXPRESSION_PARAMETERS, HyperNetwork
 

@@ -38,6 +38,12 @@ class NetworkSizes:
     # g(w) - g(0), and the part that does not depend on w is scaled by |w|^2 / (|w|^2 + tau^2),
     # 0 at rest (tau = 0: left out).
     rest_gate: float | None = None
+    # SoftDECA's vertex stage reads each region's mean of the localisable parameters (LocalLinear
+    # `regions`). Trained on the rest physics (`rest_changes`) it does not: the physics at
+    # prepare gives a region's far-reaching rest response exactly, and what is left for these
+    # inputs is fitted noise (measured on the same frames: the region controls' response errors
+    # 0.16-0.61 with them, 0.10-0.51 without; docs/training.md).
+    region_means: bool = True
 
 
 def rest_gate(weights: torch.Tensor, tau: float | None) -> torch.Tensor:

@@ -164,7 +164,11 @@ class Run:
 
     @property
     def sizes(self) -> NetworkSizes:
-        sizes = replace(SIZES[self.config.sizes], rest_gate=self.config.rest_gate)
+        sizes = replace(
+            SIZES[self.config.sizes],
+            rest_gate=self.config.rest_gate,
+            region_means=not self.config.rest_changes,
+        )
         if self.config.residual_members is not None:
             sizes = replace(sizes, residual_members=self.config.residual_members)
         return sizes

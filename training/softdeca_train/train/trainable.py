@@ -254,7 +254,9 @@ class SoftDecaHybrid(Trainable):
             local_linear=True,
             smoothing=smoothing,
             slots=EXPRESSION_SLOTS,
-            regions=None if d.skin_regions is None else varied_region_labels(d.skin_regions),
+            regions=None
+            if d.skin_regions is None or not sizes.region_means
+            else varied_region_labels(d.skin_regions),
             inputs=static_inputs(specs),
         )
         self.n_faces, self.n_vertices = d.n_faces, d.skin_vertices
