@@ -23,6 +23,7 @@ from softdeca_train.controls.metrics import (
     identity_spread,
     leakage,
     response_error,
+    rest_split,
 )
 from softdeca_train.controls.real_takes import (
     MILD_MM,
@@ -131,6 +132,40 @@ def test_identity_spread_is_how_far_one_identitys_change_misses_anothers() -> No
     measure_controls([wide], _physics, None, acc)
     measure_controls([wide], _physics, None, acc)
     assert control_entry(wide, acc, LABELS)["identity_spread"] == 0.0
+
+
+def test_a_controls_change_splits_at_rest() -> None:
+    """The part at rest and what the expression adds, each judged on its own: a model whose
+    expression part is worse than none shows it above 1."""
+    rest = np.zeros((2, 6, 3))
+    rest[..., 0] = 1e-3  # 1 mm along x at rest (repeated over the 2 expressions)
+    added = np.zeros((2, 6, 3))
+    added[0, :, 1], added[1, :, 1] = (
+        1e-3,
+        -1e-3,
+    )  # each expression adds 1 mm along +y / -y
+    dp = rest + added
+    exact = rest_split(dp, rest, dp, rest)
+    assert exact.rest_error == 0 and exact.expression_error == 0
+    assert exact.expression_share == pytest.approx(np.sqrt(0.5))  # |added| = |rest|
+    assert rest_split(dp, rest, rest, rest).expression_error == pytest.approx(
+        1.0
+    )  # none
+    wrong = rest_split(dp, rest, rest - added, rest)
+    assert wrong.rest_error == 0 and wrong.expression_error == pytest.approx(2.0)
+    assert rest_split(dp, rest, dp, 2 * rest).rest_error == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="does not move"):
+        rest_split(np.zeros_like(dp), rest, dp, rest)
+    # the gallery's entry carries the split where the control was measured at rest too
+    wide = Control("a", "a", 0.0, 2.0)
+    plain, acc = Collected(), Collected(rest=Collected())
+    for into in (plain, acc):
+        measure_controls([wide], _physics, _model(0.5, 0.0), into)
+    measure_controls([wide], _physics, _model(0.5, 0.0), acc.rest)
+    assert "expression_share" not in control_entry(wide, plain, LABELS)
+    e = control_entry(wide, acc, LABELS)
+    assert e["rest_error"] == pytest.approx(0.5) and e["expression_share"] == 0.0
+    assert e["expression_error"] is None  # the physics' expressions add nothing here
 
 
 def test_controls_come_from_the_parameter_definition() -> None:

@@ -45,6 +45,12 @@ def _add(p: argparse.ArgumentParser) -> None:
         "physics' whole range (also lists the parameters that are no controls)",
     )
     p.add_argument("--no-pictures", action="store_true", help="figures only, no PNGs")
+    p.add_argument(
+        "--split-rest",
+        action="store_true",
+        help="also solve every control at rest and split its change into that part and what "
+        "the expression adds (rest_error, expression_share, expression_error per control)",
+    )
     add_physics_cache_argument(p)
     add_tet_mesh_argument(p)
     p.add_argument(
@@ -83,6 +89,7 @@ def _run(args: argparse.Namespace) -> int:
         region_parameters=tuple(n for n in args.region_parameters.split(",") if n),
         ranges=args.ranges,
         pictures=not args.no_pictures,
+        split_rest=args.split_rest,
         tolerance=args.tolerance,
         max_iterations=args.max_iterations,
         tet_mesh=args.tet_mesh,
@@ -98,10 +105,22 @@ def _run(args: argparse.Namespace) -> int:
         print(
             f"{e['name']:28s} physics max {e['physics_max_mm']:8.3f} mm  "
             f"response error {'–' if err is None else f'{err:.2f}':>5s}  "
-            f"leakage {'–' if leak is None else f'{leak:.2f}'}"
+            f"leakage {'–' if leak is None else f'{leak:.2f}'}" + _split_text(e)
         )
     print(f"wrote {path} ({result['seconds']:.0f} s)")
     return 0
+
+
+def _split_text(e: dict) -> str:
+    """The rest split's figures of a gallery entry (--split-rest), or nothing."""
+    if "expression_share" not in e:
+        return ""
+    rest, added = e["rest_error"], e["expression_error"]
+    return (
+        f"  at rest {'–' if rest is None else f'{rest:.3f}'}"
+        f"  expression's share {e['expression_share']:.2f}"
+        f", its error {'–' if added is None else f'{added:.2f}'}"
+    )
 
 
 def add_physics_cache_argument(p: argparse.ArgumentParser) -> None:

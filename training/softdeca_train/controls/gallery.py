@@ -21,8 +21,13 @@ from softdeca_train.controls.definitions import (
     global_controls,
     region_controls,
 )
-from softdeca_train.controls.metrics import control_response, identity_spread
-from softdeca_train.controls.physics_cache import default_folder, open_cache, solve_cached
+from softdeca_train.controls.metrics import control_response, identity_spread, rest_split
+from softdeca_train.controls.physics_cache import (
+    PhysicsCache,
+    default_folder,
+    open_cache,
+    solve_cached,
+)
 from softdeca_train.controls.pictures import draw_gallery, markdown
 from softdeca_train.models.bundle import OnnxNetworks
 from softdeca_train.parameters import ParameterSet, load_parameters
@@ -54,6 +59,9 @@ class GalleryConfig:
     ict: str | None = None
     # solved physics reused across runs (controls/physics_cache.py); None: always solve
     physics_cache: Path | None = field(default_factory=default_folder)
+    # each control also at rest (every weight 0), its change split into that part and what the
+    # expression adds (metrics.rest_split): where a model's error comes from
+    split_rest: bool = False
 
     def __post_init__(self) -> None:
         if self.ranges not in RANGES:
@@ -85,6 +93,7 @@ class Collected:
     model: dict[str, list[np.ndarray]] = field(default_factory=dict)
     shown: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)  # first case
     clamped: set[str] = field(default_factory=set)
+    rest: Collected | None = None  # the same at rest (GalleryConfig.split_rest)
 
 
 Solve = Callable[[Setting], np.ndarray]  # a Setting -> skin (E, V, 3) for every expression
@@ -125,11 +134,37 @@ def _measure_case(
     def physics(s: Setting) -> np.ndarray:
         return solve_cached(cache, case, s, defaults, domains)
 
+    rest = _at_rest(case, model, cache, defaults, domains) if cfg.split_rest else None
+    if rest is not None:
+        acc.rest = acc.rest or Collected()
     for c in controls:
         measure_controls([c], physics, None if model is None else model.solve, acc)
+        if rest is not None and acc.rest is not None:
+            measure_controls([c], *rest, acc.rest)
         bar.update(1)
     if model is not None:
         acc.clamped |= model.clamped
+
+
+def _at_rest(
+    case: PhysicsCase,
+    model: ModelCase | None,
+    cache: PhysicsCache,
+    defaults: dict[str, float],
+    domains: dict[str, str],
+) -> tuple[Solve, Solve | None]:
+    """The physics and the model of `case`'s identity at rest (GalleryConfig.split_rest), each
+    shape repeated over the case's expressions, so that its change lines up with theirs."""
+    rest = case.with_weights(np.zeros((1, case.weights.shape[1]), np.float32))
+    n = len(case.weights)
+
+    def physics(s: Setting) -> np.ndarray:
+        return np.repeat(solve_cached(cache, rest, s, defaults, domains), n, axis=0)
+
+    if model is None:
+        return physics, None
+    at_rest = ModelCase(model.nets, rest)
+    return physics, lambda s: np.repeat(at_rest.solve(s), n, axis=0)
 
 
 def control_entry(c: Control, acc: Collected, labels: np.ndarray) -> dict:
@@ -138,6 +173,10 @@ def control_entry(c: Control, acc: Collected, labels: np.ndarray) -> dict:
     dm = np.concatenate(acc.model[c.name]) if c.name in acc.model else np.zeros_like(dp)
     inside = None if c.region is None else labels == REGIONS.index(c.region)
     r = control_response(dp, dm, inside)
+    split = {}
+    if acc.rest is not None and c.name in acc.rest.model:
+        rp, rm = (np.concatenate(x[c.name]) for x in (acc.rest.physics, acc.rest.model))
+        split = asdict(rest_split(dp, rp, dm, rm))
     return {
         "name": c.name,
         "parameter": c.parameter,
@@ -149,6 +188,7 @@ def control_entry(c: Control, acc: Collected, labels: np.ndarray) -> dict:
         **asdict(r),
         "identity_spread": identity_spread(acc.physics[c.name]),
         "model_clamped": c.parameter in acc.clamped,
+        **split,
     }
 
 

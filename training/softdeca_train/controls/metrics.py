@@ -87,3 +87,36 @@ def control_response(
         leakage=leakage(delta_model, inside),
         physics_leakage=leakage(delta_physics, inside),
     )
+
+
+@dataclass(frozen=True)
+class RestSplit:
+    """A control's change split at rest: the part the physics makes with no expression (which
+    a bundle's physics at prepare gives) and what each expression adds to it."""
+
+    rest_error: float | None  # ‖ΔM₀ − ΔP₀‖ / ‖ΔP₀‖ at rest; None where the physics rests
+    expression_share: float  # ‖ΔP − ΔP₀‖ / ‖ΔP‖: how much of the change the expression makes
+    # ‖(ΔM − ΔM₀) − (ΔP − ΔP₀)‖ / ‖ΔP − ΔP₀‖: above 1, the model's expression part is worse
+    # than none; None where the expression adds nothing
+    expression_error: float | None
+
+
+def rest_split(
+    delta_physics: np.ndarray,
+    rest_physics: np.ndarray,
+    delta_model: np.ndarray,
+    rest_model: np.ndarray,
+) -> RestSplit:
+    """From the changes (cases, V, 3) in metres at the expressions and at rest (each identity's
+    change at rest repeated over its expressions)."""
+    dp, dp0 = np.asarray(delta_physics, np.float64), np.asarray(rest_physics, np.float64)
+    dm, dm0 = np.asarray(delta_model, np.float64), np.asarray(rest_model, np.float64)
+    ref = float(np.linalg.norm(dp))
+    if ref == 0.0:
+        raise ValueError("the physics does not move: nothing to split")
+    added_p, added_m = dp - dp0, dm - dm0
+    return RestSplit(
+        rest_error=response_error(dm0, dp0),
+        expression_share=float(np.linalg.norm(added_p)) / ref,
+        expression_error=response_error(added_m, added_p),
+    )
