@@ -477,3 +477,22 @@ def test_code_noise_perturbs_training_only(run: Run) -> None:
     assert not torch.equal(model.predict(batch), model.predict(batch))
     model.eval()
     assert torch.equal(model.predict(batch), model.predict(batch))
+
+
+def test_the_report_names_what_it_did_not_measure() -> None:
+    from types import SimpleNamespace as NS
+
+    from softdeca_train.train import report as r
+
+    cfg = {"header": {"config": {"sparse": 8, "landmark_noise_mm": 1.0}}}
+    run = NS(
+        folder="r", config=NS(dataset="d", rest_changes=True), data=NS(manifest=cfg)
+    )
+    assert "S_t + Pd" in r._no_correction_label(run)
+    e = {"sparse/same_head": {"mean_mm": None, "frames": 0}}
+    text = "\n".join(r.sparse_section(run, e, {"mean_mm": None}, {"sparse.f_l": "c"}))
+    assert (
+        r.NOTHING_MEASURED.format(kind="sparse test frame", model="SparseSoftDECA")
+        in text
+    )
+    assert "| the bundle end" not in text and "measures them" not in text

@@ -327,9 +327,11 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "| model | mean (mm) | held-out take (mm) | coverage (mm) | ms/frame | training |",
         "| --- | ---: | ---: | ---: | ---: | ---: |",
     ]
+    nc_label = _no_correction_label(run)
     for label, key in TABLE1:
         if key in e:
             t = f"{ms[key]:.2f}" if key in ms else "–"
+            label = nc_label if key == "no-correction" else label
             lines.append(
                 f"| {label} | {_row(e[key])} | {_row(e[key], 'real_take_mm')} | "
                 f"{_row(e[key], 'coverage_mm')} | {t} | {_training(run, key)} |"
@@ -346,7 +348,7 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
             "",
             "Not trained in this run (no finished checkpoint): " + "; ".join(missing) + ".",
         ]
-    lines += _where_the_error_is(e)
+    lines += _where_the_error_is(e, nc_label)
     lines += [
         "",
         "## Dynamic sequences",
@@ -354,13 +356,17 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
         "| model | mean (mm) | held-out take (mm) | coverage (mm) | training |",
         "| --- | ---: | ---: | ---: | ---: |",
     ]
-    for label, key in DYNAMIC:
-        k = {"no-correction": "no-correction/dynamic", "softdeca": "softdeca/dynamic"}.get(key, key)
-        if k in e:
-            lines.append(
-                f"| {label} | {_row(e[k])} | {_row(e[k], 'real_take_mm')} | "
-                f"{_row(e[k], 'coverage_mm')} | {_training(run, key)} |"
-            )
+    dynamic = {"no-correction": "no-correction/dynamic", "softdeca": "softdeca/dynamic"}
+    rows = [(label, key, dynamic.get(key, key)) for label, key in DYNAMIC]
+    rows = [(label, key, k) for label, key, k in rows if _row(e.get(k)) != "–"]
+    for label, key, k in rows:
+        label = nc_label if key == "no-correction" else label
+        lines.append(
+            f"| {label} | {_row(e[k])} | {_row(e[k], 'real_take_mm')} | "
+            f"{_row(e[k], 'coverage_mm')} | {_training(run, key)} |"
+        )
+    if not rows:
+        lines[-2:] = [NOTHING_MEASURED.format(kind="dynamic test sequence", model="dynamics")]
     lines += sparse_section(
         run, e, r["bundle"].get("sparse") if r["bundle"] else None, _carried(bundle)
     )
@@ -435,21 +441,27 @@ def sparse_section(
         "| trained | same head | other head | other head + noise | ARKit face | training |",
         "| --- | ---: | ---: | ---: | ---: | ---: |",
     ]
+    measured = False
     for name, label in SPARSE_ROWS:
-        if f"{name}/same_head" in e:
+        if f"{name}/same_head" in e and _row(e[f"{name}/same_head"]) != "–":
             cells = " | ".join(_row(e[f"{name}/{w}"]) for w in SPARSE_INPUTS)
             lines.append(f"| {label} | {cells} | {_training(run, name)} |")
-    if bundle_sparse is not None:
+            measured = True
+    if _row(bundle_sparse) != "–":
         lines.append(
             f"| the bundle end to end (ONNX, encoder's h) | – | – | {_row(bundle_sparse)} | – | – |"
         )
+        measured = True
+    if not measured:
+        lines[-2:] = [NOTHING_MEASURED.format(kind="sparse test frame", model="SparseSoftDECA")]
     if carried:
         origins = ", ".join(f"`{k}` ({v})" for k, v in sorted(carried.items()))
+        measures = " The bundle row measures them on this run's test split." if measured else ""
         lines += [
             "",
             "The bundle's SparseSoftDECA is not this run's: its networks were carried as they "
             f"are from another bundle (`bundle-carry`; trained on: {origins}; the manifest's "
-            "training.replaced). The bundle row measures them on this run's test split.",
+            f"training.replaced).{measures}",
         ]
     return lines
 
@@ -486,7 +498,21 @@ def refresh_sparse(
     return readme
 
 
-def _where_the_error_is(e: dict) -> list[str]:
+def _no_correction_label(run: Run) -> str:
+    """What "no correction" is: S_t, or for a run on the rest physics S_t + Pd."""
+    if run.config.rest_changes:
+        return "no correction (S_t + Pd: the linear blend with the physics at rest)"
+    return "no correction (S_t)"
+
+
+NOTHING_MEASURED = (
+    "This run's dataset has no {kind} yet, so nothing is measured here; the bundle's "
+    "{model} networks keep the test errors their training recorded (the manifest's "
+    "`errors` and `training`)."
+)
+
+
+def _where_the_error_is(e: dict, nc_label: str = "no correction (S_t)") -> list[str]:
     """How much of the error depends on the expression at all, and the generalisation gap."""
     nc, orc = e.get("no-correction"), e.get("group-offset-oracle")
     if nc is None:
@@ -518,7 +544,7 @@ def _where_the_error_is(e: dict) -> list[str]:
         "| --- | ---: | ---: |",
     ]
     for label, key in (
-        ("no correction (S_t)", "no-correction"),
+        (nc_label, "no-correction"),
         ("SoftDECA", "softdeca"),
         ("MLP, equal time", "mlp-equal-time"),
     ):
