@@ -134,13 +134,14 @@ def _measure_case(
     def physics(s: Setting) -> np.ndarray:
         return solve_cached(cache, case, s, defaults, domains)
 
-    rest = _at_rest(case, model, cache, defaults, domains) if cfg.split_rest else None
-    if rest is not None:
-        acc.rest = acc.rest or Collected()
+    rest, at_rest = None, None
+    if cfg.split_rest:
+        rest = _at_rest(case, model, cache, defaults, domains)
+        at_rest = acc.rest = acc.rest or Collected()
     for c in controls:
         measure_controls([c], physics, None if model is None else model.solve, acc)
-        if rest is not None and acc.rest is not None:
-            measure_controls([c], *rest, acc.rest)
+        if rest is not None and at_rest is not None:
+            measure_controls([c], *rest, at_rest)
         bar.update(1)
     if model is not None:
         acc.clamped |= model.clamped
