@@ -3,7 +3,8 @@
 // and with two threads; prepare time, memory per avatar, and the error the compact hyper-tensor
 // storage adds (half and int8 against float, same frames), what the C ABI's handle adds to the
 // template's frame over the core avatar it holds, and the shipped bundle's frames (at the
-// library's default precisions, as users run it) against the machine's memory bandwidth. Writes the benchmark JSON of
+// library's default precisions, as users run it) and the random bundle's deformation-transfer
+// frames against the machine's memory bandwidth. Writes the benchmark JSON of
 // docs/ARCHITECTURE.md, Conventions ({figure: {value, unit, target, better, how}}).
 // Kept whole: every figure is measured in one run on the same inputs (take, avatars, bundles),
 // so their ratios hold; each figure's measurement is a function of its own.
@@ -528,10 +529,12 @@ struct FrameKind {
   const char* name;   // the figures' prefix
   const char* timed;  // the figure of its time
   double ms;
+  const Avatar* avatar;  // whose stats the frame sets
+  std::string how;       // what was timed
   std::function<void(std::size_t)> frame;
 };
 
-void measure_bandwidth_share(Bench& bench, const Avatar& a, const std::vector<FrameKind>& kinds, const std::string& how) {
+void measure_bandwidth_share(Bench& bench, const std::vector<FrameKind>& kinds) {
   const double gb_s = streaming_read_gb_s();
   const std::string bandwidth_how = "a sum of 64-bit words over " + std::to_string(kBandwidthBufferBytes >> 20) +
                                     " MiB written beforehand, best of " + std::to_string(kBandwidthPasses) +
@@ -540,15 +543,15 @@ void measure_bandwidth_share(Bench& bench, const Avatar& a, const std::vector<Fr
   bench.figures.raw("runtime.copy_read_gb_s", figure(gb_s, "GB/s", "streaming read bandwidth: " + bandwidth_how, NAN, "higher"));
   std::fprintf(stderr, "streaming read bandwidth %.2f GB/s;", gb_s);
   for (const FrameKind& k : kinds) {
-    const double bytes = median_frame_bytes(bench, a, k.frame);
+    const double bytes = median_frame_bytes(bench, *k.avatar, k.frame);
     const double limit_ms = bytes / (gb_s * 1e9) * 1e3;
     const std::string name = k.name;
     bench.figures.raw("runtime." + name + "_bytes_per_frame",
                       figure(bytes, "bytes/frame", "softdeca_stats.frame_bytes (the least bytes the frame reads and writes "
-                                                   "in memory, docs/runtime.md), median over the take's frames" + how));
+                                                   "in memory, docs/runtime.md), median over the take's frames" + k.how));
     bench.figures.raw("runtime." + name + "_bandwidth_share",
                       figure(limit_ms / k.ms, "ratio", name + "_bytes_per_frame / copy_read_gb_s (" + std::to_string(limit_ms) +
-                                                           " ms) over " + k.timed + how, NAN, "higher"));
+                                                           " ms) over " + k.timed + k.how, NAN, "higher"));
     std::fprintf(stderr, " %s %.0f bytes, %.3f ms at that rate of %.3f ms (%.2f);", k.name, bytes, limit_ms, k.ms, limit_ms / k.ms);
   }
   std::fprintf(stderr, "\n");
@@ -588,17 +591,33 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
                     figure(sparse / linear_again, "x", "sparse_shipped_ms over the linear blend's frames between them" + how));
   std::fprintf(stderr, "shipped bundle, template: softdeca %.3f ms, linear %.3f ms (x%.2f); sparse %.3f ms\n", softdeca, linear,
                softdeca / linear, sparse);
+  // The deformation-transfer path: the random bundle, whose every stage is nonzero, in the
+  // library's default precisions, against the same avatar's linear blend in the same way.
+  Avatar dt(bench.model, bench.rig.neutral, bench.rig.deltas, 1);
+  check(softdeca_avatar_prepare(dt.handle), "prepare");
+  const auto [dt_softdeca, dt_linear] = alternating_ms(
+      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(dt.handle, w(f), 52, out), "softdeca"); },
+      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(dt.handle, w(f), 52, out), "linear"); });
+  const std::string dt_how = "; the benchmark's random bundle (the deformation-transfer path), the template head, the "
+                             "library's default precisions, dynamics off, with normals, frames alternating with the linear "
+                             "blend of the same avatar, wall-clock; 1 thread; " + bench.how;
+  bench.figures.raw("runtime.dt_softdeca_ms", figure(dt_softdeca, "ms", "evaluate_weights" + dt_how));
+  bench.figures.raw("runtime.dt_softdeca_over_linear",
+                    figure(dt_softdeca / dt_linear, "x", "dt_softdeca_ms over the linear blend's frames between them" + dt_how, 3.0));
+  std::fprintf(stderr, "random bundle (deformation transfer), default precisions: softdeca %.3f ms, linear %.3f ms (x%.2f)\n",
+               dt_softdeca, dt_linear, dt_softdeca / dt_linear);
   measure_bandwidth_share(
-      bench, head,
-      {{"softdeca", "shipped_softdeca_ms", softdeca,
+      bench,
+      {{"softdeca", "shipped_softdeca_ms", softdeca, &head, how,
         [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(head.handle, w(f), 52, out), "softdeca"); }},
-       {"sparse", "sparse_shipped_ms", sparse,
+       {"sparse", "sparse_shipped_ms", sparse, &head, how,
         [&](std::size_t f) {
           check(softdeca_avatar_evaluate_landmarks(head.handle, input.points[f].data(), input.point_count, out), "sparse");
         }},
-       {"linear", "shipped_linear_ms", linear,
-        [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); }}},
-      how);
+       {"linear", "shipped_linear_ms", linear, &head, how,
+        [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); }},
+       {"dt", "dt_softdeca_ms", dt_softdeca, &dt, dt_how,
+        [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(dt.handle, w(f), 52, out), "softdeca"); }}});
   // The same head with SoftDECA's tables in half (twice int8's bytes), against its own linear
   // blend in the same way, and what each compact storage adds to the trained networks' output.
   Avatar head_half(shipped, bench.rig.neutral, bench.rig.deltas, 1, {SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_DEFAULT});
