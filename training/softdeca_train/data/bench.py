@@ -50,11 +50,13 @@ def bench_datagen(ict: str | None, level: int, workers: int, shards: int) -> dic
         sizes[kind] = k["bytes_per_instance"]
         secs[kind] = k["worker_seconds_per_instance"]
     d = GenerateConfig()
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     how = (
         f"make bench (python -m softdeca_train bench-datagen): {shards} shards of each kind "
         f"generated alone, {workers} worker processes x 1 simulator thread, LHM level {level}, "
-        f"tolerance {d.tolerance:g}, {cores} cores shared with other jobs; wall clock incl. "
-        "identity sampling, LHM fit, simulation and writing"
+        f"tolerance {d.tolerance:g}, {cores} cores (1-minute load average {load:.1f} at the "
+        "end, these workers included); wall clock incl. identity sampling, LHM fit, simulation "
+        "and writing"
     )
     static_frames = 0.75 * PAPER_INSTANCES
     sequences = 0.25 * PAPER_INSTANCES / d.sequence_length
