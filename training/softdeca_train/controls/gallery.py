@@ -134,14 +134,15 @@ def _measure_case(
     def physics(s: Setting) -> np.ndarray:
         return solve_cached(cache, case, s, defaults, domains)
 
-    rest, at_rest = None, None
+    # The rest split: the same controls again on the case at rest, into their own accumulator.
+    rest: tuple[Solve, Solve | None, Collected] | None = None
     if cfg.split_rest:
-        rest = _at_rest(case, model, cache, defaults, domains)
-        at_rest = acc.rest = acc.rest or Collected()
+        acc.rest = acc.rest or Collected()
+        rest = (*_at_rest(case, model, cache, defaults, domains), acc.rest)
     for c in controls:
         measure_controls([c], physics, None if model is None else model.solve, acc)
-        if rest is not None and at_rest is not None:
-            measure_controls([c], *rest, at_rest)
+        if rest is not None:
+            measure_controls([c], *rest)
         bar.update(1)
     if model is not None:
         acc.clamped |= model.clamped

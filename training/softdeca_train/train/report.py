@@ -173,8 +173,12 @@ def _training(run: Run, name: str) -> str:
     return f"{s['steps']:,} steps, {s['minutes']:.0f} min"
 
 
+def _measured(r: dict | None, key: str = "mean_mm") -> bool:
+    return r is not None and r.get(key) is not None
+
+
 def _row(r: dict | None, key: str = "mean_mm") -> str:
-    return "–" if r is None or r.get(key) is None else f"{r[key]:.3f}"
+    return f"{r[key]:.3f}" if r is not None and _measured(r, key) else "–"
 
 
 def write_report(
@@ -358,7 +362,7 @@ def _markdown(run: Run, bundle: Path, r: dict) -> str:
     ]
     dynamic = {"no-correction": "no-correction/dynamic", "softdeca": "softdeca/dynamic"}
     rows = [(label, key, dynamic.get(key, key)) for label, key in DYNAMIC]
-    rows = [(label, key, k) for label, key, k in rows if _row(e.get(k)) != "–"]
+    rows = [(label, key, k) for label, key, k in rows if _measured(e.get(k))]
     for label, key, k in rows:
         label = nc_label if key == "no-correction" else label
         lines.append(
@@ -443,11 +447,11 @@ def sparse_section(
     ]
     measured = False
     for name, label in SPARSE_ROWS:
-        if f"{name}/same_head" in e and _row(e[f"{name}/same_head"]) != "–":
+        if _measured(e.get(f"{name}/same_head")):
             cells = " | ".join(_row(e[f"{name}/{w}"]) for w in SPARSE_INPUTS)
             lines.append(f"| {label} | {cells} | {_training(run, name)} |")
             measured = True
-    if _row(bundle_sparse) != "–":
+    if _measured(bundle_sparse):
         lines.append(
             f"| the bundle end to end (ONNX, encoder's h) | – | – | {_row(bundle_sparse)} | – | – |"
         )
@@ -512,7 +516,7 @@ NOTHING_MEASURED = (
 )
 
 
-def _where_the_error_is(e: dict, nc_label: str = "no correction (S_t)") -> list[str]:
+def _where_the_error_is(e: dict, nc_label: str) -> list[str]:
     """How much of the error depends on the expression at all, and the generalisation gap."""
     nc, orc = e.get("no-correction"), e.get("group-offset-oracle")
     if nc is None:
