@@ -107,6 +107,7 @@ struct Bench {
   softdeca_output output{};
   JsonObject figures;
   std::string out_dir;  // where the benchmark JSON goes (scratch files beside it)
+  double copy_read_gb_s = 0;  // measured once, by the first bandwidth share (0: not yet)
 };
 
 // What SparseSoftDECA reads each frame: the user rig's face mesh, or the avatar's own landmarks.
@@ -534,14 +535,21 @@ struct FrameKind {
   std::function<void(std::size_t)> frame;
 };
 
-void measure_bandwidth_share(Bench& bench, const std::vector<FrameKind>& kinds) {
-  const double gb_s = streaming_read_gb_s();
+// The machine's streaming read bandwidth, measured once a run (the first call records the figure).
+double read_bandwidth(Bench& bench) {
+  if (bench.copy_read_gb_s > 0) return bench.copy_read_gb_s;
+  const double gb_s = bench.copy_read_gb_s = streaming_read_gb_s();
   const std::string bandwidth_how = "a sum of 64-bit words over " + std::to_string(kBandwidthBufferBytes >> 20) +
                                     " MiB written beforehand, best of " + std::to_string(kBandwidthPasses) +
-                                    " passes, 1 thread, measured in the same run right after the shipped bundle's frames; " +
-                                    bench.how;
+                                    " passes, 1 thread, measured once in the run, right after the first frames set against "
+                                    "it; " + bench.how;
   bench.figures.raw("runtime.copy_read_gb_s", figure(gb_s, "GB/s", "streaming read bandwidth: " + bandwidth_how, NAN, "higher"));
-  std::fprintf(stderr, "streaming read bandwidth %.2f GB/s;", gb_s);
+  std::fprintf(stderr, "streaming read bandwidth %.2f GB/s\n", gb_s);
+  return gb_s;
+}
+
+void measure_bandwidth_share(Bench& bench, const std::vector<FrameKind>& kinds) {
+  const double gb_s = read_bandwidth(bench);
   for (const FrameKind& k : kinds) {
     const double bytes = median_frame_bytes(bench, *k.avatar, k.frame);
     const double limit_ms = bytes / (gb_s * 1e9) * 1e3;
@@ -552,9 +560,9 @@ void measure_bandwidth_share(Bench& bench, const std::vector<FrameKind>& kinds) 
     bench.figures.raw("runtime." + name + "_bandwidth_share",
                       figure(limit_ms / k.ms, "ratio", name + "_bytes_per_frame / copy_read_gb_s (" + std::to_string(limit_ms) +
                                                            " ms) over " + k.timed + k.how, NAN, "higher"));
-    std::fprintf(stderr, " %s %.0f bytes, %.3f ms at that rate of %.3f ms (%.2f);", k.name, bytes, limit_ms, k.ms, limit_ms / k.ms);
+    std::fprintf(stderr, "%s: %.0f bytes, %.3f ms at that rate of %.3f ms (%.2f)\n", k.name, bytes, limit_ms, k.ms,
+                 limit_ms / k.ms);
   }
-  std::fprintf(stderr, "\n");
 }
 
 // The path users run: the shipped (trained) bundle at the library's default precisions, on the
@@ -591,21 +599,6 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
                     figure(sparse / linear_again, "x", "sparse_shipped_ms over the linear blend's frames between them" + how));
   std::fprintf(stderr, "shipped bundle, template: softdeca %.3f ms, linear %.3f ms (x%.2f); sparse %.3f ms\n", softdeca, linear,
                softdeca / linear, sparse);
-  // The deformation-transfer path: the random bundle, whose every stage is nonzero, in the
-  // library's default precisions, against the same avatar's linear blend in the same way.
-  Avatar dt(bench.model, bench.rig.neutral, bench.rig.deltas, 1);
-  check(softdeca_avatar_prepare(dt.handle), "prepare");
-  const auto [dt_softdeca, dt_linear] = alternating_ms(
-      bench, [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(dt.handle, w(f), 52, out), "softdeca"); },
-      [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(dt.handle, w(f), 52, out), "linear"); });
-  const std::string dt_how = "; the benchmark's random bundle (the deformation-transfer path), the template head, the "
-                             "library's default precisions, dynamics off, with normals, frames alternating with the linear "
-                             "blend of the same avatar, wall-clock; 1 thread; " + bench.how;
-  bench.figures.raw("runtime.dt_softdeca_ms", figure(dt_softdeca, "ms", "evaluate_weights" + dt_how));
-  bench.figures.raw("runtime.dt_softdeca_over_linear",
-                    figure(dt_softdeca / dt_linear, "x", "dt_softdeca_ms over the linear blend's frames between them" + dt_how, 3.0));
-  std::fprintf(stderr, "random bundle (deformation transfer), default precisions: softdeca %.3f ms, linear %.3f ms (x%.2f)\n",
-               dt_softdeca, dt_linear, dt_softdeca / dt_linear);
   measure_bandwidth_share(
       bench,
       {{"softdeca", "shipped_softdeca_ms", softdeca, &head, how,
@@ -615,9 +608,7 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
           check(softdeca_avatar_evaluate_landmarks(head.handle, input.points[f].data(), input.point_count, out), "sparse");
         }},
        {"linear", "shipped_linear_ms", linear, &head, how,
-        [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); }},
-       {"dt", "dt_softdeca_ms", dt_softdeca, &dt, dt_how,
-        [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(dt.handle, w(f), 52, out), "softdeca"); }}});
+        [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(head.handle, w(f), 52, out), "linear"); }}});
   // The same head with SoftDECA's tables in half (twice int8's bytes), against its own linear
   // blend in the same way, and what each compact storage adds to the trained networks' output.
   Avatar head_half(shipped, bench.rig.neutral, bench.rig.deltas, 1, {SOFTDECA_PRECISION_HALF, SOFTDECA_PRECISION_DEFAULT});
@@ -659,6 +650,28 @@ void measure_shipped(Bench& bench, const std::string& bundle_path, const std::st
   std::fprintf(stderr, "shipped bundle, fitted avatar: softdeca %.3f ms, linear %.3f ms (x%.2f)\n", own_softdeca, own_linear,
                own_softdeca / own_linear);
 }
+// The deformation-transfer path: the benchmark's random bundle, whose every stage is nonzero,
+// in the library's default precisions, against the same avatar's linear blend with frames
+// alternating (as the shipped bundle's frames), and against the memory bandwidth.
+void measure_dt_path(Bench& bench) {
+  const auto w = [&](std::size_t f) { return bench.take.weights[f].data(); };
+  softdeca_output* out = &bench.output;
+  Avatar dt(bench.model, bench.rig.neutral, bench.rig.deltas, 1);
+  check(softdeca_avatar_prepare(dt.handle), "prepare");
+  const auto softdeca = [&](std::size_t f) { check(softdeca_avatar_evaluate_weights(dt.handle, w(f), 52, out), "softdeca"); };
+  const auto [dt_softdeca, dt_linear] = alternating_ms(
+      bench, softdeca, [&](std::size_t f) { check(softdeca_avatar_evaluate_linear(dt.handle, w(f), 52, out), "linear"); });
+  const std::string dt_how = "; the benchmark's random bundle (the deformation-transfer path), the template head, the "
+                             "library's default precisions, dynamics off, with normals, frames alternating with the linear "
+                             "blend of the same avatar, wall-clock; 1 thread; " + bench.how;
+  bench.figures.raw("runtime.dt_softdeca_ms", figure(dt_softdeca, "ms", "evaluate_weights" + dt_how));
+  bench.figures.raw("runtime.dt_softdeca_over_linear",
+                    figure(dt_softdeca / dt_linear, "x", "dt_softdeca_ms over the linear blend's frames between them" + dt_how, 3.0));
+  std::fprintf(stderr, "random bundle (deformation transfer), default precisions: softdeca %.3f ms, linear %.3f ms (x%.2f)\n",
+               dt_softdeca, dt_linear, dt_softdeca / dt_linear);
+  measure_bandwidth_share(bench, {{"dt", "dt_softdeca_ms", dt_softdeca, &dt, dt_how, softdeca}});
+}
+
 }  // namespace
 
 int run_bench_runtime(const Args& args) {
@@ -703,6 +716,7 @@ int run_bench_runtime(const Args& args) {
   measure_rest_physics(bench);
   if (o.given("--own-avatar")) measure_own_avatar(bench, o.text("--own-avatar"));
   if (o.given("--shipped-bundle")) measure_shipped(bench, o.text("--shipped-bundle"), o.given("--own-avatar") ? o.text("--own-avatar") : "");
+  measure_dt_path(bench);
 
   const std::string path = o.text("--out");
   const std::size_t slash = path.rfind('/');
