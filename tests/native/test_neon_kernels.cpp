@@ -74,7 +74,7 @@ TEST(NeonKernels, HyperTensorProductsMatchThePortableOnes) {
     const FaceBlocks fb = random_faces(faces, vertices, rng);
     for (const Precision p : {Precision::Half, Precision::Float, Precision::Int8}) {
       const HyperTensor tf(Lf.data(), faces, K, 9, p), tv(Lv.data(), vertices, K, 3, p);
-      std::vector<float> rhs_neon(3 * vertices, 0.0f), rhs_portable(3 * vertices, 0.0f);
+      std::vector<float> rhs_neon(kRhsStride * vertices, 0.0f), rhs_portable(kRhsStride * vertices, 0.0f);
       dg_rhs(tf, fb, z.data(), skin.data(), 0, tf.blocks(), rhs_neon.data(), Kernel::Neon);
       dg_rhs(tf, fb, z.data(), skin.data(), 0, tf.blocks(), rhs_portable.data(), Kernel::Portable);
       const double scale = largest(rhs_portable);

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -77,7 +78,7 @@ TEST(DeformationTransfer, IdentityGradientsReturnTheInputAndTheSolveMatchesEigen
   const Grid g;
   const SkinGeometry geo = SkinGeometry::measure(g.v.data(), g.n, g.t);
   const DeformationTransfer dt(geo, g.n, g.t, 1e-3);
-  std::vector<float> zero(3 * g.n, 0.0f), out(3 * g.n);
+  std::vector<float> zero(kRhsStride * g.n, 0.0f), out(3 * g.n);
   std::vector<double> work(dt.work_size());
   const float* zero_parts[1] = {zero.data()};
   dt.solve(zero_parts, 1, g.v.data(), work.data(), out.data());
@@ -96,14 +97,14 @@ TEST(DeformationTransfer, IdentityGradientsReturnTheInputAndTheSolveMatchesEigen
   for (std::size_t v = 0; v < g.n; ++v) K(static_cast<Eigen::Index>(v), static_cast<Eigen::Index>(v)) += 1e-3 / mean_mass * geo.vertex_mass[v];
   std::mt19937 rng(3);
   std::normal_distribution<float> nd;
-  std::vector<float> r(3 * g.n), r2(3 * g.n);
+  std::vector<float> r(kRhsStride * g.n), r2(kRhsStride * g.n);  // x, y, z and an unread lane
   for (auto& x : r) x = nd(rng);
   for (std::size_t i = 0; i < r.size(); ++i) r2[i] = 0.25f * r[i];
   const float* parts[2] = {r.data(), r2.data()};
   dt.solve(parts, 2, zero.data(), work.data(), out.data());  // r + r/4 = 1.25 r
   Eigen::MatrixXd rhs(static_cast<Eigen::Index>(g.n), 3);
   for (std::size_t v = 0; v < g.n; ++v)
-    for (int c = 0; c < 3; ++c) rhs(static_cast<Eigen::Index>(v), c) = 1.25 * r[3 * v + c];
+    for (int c = 0; c < 3; ++c) rhs(static_cast<Eigen::Index>(v), c) = 1.25 * r[kRhsStride * v + static_cast<std::size_t>(c)];
   const Eigen::MatrixXd x = K.ldlt().solve(rhs);
   for (std::size_t v = 0; v < g.n; ++v)
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[3 * v + c], x(static_cast<Eigen::Index>(v), c), 1e-5 * x.cwiseAbs().maxCoeff());
@@ -136,7 +137,16 @@ TEST(DeformationTransfer, AWildNeutralVertexIsNamed) {
 }
 
 TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
-  const Grid g;
+  Grid g;
+  {  // faces in a shuffled order, which the transfer's own face order (the tensor's) must undo
+    std::mt19937 shuffle(11);
+    std::vector<std::size_t> faces(g.t.size() / 3);
+    for (std::size_t f = 0; f < faces.size(); ++f) faces[f] = f;
+    std::shuffle(faces.begin(), faces.end(), shuffle);
+    std::vector<std::int32_t> t;
+    for (const std::size_t f : faces) t.insert(t.end(), g.t.begin() + static_cast<std::ptrdiff_t>(3 * f), g.t.begin() + static_cast<std::ptrdiff_t>(3 * f + 3));
+    g.t = t;
+  }
   const SkinGeometry geo = SkinGeometry::measure(g.v.data(), g.n, g.t);
   const DeformationTransfer dt(geo, g.n, g.t, 1e-3);
   const std::size_t nf = g.t.size() / 3;
@@ -170,21 +180,24 @@ TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
   double scale = 0;
   for (double w : want) scale = std::max(scale, std::fabs(w));
   for (const Precision p : {Precision::Float, Precision::Half, Precision::Int8}) {
-    const HyperTensor tensor(L.data(), nf, K, 9, p);
+    const HyperTensor tensor(L.data(), nf, K, 9, p, dt.face_order().data());  // in the faces' order
     for (const Kernel kernel : {Kernel::Best, Kernel::Portable, Kernel::Avx2, Kernel::Avx512Vnni, Kernel::Neon}) {
       if (!kernel_available(kernel)) continue;
-      std::vector<float> got(3 * g.n, 0.0f);
+      std::vector<float> got(kRhsStride * g.n, 0.0f);
       const std::size_t half = tensor.blocks() / 2;  // two ranges, as two threads would do
       dg_rhs(tensor, dt.faces(), z.data(), skin.data(), 0, half, got.data(), kernel);
       dg_rhs(tensor, dt.faces(), z.data(), skin.data(), half, tensor.blocks(), got.data(), kernel);
       const double tol = p == Precision::Float ? 1e-5 : p == Precision::Half ? 2e-3 : 2e-2;
-      for (std::size_t i = 0; i < got.size(); ++i)
-        EXPECT_NEAR(got[i], want[i], tol * scale) << "precision " << static_cast<int>(p) << " kernel " << static_cast<int>(kernel);
+      for (std::size_t v = 0; v < g.n; ++v)
+        for (std::size_t c = 0; c < 3; ++c)
+          EXPECT_NEAR(got[kRhsStride * v + c], want[3 * v + c], tol * scale)
+              << "precision " << static_cast<int>(p) << " kernel " << static_cast<int>(kernel);
     }
     // Stored values read back within the precision's step.
     for (std::size_t f = 0; f < nf; f += 5)
       for (int k = 0; k < K; k += 3)
-        EXPECT_NEAR(tensor.at(f, k, 4), L[(f * K + k) * 9 + 4], p == Precision::Float ? 0.0 : 0.01 * 0.25);
+        EXPECT_NEAR(tensor.at(f, k, 4), L[(static_cast<std::size_t>(dt.face_order()[f]) * K + k) * 9 + 4],
+                    p == Precision::Float ? 0.0 : 0.01 * 0.25);
   }
 }
 

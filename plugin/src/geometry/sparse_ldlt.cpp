@@ -271,7 +271,7 @@ void SparseLdlt::backward(const std::vector<std::int32_t>& rows, double* y) cons
 
 void SparseLdlt::gather(const std::vector<std::int32_t>& rows, const float* const* b, std::size_t count, double* y) const {
   for (const std::int32_t r : rows) {
-    const std::size_t q = static_cast<std::size_t>(r), s = static_cast<std::size_t>(gather_[q]) * 3;
+    const std::size_t q = static_cast<std::size_t>(r), s = static_cast<std::size_t>(gather_[q]) * 4;
     for (int c = 0; c < 3; ++c) {
       double sum = 0;
       for (std::size_t k = 0; k < count; ++k) sum += b[k][s + c];

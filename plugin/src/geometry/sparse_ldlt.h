@@ -32,8 +32,9 @@ class SparseLdlt {
   std::size_t bytes() const;  // the factor and the schedule
   std::size_t solve_bytes() const;  // what a solve reads: the factor's values, indices and diagonal
 
-  // x = K^-1 (b[0] + ... + b[count-1]), xyz interleaved (n x 3); the right-hand side comes in
-  // parts (one per thread). `work`: work_size() doubles. Single-threaded.
+  // x = K^-1 (b[0] + ... + b[count-1]): x is xyz interleaved (n x 3), each b is n x 4 (x, y, z
+  // and a lane not read, so that a right-hand side is added to 16 bytes at a time); the
+  // right-hand side comes in parts (one per thread). `work`: work_size() doubles. Single-threaded.
   void solve(const float* const* b, std::size_t count, double* work, float* x) const;
   std::size_t work_size() const { return 4 * n_; }
 

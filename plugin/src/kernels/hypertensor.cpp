@@ -15,14 +15,16 @@
 
 namespace softdeca::kernels {
 
-HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision)
+HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision,
+                         const std::int32_t* order)
     : n_(n), latent_(latent), width_(width), precision_(precision) {
   const std::size_t total = blocks() * block_stride();
   const std::size_t count = n * static_cast<std::size_t>(latent) * static_cast<std::size_t>(width);
   zero_ = std::all_of(source, source + count, [](float v) { return v == 0.0f; });
   peaks_.assign(static_cast<std::size_t>(latent), 0.0f);
   const auto source_at = [&](std::size_t e, int k, int c) {
-    return source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
+    const std::size_t row = order ? static_cast<std::size_t>(order[e]) : e;
+    return source[(row * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
                   static_cast<std::size_t>(c)];
   };
   if (precision == Precision::Int8) {
@@ -49,8 +51,7 @@ HyperTensor::HyperTensor(const float* source, std::size_t n, int latent, int wid
     const std::size_t b = e / kLanes, lane = e % kLanes;
     for (int k = 0; k < latent; ++k)
       for (int c = 0; c < width; ++c) {
-        const float v = source[(e * static_cast<std::size_t>(latent) + static_cast<std::size_t>(k)) * static_cast<std::size_t>(width) +
-                               static_cast<std::size_t>(c)];
+        const float v = source_at(e, k, c);
         const std::size_t at = index(b, k, c, lane);
         if (precision == Precision::Half) half_[at] = float_to_half(v);
         else float_[at] = v;
@@ -128,21 +129,21 @@ void dg_rhs_portable(const HyperTensor& L, const FaceBlocks& faces, const float*
     const std::int32_t* idx = faces.corners.data() + b * 3 * kLanes;
     const float* cf = faces.coeff.data() + b * 3 * kLanes;
     for (std::size_t l = 0; l < kLanes; ++l) {
-      const std::size_t i = static_cast<std::size_t>(idx[l]) * 3, j = static_cast<std::size_t>(idx[kLanes + l]) * 3,
-                        kk = static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
+      const std::size_t i = static_cast<std::size_t>(idx[l]), j = static_cast<std::size_t>(idx[kLanes + l]),
+                        kk = static_cast<std::size_t>(idx[2 * kLanes + l]);
       float e1[3], e2[3];
-      for (int c = 0; c < 3; ++c) {
-        e1[c] = skin[j + c] - skin[i + c];
-        e2[c] = skin[kk + c] - skin[i + c];
+      for (std::size_t c = 0; c < 3; ++c) {
+        e1[c] = skin[3 * j + c] - skin[3 * i + c];
+        e2[c] = skin[3 * kk + c] - skin[3 * i + c];
       }
       const float c00 = cf[l], c01 = cf[kLanes + l], c11 = cf[2 * kLanes + l];
-      for (int r = 0; r < 3; ++r) {
+      for (std::size_t r = 0; r < 3; ++r) {
         const float p0 = d[3 * r][l] * e1[0] + d[3 * r + 1][l] * e1[1] + d[3 * r + 2][l] * e1[2];
         const float p1 = d[3 * r][l] * e2[0] + d[3 * r + 1][l] * e2[1] + d[3 * r + 2][l] * e2[2];
         const float col0 = p0 * c00 + p1 * c01, col1 = p0 * c01 + p1 * c11;
-        rhs[j + r] += col0;
-        rhs[kk + r] += col1;
-        rhs[i + r] -= col0 + col1;
+        rhs[kRhsStride * j + r] += col0;
+        rhs[kRhsStride * kk + r] += col1;
+        rhs[kRhsStride * i + r] -= col0 + col1;
       }
     }
   }
@@ -316,22 +317,33 @@ __attribute__((target("avx2,fma"))) inline void accumulate_rhs(const __m256* d, 
   const __m256 e2[3] = {_mm256_load_ps(edge[3]), _mm256_load_ps(edge[4]), _mm256_load_ps(edge[5])};
   const float* cf = faces.coeff.data() + b * 3 * kLanes;
   const __m256 c00 = _mm256_loadu_ps(cf), c01 = _mm256_loadu_ps(cf + kLanes), c11 = _mm256_loadu_ps(cf + 2 * kLanes);
-  alignas(32) float col[6][kLanes];
+  __m256 c[3][3];  // [corner i, j, k][x, y, z], a face per lane
   for (int r = 0; r < 3; ++r) {
     const __m256* row = d + 3 * r;
     const __m256 p0 = _mm256_fmadd_ps(row[2], e1[2], _mm256_fmadd_ps(row[1], e1[1], _mm256_mul_ps(row[0], e1[0])));
     const __m256 p1 = _mm256_fmadd_ps(row[2], e2[2], _mm256_fmadd_ps(row[1], e2[1], _mm256_mul_ps(row[0], e2[0])));
-    _mm256_store_ps(col[r], _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00)));
-    _mm256_store_ps(col[3 + r], _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01)));
+    c[1][r] = _mm256_fmadd_ps(p1, c01, _mm256_mul_ps(p0, c00));
+    c[2][r] = _mm256_fmadd_ps(p1, c11, _mm256_mul_ps(p0, c01));
+    c[0][r] = _mm256_sub_ps(_mm256_setzero_ps(), _mm256_add_ps(c[1][r], c[2][r]));
   }
-  for (std::size_t l = 0; l < kLanes; ++l) {
-    float* ri = rhs + static_cast<std::size_t>(idx[l]) * 3;
-    float* rj = rhs + static_cast<std::size_t>(idx[kLanes + l]) * 3;
-    float* rk = rhs + static_cast<std::size_t>(idx[2 * kLanes + l]) * 3;
-    for (int r = 0; r < 3; ++r) {
-      rj[r] += col[r][l];
-      rk[r] += col[3 + r][l];
-      ri[r] -= col[r][l] + col[3 + r][l];
+  // Each corner's (x, y, z) vectors to one (x, y, z, 0) per face (a 4 x 8 transpose), each added
+  // to its vertex in one 16-byte add. Faces of one block share vertices, so these adds wait on
+  // each other through memory: one chain per corner where there were three.
+  const __m256 zero = _mm256_setzero_ps();
+  for (int k = 0; k < 3; ++k) {
+    const __m256 xy_lo = _mm256_unpacklo_ps(c[k][0], c[k][1]), xy_hi = _mm256_unpackhi_ps(c[k][0], c[k][1]);
+    const __m256 z_lo = _mm256_unpacklo_ps(c[k][2], zero), z_hi = _mm256_unpackhi_ps(c[k][2], zero);
+    const __m256 l04 = _mm256_shuffle_ps(xy_lo, z_lo, 0x44), l15 = _mm256_shuffle_ps(xy_lo, z_lo, 0xEE);
+    const __m256 l26 = _mm256_shuffle_ps(xy_hi, z_hi, 0x44), l37 = _mm256_shuffle_ps(xy_hi, z_hi, 0xEE);
+    const __m256 pairs[4] = {_mm256_permute2f128_ps(l04, l15, 0x20), _mm256_permute2f128_ps(l26, l37, 0x20),
+                             _mm256_permute2f128_ps(l04, l15, 0x31), _mm256_permute2f128_ps(l26, l37, 0x31)};
+    const std::int32_t* corner = idx + k * static_cast<int>(kLanes);
+    for (std::size_t l = 0; l < kLanes; l += 2) {
+      const __m256 p = pairs[l / 2];  // lanes l and l + 1
+      float* a = rhs + kRhsStride * static_cast<std::size_t>(corner[l]);
+      float* b = rhs + kRhsStride * static_cast<std::size_t>(corner[l + 1]);
+      _mm_storeu_ps(a, _mm_add_ps(_mm_loadu_ps(a), _mm256_castps256_ps128(p)));
+      _mm_storeu_ps(b, _mm_add_ps(_mm_loadu_ps(b), _mm256_extractf128_ps(p, 1)));
     }
   }
 }

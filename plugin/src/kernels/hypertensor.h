@@ -22,8 +22,10 @@ constexpr std::size_t kLanes = 8;
 class HyperTensor {
  public:
   HyperTensor() = default;
-  // `source` is the network output, row-major [n][latent][width].
-  HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision);
+  // `source` is the network output, row-major [n][latent][width]; element e holds its row
+  // order[e] where an order is given (the caller's arrangement of the elements), else row e.
+  HyperTensor(const float* source, std::size_t n, int latent, int width, Precision precision,
+              const std::int32_t* order = nullptr);
 
   bool empty() const { return n_ == 0; }
   // Every entry of the source was zero: the product z . L is zero for every z.
@@ -68,8 +70,9 @@ class HyperTensor {
   AlignedArray<float> scales_;
 };
 
-// What the deformation-transfer right-hand side needs per skin triangle, in the same blocks:
-// corners (i, j, k) and a_f W_f as (w00, w01, w11); padding lanes have zero coefficients.
+// What the deformation-transfer right-hand side needs per skin triangle, in the same blocks and
+// in the order of the tensor's elements: corners (i, j, k) and a_f W_f as (w00, w01, w11);
+// padding lanes have zero coefficients.
 struct FaceBlocks {
   std::size_t blocks = 0;
   AlignedArray<std::int32_t> corners;  // [blocks][3][8]
@@ -83,8 +86,11 @@ struct FaceBlocks {
 enum class Kernel { Best, Portable, Avx2, Avx512Vnni, Neon };
 bool kernel_available(Kernel kernel);
 
-// rhs (V x 3, accumulated) += sum over the faces of blocks [b0, b1) of
+// rhs (V x kRhsStride: x, y, z and a lane no kernel reads, accumulated) += sum over the faces of
+// blocks [b0, b1) of
 //   D_f a_f W_f ((G_f - I) E_f(S))^T   with   G_f - I = sum_k z_k L[f, k] (row-major 3x3).
+// The fourth lane lets a vector kernel add a face's term to a corner in one 16-byte add.
+constexpr std::size_t kRhsStride = 4;
 void dg_rhs(const HyperTensor& L, const FaceBlocks& faces, const float* z, const float* skin, std::size_t b0,
             std::size_t b1, float* rhs, Kernel kernel = Kernel::Best);
 

@@ -142,22 +142,24 @@ void accumulate_rhs(const Lanes* d, const FaceBlocks& faces, std::size_t b, cons
     float32x4_t e[6];
     for (int c = 0; c < 6; ++c) e[c] = vld1q_f32(edge[c]);
     const float32x4_t c00 = vld1q_f32(cf + l0), c01 = vld1q_f32(cf + kLanes + l0), c11 = vld1q_f32(cf + 2 * kLanes + l0);
-    alignas(16) float col[6][4];
-    for (int r = 0; r < 3; ++r) {
+    float32x4x4_t corner[3];  // [i, j, k]: x, y, z and 0, a face per lane
+    for (std::size_t r = 0; r < 3; ++r) {
       const float32x4_t m0 = half ? d[3 * r].hi : d[3 * r].lo, m1 = half ? d[3 * r + 1].hi : d[3 * r + 1].lo,
                         m2 = half ? d[3 * r + 2].hi : d[3 * r + 2].lo;
       const float32x4_t p0 = dot3(m0, e[0], m1, e[1], m2, e[2]), p1 = dot3(m0, e[3], m1, e[4], m2, e[5]);
-      vst1q_f32(col[r], vfmaq_f32(vmulq_f32(p0, c00), p1, c01));
-      vst1q_f32(col[3 + r], vfmaq_f32(vmulq_f32(p0, c01), p1, c11));
+      corner[1].val[r] = vfmaq_f32(vmulq_f32(p0, c00), p1, c01);
+      corner[2].val[r] = vfmaq_f32(vmulq_f32(p0, c01), p1, c11);
+      corner[0].val[r] = vnegq_f32(vaddq_f32(corner[1].val[r], corner[2].val[r]));
     }
-    for (std::size_t l = 0; l < 4; ++l) {
-      float* ri = rhs + static_cast<std::size_t>(idx[l0 + l]) * 3;
-      float* rj = rhs + static_cast<std::size_t>(idx[kLanes + l0 + l]) * 3;
-      float* rk = rhs + static_cast<std::size_t>(idx[2 * kLanes + l0 + l]) * 3;
-      for (int r = 0; r < 3; ++r) {
-        rj[r] += col[r][l];
-        rk[r] += col[3 + r][l];
-        ri[r] -= col[r][l] + col[3 + r][l];
+    // As the AVX2 kernel: each face's (x, y, z, 0) added to its corner in one 16-byte add
+    // (vst4q interleaves the four vectors into one per face).
+    for (std::size_t k = 0; k < 3; ++k) {
+      corner[k].val[3] = vdupq_n_f32(0.0f);
+      alignas(16) float lanes[4][4];
+      vst4q_f32(&lanes[0][0], corner[k]);
+      for (std::size_t l = 0; l < 4; ++l) {
+        float* a = rhs + kRhsStride * static_cast<std::size_t>(idx[k * kLanes + l0 + l]);
+        vst1q_f32(a, vaddq_f32(vld1q_f32(a), vld1q_f32(lanes[l])));
       }
     }
   }

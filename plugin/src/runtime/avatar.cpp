@@ -38,7 +38,7 @@ Avatar::Avatar(std::shared_ptr<const Model> model, const AvatarDesc& d)
       dynamics_(vs_),
       normals_(triangles_, vh_) {
   for (std::size_t p = 0; p < worker_.parts(); ++p) {
-    rhs_.emplace_back(vs_ * 3);
+    rhs_.emplace_back(vs_ * kernels::kRhsStride);
     rhs_parts_.push_back(rhs_.back().data());
   }
   // Landmarks on the avatar's neutral skin.

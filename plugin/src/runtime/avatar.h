@@ -186,10 +186,11 @@ class Avatar {
 
  private:
   std::shared_ptr<const Preparation> current() const;
-  // A hypernetwork's values stored at `precision` (its model's).
+  // A hypernetwork's values stored at `precision` (its model's), element e holding row order[e]
+  // where an order is given.
   kernels::HyperTensor hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                            const std::vector<float>& identity, std::size_t n, std::size_t width,
-                           kernels::Precision precision) const;
+                           kernels::Precision precision, const std::int32_t* order = nullptr) const;
   // The same network's values, checked, before they are stored ([n][latent][width]).
   std::vector<float> hyper_values(const OnnxNetwork& net, const std::vector<float>& parameters,
                                   const std::vector<float>& identity, std::size_t n, std::size_t width) const;

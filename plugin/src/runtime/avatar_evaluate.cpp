@@ -97,7 +97,7 @@ void Avatar::softdeca_frame(const Preparation& prep, AvatarStats& st) {
   const std::size_t blocks = prep.face_l.blocks();
   auto pass = [&](std::size_t part, std::size_t n_parts) {
     float* rhs = rhs_[part].data();
-    std::memset(rhs, 0, vs_ * 3 * sizeof(float));
+    std::memset(rhs, 0, vs_ * kernels::kRhsStride * sizeof(float));
     kernels::dg_rhs(prep.face_l, prep.dt->faces(), z_.data(), head_.data(), blocks * part / n_parts,
                     blocks * (part + 1) / n_parts, rhs);
   };

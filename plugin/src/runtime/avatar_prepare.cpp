@@ -48,9 +48,9 @@ std::vector<float> Avatar::hyper_values(const OnnxNetwork& net, const std::vecto
 // The same, stored.
 kernels::HyperTensor Avatar::hyper_tensor(const OnnxNetwork& net, const std::vector<float>& parameters,
                                  const std::vector<float>& identity, std::size_t n, std::size_t width,
-                                 kernels::Precision precision) const {
+                                 kernels::Precision precision, const std::int32_t* order) const {
   return kernels::HyperTensor(hyper_values(net, parameters, identity, n, width).data(), n, m_.latent, static_cast<int>(width),
-                              precision);
+                              precision, order);
 }
 
 std::size_t Preparation::bytes() const {
@@ -126,7 +126,8 @@ std::vector<float> Avatar::prepare_softdeca_stages(const prepare::ParameterState
   const auto& cols = hyper.spec().parameter_columns;
   std::vector<float> p(nf_ * cols.size());
   params.face_matrix(cols, p.data());
-  prep.face_l = hyper_tensor(hyper, p, identity, nf_, 9, precisions_.softdeca);
+  // In the deformation transfer's face order (its FaceBlocks).
+  prep.face_l = hyper_tensor(hyper, p, identity, nf_, 9, precisions_.softdeca, dt_->face_order().data());
   std::vector<float> vertex_l;
   if (const OnnxNetwork* stage = model_->softdeca_vertex_stage()) {
     std::vector<float> pv(vs_ * stage->spec().parameter_columns.size());
@@ -195,7 +196,7 @@ std::vector<float> Avatar::softdeca_rest(const Preparation& prep) const {
   if (prep.face_l.zero()) {
     std::copy(neutral_.begin(), neutral_.begin() + static_cast<std::ptrdiff_t>(vs_ * 3), out.begin());
   } else {
-    std::vector<float> rhs(vs_ * 3, 0.0f);
+    std::vector<float> rhs(vs_ * kernels::kRhsStride, 0.0f);
     kernels::dg_rhs(prep.face_l, prep.dt->faces(), z.data(), neutral_.data(), 0, prep.face_l.blocks(), rhs.data());
     std::vector<double> work(prep.dt->work_size());
     const float* parts[] = {rhs.data()};

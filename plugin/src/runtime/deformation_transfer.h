@@ -32,14 +32,20 @@ class DeformationTransfer {
                       double regularisation, std::size_t parts = 1);
 
   const kernels::FaceBlocks& faces() const { return faces_; }
+  // The faces in the order of faces(): element e of the per-face hyper-tensor is face
+  // face_order()[e] (kernels::HyperTensor's `order`).
+  const std::vector<std::int32_t>& face_order() const { return face_order_; }
   std::size_t vertices() const { return ldlt_.size(); }
-  std::size_t bytes() const { return ldlt_.bytes() + faces_.corners.bytes() + faces_.coeff.bytes(); }
+  std::size_t bytes() const {
+    return ldlt_.bytes() + faces_.corners.bytes() + faces_.coeff.bytes() + face_order_.size() * sizeof(std::int32_t);
+  }
   std::size_t factor_nonzeros() const { return ldlt_.factor_nonzeros(); }
   // What a frame reads: the right-hand side's face blocks, and the factor in the solve.
   std::size_t face_bytes() const { return faces_.corners.bytes() + faces_.coeff.bytes(); }
   std::size_t solve_bytes() const { return ldlt_.solve_bytes(); }
 
-  // out = skin + K^-1 (r[0] + ... + r[count-1]). `work`: work_size() doubles.
+  // out = skin + K^-1 (r[0] + ... + r[count-1]), each r V x 4 (kernels::dg_rhs). `work`:
+  // work_size() doubles.
   std::size_t work_size() const { return ldlt_.work_size(); }
   void solve(const float* const* r, std::size_t count, const float* skin, double* work, float* out) const;
   // The same in SparseLdlt's phases (every part of phase p before phase p + 1).
@@ -51,6 +57,7 @@ class DeformationTransfer {
   double serial_fraction() const { return ldlt_.serial_fraction(); }
 
  private:
+  std::vector<std::int32_t> face_order_;
   kernels::FaceBlocks faces_;
   geometry::SparseLdlt ldlt_;
 };
