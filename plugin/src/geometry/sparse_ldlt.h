@@ -1,12 +1,14 @@
 // A prefactored symmetric positive definite solve for three right-hand sides at once.
 // The shared LDL^T factorisation (geometry/ldlt_factor.h) factorises
 // P K P^T = L D L^T once; the factor is kept column-major: the backward substitution gathers
-// (a dot product per column), the forward one scatters (an axpy per column), both streaming
-// the factor in order over one xyz(w) vector that stays in L2. With several threads the
-// forward pass gathers from a second, row-major copy instead (no two threads write one row).
-// Factor values are stored as float and indices as uint16 when the size allows (accumulation
-// is in double): the solve is bound by the bytes it reads, and this halves them at a relative
-// error of ~1e-7 (measured against double values, tests/native/test_runtime_math.cpp).
+// (a dot product per column), the forward one scatters (an axpy per column, two rows per
+// instruction with AVX-512), both streaming the factor in order over one xyz(w) vector that
+// stays in L2. One copy serves both passes, so the backward pass finds in cache what the forward
+// one read: a row-major copy for a gathering forward pass was faster alone and slower in a
+// frame (docs/performance-notes.md). With several threads the forward pass does gather from a
+// second, row-major copy (no two threads write one row). Factor values are stored as float and
+// indices as uint16 when the size allows (accumulation is in double), a relative error of
+// ~1e-7 (measured against double values, tests/native/test_runtime_math.cpp).
 // Threads: the elimination tree splits into independent subtrees below a small top part; both
 // substitutions run the subtrees in parallel (one per part) and the top part alone.
 #pragma once
