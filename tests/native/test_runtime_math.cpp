@@ -2,16 +2,15 @@
 // hyper-tensor kernels, the prefactored solve, blendshape runs, normals, rigid fits, dynamics,
 // the worker, parameter states, and the manifest's JSON and tar readers.
 #include <gtest/gtest.h>
-
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -139,8 +138,10 @@ TEST(DeformationTransfer, AWildNeutralVertexIsNamed) {
 
 TEST(DeformationTransfer, KernelMatchesTheDirectRightHandSide) {
   Grid g;  // its faces shuffled, which the transfer's own face order (the tensor's) must undo
-  auto* triangles = reinterpret_cast<std::array<std::int32_t, 3>*>(g.t.data());
-  std::shuffle(triangles, triangles + g.t.size() / 3, std::mt19937(11));
+  std::vector<std::int32_t> order(g.t.size() / 3), shuffled(g.t.size());
+  std::iota(order.begin(), order.end(), 0), std::shuffle(order.begin(), order.end(), std::mt19937(11));
+  for (std::size_t f = 0; f < order.size(); ++f) std::copy_n(g.t.begin() + 3 * order[f], 3, shuffled.begin() + 3 * f);
+  g.t = shuffled;
   const SkinGeometry geo = SkinGeometry::measure(g.v.data(), g.n, g.t);
   const DeformationTransfer dt(geo, g.n, g.t, 1e-3);
   const std::size_t nf = g.t.size() / 3;
@@ -496,5 +497,4 @@ TEST(ParameterState, ComparesKindsValuesAndMaps) {
   x.set_vertices(1, other, 3);
   EXPECT_FALSE(x == y);
 }
-
 }  // namespace

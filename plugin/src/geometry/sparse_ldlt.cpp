@@ -199,8 +199,9 @@ __attribute__((target("avx2,fma"))) void scatter_avx2(const std::int32_t* cols, 
 }
 
 // The same with AVX-512: two rows of the column per fused multiply-add, half the instructions
-// per factor value (the solve 0.05 ms faster in a frame, docs/performance-notes.md). GCC 12's own AVX-512 headers fill the unused upper lanes
-// of these casts and inserts with _mm512_undefined_pd, which -Wmaybe-uninitialized reports.
+// per factor value (the solve 0.05 ms faster in a frame, docs/performance-notes.md). GCC 12's
+// own AVX-512 headers fill the unused upper lanes of these casts and inserts with
+// _mm512_undefined_pd, which -Wmaybe-uninitialized reports.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
